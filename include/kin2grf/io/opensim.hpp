@@ -1,0 +1,54 @@
+// kin2grf I/O: OpenSim text formats.
+//  - TRC (marker trajectories): tab-separated, a 5-line header (PathFileType, keys, values,
+//    marker names, X1 Y1 Z1 ...), units mm or m, usually Y up.
+//  - MOT/STO (tables): a header ended by `endheader`, either OpenSim 1.x/4.x keys (`version`,
+//    `nRows`, `nColumns` counting the time column, `inDegrees`, `DataType`) or the older SIMM keys
+//    (`name`, `datacolumns`, `datarows`, `range`); then one line of column labels and the rows.
+//  - GRF .mot: columns `<prefix>ground_force_<side>v[xyz]`, `..._p[xyz]`, `<prefix>ground_torque_
+//    <side>[xyz]` (prefix "", "1_", "R_", "L_"...; side "", "r_", "l_"): force on the body (N),
+//    COP (m) and the torque at the COP (N m), lab frame, Y up.
+#pragma once
+
+#include <Eigen/Dense>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kin2grf/io/trial.hpp"
+
+namespace kin2grf {
+
+/// A MOT/STO table: the first column is time.
+struct Table {
+  std::string name;
+  std::vector<std::string> labels;  ///< including "time"
+  Eigen::MatrixXd data;             ///< rows x labels
+  std::map<std::string, std::string> header;
+  bool in_degrees = false;
+  [[nodiscard]] int column(const std::string& label) const;  ///< -1 when absent
+};
+
+MarkerTrajectories read_trc(const std::string& path, std::vector<std::string>* warnings = nullptr);
+MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
+                             std::vector<std::string>* warnings = nullptr);
+/// Writes millimetres (the TRC norm), `up_axis` kept as in memory.
+std::string format_trc(const MarkerTrajectories& m, const std::string& file_name);
+void write_trc(const std::string& path, const MarkerTrajectories& m);
+
+Table read_sto(const std::string& path);
+Table parse_sto(const std::string& text, const std::string& path);
+/// OpenSim 4 header (version=1, nRows, nColumns, inDegrees, endheader).
+std::string format_sto(const Table& t);
+void write_sto(const std::string& path, const Table& t);
+
+/// The GRF channel sets of a table (empty when it has none). Time regularised to a uniform grid
+/// when the stored times deviate by less than half a sample (rounded time columns).
+std::optional<ForcePlateRecording> grf_from_table(const Table& t, const std::string& path,
+                                                  double cop_threshold_N,
+                                                  std::vector<std::string>& warnings);
+
+/// OpenSim ExternalLoads-ready table: right foot unprefixed, left foot `1_`-prefixed.
+Table grf_table(const Eigen::VectorXd& time_s, const ForcePlate& right, const ForcePlate& left);
+
+}  // namespace kin2grf

@@ -1,0 +1,34 @@
+// kin2grf: what `kin2grf info` reports about a trial, as JSON and as text.
+//
+// JSON schema (stable; documented in docs/FORMATS.md):
+//   format: "C3D"|"TRC"|"MOT"|"STO", encoding: string, path: string,
+//   rate_hz: number|null (marker rate), frames: {first, last, count}, duration_s,
+//   up_axis: "X"|"Y"|"Z", markers: [names], missing: [{marker, frames: count,
+//   intervals: [[first_frame, last_frame], ...]}], model_outputs: count,
+//   force_plates: [{name, type, rate_hz, size_m: [w, l]|null, centre_m: [x,y,z]|null,
+//                   side_hint, loaded: [{start_s, end_s, peak_vertical_N}]}],
+//   events: [{label, side, time_s}], body_mass_kg: number|null, height_m: number|null,
+//   warnings: [strings]
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "kin2grf/io/trial.hpp"
+
+namespace kin2grf {
+
+struct LoadedInterval {
+  double start_s = 0, end_s = 0, peak_vertical_N = 0;
+  Eigen::Index first_sample = 0, last_sample = 0;
+};
+
+/// Intervals where the plate's vertical force exceeds `threshold_N`; dips under 10 ms are
+/// bridged and intervals under 10 ms dropped (noise around the threshold, not contacts).
+std::vector<LoadedInterval> loaded_intervals(const ForcePlateRecording& rec, const ForcePlate& plate,
+                                             double threshold_N = 20.0);
+
+nlohmann::json trial_summary(const Trial& t, double load_threshold_N = 20.0);
+std::string format_summary(const nlohmann::json& s);
+
+}  // namespace kin2grf

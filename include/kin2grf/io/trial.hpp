@@ -1,0 +1,94 @@
+// kin2grf I/O: the one in-memory form of a motion-capture recording, whatever the file format.
+//
+// Conventions (all readers produce, all writers take, exactly this):
+//  - SI units: metres, seconds, newtons, newton-metres.
+//  - Positions in the file's own lab frame; `up_axis` records which lab axis points up.
+//  - Missing marker samples are NaN (C3D negative residual, blank/NaN TRC cells).
+//  - Forces are the ground reaction acting ON the body (upward vertical positive).
+//  - Times: marker frame i (0-based in the arrays) is at time_s[i]; for C3D this is
+//    (first_frame - 1 + i) / rate_hz, the same clock as the C3D EVENT group.
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace kin2grf {
+
+enum class Axis { X = 0, Y = 1, Z = 2 };
+enum class Side { Right, Left, General };
+
+const char* to_string(Axis a);
+const char* to_string(Side s);
+
+/// Marker trajectories of one trial, N frames x 3 per marker, metres, lab frame.
+struct MarkerTrajectories {
+  std::vector<std::string> names;
+  std::vector<std::string> descriptions;  ///< empty strings when the file has none
+  std::vector<Eigen::MatrixX3d> positions_m;  ///< per marker, N x 3, NaN where missing
+  double rate_hz = 0.0;
+  int first_frame = 1;            ///< the file's frame number of row 0
+  Eigen::VectorXd time_s;         ///< N
+  Axis up_axis = Axis::Z;
+
+  [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
+  /// Index of a marker by exact name, or -1.
+  [[nodiscard]] int find(const std::string& name) const;
+  /// Frames (0-based) where the marker is missing (any coordinate NaN).
+  [[nodiscard]] std::vector<Eigen::Index> missing_frames(int marker) const;
+};
+
+/// One force plate (or one per-foot channel set of a processed GRF file).
+struct ForcePlate {
+  std::string name;               ///< e.g. "FP1" or "right" for GRF .mot columns
+  int type = 0;                   ///< C3D FORCE_PLATFORM:TYPE (1-4); 0 for processed GRF files
+  bool has_geometry = false;      ///< corners/origin known (C3D); false for GRF .mot
+  std::array<Eigen::Vector3d, 4> corners_m{};  ///< lab frame, C3D corner order
+  Eigen::Vector3d centre_m = Eigen::Vector3d::Zero();   ///< surface centre, lab frame
+  Eigen::Vector3d origin_m = Eigen::Vector3d::Zero();   ///< FORCE_PLATFORM:ORIGIN as used (plate frame)
+  Eigen::Matrix3d lab_R_plate = Eigen::Matrix3d::Identity();  ///< plate axes in the lab frame
+  Side side_hint = Side::General; ///< from GRF column names (r/l), General for C3D plates
+
+  // Per sample (rate of the owning ForcePlateRecording), lab frame:
+  Eigen::MatrixX3d force_N;            ///< ground reaction on the body
+  Eigen::MatrixX3d moment_centre_Nm;   ///< moment about the surface centre (NaN without geometry)
+  Eigen::MatrixX3d cop_m;              ///< centre of pressure on the surface; NaN below threshold
+  Eigen::MatrixX3d free_moment_Nm;     ///< moment about the COP (only its vertical part is non-zero
+                                       ///< for a plate); NaN where the COP is undefined
+
+  [[nodiscard]] double width_m() const;   ///< |c1 - c2|
+  [[nodiscard]] double length_m() const;  ///< |c1 - c4|
+};
+
+struct ForcePlateRecording {
+  double rate_hz = 0.0;
+  Eigen::VectorXd time_s;           ///< same clock as MarkerTrajectories::time_s
+  double cop_threshold_N = 10.0;    ///< |vertical force| below which the COP is NaN
+  std::vector<ForcePlate> plates;
+  Axis up_axis = Axis::Z;
+  [[nodiscard]] Eigen::Index samples() const { return time_s.size(); }
+};
+
+struct Event {
+  std::string label;   ///< "Foot Strike", "Foot Off", ...
+  Side side = Side::General;
+  double time_s = 0.0;
+};
+
+/// A loaded trial: what `kin2grf info` describes.
+struct Trial {
+  std::string path;
+  std::string format;      ///< "C3D", "TRC", "MOT"
+  std::string encoding;    ///< C3D processor type ("Intel", "DEC", "SGI/MIPS"), data format
+  MarkerTrajectories markers;
+  std::optional<ForcePlateRecording> plates;
+  std::vector<Event> events;
+  std::optional<double> body_mass_kg;
+  std::optional<double> height_m;
+  std::vector<std::string> model_outputs;  ///< C3D points that are model outputs, not markers
+  std::vector<std::string> warnings;
+};
+
+}  // namespace kin2grf

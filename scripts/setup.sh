@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Install what kin2grf needs from Debian's packages (and nothing from anywhere else).
+# Safe to run again: it skips apt when every package is already installed.
+set -euo pipefail
+packages=(cmake make g++ clang libclang-rt-14-dev libeigen3-dev libcli11-dev nlohmann-json3-dev
+          libgtest-dev libgmock-dev libbenchmark-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+echo "setup: all packages present"

@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Build with warnings as errors and run the whole test suite, then the reader and corrupt-file
+# tests again under AddressSanitizer/UBSan. This is the README's test command and what CI runs.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+cmake --preset ci >/dev/null
+cmake --build --preset ci
+ctest --preset ci -j2
+cmake --preset asan >/dev/null
+cmake --build --preset asan --target kin2grf_tests
+ctest --preset asan -j2 -R 'C3d|Trc|Sto|Corrupt|Fuzz'

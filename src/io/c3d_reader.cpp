@@ -1,0 +1,588 @@
+// C3D reader, written from the C3D specification because no C3D library is packaged in Debian.
+// See include/kin2grf/io/c3d.hpp for what is supported and the conventions.
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <numeric>
+#include <sstream>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/c3d.hpp"
+#include "kin2grf/io/force_plate.hpp"
+#include "kin2grf/io/text.hpp"
+
+namespace kin2grf {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// Bounds-checked decoding of the file's bytes in the file's processor encoding.
+class Bytes {
+ public:
+  Bytes(const std::vector<std::uint8_t>& data, std::string path)
+      : data_(data), path_(std::move(path)) {}
+
+  void set_processor(int p) { processor_ = p; }
+  [[nodiscard]] int processor() const { return processor_; }
+  [[nodiscard]] std::size_t size() const { return data_.size(); }
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+  void need(std::size_t offset, std::size_t n, const std::string& what) const {
+    if (offset > data_.size() || n > data_.size() - offset) {
+      std::ostringstream os;
+      os << path_ << ": truncated file: " << what << " needs bytes " << offset << ".."
+         << offset + n << " but the file has " << data_.size() << " bytes";
+      throw InputError(os.str());
+    }
+  }
+  [[nodiscard]] std::uint8_t u8(std::size_t o, const char* what) const {
+    need(o, 1, what);
+    return data_[o];
+  }
+  [[nodiscard]] std::int8_t i8(std::size_t o, const char* what) const {
+    return static_cast<std::int8_t>(u8(o, what));
+  }
+  [[nodiscard]] std::uint16_t u16(std::size_t o, const char* what) const {
+    need(o, 2, what);
+    return u16_unchecked(o);
+  }
+  [[nodiscard]] std::int16_t i16(std::size_t o, const char* what) const {
+    return static_cast<std::int16_t>(u16(o, what));
+  }
+  [[nodiscard]] float f32(std::size_t o, const char* what) const {
+    need(o, 4, what);
+    return f32_unchecked(o);
+  }
+  [[nodiscard]] std::uint16_t u16_unchecked(std::size_t o) const {
+    if (processor_ == 86) return static_cast<std::uint16_t>((data_[o] << 8) | data_[o + 1]);
+    return static_cast<std::uint16_t>(data_[o] | (data_[o + 1] << 8));
+  }
+  [[nodiscard]] float f32_unchecked(std::size_t o) const {
+    std::uint8_t b[4];
+    if (processor_ == 86) {  // SGI/MIPS: big-endian IEEE
+      b[0] = data_[o + 3]; b[1] = data_[o + 2]; b[2] = data_[o + 1]; b[3] = data_[o];
+    } else if (processor_ == 85) {  // DEC/VAX F-float: words swapped, value = IEEE bits / 4
+      if ((data_[o + 1] & 0x7F) == 0 && (data_[o] & 0x80) == 0) return 0.0f;  // exponent 0
+      b[0] = data_[o + 2]; b[1] = data_[o + 3]; b[2] = data_[o]; b[3] = data_[o + 1];
+      float f;
+      std::memcpy(&f, b, 4);
+      return f / 4.0f;
+    } else {
+      std::memcpy(b, &data_[o], 4);
+    }
+    float f;
+    std::memcpy(&f, b, 4);
+    return f;
+  }
+
+ private:
+  const std::vector<std::uint8_t>& data_;
+  std::string path_;
+  int processor_ = 84;
+};
+
+std::string upper(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string processor_name(int p) {
+  switch (p) {
+    case 84: return "Intel";
+    case 85: return "DEC";
+    case 86: return "SGI/MIPS";
+    default: return "unknown";
+  }
+}
+
+/// Parameter section: groups and parameters, resolved to "GROUP:NAME" keys.
+void parse_parameters(const Bytes& b, std::size_t start, C3dFile& file) {
+  const std::size_t nblocks = b.u8(start + 2, "parameter section header (block count)");
+  std::size_t end = start + std::max<std::size_t>(nblocks, 1) * 512;
+  if (end > b.size()) end = b.size();  // some writers overstate the count; stay in the file
+  std::map<int, std::string> groups;
+  struct Pending { int group; std::string name; C3dParameter p; };
+  std::vector<Pending> pending;
+  std::size_t p = start + 4;
+  for (int guard = 0; guard < 100000; ++guard) {
+    if (p + 2 > end) break;
+    const int nlen = std::abs(static_cast<int>(b.i8(p, "parameter name length")));
+    const int id = b.i8(p + 1, "parameter group id");
+    if (nlen == 0 || id == 0) break;
+    b.need(p + 2, static_cast<std::size_t>(nlen) + 2, "parameter name");
+    std::string name;
+    for (int i = 0; i < nlen; ++i) name.push_back(static_cast<char>(b.u8(p + 2 + i, "parameter name")));
+    name = upper(trim(name));
+    std::size_t q = p + 2 + static_cast<std::size_t>(nlen);
+    const int offset = b.i16(q, "parameter offset to next");
+    const std::size_t next = q + static_cast<std::size_t>(offset);
+    q += 2;
+    if (id < 0) {
+      groups[-id] = name;
+    } else {
+      C3dParameter par;
+      par.type = b.i8(q, "parameter type");
+      const int ndims = b.u8(q + 1, "parameter dimension count");
+      if (par.type != -1 && par.type != 1 && par.type != 2 && par.type != 4) {
+        std::ostringstream os;
+        os << b.path() << ": parameter '" << name << "' at byte " << p << " has invalid type "
+           << par.type << " (expected -1, 1, 2 or 4)";
+        throw InputError(os.str());
+      }
+      std::size_t count = 1;
+      for (int d = 0; d < ndims; ++d) {
+        const int dim = b.u8(q + 2 + d, "parameter dimension");
+        par.dims.push_back(dim);
+        count *= static_cast<std::size_t>(dim);
+      }
+      q += 2 + static_cast<std::size_t>(ndims);
+      const std::size_t elem = static_cast<std::size_t>(std::abs(par.type));
+      const std::size_t nbytes = count * elem;
+      if (q + nbytes > end) {
+        std::ostringstream os;
+        os << b.path() << ": parameter '" << name << "' at byte " << p << " declares " << nbytes
+           << " data bytes, past the end of the parameter section (byte " << end << ")";
+        throw InputError(os.str());
+      }
+      if (par.type == -1) {
+        const std::size_t len = ndims == 0 ? 1 : static_cast<std::size_t>(par.dims[0]);
+        const std::size_t nstr = len == 0 ? 0 : count / len;
+        for (std::size_t s = 0; s < nstr; ++s) {
+          std::string str;
+          for (std::size_t c = 0; c < len; ++c) {
+            const char ch = static_cast<char>(b.u8(q + s * len + c, "parameter string"));
+            str.push_back(ch == '\0' ? ' ' : ch);
+          }
+          par.strings.push_back(rtrim(str));
+        }
+      } else {
+        par.numbers.reserve(count);
+        for (std::size_t i = 0; i < count; ++i) {
+          const std::size_t o = q + i * elem;
+          double v = 0.0;
+          if (par.type == 1) v = b.u8(o, "parameter byte");
+          else if (par.type == 2) v = b.i16(o, "parameter int16");
+          else v = b.f32(o, "parameter float");
+          par.numbers.push_back(v);
+        }
+      }
+      par.raw.assign(nbytes, 0);
+      pending.push_back({id, name, std::move(par)});
+    }
+    if (offset <= 0) break;        // 0 marks the last entry; negative would loop
+    if (next <= p) break;
+    p = next;
+  }
+  for (auto& e : pending) {
+    auto g = groups.find(e.group);
+    const std::string gname = g == groups.end() ? "GROUP" + std::to_string(e.group) : g->second;
+    file.parameters[gname + ":" + e.name] = std::move(e.p);
+  }
+}
+
+double number(const C3dFile& f, const std::string& key, double fallback, std::size_t i = 0) {
+  const auto* p = f.find(key);
+  if (p == nullptr || p->numbers.size() <= i) return fallback;
+  return p->numbers[i];
+}
+
+/// int16 fields that are counts: stored signed, meant unsigned above 32767.
+int count_value(double v) { return v < 0 ? static_cast<int>(v) + 65536 : static_cast<int>(v); }
+
+std::vector<std::string> strings_multi(const C3dFile& f, const std::string& group,
+                                       const std::string& base) {
+  std::vector<std::string> out;
+  for (int k = 1; k < 100; ++k) {
+    const std::string key = group + ":" + base + (k == 1 ? "" : std::to_string(k));
+    const auto* p = f.find(key);
+    if (p == nullptr) {
+      if (k == 1) continue;
+      break;
+    }
+    out.insert(out.end(), p->strings.begin(), p->strings.end());
+  }
+  return out;
+}
+
+double length_unit_scale(const std::string& unit_in, const std::string& path,
+                         const std::string& field) {
+  const std::string u = upper(trim(unit_in));
+  if (u == "MM" || u.empty()) return 1e-3;
+  if (u == "CM") return 1e-2;
+  if (u == "M") return 1.0;
+  throw InputError(path + ": " + field + " = '" + unit_in +
+                   "' is not a length unit kin2grf knows (mm, cm, m)");
+}
+
+bool finite_all(std::initializer_list<double> v) {
+  return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+}
+
+}  // namespace
+
+const C3dParameter* C3dFile::find(const std::string& key) const {
+  auto it = parameters.find(key);
+  return it == parameters.end() ? nullptr : &it->second;
+}
+
+C3dFile read_c3d_header(const std::vector<std::uint8_t>& bytes, const std::string& path) {
+  Bytes b(bytes, path);
+  if (bytes.size() < 512) {
+    throw InputError(path + ": not a C3D file: " + std::to_string(bytes.size()) +
+                     " bytes, shorter than the 512-byte header");
+  }
+  if (bytes[1] != 0x50) {
+    throw InputError(path + ": not a C3D file: header byte 2 is " + std::to_string(bytes[1]) +
+                     ", expected 80 (0x50)");
+  }
+  C3dFile f;
+  f.path = path;
+  const std::size_t pblock = bytes[0];
+  if (pblock < 2) {
+    throw InputError(path + ": header byte 1 (first parameter block) is " +
+                     std::to_string(pblock) + ", expected 2 or more");
+  }
+  const std::size_t pstart = (pblock - 1) * 512;
+  const int proc = b.u8(pstart + 3, "parameter section header (processor type)");
+  if (proc < 84 || proc > 86) {
+    throw InputError(path + ": unknown processor type " + std::to_string(proc) + " at byte " +
+                     std::to_string(pstart + 3) + " (expected 84 Intel, 85 DEC, 86 SGI/MIPS)");
+  }
+  b.set_processor(proc);
+  f.processor = processor_name(proc);
+  f.point_count = b.u16(2, "header: point count");
+  f.analog_per_frame = b.u16(4, "header: analog values per frame");
+  f.first_frame = b.u16(6, "header: first frame");
+  f.last_frame = b.u16(8, "header: last frame");
+  f.point_scale = b.f32(12, "header: scale");
+  f.data_start_block = b.u16(16, "header: data start block");
+  f.point_rate_hz = b.f32(20, "header: frame rate");
+  parse_parameters(b, pstart, f);
+  // The parameters are authoritative where present.
+  if (const auto* p = f.find("POINT:USED"); p && !p->numbers.empty())
+    f.point_count = count_value(p->numbers[0]);
+  if (const auto* p = f.find("POINT:SCALE"); p && !p->numbers.empty()) f.point_scale = p->numbers[0];
+  if (const auto* p = f.find("POINT:RATE"); p && !p->numbers.empty()) f.point_rate_hz = p->numbers[0];
+  if (const auto* p = f.find("POINT:DATA_START"); p && !p->numbers.empty())
+    f.data_start_block = count_value(p->numbers[0]);
+  const auto* s = f.find("TRIAL:ACTUAL_START_FIELD");
+  const auto* e = f.find("TRIAL:ACTUAL_END_FIELD");
+  if (s && e && s->numbers.size() >= 2 && e->numbers.size() >= 2) {
+    const long first = count_value(s->numbers[0]) + 65536L * count_value(s->numbers[1]);
+    const long last = count_value(e->numbers[0]) + 65536L * count_value(e->numbers[1]);
+    if (first >= 1 && last >= first && last < (1L << 30)) {
+      f.first_frame = static_cast<int>(first);
+      f.last_frame = static_cast<int>(last);
+    }
+  }
+  f.float_data = f.point_scale < 0;
+  if (!std::isfinite(f.point_scale) || f.point_scale == 0.0) {
+    throw InputError(path + ": POINT:SCALE is " + std::to_string(f.point_scale) +
+                     " (must be a finite non-zero number)");
+  }
+  if (!std::isfinite(f.point_rate_hz) || f.point_rate_hz <= 0 || f.point_rate_hz > 1e6) {
+    throw InputError(path + ": POINT:RATE is " + std::to_string(f.point_rate_hz) +
+                     " Hz (must be positive and finite)");
+  }
+  if (f.last_frame < f.first_frame) {
+    throw InputError(path + ": last frame " + std::to_string(f.last_frame) +
+                     " is before first frame " + std::to_string(f.first_frame));
+  }
+  if (f.data_start_block < 2) {
+    throw InputError(path + ": POINT:DATA_START / header data block is " +
+                     std::to_string(f.data_start_block) + " (must be 2 or more)");
+  }
+  return f;
+}
+
+Trial read_c3d(const std::string& path, const C3dReadOptions& options) {
+  return read_c3d_bytes(read_file_bytes(path), path, options);
+}
+
+Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& path,
+                     const C3dReadOptions& options) {
+  const C3dFile f = read_c3d_header(bytes, path);
+  Bytes b(bytes, path);
+  b.set_processor(f.processor == "Intel" ? 84 : f.processor == "DEC" ? 85 : 86);
+  Trial t;
+  t.path = path;
+  t.format = "C3D";
+  t.encoding = f.processor + (f.float_data ? ", float" : ", integer");
+
+  const long nframes = static_cast<long>(f.last_frame) - f.first_frame + 1;
+  const int npoints = f.point_count;
+  // Analog layout.
+  int nchannels = count_value(number(f, "ANALOG:USED", 0));
+  double analog_rate = number(f, "ANALOG:RATE", 0);
+  int spf = 0;  // analog samples per point frame
+  if (nchannels > 0) {
+    if (!std::isfinite(analog_rate) || analog_rate <= 0) {
+      throw InputError(path + ": ANALOG:RATE is " + std::to_string(analog_rate) +
+                       " with ANALOG:USED = " + std::to_string(nchannels));
+    }
+    const double ratio = analog_rate / f.point_rate_hz;
+    spf = static_cast<int>(std::lround(ratio));
+    if (spf < 1 || std::abs(ratio - spf) > 1e-3 * ratio) {
+      throw InputError(path + ": ANALOG:RATE " + std::to_string(analog_rate) +
+                       " Hz is not an integer multiple of POINT:RATE " +
+                       std::to_string(f.point_rate_hz) + " Hz");
+    }
+    if (f.analog_per_frame != nchannels * spf) {
+      if (f.analog_per_frame % spf == 0 && f.analog_per_frame / spf >= nchannels) {
+        t.warnings.push_back("header analog values per frame (" + std::to_string(f.analog_per_frame) +
+                             ") differs from ANALOG:USED x samples per frame; using the header");
+      } else {
+        throw InputError(path + ": header analog values per frame (" +
+                         std::to_string(f.analog_per_frame) + ") does not match ANALOG:USED (" +
+                         std::to_string(nchannels) + ") x samples per frame (" +
+                         std::to_string(spf) + ")");
+      }
+    }
+  }
+  const int analog_slots = nchannels > 0 ? f.analog_per_frame / spf : 0;  // channels stored
+  if (npoints > 0 || analog_slots > 0) {
+    if (nframes > 50'000'000) throw InputError(path + ": absurd frame count " + std::to_string(nframes));
+  }
+  const std::size_t word = f.float_data ? 4 : 2;
+  const std::size_t frame_bytes =
+      (static_cast<std::size_t>(npoints) * 4 + static_cast<std::size_t>(analog_slots) * spf) * word;
+  const std::size_t data_start = (static_cast<std::size_t>(f.data_start_block) - 1) * 512;
+  const std::size_t needed = frame_bytes * static_cast<std::size_t>(nframes);
+  if (data_start > bytes.size() || needed > bytes.size() - data_start) {
+    const std::size_t avail = data_start > bytes.size() ? 0 : (bytes.size() - data_start);
+    const long complete = frame_bytes ? static_cast<long>(avail / frame_bytes) : 0;
+    throw InputError(path + ": truncated file: the data section at byte " +
+                     std::to_string(data_start) + " needs " + std::to_string(needed) +
+                     " bytes for frames " + std::to_string(f.first_frame) + ".." +
+                     std::to_string(f.last_frame) + " but only " + std::to_string(avail) +
+                     " remain (the data stop in frame " +
+                     std::to_string(f.first_frame + complete) + ")");
+  }
+
+  // ---- Points -----------------------------------------------------------------------------
+  const auto* units = f.find("POINT:UNITS");
+  const std::string unit_str = units && !units->strings.empty() ? units->strings[0] : "mm";
+  if (!units) t.warnings.push_back("POINT:UNITS missing; assuming mm");
+  const double to_m = length_unit_scale(unit_str, path, "POINT:UNITS");
+
+  std::vector<std::string> labels = strings_multi(f, "POINT", "LABELS");
+  std::vector<std::string> descs = strings_multi(f, "POINT", "DESCRIPTIONS");
+  if (static_cast<int>(labels.size()) < npoints) {
+    t.warnings.push_back("POINT:LABELS has " + std::to_string(labels.size()) + " names for " +
+                         std::to_string(npoints) + " points; the rest are named *<n>");
+  }
+  // Model outputs stored as points (Vicon Plug-in Gait angles, forces, ...) are not markers.
+  std::vector<std::string> model_outputs;
+  for (const char* g : {"ANGLES", "FORCES", "MOMENTS", "POWERS", "SCALARS", "REACTIONS"}) {
+    for (const auto& s : strings_multi(f, "POINT", g)) model_outputs.push_back(s);
+  }
+  auto is_model_output = [&](const std::string& n) {
+    return !n.empty() && std::find(model_outputs.begin(), model_outputs.end(), n) != model_outputs.end();
+  };
+
+  MarkerTrajectories& m = t.markers;
+  m.rate_hz = f.point_rate_hz;
+  m.first_frame = f.first_frame;
+  m.up_axis = Axis::Z;
+  m.time_s.resize(nframes);
+  for (long i = 0; i < nframes; ++i) m.time_s[i] = static_cast<double>(f.first_frame - 1 + i) / f.point_rate_hz;
+  std::vector<int> point_slot;
+  for (int k = 0; k < npoints; ++k) {
+    std::string name = k < static_cast<int>(labels.size()) ? labels[k] : "";
+    if (name.empty()) name = "*" + std::to_string(k + 1);
+    if (is_model_output(name)) {
+      t.model_outputs.push_back(name);
+      continue;
+    }
+    if (m.find(name) >= 0) {
+      t.warnings.push_back("point label '" + name + "' repeated; the later one is named " + name +
+                           "#" + std::to_string(k + 1));
+      name += "#" + std::to_string(k + 1);
+    }
+    m.names.push_back(name);
+    m.descriptions.push_back(k < static_cast<int>(descs.size()) ? descs[k] : "");
+    m.positions_m.emplace_back(nframes, 3);
+    point_slot.push_back(k);
+  }
+  const double scale = std::abs(f.point_scale);
+  for (std::size_t mk = 0; mk < point_slot.size(); ++mk) {
+    const std::size_t slot = static_cast<std::size_t>(point_slot[mk]);
+    auto& P = m.positions_m[mk];
+    for (long i = 0; i < nframes; ++i) {
+      const std::size_t o = data_start + static_cast<std::size_t>(i) * frame_bytes + slot * 4 * word;
+      double x, y, z, res;
+      if (f.float_data) {
+        x = b.f32_unchecked(o); y = b.f32_unchecked(o + 4); z = b.f32_unchecked(o + 8);
+        res = b.f32_unchecked(o + 12);
+      } else {
+        x = static_cast<std::int16_t>(b.u16_unchecked(o)) * scale;
+        y = static_cast<std::int16_t>(b.u16_unchecked(o + 2)) * scale;
+        z = static_cast<std::int16_t>(b.u16_unchecked(o + 4)) * scale;
+        res = static_cast<std::int16_t>(b.u16_unchecked(o + 6));
+      }
+      if (res < 0 || !finite_all({x, y, z})) {
+        P.row(i).setConstant(kNaN);
+      } else {
+        P(i, 0) = x * to_m; P(i, 1) = y * to_m; P(i, 2) = z * to_m;
+      }
+    }
+  }
+
+  // ---- Analog ---------------------------------------------------------------------------
+  AnalogData analog;
+  if (nchannels > 0) {
+    const long nsamples = nframes * spf;
+    analog.rate_hz = analog_rate;
+    analog.first_time_s = (f.first_frame - 1) / f.point_rate_hz;
+    analog.values.resize(nsamples, nchannels);
+    analog.labels = strings_multi(f, "ANALOG", "LABELS");
+    analog.units = strings_multi(f, "ANALOG", "UNITS");
+    analog.labels.resize(static_cast<std::size_t>(nchannels));
+    analog.units.resize(static_cast<std::size_t>(nchannels));
+    const double gen_scale = number(f, "ANALOG:GEN_SCALE", 1.0);
+    const auto* fmt = f.find("ANALOG:FORMAT");
+    const bool is_unsigned = fmt && !fmt->strings.empty() && upper(fmt->strings[0]) == "UNSIGNED";
+    std::vector<double> ch_scale(static_cast<std::size_t>(nchannels), 1.0);
+    std::vector<double> ch_offset(static_cast<std::size_t>(nchannels), 0.0);
+    if (const auto* p = f.find("ANALOG:SCALE")) {
+      for (int c = 0; c < nchannels && c < static_cast<int>(p->numbers.size()); ++c)
+        ch_scale[c] = p->numbers[c];
+    }
+    if (const auto* p = f.find("ANALOG:OFFSET")) {
+      for (int c = 0; c < nchannels && c < static_cast<int>(p->numbers.size()); ++c)
+        ch_offset[c] = is_unsigned ? count_value(p->numbers[c]) : p->numbers[c];
+    }
+    if (!std::isfinite(gen_scale)) throw InputError(path + ": ANALOG:GEN_SCALE is not finite");
+    for (int c = 0; c < nchannels; ++c) {
+      if (!std::isfinite(ch_scale[c]))
+        throw InputError(path + ": ANALOG:SCALE[" + std::to_string(c + 1) + "] is not finite");
+    }
+    const std::size_t analog_off = static_cast<std::size_t>(npoints) * 4 * word;
+    for (long i = 0; i < nframes; ++i) {
+      for (int s = 0; s < spf; ++s) {
+        const long row = i * spf + s;
+        for (int c = 0; c < nchannels; ++c) {
+          const std::size_t o = data_start + static_cast<std::size_t>(i) * frame_bytes + analog_off +
+                                (static_cast<std::size_t>(s) * analog_slots + c) * word;
+          double raw;
+          if (f.float_data) raw = b.f32_unchecked(o);
+          else if (is_unsigned) raw = b.u16_unchecked(o);
+          else raw = static_cast<std::int16_t>(b.u16_unchecked(o));
+          analog.values(row, c) = (raw - ch_offset[c]) * ch_scale[c] * gen_scale;
+        }
+      }
+    }
+  }
+
+  // ---- Force plates -----------------------------------------------------------------------
+  const int nplates = count_value(number(f, "FORCE_PLATFORM:USED", 0));
+  if (nplates > 0) {
+    if (nchannels == 0) {
+      throw InputError(path + ": FORCE_PLATFORM:USED = " + std::to_string(nplates) +
+                       " but there are no analog channels (ANALOG:USED = 0)");
+    }
+    std::vector<PlateDescription> descs_fp;
+    const auto* types = f.find("FORCE_PLATFORM:TYPE");
+    const auto* corners = f.find("FORCE_PLATFORM:CORNERS");
+    const auto* origin = f.find("FORCE_PLATFORM:ORIGIN");
+    const auto* channel = f.find("FORCE_PLATFORM:CHANNEL");
+    const auto* cal = f.find("FORCE_PLATFORM:CAL_MATRIX");
+    if (!types || !corners || !origin || !channel) {
+      throw InputError(path + ": FORCE_PLATFORM:USED = " + std::to_string(nplates) +
+                       " but TYPE, CORNERS, ORIGIN or CHANNEL is missing");
+    }
+    const int chan_rows = channel->dims.empty() ? 0 : channel->dims[0];
+    for (int p = 0; p < nplates; ++p) {
+      PlateDescription d;
+      d.name = "FP" + std::to_string(p + 1);
+      if (static_cast<int>(types->numbers.size()) <= p)
+        throw InputError(path + ": FORCE_PLATFORM:TYPE has no entry for plate " + std::to_string(p + 1));
+      d.type = static_cast<int>(types->numbers[p]);
+      if (d.type < 1 || d.type > 4) {
+        throw InputError(path + ": FORCE_PLATFORM:TYPE[" + std::to_string(p + 1) + "] = " +
+                         std::to_string(d.type) + " is not supported (types 1-4 are)");
+      }
+      if (corners->numbers.size() < static_cast<std::size_t>(12 * (p + 1)))
+        throw InputError(path + ": FORCE_PLATFORM:CORNERS has no entry for plate " + std::to_string(p + 1));
+      for (int c = 0; c < 4; ++c)
+        for (int a = 0; a < 3; ++a) d.corners(a, c) = corners->numbers[12 * p + 3 * c + a] * to_m;
+      if (origin->numbers.size() < static_cast<std::size_t>(3 * (p + 1)))
+        throw InputError(path + ": FORCE_PLATFORM:ORIGIN has no entry for plate " + std::to_string(p + 1));
+      for (int a = 0; a < 3; ++a) d.origin(a) = origin->numbers[3 * p + a] * to_m;
+      const int nch = d.type == 3 ? 8 : 6;
+      if (chan_rows < nch || channel->numbers.size() < static_cast<std::size_t>(chan_rows * (p + 1))) {
+        throw InputError(path + ": FORCE_PLATFORM:CHANNEL has fewer than " + std::to_string(nch) +
+                         " channels for plate " + std::to_string(p + 1) + " (type " +
+                         std::to_string(d.type) + ")");
+      }
+      for (int c = 0; c < nch; ++c) {
+        const int ch = static_cast<int>(channel->numbers[static_cast<std::size_t>(chan_rows * p + c)]);
+        if (ch < 1 || ch > nchannels) {
+          throw InputError(path + ": FORCE_PLATFORM:CHANNEL[" + std::to_string(c + 1) + "," +
+                           std::to_string(p + 1) + "] = " + std::to_string(ch) +
+                           " is not an analog channel (1.." + std::to_string(nchannels) + ")");
+        }
+        d.channels.push_back(ch - 1);
+      }
+      if (d.type == 4) {
+        if (!cal || cal->numbers.size() < static_cast<std::size_t>(36 * (p + 1))) {
+          throw InputError(path + ": plate " + std::to_string(p + 1) +
+                           " is TYPE 4 but FORCE_PLATFORM:CAL_MATRIX has no 6x6 entry for it");
+        }
+        for (int i = 0; i < 6; ++i)
+          for (int j = 0; j < 6; ++j) {
+            const std::size_t k = options.cal_matrix_first_index_fastest
+                                      ? static_cast<std::size_t>(36 * p + i + 6 * j)
+                                      : static_cast<std::size_t>(36 * p + 6 * i + j);
+            d.cal_matrix(i, j) = cal->numbers[k];
+          }
+      }
+      if (!d.corners.allFinite() || !d.origin.allFinite())
+        throw InputError(path + ": FORCE_PLATFORM CORNERS/ORIGIN of plate " + std::to_string(p + 1) +
+                         " contain NaN or infinity");
+      descs_fp.push_back(std::move(d));
+    }
+    PlateProcessing proc;
+    proc.cop_threshold_N = options.cop_threshold_N;
+    proc.zero_offset = options.zero_offset;
+    proc.unloaded_threshold_N = options.unloaded_threshold_N;
+    if (const auto* z = f.find("FORCE_PLATFORM:ZERO"); z && z->numbers.size() >= 2) {
+      proc.zero_first_sample = static_cast<long>((z->numbers[0] - 1) * spf);
+      proc.zero_last_sample = static_cast<long>(z->numbers[1] * spf) - 1;
+    }
+    t.plates = compute_plates(analog, descs_fp, proc, path, t.warnings);
+    t.plates->up_axis = Axis::Z;
+  }
+
+  // ---- Events, subject ----------------------------------------------------------------------
+  if (const auto* times = f.find("EVENT:TIMES")) {
+    const int used = count_value(number(f, "EVENT:USED", static_cast<double>(times->numbers.size() / 2)));
+    const std::vector<std::string> ev_labels = strings_multi(f, "EVENT", "LABELS");
+    const std::vector<std::string> ev_ctx = strings_multi(f, "EVENT", "CONTEXTS");
+    for (int e = 0; e < used && static_cast<std::size_t>(2 * e + 1) < times->numbers.size(); ++e) {
+      Event ev;
+      ev.label = e < static_cast<int>(ev_labels.size()) ? ev_labels[e] : "";
+      const std::string ctx = e < static_cast<int>(ev_ctx.size()) ? upper(ev_ctx[e]) : "";
+      ev.side = ctx == "RIGHT" ? Side::Right : ctx == "LEFT" ? Side::Left : Side::General;
+      ev.time_s = 60.0 * times->numbers[2 * e] + times->numbers[2 * e + 1];
+      if (std::isfinite(ev.time_s)) t.events.push_back(ev);
+    }
+    std::sort(t.events.begin(), t.events.end(),
+              [](const Event& a, const Event& c) { return a.time_s < c.time_s; });
+  }
+  if (const auto* bm = f.find("PROCESSING:BODYMASS"); bm && !bm->numbers.empty() &&
+                                                          std::isfinite(bm->numbers[0]) &&
+                                                          bm->numbers[0] > 0) {
+    t.body_mass_kg = bm->numbers[0];
+  }
+  if (const auto* h = f.find("PROCESSING:HEIGHT"); h && !h->numbers.empty() &&
+                                                     std::isfinite(h->numbers[0]) && h->numbers[0] > 0) {
+    t.height_m = h->numbers[0] > 10 ? h->numbers[0] / 1000.0 : h->numbers[0];  // stored in mm
+  }
+  return t;
+}
+
+}  // namespace kin2grf

@@ -1,0 +1,231 @@
+#include "kin2grf/io/force_plate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/text.hpp"
+
+namespace kin2grf {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// Scale of a moment channel's unit to N m (N mm is the C3D norm when units are missing).
+double moment_unit_scale(const std::string& unit, std::vector<std::string>& warnings,
+                         const std::string& plate, const std::string& label) {
+  std::string u = to_lower(trim(unit));
+  u.erase(std::remove_if(u.begin(), u.end(), [](char c) { return c == '.' || c == '*' || c == ' ' || c == '-'; }),
+          u.end());
+  if (u == "nmm" || u == "ntmm") return 1e-3;
+  if (u == "nm" || u == "ntm") return 1.0;
+  warnings.push_back(plate + ": moment channel '" + label + "' has unit '" + unit +
+                     "'; assuming N mm");
+  return 1e-3;
+}
+
+double length_unit_scale_channel(const std::string& unit, std::vector<std::string>& warnings,
+                                 const std::string& plate, const std::string& label) {
+  const std::string u = to_lower(trim(unit));
+  if (u == "mm") return 1e-3;
+  if (u == "m") return 1.0;
+  if (u == "cm") return 1e-2;
+  warnings.push_back(plate + ": COP channel '" + label + "' has unit '" + unit + "'; assuming mm");
+  return 1e-3;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+struct PlateLoads {
+  Eigen::MatrixX3d F;   // plate frame, force on the body convention applied later by rotation
+  Eigen::MatrixX3d Mc;  // about surface centre, plate frame
+};
+
+PlateLoads plate_loads(const Eigen::MatrixXd& ch, const PlateDescription& d,
+                       const std::vector<double>& scale) {
+  const Eigen::Index n = ch.rows();
+  PlateLoads L;
+  L.F.resize(n, 3);
+  L.Mc.resize(n, 3);
+  Eigen::Vector3d o = d.origin;
+  if (d.type != 3 && o.z() > 0) o = -o;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Eigen::Matrix<double, 8, 1> v = Eigen::Matrix<double, 8, 1>::Zero();
+    // Type 4: the calibration matrix acts on the raw signals; the units apply to its outputs.
+    for (std::size_t c = 0; c < d.channels.size(); ++c)
+      v(static_cast<Eigen::Index>(c)) = ch(i, static_cast<Eigen::Index>(c)) * (d.type == 4 ? 1.0 : scale[c]);
+    Eigen::Vector3d F, Mo, oc;
+    switch (d.type) {
+      case 1: {
+        F = v.head<3>();
+        const Eigen::Vector3d p(v(3), v(4), 0.0);
+        Mo = p.cross(F) + Eigen::Vector3d(0, 0, v(5));
+        oc.setZero();
+        break;
+      }
+      case 3: {
+        const double a = d.origin.x(), b = d.origin.y(), az0 = -std::abs(d.origin.z());
+        F = Eigen::Vector3d(v(0) + v(1), v(2) + v(3), v(4) + v(5) + v(6) + v(7));
+        Mo = Eigen::Vector3d(b * (v(4) + v(5) - v(6) - v(7)), a * (-v(4) + v(5) + v(6) - v(7)),
+                             b * (-v(0) + v(1)) + a * (v(2) - v(3)));
+        oc = Eigen::Vector3d(0, 0, -az0);
+        break;
+      }
+      case 4: {
+        Eigen::Matrix<double, 6, 1> w = d.cal_matrix * v.head<6>();
+        for (Eigen::Index c = 0; c < 6; ++c) w(c) *= scale[static_cast<std::size_t>(c)];
+        F = w.head<3>();
+        Mo = w.tail<3>();
+        oc = -o;
+        break;
+      }
+      default:
+        F = v.head<3>();
+        Mo = v.segment<3>(3);
+        oc = -o;
+    }
+    L.F.row(i) = F.transpose();
+    L.Mc.row(i) = (Mo + oc.cross(F)).transpose();
+  }
+  return L;
+}
+
+}  // namespace
+
+Eigen::Matrix3d plate_axes(const Eigen::Matrix<double, 3, 4>& c) {
+  Eigen::Vector3d x = c.col(0) - c.col(1);
+  Eigen::Vector3d y = c.col(0) - c.col(3);
+  if (x.norm() < 1e-9 || y.norm() < 1e-9) return Eigen::Matrix3d::Identity();
+  x.normalize();
+  Eigen::Vector3d z = x.cross(y).normalized();
+  y = z.cross(x);
+  Eigen::Matrix3d R;
+  R << x, y, z;
+  return R;
+}
+
+ForcePlateRecording compute_plates(const AnalogData& analog,
+                                   const std::vector<PlateDescription>& plates,
+                                   const PlateProcessing& proc, const std::string& path,
+                                   std::vector<std::string>& warnings) {
+  ForcePlateRecording rec;
+  rec.rate_hz = analog.rate_hz;
+  rec.cop_threshold_N = proc.cop_threshold_N;
+  rec.up_axis = proc.up_axis;
+  const Eigen::Index n = analog.values.rows();
+  rec.time_s.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) rec.time_s[i] = analog.first_time_s + static_cast<double>(i) / analog.rate_hz;
+  const int up = static_cast<int>(proc.up_axis);
+  for (const auto& d : plates) {
+    ForcePlate fp;
+    fp.name = d.name;
+    fp.type = d.type;
+    fp.has_geometry = true;
+    for (int c = 0; c < 4; ++c) fp.corners_m[static_cast<std::size_t>(c)] = d.corners.col(c);
+    fp.centre_m = d.corners.rowwise().mean();
+    fp.origin_m = (d.type != 3 && d.origin.z() > 0) ? Eigen::Vector3d(-d.origin) : d.origin;
+    fp.lab_R_plate = plate_axes(d.corners);
+    if ((d.corners.col(0) - d.corners.col(1)).norm() < 1e-6 ||
+        (d.corners.col(0) - d.corners.col(3)).norm() < 1e-6) {
+      throw InputError(path + ": FORCE_PLATFORM:CORNERS of " + d.name +
+                       " are degenerate (coincident corners)");
+    }
+    // Channel scales to N and N m (and m for type-1 COP channels).
+    std::vector<double> scale(d.channels.size(), 1.0);
+    for (std::size_t c = 0; c < d.channels.size(); ++c) {
+      const auto ch = static_cast<std::size_t>(d.channels[c]);
+      const std::string unit = ch < analog.units.size() ? analog.units[ch] : "";
+      const std::string label = ch < analog.labels.size() ? analog.labels[ch] : "";
+      if (d.type == 2 || d.type == 4) {
+        if (c >= 3) scale[c] = moment_unit_scale(unit, warnings, d.name, label);
+      } else if (d.type == 1) {
+        if (c == 3 || c == 4) scale[c] = length_unit_scale_channel(unit, warnings, d.name, label);
+        if (c == 5) scale[c] = moment_unit_scale(unit, warnings, d.name, label);
+      }
+    }
+    Eigen::MatrixXd ch(n, static_cast<Eigen::Index>(d.channels.size()));
+    for (std::size_t c = 0; c < d.channels.size(); ++c) ch.col(static_cast<Eigen::Index>(c)) = analog.values.col(d.channels[c]);
+
+    auto loads = [&](const Eigen::MatrixXd& channels) { return plate_loads(channels, d, scale); };
+    PlateLoads L = loads(ch);
+    if (proc.zero_offset != ZeroOffset::None) {
+      Eigen::RowVectorXd offset = Eigen::RowVectorXd::Zero(ch.cols());
+      bool ok = false;
+      if (proc.zero_offset == ZeroOffset::ZeroParameter) {
+        if (proc.zero_first_sample >= 0 && proc.zero_last_sample >= proc.zero_first_sample &&
+            proc.zero_last_sample < n && proc.zero_last_sample > 0) {
+          offset = ch.middleRows(proc.zero_first_sample, proc.zero_last_sample - proc.zero_first_sample + 1)
+                       .colwise().mean();
+          ok = true;
+        } else {
+          warnings.push_back(d.name + ": FORCE_PLATFORM:ZERO gives no valid frame range; offsets not removed");
+        }
+      } else {
+        const Eigen::MatrixX3d Flab = L.F * fp.lab_R_plate.transpose();
+        std::vector<Eigen::Index> idx;
+        for (Eigen::Index i = 0; i < n; ++i)
+          if (std::abs(Flab(i, up)) < proc.unloaded_threshold_N) idx.push_back(i);
+        if (idx.size() >= 10) {
+          for (Eigen::Index c = 0; c < ch.cols(); ++c) {
+            std::vector<double> v;
+            v.reserve(idx.size());
+            for (auto i : idx) v.push_back(ch(i, c));
+            offset(c) = median(std::move(v));
+          }
+          ok = true;
+        } else {
+          warnings.push_back(d.name + ": never unloaded (|F| < " +
+                             std::to_string(proc.unloaded_threshold_N) + " N); offsets not removed");
+        }
+      }
+      if (ok) {
+        ch.rowwise() -= offset;
+        L = loads(ch);
+      }
+    }
+    const Eigen::Matrix3d& R = fp.lab_R_plate;
+    fp.force_N = L.F * R.transpose();
+    fp.moment_centre_Nm = L.Mc * R.transpose();
+    fp.cop_m.resize(n, 3);
+    fp.free_moment_Nm.resize(n, 3);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Vector3d F = L.F.row(i).transpose();
+      const Eigen::Vector3d Mc = L.Mc.row(i).transpose();
+      if (!(std::abs(fp.force_N(i, up)) >= proc.cop_threshold_N) || std::abs(F.z()) < 1e-12) {
+        fp.cop_m.row(i).setConstant(kNaN);
+        fp.free_moment_Nm.row(i).setConstant(kNaN);
+        continue;
+      }
+      const Eigen::Vector3d p(-Mc.y() / F.z(), Mc.x() / F.z(), 0.0);
+      const double Tz = Mc.z() - (p.x() * F.y() - p.y() * F.x());
+      fp.cop_m.row(i) = (fp.centre_m + R * p).transpose();
+      fp.free_moment_Nm.row(i) = (R * Eigen::Vector3d(0, 0, Tz)).transpose();
+    }
+    rec.plates.push_back(std::move(fp));
+  }
+  return rec;
+}
+
+Eigen::MatrixX3d moment_about(const ForcePlate& plate, const Eigen::Vector3d& P) {
+  const Eigen::Index n = plate.force_N.rows();
+  Eigen::MatrixX3d M(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Vector3d F = plate.force_N.row(i).transpose();
+    const Eigen::Vector3d c = plate.cop_m.row(i).transpose();
+    const Eigen::Vector3d T = plate.free_moment_Nm.row(i).transpose();
+    if (!c.allFinite() || !T.allFinite()) {
+      M.row(i) = (F.norm() < 1e-9 ? Eigen::Vector3d::Zero() : Eigen::Vector3d::Constant(kNaN)).transpose();
+      continue;
+    }
+    M.row(i) = ((c - P).cross(F) + T).transpose();
+  }
+  return M;
+}
+
+}  // namespace kin2grf

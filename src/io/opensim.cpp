@@ -1,0 +1,396 @@
+#include "kin2grf/io/opensim.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <regex>
+#include <sstream>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/text.hpp"
+
+namespace kin2grf {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines = split(text, "\n", true);
+  for (auto& l : lines)
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+  return lines;
+}
+
+std::string fmt(double v) {
+  if (!std::isfinite(v)) return "NaN";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.8g", v);
+  return buf;
+}
+
+std::string where(const std::string& path, std::size_t line) {
+  return path + ":" + std::to_string(line + 1);
+}
+
+}  // namespace
+
+int Table::column(const std::string& label) const {
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (labels[i] == label) return static_cast<int>(i);
+  return -1;
+}
+
+MarkerTrajectories read_trc(const std::string& path, std::vector<std::string>* warnings) {
+  return parse_trc(read_file_text(path), path, warnings);
+}
+
+MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
+                             std::vector<std::string>* warnings) {
+  const auto lines = lines_of(text);
+  if (lines.size() < 5 || lines[0].rfind("PathFileType", 0) != 0) {
+    throw InputError(path + ": not a TRC file (the first line must start with 'PathFileType' and the "
+                            "header has 5 lines)");
+  }
+  const auto keys = split(lines[1], " \t", false);
+  const auto vals = split(lines[2], " \t", false);
+  if (keys.size() != vals.size()) {
+    throw InputError(where(path, 2) + ": the header has " + std::to_string(keys.size()) +
+                     " keys on line 2 but " + std::to_string(vals.size()) + " values on line 3");
+  }
+  std::map<std::string, std::string> h;
+  for (std::size_t i = 0; i < keys.size(); ++i) h[keys[i]] = vals[i];
+  auto num = [&](const std::string& k) {
+    auto it = h.find(k);
+    double v = kNaN;
+    if (it == h.end() || !parse_double(it->second, v) || !std::isfinite(v))
+      throw InputError(where(path, 2) + ": header field " + k + " is missing or not a number");
+    return v;
+  };
+  MarkerTrajectories m;
+  m.rate_hz = num("DataRate");
+  if (m.rate_hz <= 0) throw InputError(where(path, 2) + ": DataRate must be positive");
+  const double nmark_decl = num("NumMarkers");
+  const double nframes_decl = num("NumFrames");
+  const std::string units = h.count("Units") ? to_lower(h["Units"]) : "mm";
+  double to_m = 1e-3;
+  if (units == "m") to_m = 1.0;
+  else if (units == "cm") to_m = 1e-2;
+  else if (units != "mm") throw InputError(where(path, 2) + ": Units '" + h["Units"] + "' is not mm, cm or m");
+  m.up_axis = Axis::Y;
+
+  const auto name_cells = split(lines[3], "\t", true);
+  std::vector<std::string> names;
+  for (std::size_t i = 2; i < name_cells.size(); ++i) {
+    const std::string n = trim(name_cells[i]);
+    if (!n.empty()) names.push_back(n);
+  }
+  if (name_cells.size() < 2 || trim(name_cells[0]) != "Frame#") {
+    throw InputError(where(path, 3) + ": expected 'Frame#<tab>Time<tab>names...'");
+  }
+  if (static_cast<double>(names.size()) != nmark_decl) {
+    throw InputError(where(path, 3) + ": NumMarkers says " + fmt(nmark_decl) + " but " +
+                     std::to_string(names.size()) + " marker names follow");
+  }
+  const std::size_t nm = names.size();
+  std::vector<std::vector<double>> rows;
+  std::vector<int> frames;
+  std::size_t short_rows = 0;
+  for (std::size_t li = 5; li < lines.size(); ++li) {
+    if (trim(lines[li]).empty()) continue;
+    auto cells = split(lines[li], "\t", true);
+    if (cells.size() < nm * 3 + 2) {
+      // Some writers separate by spaces.
+      auto ws = split(lines[li], " \t", false);
+      if (ws.size() == nm * 3 + 2) cells = ws;
+    }
+    while (cells.size() > nm * 3 + 2 && trim(cells.back()).empty()) cells.pop_back();
+    if (cells.size() > nm * 3 + 2) {
+      throw InputError(where(path, li) + ": " + std::to_string(cells.size()) + " columns, but " +
+                       std::to_string(nm) + " markers make " + std::to_string(nm * 3 + 2));
+    }
+    if (cells.size() < nm * 3 + 2) ++short_rows;
+    std::vector<double> r(nm * 3 + 1, kNaN);
+    double fr = kNaN;
+    if (!parse_double(cells[0], fr) || !std::isfinite(fr))
+      throw InputError(where(path, li) + ": Frame# '" + cells[0] + "' is not a number");
+    if (cells.size() < 2 || !parse_double(cells[1], r[0]) || !std::isfinite(r[0]))
+      throw InputError(where(path, li) + ": Time is missing or not a number");
+    for (std::size_t c = 2; c < cells.size(); ++c) {
+      const std::string cell = trim(cells[c]);
+      if (cell.empty()) continue;
+      double v;
+      if (!parse_double(cell, v)) {
+        throw InputError(where(path, li) + ": marker " + names[(c - 2) / 3] + " " +
+                         "XYZ"[(c - 2) % 3] + " = '" + cell + "' is not a number");
+      }
+      r[c - 1] = v;
+    }
+    frames.push_back(static_cast<int>(fr));
+    rows.push_back(std::move(r));
+  }
+  if (rows.empty()) throw InputError(path + ": no data rows after the header");
+  if (static_cast<double>(rows.size()) != nframes_decl && warnings) {
+    warnings->push_back("NumFrames says " + fmt(nframes_decl) + " but " + std::to_string(rows.size()) +
+                        " data rows were read");
+  }
+  if (short_rows && warnings) {
+    warnings->push_back(std::to_string(short_rows) +
+                        " rows end early; their trailing markers are treated as missing");
+  }
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  m.first_frame = frames.front();
+  m.time_s.resize(n);
+  m.names = names;
+  m.descriptions.assign(nm, "");
+  m.positions_m.assign(nm, Eigen::MatrixX3d(n, 3));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& r = rows[static_cast<std::size_t>(i)];
+    m.time_s[i] = r[0];
+    for (std::size_t k = 0; k < nm; ++k) {
+      const double x = r[1 + 3 * k], y = r[2 + 3 * k], z = r[3 + 3 * k];
+      if (std::isfinite(x) && std::isfinite(y) && std::isfinite(z)) {
+        m.positions_m[k].row(i) << x * to_m, y * to_m, z * to_m;
+      } else {
+        m.positions_m[k].row(i).setConstant(kNaN);
+      }
+    }
+    if (i > 0 && !(m.time_s[i] > m.time_s[i - 1]))
+      throw InputError(path + ": Time does not increase at frame " + std::to_string(frames[static_cast<std::size_t>(i)]));
+  }
+  return m;
+}
+
+std::string format_trc(const MarkerTrajectories& m, const std::string& file_name) {
+  std::ostringstream os;
+  const auto n = m.frames();
+  os << "PathFileType\t4\t(X/Y/Z)\t" << file_name << "\n";
+  os << "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNumFrames\n";
+  os << fmt(m.rate_hz) << "\t" << fmt(m.rate_hz) << "\t" << n << "\t" << m.names.size() << "\tmm\t"
+     << fmt(m.rate_hz) << "\t" << m.first_frame << "\t" << n << "\n";
+  os << "Frame#\tTime";
+  for (const auto& name : m.names) os << "\t" << name << "\t\t";
+  os << "\n\t";
+  for (std::size_t k = 0; k < m.names.size(); ++k) os << "\tX" << k + 1 << "\tY" << k + 1 << "\tZ" << k + 1;
+  os << "\n\n";
+  for (Eigen::Index i = 0; i < n; ++i) {
+    os << m.first_frame + i << "\t" << fmt(m.time_s[i]);
+    for (const auto& P : m.positions_m) {
+      for (int a = 0; a < 3; ++a) {
+        os << "\t";
+        if (std::isfinite(P(i, a))) os << fmt(P(i, a) * 1000.0);
+      }
+    }
+    os << "\n";
+  }
+  return os.str();
+}
+
+void write_trc(const std::string& path, const MarkerTrajectories& m) {
+  write_file_text(path, format_trc(m, std::filesystem::path(path).filename().string()));
+}
+
+Table read_sto(const std::string& path) { return parse_sto(read_file_text(path), path); }
+
+Table parse_sto(const std::string& text, const std::string& path) {
+  const auto lines = lines_of(text);
+  Table t;
+  std::size_t li = 0;
+  bool found_end = false;
+  for (; li < lines.size(); ++li) {
+    const std::string l = trim(lines[li]);
+    if (l == "endheader") {
+      found_end = true;
+      ++li;
+      break;
+    }
+    if (li == 0 && l.find('=') == std::string::npos) {
+      t.name = l.rfind("name ", 0) == 0 ? trim(l.substr(5)) : l;
+      continue;
+    }
+    const auto eq = l.find('=');
+    if (eq != std::string::npos) {
+      t.header[trim(l.substr(0, eq))] = trim(l.substr(eq + 1));
+    } else {
+      const auto sp = l.find_first_of(" \t");
+      if (sp != std::string::npos) t.header[l.substr(0, sp)] = trim(l.substr(sp + 1));
+    }
+  }
+  if (!found_end) throw InputError(path + ": not a MOT/STO file: no 'endheader' line");
+  while (li < lines.size() && trim(lines[li]).empty()) ++li;
+  if (li >= lines.size()) throw InputError(path + ": no column labels after 'endheader'");
+  for (const auto& s : split(lines[li], "\t", false)) {
+    const std::string c = trim(s);
+    if (!c.empty()) t.labels.push_back(c);
+  }
+  if (t.labels.size() <= 1) {
+    t.labels.clear();
+    for (const auto& s : split(lines[li], " \t", false)) t.labels.push_back(s);
+  }
+  const std::size_t label_line = li;
+  const std::size_t ncol = t.labels.size();
+  auto declared = [&](const char* k1, const char* k2) -> long {
+    for (const char* k : {k1, k2}) {
+      auto it = t.header.find(k);
+      if (it == t.header.end()) continue;
+      double v;
+      if (!parse_double(it->second, v) || !std::isfinite(v) || v < 0)
+        throw InputError(path + ": header field " + std::string(k) + " = '" + it->second + "' is not a count");
+      return static_cast<long>(v);
+    }
+    return -1;
+  };
+  const long ncol_decl = declared("nColumns", "datacolumns");
+  const long nrow_decl = declared("nRows", "datarows");
+  if (ncol_decl >= 0 && static_cast<std::size_t>(ncol_decl) != ncol) {
+    throw InputError(where(path, label_line) + ": header says " + std::to_string(ncol_decl) +
+                     " columns but " + std::to_string(ncol) + " labels follow");
+  }
+  if (auto it = t.header.find("inDegrees"); it != t.header.end()) t.in_degrees = to_lower(it->second) == "yes";
+  std::vector<double> values;
+  long nrows = 0;
+  for (++li; li < lines.size(); ++li) {
+    if (trim(lines[li]).empty()) continue;
+    const auto cells = split(lines[li], " \t", false);
+    if (cells.size() != ncol) {
+      throw InputError(where(path, li) + ": " + std::to_string(cells.size()) + " values but " +
+                       std::to_string(ncol) + " columns");
+    }
+    for (std::size_t c = 0; c < ncol; ++c) {
+      double v;
+      if (!parse_double(cells[c], v))
+        throw InputError(where(path, li) + ": column " + t.labels[c] + " = '" + cells[c] + "' is not a number");
+      values.push_back(v);
+    }
+    ++nrows;
+  }
+  if (nrow_decl >= 0 && nrow_decl != nrows) {
+    throw InputError(path + ": header says " + std::to_string(nrow_decl) + " rows but " +
+                     std::to_string(nrows) + " data rows follow");
+  }
+  t.data.resize(nrows, static_cast<Eigen::Index>(ncol));
+  for (long r = 0; r < nrows; ++r)
+    for (std::size_t c = 0; c < ncol; ++c) t.data(r, static_cast<Eigen::Index>(c)) = values[static_cast<std::size_t>(r) * ncol + c];
+  return t;
+}
+
+std::string format_sto(const Table& t) {
+  std::ostringstream os;
+  os << (t.name.empty() ? "kin2grf" : t.name) << "\nversion=1\nnRows=" << t.data.rows()
+     << "\nnColumns=" << t.labels.size() << "\ninDegrees=" << (t.in_degrees ? "yes" : "no");
+  for (const auto& [k, v] : t.header) {
+    if (k == "version" || k == "nRows" || k == "nColumns" || k == "inDegrees") continue;
+    os << "\n" << k << "=" << v;
+  }
+  os << "\nendheader\n";
+  for (std::size_t c = 0; c < t.labels.size(); ++c) os << (c ? "\t" : "") << t.labels[c];
+  os << "\n";
+  for (Eigen::Index r = 0; r < t.data.rows(); ++r) {
+    for (Eigen::Index c = 0; c < t.data.cols(); ++c) os << (c ? "\t" : "") << fmt(t.data(r, c));
+    os << "\n";
+  }
+  return os.str();
+}
+
+void write_sto(const std::string& path, const Table& t) { write_file_text(path, format_sto(t)); }
+
+std::optional<ForcePlateRecording> grf_from_table(const Table& t, const std::string& path,
+                                                  double cop_threshold_N,
+                                                  std::vector<std::string>& warnings) {
+  static const std::regex vre("^(.*)ground_force_(.*)v([xyz])$");
+  struct Set { std::string prefix, side; };
+  std::vector<Set> sets;
+  for (const auto& l : t.labels) {
+    std::smatch mm;
+    if (std::regex_match(l, mm, vre) && mm[3] == "x") sets.push_back({mm[1], mm[2]});
+  }
+  if (sets.empty()) return std::nullopt;
+  if (t.data.rows() < 2) throw InputError(path + ": a GRF table needs at least 2 rows");
+  ForcePlateRecording rec;
+  rec.cop_threshold_N = cop_threshold_N;
+  rec.up_axis = Axis::Y;
+  const Eigen::Index n = t.data.rows();
+  const Eigen::VectorXd time = t.data.col(0);
+  const double t0 = time[0];
+  const double dt = (time[n - 1] - t0) / static_cast<double>(n - 1);
+  if (!(dt > 0) || !std::isfinite(dt)) throw InputError(path + ": time column does not increase");
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) worst = std::max(worst, std::abs(time[i] - (t0 + static_cast<double>(i) * dt)));
+  if (worst > 0.5 * dt) {
+    throw InputError(path + ": time column is not uniformly sampled (deviation " + fmt(worst) +
+                     " s from a uniform grid of " + fmt(dt) + " s)");
+  }
+  if (worst > 1e-9 * std::max(1.0, std::abs(time[n - 1]))) {
+    warnings.push_back("time column deviates up to " + fmt(worst * 1e3) +
+                       " ms from a uniform grid (rounded times); using a uniform " + fmt(1.0 / dt) + " Hz grid");
+  }
+  rec.rate_hz = 1.0 / dt;
+  rec.time_s.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) rec.time_s[i] = t0 + static_cast<double>(i) * dt;
+  for (const auto& s : sets) {
+    ForcePlate fp;
+    fp.name = s.prefix + "ground_force" + (s.side.empty() ? "" : "_" + s.side.substr(0, s.side.size() - 1));
+    const std::string tag = to_lower(s.prefix + s.side);
+    if (tag == "r_" || tag.rfind("r_", 0) == 0 || s.side == "r_") fp.side_hint = Side::Right;
+    if (tag == "l_" || tag.rfind("l_", 0) == 0 || s.side == "l_") fp.side_hint = Side::Left;
+    fp.force_N.resize(n, 3);
+    fp.cop_m.resize(n, 3);
+    fp.free_moment_Nm.resize(n, 3);
+    fp.moment_centre_Nm = Eigen::MatrixX3d::Constant(n, 3, kNaN);
+    bool has_torque = true;
+    for (int a = 0; a < 3; ++a) {
+      const std::string ax(1, "xyz"[a]);
+      const int cv = t.column(s.prefix + "ground_force_" + s.side + "v" + ax);
+      const int cp = t.column(s.prefix + "ground_force_" + s.side + "p" + ax);
+      const int ct = t.column(s.prefix + "ground_torque_" + s.side + ax);
+      if (cv < 0 || cp < 0)
+        throw InputError(path + ": GRF column set '" + fp.name + "' lacks " + (cv < 0 ? "v" : "p") + ax);
+      fp.force_N.col(a) = t.data.col(cv);
+      fp.cop_m.col(a) = t.data.col(cp);
+      if (ct < 0) has_torque = false;
+      else fp.free_moment_Nm.col(a) = t.data.col(ct);
+    }
+    if (!has_torque) {
+      fp.free_moment_Nm.setZero();
+      warnings.push_back(fp.name + ": no ground_torque columns; free moment taken as zero");
+    }
+    if (!fp.force_N.allFinite()) throw InputError(path + ": GRF column set '" + fp.name + "' has NaN forces");
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (std::abs(fp.force_N(i, 1)) < cop_threshold_N) {
+        fp.cop_m.row(i).setConstant(kNaN);  // stale or undefined COP of an unloaded plate
+        fp.free_moment_Nm.row(i).setConstant(kNaN);
+      }
+    }
+    rec.plates.push_back(std::move(fp));
+  }
+  return rec;
+}
+
+Table grf_table(const Eigen::VectorXd& time_s, const ForcePlate& right, const ForcePlate& left) {
+  Table t;
+  t.name = "kin2grf_grf";
+  t.labels = {"time"};
+  const char* ax = "xyz";
+  for (const std::string prefix : {"", "1_"}) {
+    for (int a = 0; a < 3; ++a) t.labels.push_back(prefix + "ground_force_v" + ax[a]);
+    for (int a = 0; a < 3; ++a) t.labels.push_back(prefix + "ground_force_p" + ax[a]);
+  }
+  for (const std::string prefix : {"", "1_"})
+    for (int a = 0; a < 3; ++a) t.labels.push_back(prefix + "ground_torque_" + ax[a]);
+  const Eigen::Index n = time_s.size();
+  t.data.resize(n, static_cast<Eigen::Index>(t.labels.size()));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Eigen::Index c = 0;
+    t.data(i, c++) = time_s[i];
+    for (const ForcePlate* p : {&right, &left}) {
+      for (int a = 0; a < 3; ++a) t.data(i, c++) = p->force_N(i, a);
+      for (int a = 0; a < 3; ++a) t.data(i, c++) = std::isfinite(p->cop_m(i, a)) ? p->cop_m(i, a) : 0.0;
+    }
+    for (const ForcePlate* p : {&right, &left})
+      for (int a = 0; a < 3; ++a)
+        t.data(i, c++) = std::isfinite(p->free_moment_Nm(i, a)) ? p->free_moment_Nm(i, a) : 0.0;
+  }
+  return t;
+}
+
+}  // namespace kin2grf

@@ -1,0 +1,38 @@
+#include "kin2grf/io/trial.hpp"
+
+namespace kin2grf {
+
+const char* to_string(Axis a) {
+  switch (a) {
+    case Axis::X: return "X";
+    case Axis::Y: return "Y";
+    default: return "Z";
+  }
+}
+
+const char* to_string(Side s) {
+  switch (s) {
+    case Side::Right: return "right";
+    case Side::Left: return "left";
+    default: return "general";
+  }
+}
+
+int MarkerTrajectories::find(const std::string& name) const {
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+std::vector<Eigen::Index> MarkerTrajectories::missing_frames(int marker) const {
+  std::vector<Eigen::Index> out;
+  const auto& P = positions_m.at(static_cast<std::size_t>(marker));
+  for (Eigen::Index i = 0; i < P.rows(); ++i)
+    if (!P.row(i).allFinite()) out.push_back(i);
+  return out;
+}
+
+double ForcePlate::width_m() const { return (corners_m[0] - corners_m[1]).norm(); }
+double ForcePlate::length_m() const { return (corners_m[0] - corners_m[3]).norm(); }
+
+}  // namespace kin2grf

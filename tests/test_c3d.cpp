@@ -1,0 +1,345 @@
+// C3D reader/writer tests: real files from ../shared/data (skipped when absent), round trips in
+// every encoding, and corrupt files that must give a clear error, never a crash.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/c3d.hpp"
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/io/opensim.hpp"
+#include "kin2grf/io/summary.hpp"
+#include "test_support.hpp"
+
+using namespace kin2grf;
+
+namespace {
+
+Trial small_trial() {
+  Trial t;
+  t.format = "C3D";
+  auto& m = t.markers;
+  m.rate_hz = 100.0;
+  m.first_frame = 1;
+  const int n = 20;
+  m.time_s = Eigen::VectorXd::LinSpaced(n, 0.0, (n - 1) / 100.0);
+  m.names = {"RHEE", "RTOE", "LASI"};
+  m.descriptions = {"heel", "", "pelvis"};
+  for (int k = 0; k < 3; ++k) {
+    Eigen::MatrixX3d P(n, 3);
+    for (int i = 0; i < n; ++i) P.row(i) << 0.1 * k + 0.01 * i, 0.2 - 0.003 * i, 0.05 + 0.4 * k;
+    m.positions_m.push_back(P);
+  }
+  m.positions_m[1].row(5).setConstant(std::nan(""));
+  ForcePlateRecording rec;
+  rec.rate_hz = 400.0;
+  const int ns = n * 4;
+  rec.time_s = Eigen::VectorXd::LinSpaced(ns, 0.0, (ns - 1) / 400.0);
+  ForcePlate fp;
+  fp.name = "FP1";
+  fp.type = 2;
+  fp.has_geometry = true;
+  fp.corners_m = {Eigen::Vector3d(0.5, 0.6, 0), Eigen::Vector3d(0.0, 0.6, 0), Eigen::Vector3d(0.0, 0.0, 0),
+                  Eigen::Vector3d(0.5, 0.0, 0)};
+  fp.centre_m = Eigen::Vector3d(0.25, 0.3, 0);
+  fp.origin_m = Eigen::Vector3d(0.001, -0.002, -0.04);
+  Eigen::Matrix<double, 3, 4> C;
+  for (int c = 0; c < 4; ++c) C.col(c) = fp.corners_m[static_cast<std::size_t>(c)];
+  fp.lab_R_plate = plate_axes(C);
+  fp.force_N.resize(ns, 3);
+  fp.cop_m.resize(ns, 3);
+  fp.free_moment_Nm.resize(ns, 3);
+  fp.moment_centre_Nm = Eigen::MatrixX3d::Constant(ns, 3, std::nan(""));
+  for (int i = 0; i < ns; ++i) {
+    const double s = std::sin(M_PI * i / (ns - 1));
+    fp.force_N.row(i) << 50 * s, -10 * s, 700 * s + 1e-9;
+    fp.cop_m.row(i) << 0.2 + 0.1 * i / ns, 0.3, 0.0;
+    fp.free_moment_Nm.row(i) << 0, 0, 2 * s;
+  }
+  rec.plates.push_back(fp);
+  t.plates = rec;
+  t.events = {{"Foot Strike", Side::Right, 0.05}, {"Foot Off", Side::Left, 0.12}};
+  t.body_mass_kg = 71.5;
+  return t;
+}
+
+void expect_near_matrix(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b, double tol, const std::string& what) {
+  ASSERT_EQ(a.rows(), b.rows()) << what;
+  for (Eigen::Index i = 0; i < a.rows(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      if (std::isnan(b(i, c))) {
+        EXPECT_TRUE(std::isnan(a(i, c))) << what << " row " << i;
+      } else {
+        EXPECT_NEAR(a(i, c), b(i, c), tol) << what << " row " << i << " col " << c;
+      }
+    }
+}
+
+std::string expect_input_error(const std::vector<std::uint8_t>& bytes, const std::string& name) {
+  try {
+    (void)read_c3d_bytes(bytes, name);
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << "message must name the file: " << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << name << ": expected an InputError";
+  return "";
+}
+
+}  // namespace
+
+TEST(C3dRoundTrip, EveryEncodingReadsBackTheSameTrial) {
+  const Trial t = small_trial();
+  for (auto proc : {C3dProcessor::Intel, C3dProcessor::DEC, C3dProcessor::SGI}) {
+    for (bool fl : {true, false}) {
+      C3dWriteOptions o;
+      o.processor = proc;
+      o.float_data = fl;
+      o.point_scale_mm = 0.1;
+      o.analog_samples_per_frame = 4;
+      const auto bytes = write_c3d_bytes(t, o);
+      const std::string what = "processor " + std::to_string(static_cast<int>(proc)) + (fl ? " float" : " int");
+      const Trial r = read_c3d_bytes(bytes, "roundtrip.c3d");
+      ASSERT_EQ(r.markers.names, t.markers.names) << what;
+      EXPECT_EQ(r.markers.descriptions[0], "heel");
+      const double tol = fl ? 1e-6 : 5.1e-5;  // float32 in mm, or 0.1 mm integer steps
+      for (std::size_t k = 0; k < 3; ++k)
+        expect_near_matrix(r.markers.positions_m[k], t.markers.positions_m[k], tol, what + " marker");
+      ASSERT_TRUE(r.plates.has_value()) << what;
+      ASSERT_EQ(r.plates->plates.size(), 1u);
+      const auto& a = r.plates->plates[0];
+      const auto& b = t.plates->plates[0];
+      EXPECT_DOUBLE_EQ(r.plates->rate_hz, 400.0);
+      expect_near_matrix(a.force_N, b.force_N, fl ? 1e-3 : 0.05, what + " force");
+      for (Eigen::Index i = 0; i < a.force_N.rows(); ++i) {
+        if (b.force_N(i, 2) < 50) continue;  // COP is ill-conditioned at tiny loads
+        for (int c = 0; c < 2; ++c) EXPECT_NEAR(a.cop_m(i, c), b.cop_m(i, c), fl ? 1e-5 : 5e-4) << what << " cop " << i;
+        EXPECT_NEAR(a.free_moment_Nm(i, 2), b.free_moment_Nm(i, 2), fl ? 1e-3 : 0.05) << what;
+      }
+      ASSERT_EQ(r.events.size(), 2u);
+      EXPECT_EQ(r.events[0].label, "Foot Strike");
+      EXPECT_EQ(r.events[0].side, Side::Right);
+      EXPECT_NEAR(r.events[1].time_s, 0.12, 1e-6);
+      ASSERT_TRUE(r.body_mass_kg.has_value());
+      EXPECT_NEAR(*r.body_mass_kg, 71.5, 1e-4);
+    }
+  }
+}
+
+TEST(C3dCorrupt, EveryStructuralErrorNamesTheFileAndField) {
+  C3dWriteOptions o;
+  o.analog_samples_per_frame = 4;
+  const auto good = write_c3d_bytes(small_trial(), o);
+  ASSERT_NO_THROW(read_c3d_bytes(good, "good.c3d"));
+
+  // Truncated in the data section.
+  auto b = good;
+  b.resize(b.size() - 700);
+  EXPECT_NE(expect_input_error(b, "truncated.c3d").find("truncated"), std::string::npos);
+  // Shorter than the header.
+  b.assign(good.begin(), good.begin() + 100);
+  expect_input_error(b, "tiny.c3d");
+  // Not a C3D at all.
+  b = good;
+  b[1] = 0x12;
+  EXPECT_NE(expect_input_error(b, "notc3d.c3d").find("0x50"), std::string::npos);
+  // Parameter pointer out of range.
+  b = good;
+  b[0] = 200;
+  expect_input_error(b, "pointer.c3d");
+  // Unknown processor type.
+  b = good;
+  b[512 + 3] = 99;
+  EXPECT_NE(expect_input_error(b, "processor.c3d").find("processor type 99"), std::string::npos);
+  // Empty file.
+  expect_input_error({}, "empty.c3d");
+}
+
+TEST(C3dCorrupt, NaNScaleAndAbsurdCountsAreRejected) {
+  C3dWriteOptions o;
+  o.analog_samples_per_frame = 4;
+  Trial t = small_trial();
+  auto good = write_c3d_bytes(t, o);
+  // Find POINT:SCALE's float in the parameter section and set it to NaN.
+  auto find = [&](const std::string& name) {
+    for (std::size_t i = 512; i + name.size() < 1536; ++i)
+      if (std::equal(name.begin(), name.end(), good.begin() + static_cast<long>(i))) return i;
+    return std::size_t{0};
+  };
+  std::size_t pos = find("SCALE");
+  ASSERT_GT(pos, 0u);
+  auto b = good;
+  const std::size_t data = pos + 5 + 2 + 2;  // name, offset, type, ndims (0 dims)
+  b[data] = 0x00; b[data + 1] = 0x00; b[data + 2] = 0xC0; b[data + 3] = 0x7F;  // quiet NaN (Intel)
+  EXPECT_NE(expect_input_error(b, "nanscale.c3d").find("POINT:SCALE"), std::string::npos);
+  // Declared frame count far larger than the data.
+  b = good;
+  pos = find("ACTUAL_END_FIELD");
+  ASSERT_GT(pos, 0u);
+  const std::size_t end_field = pos + 16 + 2 + 1 + 1 + 1;  // name, offset, type, ndims, dim
+  b[end_field] = 0xFF; b[end_field + 1] = 0x7F;              // last frame 32767
+  EXPECT_NE(expect_input_error(b, "frames.c3d").find("truncated"), std::string::npos);
+  // A parameter whose dimensions run past the parameter section.
+  b = good;
+  pos = find("LABELS");
+  ASSERT_GT(pos, 0u);
+  b[pos + 6 + 2 + 1 + 1] = 250;  // first dimension of POINT:LABELS
+  b[pos + 6 + 2 + 1 + 2] = 250;
+  expect_input_error(b, "dims.c3d");
+}
+
+TEST(C3dCorrupt, RandomByteFlipsNeverCrash) {
+  C3dWriteOptions o;
+  o.analog_samples_per_frame = 4;
+  const auto good = write_c3d_bytes(small_trial(), o);
+  std::mt19937 rng(12345);
+  int errors = 0, reads = 0;
+  for (int trial = 0; trial < 1500; ++trial) {
+    auto b = good;
+    const int flips = 1 + static_cast<int>(rng() % 6);
+    for (int f = 0; f < flips; ++f) {
+      // Favour the header and parameter section, where structure lives.
+      const std::size_t pos = (rng() % 4 == 0) ? rng() % b.size() : rng() % std::min<std::size_t>(b.size(), 1536);
+      b[pos] = static_cast<std::uint8_t>(rng());
+    }
+    try {
+      (void)read_c3d_bytes(b, "flip.c3d");
+      ++reads;
+    } catch (const InputError&) {
+      ++errors;
+    }
+  }
+  EXPECT_EQ(errors + reads, 1500);
+  EXPECT_GT(errors, 0);
+}
+
+TEST(C3dShared, Walking2MatchesOpenSimReferenceAt2p80s) {
+  KIN2GRF_REQUIRE_DATA();
+  const Trial t = read_c3d(test::data_file("opensim_c3d_overground_walk/walking2.c3d"));
+  ASSERT_TRUE(t.plates.has_value());
+  ASSERT_EQ(t.plates->plates.size(), 2u);
+  const Table ref = read_sto(test::data_file("opensim_c3d_overground_walk/std_cop_walking2_grfs.sto"));
+  int row = -1;
+  for (Eigen::Index r = 0; r < ref.data.rows(); ++r)
+    if (std::abs(ref.data(r, 0) - 2.80) < 1e-6) row = static_cast<int>(r);
+  ASSERT_GE(row, 0);
+  // OpenSim's reference time 0 is the first analog sample.
+  const Eigen::Index k = static_cast<Eigen::Index>(std::lround(2.80 * t.plates->rate_hz));
+  for (int p = 0; p < 2; ++p) {
+    const auto& fp = t.plates->plates[static_cast<std::size_t>(p)];
+    const std::string pre = std::to_string(p + 1) + "_";
+    for (int a = 0; a < 3; ++a) {
+      const double f_ref = ref.data(row, ref.column("f" + pre + std::to_string(a + 1)));
+      EXPECT_NEAR(fp.force_N(k, a), f_ref, 0.1) << "plate " << p + 1 << " force axis " << a;
+    }
+    if (std::abs(fp.force_N(k, 2)) < 20) continue;  // plate 2 unloaded at 2.80 s
+    for (int a = 0; a < 2; ++a) {
+      const double p_ref_mm = ref.data(row, ref.column("p" + pre + std::to_string(a + 1)));
+      EXPECT_NEAR(fp.cop_m(k, a) * 1000.0, p_ref_mm, 0.5) << "plate " << p + 1 << " COP axis " << a;
+    }
+  }
+  // The documented values of the data README.
+  EXPECT_NEAR(t.plates->plates[0].force_N(k, 2), 948.32, 0.1);
+  EXPECT_NEAR(t.plates->plates[0].cop_m(k, 0) * 1000, 781.52, 0.5);
+}
+
+TEST(C3dShared, IntelDecSgiEncodingsReadIdentically) {
+  KIN2GRF_REQUIRE_DATA();
+  const Trial pi = read_c3d(test::data_file("c3d_format_samples/Eb015pi.c3d"));
+  const Trial sr = read_c3d(test::data_file("c3d_format_samples/Eb015sr.c3d"));
+  const Trial vr = read_c3d(test::data_file("c3d_format_samples/Eb015vr.c3d"));
+  EXPECT_EQ(pi.encoding, "Intel, integer");
+  EXPECT_EQ(sr.encoding, "SGI/MIPS, float");
+  EXPECT_EQ(vr.encoding, "DEC, float");
+  for (const Trial* o : {&sr, &vr}) {
+    ASSERT_EQ(o->markers.names, pi.markers.names);
+    for (std::size_t k = 0; k < pi.markers.names.size(); ++k)
+      expect_near_matrix(o->markers.positions_m[k], pi.markers.positions_m[k], 1e-6, pi.markers.names[k]);
+    ASSERT_TRUE(o->plates && pi.plates);
+    for (std::size_t p = 0; p < pi.plates->plates.size(); ++p)
+      expect_near_matrix(o->plates->plates[p].force_N, pi.plates->plates[p].force_N, 1e-3, "force");
+  }
+  // Marker 1 at frame 101 (README): (250.67, 227.25, 35.33) mm.
+  EXPECT_NEAR(pi.markers.positions_m[0](100, 0) * 1000, 250.67, 0.01);
+  EXPECT_NEAR(vr.markers.positions_m[0](100, 1) * 1000, 227.25, 0.01);
+  EXPECT_NEAR(sr.markers.positions_m[0](100, 2) * 1000, 35.33, 0.01);
+}
+
+TEST(C3dShared, Type4CalMatrixFirstIndexFastestMatchesType2) {
+  KIN2GRF_REQUIRE_DATA();
+  // Assumed order: CAL_MATRIX element (row i, column j) stored at i + 6 j (first index fastest,
+  // like every C3D array), loads = CAL_MATRIX * raw channels.
+  const Trial t2 = read_c3d(test::data_file("c3d_format_samples/TYPE-2.C3D"));
+  const Trial t4 = read_c3d(test::data_file("c3d_format_samples/TYPE-4.C3D"));
+  ASSERT_EQ(t4.plates->plates[0].type, 4);
+  const double peak2 = t2.plates->plates[0].force_N.col(2).maxCoeff();
+  const double peak4 = t4.plates->plates[0].force_N.col(2).maxCoeff();
+  EXPECT_NEAR(peak2, 398.0, 4.0);
+  EXPECT_LT(std::abs(peak4 - peak2) / peak2, 0.03) << "TYPE-2 " << peak2 << " N, TYPE-4 " << peak4 << " N";
+}
+
+TEST(C3dShared, FirstFrameOtherThanOneAndEvents) {
+  KIN2GRF_REQUIRE_DATA();
+  const Trial t = read_c3d(test::data_file("btk_plugingait_walk/PiG_Motion-FlatFoot-Full.c3d"));
+  EXPECT_EQ(t.markers.first_frame, 148);
+  EXPECT_NEAR(t.markers.time_s[0], 1.47, 1e-9);
+  ASSERT_TRUE(t.body_mass_kg.has_value());
+  EXPECT_NEAR(*t.body_mass_kg, 47.5, 1e-4);
+  EXPECT_FALSE(t.events.empty());
+  EXPECT_GE(t.markers.find("RHEE"), 0);
+  EXPECT_LT(t.markers.find("LKneeAngles"), 0) << "model outputs are not markers";
+  // FP1 = right foot, peak 483 N (README), force on the body points up.
+  const auto& fp1 = t.plates->plates[0];
+  EXPECT_NEAR(fp1.force_N.col(2).maxCoeff(), 483.0, 2.0);
+}
+
+TEST(AllShared, EveryRecordingLoadsAndIsDescribed) {
+  KIN2GRF_REQUIRE_DATA();
+  int files = 0;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(test::data_dir())) {
+    std::string ext = e.path().extension().string();
+    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".c3d" && ext != ".trc" && ext != ".mot" && ext != ".sto") continue;
+    SCOPED_TRACE(e.path().string());
+    Trial t;
+    ASSERT_NO_THROW(t = load_trial(e.path().string()));
+    const auto s = trial_summary(t);
+    EXPECT_TRUE(s.contains("force_plates"));
+    if (ext == ".c3d" || ext == ".trc") {
+      EXPECT_GT(t.markers.names.size(), 0u);
+    }
+    ++files;
+  }
+  EXPECT_GE(files, 25);
+}
+
+TEST(Cli, InfoJsonOnWalking2ReportsTwoPlates) {
+  KIN2GRF_REQUIRE_DATA();
+  const std::string cmd = std::string(KIN2GRF_CLI) + " info --json " +
+                          test::data_file("opensim_c3d_overground_walk/walking2.c3d");
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  ASSERT_TRUE(pipe);
+  std::string out;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, pipe.get())) out += buf;
+  const auto j = nlohmann::json::parse(out);
+  for (const char* key : {"format", "rate_hz", "frames", "markers", "force_plates", "events"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["format"], "C3D");
+  EXPECT_EQ(j["force_plates"].size(), 2u);
+  EXPECT_DOUBLE_EQ(j["rate_hz"].get<double>(), 250.0);
+}
+
+TEST(Cli, InfoOnMissingFileNamesIt) {
+  const std::string cmd = std::string(KIN2GRF_CLI) + " info /nonexistent/trial.c3d 2>&1";
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  std::string out;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, pipe.get())) out += buf;
+  EXPECT_NE(out.find("/nonexistent/trial.c3d"), std::string::npos) << out;
+}

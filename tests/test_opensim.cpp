@@ -1,0 +1,115 @@
+// OpenSim TRC and MOT/STO tests: shared files, round trips, and malformed headers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/io/opensim.hpp"
+#include "test_support.hpp"
+
+using namespace kin2grf;
+
+TEST(Trc, RoundTripKeepsValuesAndGaps) {
+  MarkerTrajectories m;
+  m.rate_hz = 60;
+  m.first_frame = 1;
+  m.time_s = Eigen::VectorXd::LinSpaced(5, 0, 4 / 60.0);
+  m.names = {"A", "B.Heel"};
+  m.descriptions = {"", ""};
+  m.up_axis = Axis::Y;
+  for (int k = 0; k < 2; ++k) m.positions_m.push_back(Eigen::MatrixX3d::Random(5, 3));
+  m.positions_m[1].row(2).setConstant(std::nan(""));
+  const auto r = parse_trc(format_trc(m, "x.trc"), "x.trc");
+  ASSERT_EQ(r.names, m.names);
+  EXPECT_DOUBLE_EQ(r.rate_hz, 60);
+  for (int k = 0; k < 2; ++k)
+    for (int i = 0; i < 5; ++i)
+      for (int a = 0; a < 3; ++a) {
+        if (std::isnan(m.positions_m[k](i, a))) EXPECT_TRUE(std::isnan(r.positions_m[k](i, a)));
+        else EXPECT_NEAR(r.positions_m[k](i, a), m.positions_m[k](i, a), 1e-7);  // 8 digits in mm
+      }
+}
+
+TEST(Trc, MalformedFilesNameTheLineAndField) {
+  const std::string head =
+      "PathFileType\t4\t(X/Y/Z)\tx.trc\nDataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\n";
+  auto err = [&](const std::string& text) {
+    try {
+      (void)parse_trc(text, "bad.trc");
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.trc"), std::string::npos);
+      return std::string(e.what());
+    }
+    ADD_FAILURE() << "no error for:\n" << text;
+    return std::string();
+  };
+  EXPECT_NE(err(head + "60\t60\t1\t2\tmm\nFrame#\tTime\tA\t\t\n\t\tX1\tY1\tZ1\n\n1\t0\t1\t2\t3\n").find("NumMarkers"),
+            std::string::npos);
+  EXPECT_NE(err(head + "60\t60\t1\t1\tfeet\nFrame#\tTime\tA\t\t\n\t\tX1\tY1\tZ1\n\n1\t0\t1\t2\t3\n").find("Units"),
+            std::string::npos);
+  EXPECT_NE(err(head + "60\t60\t1\t1\tmm\nFrame#\tTime\tA\t\t\n\t\tX1\tY1\tZ1\n\n1\t0\t1\t2\t3\t4\t5\n").find("columns"),
+            std::string::npos);
+  EXPECT_NE(err(head + "60\t60\t1\t1\tmm\nFrame#\tTime\tA\t\t\n\t\tX1\tY1\tZ1\n\n1\t0\t1\tabc\t3\n").find("Y"),
+            std::string::npos);
+  err("hello\n");
+  err(head + "abc\t60\t1\t1\tmm\nFrame#\tTime\tA\n\n");
+}
+
+TEST(Sto, VersionOneAndOldHeadersAndCountChecks) {
+  const std::string v1 = "grf\nversion=1\nnRows=2\nnColumns=3\ninDegrees=no\nendheader\ntime\ta\tb\n0\t1\t2\n0.1\t3\t4\n";
+  const Table t = parse_sto(v1, "v1.mot");
+  EXPECT_EQ(t.labels.size(), 3u);
+  EXPECT_DOUBLE_EQ(t.data(1, 2), 4);
+  const std::string old = "name x\ndatacolumns 3\ndatarows 1\nrange 0 0\nendheader\ntime a b\n0 1 2\n";
+  EXPECT_EQ(parse_sto(old, "old.mot").data.rows(), 1);
+  const Table rt = parse_sto(format_sto(t), "rt.sto");
+  EXPECT_EQ(rt.labels, t.labels);
+  EXPECT_EQ(rt.data, t.data);
+  EXPECT_THROW(parse_sto("grf\nnRows=3\nnColumns=3\nendheader\ntime\ta\tb\n0\t1\t2\n", "rows.mot"), InputError);
+  EXPECT_THROW(parse_sto("grf\nnRows=1\nnColumns=4\nendheader\ntime\ta\tb\n0\t1\t2\n", "cols.mot"), InputError);
+  EXPECT_THROW(parse_sto("grf\nendheader\ntime\ta\tb\n0\t1\n", "short.mot"), InputError);
+  EXPECT_THROW(parse_sto("no header\n0 1 2\n", "nohdr.mot"), InputError);
+}
+
+TEST(Sto, GrfColumnsBecomePlates) {
+  const std::string text =
+      "grf\nversion=1\nnRows=3\nnColumns=10\ninDegrees=no\nendheader\n"
+      "time\tground_force_r_vx\tground_force_r_vy\tground_force_r_vz\tground_force_r_px\tground_force_r_py\t"
+      "ground_force_r_pz\tground_torque_r_x\tground_torque_r_y\tground_torque_r_z\n"
+      "0\t1\t0\t0\t0.5\t0\t0.1\t0\t0\t0\n0.001\t2\t500\t0\t0.6\t0\t0.1\t0\t3\t0\n0.002\t3\t600\t0\t0.7\t0\t0.1\t0\t4\t0\n";
+  std::vector<std::string> w;
+  const auto rec = grf_from_table(parse_sto(text, "g.mot"), "g.mot", 10.0, w);
+  ASSERT_TRUE(rec.has_value());
+  ASSERT_EQ(rec->plates.size(), 1u);
+  EXPECT_EQ(rec->plates[0].side_hint, Side::Right);
+  EXPECT_TRUE(std::isnan(rec->plates[0].cop_m(0, 0))) << "unloaded: stale COP must not be used";
+  EXPECT_DOUBLE_EQ(rec->plates[0].cop_m(2, 0), 0.7);
+  EXPECT_NEAR(rec->rate_hz, 1000.0, 1e-9);
+}
+
+TEST(SharedOpenSim, TreadmillGrfRoundedTimesAreRegularised) {
+  KIN2GRF_REQUIRE_DATA();
+  const Trial t = load_trial(test::data_file("opensim_subject01_treadmill_walk/subject01_walk1_grf.mot"));
+  ASSERT_TRUE(t.plates.has_value());
+  EXPECT_EQ(t.plates->plates.size(), 2u);
+  EXPECT_NEAR(t.plates->rate_hz, 600.0, 1e-6);
+  EXPECT_FALSE(t.warnings.empty());
+  const Trial run = load_trial(test::data_file("rajagopal2016_treadmill_run/grf_run.mot"));
+  ASSERT_EQ(run.plates->plates.size(), 2u);
+  EXPECT_EQ(run.plates->plates[0].side_hint, Side::Right);
+  EXPECT_EQ(run.plates->plates[1].side_hint, Side::Left);
+  EXPECT_GT(run.plates->plates[0].force_N.col(1).maxCoeff(), 1800.0);
+}
+
+TEST(SharedOpenSim, TrcFirstFrameAndUnits) {
+  KIN2GRF_REQUIRE_DATA();
+  const Trial t = load_trial(test::data_file("rajagopal2016_treadmill_run/motion_capture_run.trc"));
+  EXPECT_EQ(t.markers.first_frame, 23);
+  EXPECT_NEAR(t.markers.time_s[0], 0.23, 1e-9);
+  EXPECT_EQ(t.markers.up_axis, Axis::Y);
+  EXPECT_EQ(t.markers.frames(), 510);
+  const int rcal = t.markers.find("RCAL");
+  ASSERT_GE(rcal, 0);
+  EXPECT_LT(std::abs(t.markers.positions_m[static_cast<std::size_t>(rcal)](0, 1)), 1.0) << "metres, not mm";
+}
