@@ -2,10 +2,14 @@
 #include <CLI/CLI.hpp>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/summary.hpp"
+#include "kin2grf/io/text.hpp"
+#include "kin2grf/output/results.hpp"
+#include "kin2grf/pipeline.hpp"
 
 namespace {
 
@@ -15,6 +19,102 @@ int run_info(const std::string& file, bool json, double threshold) {
   const auto s = kin2grf::trial_summary(t, threshold);
   if (json) std::cout << s.dump(2) << "\n";
   else std::cout << kin2grf::format_summary(s);
+  return 0;
+}
+
+struct EstimateArgs {
+  std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "paper",
+      anthropometry = "winter", up_axis;
+  double mass = 0, r = 1e4, kin_cutoff = 6, post_cutoff = 12, ground_shift = 0, speed_gate = 0;
+  std::optional<double> ground_level;
+  int max_gap = 10;
+};
+
+void add_estimate_options(CLI::App* c, EstimateArgs& a) {
+  c->add_option("TRIAL", a.trial, "Motion trial (C3D or TRC)")->required();
+  c->add_option("--static", a.static_trial, "Static calibration trial (for virtual knee/ankle landmarks)");
+  c->add_option("--markers", a.markers, "Marker-set preset name or mapping file (JSON); default: recognised");
+  c->add_option("--mass", a.mass, "Body mass, kg (default: PROCESSING:Bodymass of a C3D)");
+  c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
+      ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
+  c->add_option("--r", a.r, "Activation parameter r, N/m (Eq. 8)")->capture_default_str();
+  c->add_option("--kinematic-cutoff", a.kin_cutoff, "Kinematics low-pass cut-off, Hz")->capture_default_str();
+  c->add_option("--post-cutoff", a.post_cutoff, "Multiplier post-filter cut-off, Hz")->capture_default_str();
+  c->add_option("--ground-level", a.ground_level, "Floor height in the lab's up axis, m (default: estimated)");
+  c->add_option("--ground-shift", a.ground_shift, "Shift the ground by this much, m (robustness study)")->capture_default_str();
+  c->add_option("--speed-gate", a.speed_gate, "Contact allowed only below this sole speed, m/s (0 = off, the paper)")
+      ->capture_default_str();
+  c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
+      ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
+  c->add_option("--anthropometry", a.anthropometry, "winter or de-leva")->capture_default_str();
+  c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
+  c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
+  c->add_option("-o,--output", a.out_mot, "OpenSim GRF .mot output");
+  c->add_option("--csv", a.out_csv, "Per-frame CSV output (sagittal frame)");
+  c->add_option("--json", a.out_json, "JSON summary output");
+}
+
+kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
+  kin2grf::EstimateOptions o;
+  if (a.mass > 0) o.mass_kg = a.mass;
+  o.anthropometry = a.anthropometry;
+  o.kinematic_cutoff_hz = a.kin_cutoff;
+  o.post_cutoff_hz = a.post_cutoff;
+  o.ground_level_m = a.ground_level;
+  o.contact.foot_model = a.foot_model == "cop" ? kin2grf::FootModel::Cop : kin2grf::FootModel::ThreePoint;
+  o.contact.ground_shift_m = a.ground_shift;
+  o.solver.r_N_per_m = a.r;
+  o.solver.norm = a.norm == "paper" ? kin2grf::MultiplierNorm::Paper : kin2grf::MultiplierNorm::TorqueScaled;
+  o.solver.speed_gate_mps = a.speed_gate;
+  o.landmarks.max_gap_frames = a.max_gap;
+  if (!a.up_axis.empty()) {
+    const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(a.up_axis[0])));
+    if (c < 'X' || c > 'Z' || a.up_axis.size() != 1) throw kin2grf::InputError("--up-axis must be X, Y or Z");
+    o.landmarks.up_axis = static_cast<kin2grf::Axis>(c - 'X');
+  }
+  return o;
+}
+
+nlohmann::json settings_json(const EstimateArgs& a) {
+  return {{"trial", a.trial}, {"static", a.static_trial}, {"foot_model", a.foot_model}, {"r_N_per_m", a.r},
+          {"kinematic_cutoff_hz", a.kin_cutoff}, {"post_cutoff_hz", a.post_cutoff}, {"norm", a.norm},
+          {"speed_gate_mps", a.speed_gate}, {"anthropometry", a.anthropometry}, {"ground_shift_m", a.ground_shift},
+          {"ground_level_m", a.ground_level ? nlohmann::json(*a.ground_level) : nlohmann::json("auto")}};
+}
+
+int run_estimate(const EstimateArgs& a) {
+  const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
+  std::optional<kin2grf::Trial> st;
+  if (!a.static_trial.empty()) st = kin2grf::load_trial(a.static_trial);
+  kin2grf::MarkerSet custom;
+  const kin2grf::MarkerSet* set = nullptr;
+  if (!a.markers.empty()) {
+    set = kin2grf::find_marker_set(a.markers);
+    if (!set) {
+      custom = kin2grf::load_marker_set(a.markers);
+      set = &custom;
+    }
+  } else {
+    set = kin2grf::recognise_marker_set(trial.markers);
+    if (!set) {
+      std::string names;
+      for (const auto& s : kin2grf::builtin_marker_sets()) names += " " + s.name;
+      throw kin2grf::InputError(a.trial + ": marker set not recognised (presets:" + names +
+                                "). Give --markers FILE.json with a rule for each landmark: shoulder, hip, knee_r, "
+                                "ankle_r, heel_r, mt_r, hallux_r and the same _l (see docs/MARKERSETS.md)");
+    }
+    std::cerr << "kin2grf: marker set recognised: " << set->name << "\n";
+  }
+  const auto r = kin2grf::estimate(trial, st ? &*st : nullptr, *set, to_options(a));
+  for (const auto& m : r.messages) std::cerr << "kin2grf: " << m << "\n";
+  std::cerr << "kin2grf: " << r.time_s.size() << " frames, mass " << r.mass_kg << " kg, "
+            << static_cast<long>(static_cast<double>(r.time_s.size()) / std::max(1e-9, r.seconds_kinematics + r.seconds_dynamics))
+            << " frames/s\n";
+  if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r);
+  if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::format_results_csv(r));
+  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::results_summary(r, settings_json(a)).dump(2) + "\n");
+  if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty())
+    std::cout << kin2grf::results_summary(r, settings_json(a)).dump(2) << "\n";
   return 0;
 }
 
@@ -35,6 +135,10 @@ int main(int argc, char** argv) {
   info->add_option("--load-threshold", info_threshold, "Vertical force (N) above which a plate counts as loaded")
       ->capture_default_str();
 
+  EstimateArgs est;
+  auto* estimate = app.add_subcommand("estimate", "Estimate GRF, COP, GRM and joint torques from markers");
+  add_estimate_options(estimate, est);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -42,6 +146,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*info) return run_info(info_file, info_json, info_threshold);
+    if (*estimate) return run_estimate(est);
   } catch (const kin2grf::InputError& e) {
     std::cerr << "kin2grf: error: " << e.what() << "\n";
     return 2;

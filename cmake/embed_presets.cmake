@@ -1,0 +1,12 @@
+# Generates a C++ source holding the built-in marker-set presets (data/presets/*.json) as text.
+file(GLOB preset_files "${PRESET_DIR}/*.json")
+list(SORT preset_files)
+set(content "// Generated from data/presets/*.json by cmake/embed_presets.cmake. Do not edit.\n#include <string>\n#include <utility>\n#include <vector>\nnamespace kin2grf {\nconst std::vector<std::pair<std::string, std::string>>& builtin_preset_texts() {\n  static const std::vector<std::pair<std::string, std::string>> t = {\n")
+foreach(f ${preset_files})
+  file(READ "${f}" text)
+  get_filename_component(name "${f}" NAME)
+  string(APPEND content "    {\"${name}\", R\"kin2grf(${text})kin2grf\"},\n")
+endforeach()
+string(APPEND content "  };\n  return t;\n}\n}  // namespace kin2grf\n")
+file(WRITE "${OUTPUT}.tmp" "${content}")
+execute_process(COMMAND ${CMAKE_COMMAND} -E copy_if_different "${OUTPUT}.tmp" "${OUTPUT}")

@@ -1,0 +1,81 @@
+// kin2grf dynamics: the foot-ground contact models of the paper (Sect. 2.3).
+//
+// Sole points (model.hpp, FootContactGeometry): A under the heel and B under the MT head, both
+// on the foot; C under the hallux, on the toes. Foot inclination (paper's theta_A):
+//   theta_A = -(theta_foot - theta_foot,flat),
+// positive when the heel is raised (plantar flexion against the ground), negative at heel strike
+// (toes up), so that the paper's event angles keep their signs (HS -0.3, HO 0, MO 0.15, TO 1 rad).
+//
+// Foot model 2 ("cop", the paper's, Eq. 2): one contact point D, the COP, with
+//   y_D = min(y_A, y_B, y_C),  x_D = the point at arc fraction s = F(theta_A) of the sole
+//   polyline A -> B -> C (s = 0 at A, 1 at C).
+// F is piecewise between the four event angles: half-cosine (sinusoidal) HS->HO and HO->MO,
+// linear MO->TO, constant outside, through the positions s_HS, s_HO, s_MO, s_TO (fitted, see
+// docs/METHOD-NOTES.md). D* is the foot's material point at D this frame; contact at D*:
+// normal gap g_n = y_D* - ground, multipliers lambda_n (normal) and lambda_t (tangential stick).
+// Foot model 1 ("three-point"): non-penetration and sticking at A, B and C.
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <vector>
+
+#include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/model/model.hpp"
+
+namespace kin2grf {
+
+enum class FootModel { Cop, ThreePoint };
+
+/// x_D = F(theta_A) of the paper: event angles (rad) and the COP's arc fraction at each event.
+struct CopFunction {
+  double delta_hs = -0.3, delta_ho = 0.0, delta_mo = 0.15, delta_to = 1.0;
+  double s_hs = 0.08, s_ho = 0.45, s_mo = 0.78, s_to = 0.97;
+  [[nodiscard]] double fraction(double theta_a) const;
+};
+
+/// One potential contact point this frame (model 2: D*, model 1: A, B or C).
+struct ContactPoint {
+  int side = 0;
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< lab sagittal, m
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  ///< of the material point, m/s
+  double gap_m = 0.0;                                  ///< y - ground
+  Eigen::VectorXd jac_normal, jac_tangent;             ///< d(y)/dq and d(x)/dq, 63 each
+};
+
+struct FrameContacts {
+  std::vector<ContactPoint> points;  ///< model 2: [D*_R, D*_L]; model 1: [A_R,B_R,C_R,A_L,B_L,C_L]
+  std::array<double, 2> foot_inclination_rad{};  ///< theta_A per side
+  std::array<double, 2> cop_fraction{};          ///< model 2: s = F(theta_A)
+};
+
+struct ContactModelOptions {
+  FootModel foot_model = FootModel::Cop;
+  CopFunction cop;
+  double ground_level_m = 0.0;  ///< the floor's height in the sagittal frame
+  double ground_shift_m = 0.0;  ///< added to the ground (the paper's robustness study)
+};
+
+/// World positions of the sole points A, B, C of a foot at frame i.
+std::array<Eigen::Vector2d, 3> sole_points(const Model& model, const ModelMotion& motion, Eigen::Index i, int side);
+
+/// Fill the D* columns of q/qd/qdd (model 2) and return each frame's contact points.
+std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactModelOptions& options, ModelMotion& motion);
+
+}  // namespace kin2grf
+
+namespace kin2grf {
+
+/// Contact calibration (Sect. 2.3: "A, B, C at ground level under heel, MT and hallux"):
+/// per foot, the foot-flat frames are those where both the heel and the MT landmark are within
+/// 15 mm of their 10th-percentile height; there, theta_foot,flat is the median foot angle and
+/// A, B (foot frame) and C (toes frame) are the medians of the points at ground level straight
+/// below the heel, MT and hallux landmarks. Returns the number of flat frames per foot.
+std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, double ground_level_m);
+
+/// Automatic ground level: 0 (the lab floor, where capture systems put it) when the feet's
+/// flat-stance landmarks stand 0-150 mm above it; otherwise the lowest of them (a raised or
+/// offset walkway), with a message.
+double estimate_ground_level(const SagittalLandmarks& lm, std::string& message);
+
+}  // namespace kin2grf

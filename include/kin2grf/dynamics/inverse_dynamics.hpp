@@ -1,0 +1,78 @@
+// kin2grf dynamics: least-squares Lagrange multipliers with unilateral contact activation
+// (paper Sect. 2.4-2.5, Eqs. 5-10).
+//
+// Equation of motion (Eq. 5), with the sign of lambda chosen so that a compressive normal
+// contact force is lambda_n >= 0 (upward on the body):
+//   M qdd = f + Phi_q(q, t)^T lambda.
+// Given qdd, with the active set C of contacts (inactive multipliers fixed at zero, Eq. 6):
+//   lambda_A = argmin ||lambda||_W  over  argmin || Phi_q,A^T lambda - (M qdd - f) ||      (Eq. 7)
+// i.e. the minimum-norm least-squares solution (the pseudo-inverse for W = I, the paper).
+// How it is computed: Phi_q,A^T = [B C], B the 60 bilateral columns (full column rank), C the
+// contact columns. With B = Q R (Householder QR, once per frame) and U the 3 columns of Q
+// orthogonal to range(B) (the global x, y, rotation directions), the least-squares residual
+// only lives in U: lambda_C solves the 3-equation problem U^T C lambda_C ~ U^T b, its remaining
+// freedom is fixed by minimising ||W_C lambda_C||^2 + ||W_B B^+ (b - C lambda_C)||^2 (an SVD of
+// at most 3 x 12 and a small least squares), and lambda_B = B^+ (b - C lambda_C). This is the
+// exact pseudo-inverse solution of the full 63-column problem, without refactoring it for
+// each active set.
+// Activation (Alart-Curnier mixed criterion, Eqs. 8-9): contact j is active when
+//   lambda_n,j - r g_n,j > 0.
+// Semi-smooth Newton / active-set iterations (Fig. 5): start with every contact active, solve,
+// reclassify, repeat until the set repeats; a set seen before ends the loop (cycle guard, the
+// last solution is kept) and so does the iteration cap.
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <vector>
+
+#include "kin2grf/dynamics/contact.hpp"
+#include "kin2grf/model/model.hpp"
+
+namespace kin2grf {
+
+enum class MultiplierNorm {
+  Paper,        ///< W = I over every multiplier (the paper's pseudo-inverse)
+  TorqueScaled  ///< rigid-body internal forces out of the norm, joint torques / torque_length_m
+};
+
+struct SolverOptions {
+  double r_N_per_m = 1e4;      ///< activation parameter r (Eq. 8)
+  int max_iterations = 20;
+  MultiplierNorm norm = MultiplierNorm::Paper;
+  double torque_length_m = 0.9;
+  /// A contact point may be active only while its horizontal speed relative to the ground
+  /// (or belt) is below this (m/s); <= 0 disables the gate (the paper).
+  double speed_gate_mps = 0.0;
+  double belt_velocity_mps = 0.0;  ///< ground velocity along x (treadmill belt), m/s
+};
+
+struct FrameSolution {
+  std::array<Eigen::Vector2d, 2> force_N{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};  ///< per foot (x, y)
+  std::array<double, 2> cop_x_m{0.0, 0.0};  ///< NaN when the foot carries no load
+  std::array<bool, 2> active{false, false};
+  Eigen::Matrix<double, kJointCount, 1> joint_torque_Nm = Eigen::Matrix<double, kJointCount, 1>::Zero();
+  Eigen::VectorXd contact_lambda;           ///< per contact point (n, t) pairs
+  std::vector<bool> contact_active;
+  int iterations = 0;
+  bool cycled = false;
+  bool capped = false;
+};
+
+/// Per-frame solver; owns its workspace so that a trial's frames reuse the same buffers.
+class ContactSolver {
+ public:
+  ContactSolver(const Model& model, const SolverOptions& options);
+  /// q, qdd: the frame's 63 coordinates (D* filled) and accelerations.
+  FrameSolution solve(const Eigen::VectorXd& q, const Eigen::VectorXd& qdd, const FrameContacts& contacts);
+  /// The bilateral constraint Jacobian Phi_q (60 x 63) at q (exposed for tests).
+  [[nodiscard]] Eigen::MatrixXd bilateral_jacobian(const Eigen::VectorXd& q) const;
+
+ private:
+  const Model& model_;
+  SolverOptions options_;
+  Eigen::VectorXd mass_, gravity_, weight_bilateral_;
+  Eigen::MatrixXd B_;
+};
+
+}  // namespace kin2grf

@@ -1,0 +1,56 @@
+// kin2grf kinematics: sagittal landmarks -> model coordinates q, qd, qdd (paper Sect. 2.2).
+//
+// Independent coordinates (11): hip x, y, torso angle and the 8 joint angles. They are read
+// from the landmarks, low-pass filtered (filter.hpp, 6 Hz default) and differentiated by
+// central differences. The dependent coordinates are then rebuilt by forward kinematics of the
+// chain with FIXED segment lengths, at position, velocity and acceleration level:
+//   r_X = r_P + R(theta) rho_X,  v_X = v_P + w k x (r_X - r_P),
+//   a_X = a_P + alpha k x (r_X - r_P) - w^2 (r_X - r_P),
+// so q, qd, qdd satisfy the bilateral constraints (and their time derivatives) to round-off.
+// Contact constraints play no part here (the paper's decoupling).
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <string>
+#include <vector>
+
+#include "kin2grf/model/model.hpp"
+
+namespace kin2grf {
+
+/// The 12 landmarks in the sagittal frame (x forward, y up), metres, N x 2 each; no NaN.
+struct SagittalLandmarks {
+  double rate_hz = 0.0;
+  Eigen::VectorXd time_s;
+  std::array<Eigen::MatrixX2d, kLandmarkCount> p;
+  [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
+};
+
+/// Medians over the frames of the landmark distances (fixed-length model) and of the heel's
+/// place in the foot frame.
+BodyGeometry measure_geometry(const SagittalLandmarks& lm);
+
+/// Per-frame relative variation of the landmark distances (for the report): max |L - median| / median.
+std::array<double, kSegmentCount> length_variation(const SagittalLandmarks& lm, const BodyGeometry& g);
+
+/// Columns: 0 hip x, 1 hip y, 2 torso angle, 3..10 joint angles phi_j (unwrapped), N x 11.
+Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm);
+
+struct ModelMotion {
+  double rate_hz = 0.0;
+  Eigen::VectorXd time_s;
+  Eigen::MatrixXd q, qd, qdd;  ///< N x 63; the D* columns are filled by the contact model
+  [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
+};
+
+/// Forward kinematics of the fixed-length chain from the independent coordinates and their
+/// first and second time derivatives (N x 11 each).
+ModelMotion reconstruct_motion(const Model& model, const Eigen::MatrixXd& x, const Eigen::MatrixXd& xd,
+                               const Eigen::MatrixXd& xdd, double rate_hz, const Eigen::VectorXd& time_s);
+
+/// The whole kinematic step: independent coordinates, filter at cutoff_hz, differentiate,
+/// reconstruct.
+ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz);
+
+}  // namespace kin2grf

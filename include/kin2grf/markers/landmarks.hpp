@@ -1,0 +1,111 @@
+// kin2grf markers: marker sets (presets or a user mapping file) -> the model's 12 landmarks.
+//
+// A marker set is data (JSON, data/presets/*.json; format in docs/MARKERSETS.md): for each
+// landmark a rule, one of
+//   {"marker": "RKNE"}                        one marker
+//   {"mean": ["RMT1", "RMT2"]}                the mean of several markers
+//   {"harrington": {"rasis": .., "lasis": .., "rpsis"|"sacrum": .., "lpsis": ..}}
+//       hip: the mean of both hip joint centres by Harrington et al. 2007 (J Biomech 40:595):
+//       in the pelvis frame (origin mid-ASIS, x anterior, y superior, z right, mm)
+//       x = -0.24 PD - 9.9, y = -0.30 PW - 10.9 (PW ASIS width, PD mid-ASIS to mid-PSIS); the
+//       lateral terms cancel in the mean of the two sides.
+//   {"static": ["R.Knee.Lat", "R.Knee.Med"], "cluster": ["R.Thigh.Upper", ...]}
+//       a virtual landmark: the mean of the static markers, expressed in the cluster's frame in
+//       the static trial, carried by the cluster (least-squares rigid fit) in the motion trial.
+//   {"pelvis_up": 0.50}                       shoulder fallback when a set has no upper-body
+//       markers: the hip moved by the given length along the pelvis's superior axis (an
+//       approximation: the torso is taken as upright as the pelvis).
+//   {"virtual_hallux": 0.30}                  hallux fallback: a toes segment of that fraction of
+//       the ankle-MT length, straight along the foot in swing, held at the MT head's foot-flat
+//       height while the heel rises (the toes stay on the ground at push-off).
+// Gaps of up to max_gap_frames are filled by cubic (Catmull-Rom) interpolation between the
+// neighbouring valid samples; longer gaps end the processed window (the longest run of frames
+// where every landmark is defined), with a message naming the marker and frames.
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kin2grf/io/trial.hpp"
+#include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/model/model.hpp"
+
+namespace kin2grf {
+
+struct LandmarkRule {
+  std::string kind;                  ///< marker, mean, harrington, static, pelvis_up, virtual_hallux
+  std::vector<std::string> markers;  ///< marker / mean / static markers
+  std::vector<std::string> cluster;  ///< static: tracking cluster
+  std::map<std::string, std::string> pelvis;  ///< harrington / pelvis_up: rasis, lasis, rpsis, lpsis | sacrum
+  double value = 0.0;                ///< pelvis_up length (m), virtual_hallux fraction
+};
+
+struct MarkerSet {
+  std::string name;
+  std::string description;
+  std::vector<std::string> signature;  ///< markers whose presence recognises the set
+  std::array<LandmarkRule, kLandmarkCount> rules;
+  [[nodiscard]] bool needs_static() const;
+  /// Every marker a motion trial must have.
+  [[nodiscard]] std::vector<std::string> motion_markers() const;
+};
+
+const char* landmark_name(int id);  ///< "shoulder", "hip", "knee_r", ...
+MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source);
+MarkerSet load_marker_set(const std::string& path);
+const std::vector<MarkerSet>& builtin_marker_sets();
+/// Preset by name, or nullptr.
+const MarkerSet* find_marker_set(const std::string& name);
+/// The first built-in set whose signature markers are all present, or nullptr.
+const MarkerSet* recognise_marker_set(const MarkerTrajectories& m);
+
+struct LandmarkOptions {
+  int max_gap_frames = 10;
+  std::optional<Axis> up_axis;      ///< default: the file's
+  std::optional<int> progression_sign;  ///< +1/-1 along the detected axis; default: detected
+  std::optional<Axis> progression_axis;
+};
+
+/// 3D landmarks in the lab frame, N x 3 each, NaN where undefined.
+struct Landmarks3D {
+  std::array<Eigen::MatrixX3d, kLandmarkCount> p;
+  std::vector<std::string> messages;
+};
+
+/// The sagittal frame: x along progression, y up, origin the lab origin.
+struct SagittalFrame {
+  Eigen::Vector3d forward = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d lateral = Eigen::Vector3d::UnitY();  ///< forward x up (to the right)
+  bool treadmill = false;           ///< the pelvis does not progress
+  double belt_velocity_mps = 0.0;   ///< ground velocity along x on a treadmill (sagittal)
+  std::string how;                  ///< how progression was found
+  [[nodiscard]] Eigen::Vector2d to_sagittal(const Eigen::Vector3d& p) const { return {p.dot(forward), p.dot(up)}; }
+};
+
+Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& motion,
+                              const MarkerTrajectories* static_trial, const LandmarkOptions& options,
+                              const std::string& path);
+
+SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajectories& motion,
+                                    const LandmarkOptions& options);
+
+struct SagittalWindow {
+  SagittalLandmarks landmarks;  ///< only the processed window
+  Eigen::Index first = 0;       ///< index of its first frame in the trial
+  std::array<Eigen::VectorXd, 2> foot_lateral_m;  ///< per side: lateral coordinate of the foot
+  std::vector<std::string> messages;
+};
+
+/// Gap filling, the longest fully defined window, projection on the sagittal plane, and the
+/// virtual hallux when the set has none.
+SagittalWindow sagittal_landmarks(const Landmarks3D& lm, const MarkerSet& set, const SagittalFrame& frame,
+                                  const MarkerTrajectories& motion, const LandmarkOptions& options,
+                                  const std::string& path);
+
+}  // namespace kin2grf

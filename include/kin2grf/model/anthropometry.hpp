@@ -1,0 +1,37 @@
+// kin2grf model: anthropometric tables (segment mass, centre of mass, radius of gyration).
+//
+// Winter (default): D.A. Winter, Biomechanics and Motor Control of Human Movement, 4th ed.
+// (2009), Table 4.1 (Dempster's cadaver data). Fractions of body mass M and of segment length L:
+//   HAT  greater trochanter -> glenohumeral joint  0.678  COM 0.626 from the hip  rho 0.496
+//   thigh  hip -> knee                              0.100  COM 0.433 from the hip  rho 0.323
+//   shank  knee -> ankle                            0.0465 COM 0.433 from the knee rho 0.302
+//   foot   ankle -> 2nd metatarsal head             0.0145 COM 0.50  from ankle    rho 0.475
+// de Leva (1996, J Biomech 29:1223, male, Table 4): thigh 0.1416 (COM 0.4095 from the hip,
+// sagittal rho 0.329), shank 0.0433 (0.4459 from the knee, rho 0.255), foot 0.0137 (rho 0.257),
+// HAT = 1 - legs = 0.6028; de Leva gives no composite HAT, so its COM and rho stay Winter's,
+// and the foot COM stays at mid ankle-MT (de Leva measures the foot from heel to toe tip).
+// Toes are in neither table: they get 10 % of the foot mass (the foot keeps 90 %), COM at
+// mid MT-hallux, rho 0.29 (a slender rod); documented choices.
+#pragma once
+
+#include <string>
+
+namespace kin2grf {
+
+struct SegmentInertia {
+  double mass_fraction;   ///< of body mass
+  double com_fraction;    ///< of segment length, from the proximal end
+  double gyration_fraction;  ///< radius of gyration about the COM / segment length
+};
+
+struct AnthropometricTable {
+  std::string name;
+  SegmentInertia hat, thigh, shank, foot, toes;
+};
+
+const AnthropometricTable& winter_table();
+const AnthropometricTable& de_leva_table();
+/// "winter" or "de-leva"; InputError otherwise.
+const AnthropometricTable& anthropometric_table(const std::string& name);
+
+}  // namespace kin2grf

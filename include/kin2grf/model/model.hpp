@@ -1,0 +1,106 @@
+// kin2grf model: the 9-body sagittal model of the paper (Sect. 2.2, Fig. 1) in absolute
+// coordinates.
+//
+// Frame: x forward along progression, y up, angles counter-clockwise from +x (SI units).
+// Bodies: torso (HAT, hip -> shoulder), thigh, shank, foot (ankle, heel, MT head triangle) and
+// toes (MT head -> hallux), right and left. Landmarks I..XII: shoulder, hip (one point for both
+// thighs), and per side knee, ankle, heel, MT head, hallux.
+//
+// Generalised coordinates q (63, METHOD.md):
+//   [0, 24)  x, y of the 12 landmarks        [24, 42) x, y of the 9 centres of mass
+//   [42, 51) absolute angle theta_s of each body
+//   [51, 59) relative joint angles phi_j = theta_child - theta_parent (hip, knee, ankle, MTP x2)
+//   [59, 63) x, y of D*_R, D*_L (material points of the feet under the COP, Sect. 2.3)
+// Bilateral constraints (60): per body, each attached point X and the COM G satisfy
+//   X - P - R(theta_s) rho_X = 0 (P the body's proximal landmark, rho_X fixed in the body
+//   frame): 40 rows; 8 angle definitions phi_j - theta_child + theta_parent = 0; 8 rheonomic
+//   phi_j - phi_j(t) = 0; 4 rows D* - A - R(theta_foot) rho_D = 0.
+// Mass matrix: diagonal and constant, m_s on (x_G, y_G), I_G,s on theta_s, zero elsewhere.
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <string>
+
+#include "kin2grf/model/anthropometry.hpp"
+
+namespace kin2grf {
+
+enum LandmarkId : int {
+  kShoulder = 0, kHip = 1,
+  kKneeR = 2, kAnkleR = 3, kHeelR = 4, kMtR = 5, kHalluxR = 6,
+  kKneeL = 7, kAnkleL = 8, kHeelL = 9, kMtL = 10, kHalluxL = 11,
+  kLandmarkCount = 12
+};
+enum SegmentId : int {
+  kTorso = 0, kThighR = 1, kShankR = 2, kFootR = 3, kToesR = 4,
+  kThighL = 5, kShankL = 6, kFootL = 7, kToesL = 8, kSegmentCount = 9
+};
+enum FootSide : int { kRight = 0, kLeft = 1 };
+
+constexpr int landmark(int side, int which /*0 knee,1 ankle,2 heel,3 MT,4 hallux*/) { return 2 + 5 * side + which; }
+constexpr int segment(int side, int which /*0 thigh,1 shank,2 foot,3 toes*/) { return 1 + 4 * side + which; }
+
+namespace coord {
+constexpr int kPoints = 0, kComs = 24, kTheta = 42, kPhi = 51, kDStar = 59, kCount = 63;
+constexpr int point_x(int p) { return 2 * p; }
+constexpr int com_x(int s) { return kComs + 2 * s; }
+constexpr int theta(int s) { return kTheta + s; }
+constexpr int phi(int j) { return kPhi + j; }
+constexpr int dstar_x(int side) { return kDStar + 2 * side; }
+}  // namespace coord
+constexpr int kBilateralCount = 60;
+constexpr int kJointCount = 8;  ///< hip R, knee R, ankle R, MTP R, hip L, knee L, ankle L, MTP L
+
+/// Parent and child body of joint j.
+constexpr int joint_parent(int j) { return (j % 4 == 0) ? kTorso : segment(j / 4, j % 4 - 1); }
+constexpr int joint_child(int j) { return segment(j / 4, j % 4); }
+const char* joint_name(int j);
+const char* segment_name(int s);
+
+/// One rigid body: its proximal landmark, the other landmarks it carries and its COM, all in
+/// the body frame (origin at the proximal landmark, x toward the distal landmark).
+struct Body {
+  int proximal = 0;
+  std::array<int, 2> points{-1, -1};            ///< attached landmarks (-1 unused)
+  std::array<Eigen::Vector2d, 2> points_local{};
+  Eigen::Vector2d com_local = Eigen::Vector2d::Zero();
+  double mass_kg = 0.0;
+  double inertia_kgm2 = 0.0;  ///< about the COM
+  double length_m = 0.0;
+};
+
+/// The sole points of a foot used by the contact models: under the heel (A) and the MT head
+/// (B) in the foot frame, under the hallux (C) in the toes frame, at ground level in the
+/// foot-flat reference pose (Sect. 2.3).
+struct FootContactGeometry {
+  Eigen::Vector2d heel_local = Eigen::Vector2d::Zero();    ///< A, foot frame
+  Eigen::Vector2d mt_local = Eigen::Vector2d::Zero();      ///< B, foot frame
+  Eigen::Vector2d hallux_local = Eigen::Vector2d::Zero();  ///< C, toes frame
+  double flat_angle_rad = 0.0;  ///< theta_foot (ankle->MT direction) in the foot-flat pose
+};
+
+struct Model {
+  double body_mass_kg = 0.0;
+  double gravity_mps2 = 9.81;
+  std::array<Body, kSegmentCount> bodies{};
+  std::array<FootContactGeometry, 2> feet{};
+  std::string anthropometry = "winter";
+
+  /// Diagonal of the constant mass matrix (63).
+  [[nodiscard]] Eigen::VectorXd mass_diagonal() const;
+  /// Generalised gravity force f (63): -m_s g on y_G.
+  [[nodiscard]] Eigen::VectorXd gravity_force() const;
+};
+
+/// Body lengths and the heel's place in the foot frame, in metres (as measured or given).
+struct BodyGeometry {
+  double torso = 0.5;
+  std::array<double, 2> thigh{0.42, 0.42}, shank{0.42, 0.42}, foot{0.15, 0.15}, toes{0.05, 0.05};
+  std::array<Eigen::Vector2d, 2> heel_local{Eigen::Vector2d(-0.06, -0.04), Eigen::Vector2d(-0.06, -0.04)};
+};
+
+/// Masses and inertias from the table; geometry as given; contact geometry default (set later).
+Model build_model(const BodyGeometry& geometry, double body_mass_kg, const AnthropometricTable& table);
+
+}  // namespace kin2grf

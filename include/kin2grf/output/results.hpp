@@ -1,0 +1,18 @@
+// kin2grf outputs: an estimate as OpenSim GRF .mot (lab frame), CSV (sagittal frame, units in
+// the header) and a JSON summary.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "kin2grf/pipeline.hpp"
+
+namespace kin2grf {
+
+/// OpenSim ExternalLoads-ready: ground_force_v/p, ground_torque_ (right), 1_-prefixed (left),
+/// lab frame of the input, metres, force on the body.
+void write_grf_mot(const std::string& path, const EstimateResult& r);
+std::string format_results_csv(const EstimateResult& r);
+nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings);
+
+}  // namespace kin2grf

@@ -1,0 +1,66 @@
+// kin2grf: the whole method on one trial, markers -> landmarks -> model coordinates ->
+// kinematics -> contact/inverse dynamics -> filtered results (paper Sect. 2).
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kin2grf/dynamics/contact.hpp"
+#include "kin2grf/dynamics/inverse_dynamics.hpp"
+#include "kin2grf/io/trial.hpp"
+#include "kin2grf/markers/landmarks.hpp"
+#include "kin2grf/model/model.hpp"
+
+namespace kin2grf {
+
+struct EstimateOptions {
+  std::optional<double> mass_kg;           ///< else PROCESSING:Bodymass; none -> error
+  std::string anthropometry = "winter";
+  double kinematic_cutoff_hz = 6.0;        ///< paper: 6 Hz
+  double post_cutoff_hz = 12.0;            ///< paper: 12 Hz
+  std::optional<double> ground_level_m;    ///< else estimate_ground_level
+  ContactModelOptions contact;
+  SolverOptions solver;
+  LandmarkOptions landmarks;
+  /// GRM reference point in the sagittal frame (x along progression, y up), m.
+  Eigen::Vector2d grm_reference_m = Eigen::Vector2d::Zero();
+};
+
+struct FootResult {
+  Eigen::MatrixX2d force_N;      ///< (anterior, vertical), post-filtered, zero when inactive
+  Eigen::MatrixX2d raw_force_N;  ///< before the post-filter
+  Eigen::VectorXd cop_x_m;       ///< along progression; NaN when inactive
+  std::vector<bool> contact;
+};
+
+struct EstimateResult {
+  std::string marker_set;
+  double mass_kg = 0.0;
+  double ground_level_m = 0.0;
+  SagittalFrame frame;
+  Model model;
+  Eigen::VectorXd time_s;
+  Eigen::Index first_index = 0;    ///< first processed frame's index in the trial
+  int first_frame_number = 1;      ///< its frame number in the file
+  std::array<FootResult, 2> feet;
+  Eigen::VectorXd grm_Nm;          ///< sagittal ground reaction moment about grm_reference_m
+  Eigen::MatrixXd joint_torque_Nm; ///< N x 8, moment on the child body, counter-clockwise +
+  Eigen::MatrixXd joint_force_N;   ///< N x 16, force on the child body's subtree (x, y) per joint
+  Eigen::MatrixX3d residual;       ///< N x 3: dynamic inconsistency (Fx N, Fy N, M N m)
+  std::vector<int> iterations;
+  int cycled_frames = 0, capped_frames = 0;
+  std::array<Eigen::VectorXd, 2> foot_lateral_m;
+  std::vector<std::string> messages;
+  double seconds_kinematics = 0, seconds_dynamics = 0;
+};
+
+EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set,
+                        const EstimateOptions& options);
+
+/// The per-foot results as lab-frame force plates (force, COP, free moment), for the .mot writer.
+std::array<ForcePlate, 2> as_lab_plates(const EstimateResult& r);
+
+}  // namespace kin2grf

@@ -1,0 +1,206 @@
+#include "kin2grf/dynamics/contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace kin2grf {
+namespace {
+
+Eigen::Matrix2d rot(double a) {
+  Eigen::Matrix2d R;
+  R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+  return R;
+}
+Eigen::Vector2d perp(const Eigen::Vector2d& r) { return Eigen::Vector2d(-r.y(), r.x()); }
+
+double half_cosine(double a, double b, double u) { return a + (b - a) * 0.5 * (1.0 - std::cos(M_PI * u)); }
+
+/// Material point of body s at lab position X this frame: its velocity, acceleration and the
+/// Jacobian rows of its x and y with respect to q (through the proximal landmark and theta_s).
+struct MaterialPoint {
+  Eigen::Vector2d v, a;
+  Eigen::VectorXd jx, jy;
+};
+
+MaterialPoint material_point(const Model& model, const ModelMotion& m, Eigen::Index i, int s, const Eigen::Vector2d& X) {
+  const int P = model.bodies[s].proximal;
+  const Eigen::Vector2d rP(m.q(i, coord::point_x(P)), m.q(i, coord::point_x(P) + 1));
+  const Eigen::Vector2d vP(m.qd(i, coord::point_x(P)), m.qd(i, coord::point_x(P) + 1));
+  const Eigen::Vector2d aP(m.qdd(i, coord::point_x(P)), m.qdd(i, coord::point_x(P) + 1));
+  const double w = m.qd(i, coord::theta(s)), al = m.qdd(i, coord::theta(s));
+  const Eigen::Vector2d d = X - rP;
+  MaterialPoint mp;
+  mp.v = vP + w * perp(d);
+  mp.a = aP + al * perp(d) - w * w * d;
+  mp.jx = Eigen::VectorXd::Zero(coord::kCount);
+  mp.jy = Eigen::VectorXd::Zero(coord::kCount);
+  mp.jx[coord::point_x(P)] = 1.0;
+  mp.jx[coord::theta(s)] = -d.y();
+  mp.jy[coord::point_x(P) + 1] = 1.0;
+  mp.jy[coord::theta(s)] = d.x();
+  return mp;
+}
+
+}  // namespace
+
+double CopFunction::fraction(double th) const {
+  if (th <= delta_hs) return s_hs;
+  if (th <= delta_ho) return half_cosine(s_hs, s_ho, (th - delta_hs) / (delta_ho - delta_hs));
+  if (th <= delta_mo) return half_cosine(s_ho, s_mo, (th - delta_ho) / (delta_mo - delta_ho));
+  if (th <= delta_to) return s_mo + (s_to - s_mo) * (th - delta_mo) / (delta_to - delta_mo);
+  return s_to;
+}
+
+std::array<Eigen::Vector2d, 3> sole_points(const Model& model, const ModelMotion& m, Eigen::Index i, int side) {
+  const int foot = segment(side, 2), toes = segment(side, 3);
+  const int ankle = landmark(side, 1), mt = landmark(side, 3);
+  const Eigen::Vector2d rA(m.q(i, coord::point_x(ankle)), m.q(i, coord::point_x(ankle) + 1));
+  const Eigen::Vector2d rM(m.q(i, coord::point_x(mt)), m.q(i, coord::point_x(mt) + 1));
+  const Eigen::Matrix2d Rf = rot(m.q(i, coord::theta(foot)));
+  const Eigen::Matrix2d Rt = rot(m.q(i, coord::theta(toes)));
+  const auto& fg = model.feet[side];
+  return {rA + Rf * fg.heel_local, rA + Rf * fg.mt_local, rM + Rt * fg.hallux_local};
+}
+
+std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactModelOptions& o, ModelMotion& m) {
+  const Eigen::Index n = m.frames();
+  std::vector<FrameContacts> out(static_cast<std::size_t>(n));
+  const double ground = o.ground_level_m + o.ground_shift_m;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    FrameContacts& fc = out[static_cast<std::size_t>(i)];
+    for (int side = 0; side < 2; ++side) {
+      const int foot = segment(side, 2), toes = segment(side, 3);
+      const auto sp = sole_points(model, m, i, side);
+      fc.foot_inclination_rad[side] = -(m.q(i, coord::theta(foot)) - model.feet[side].flat_angle_rad);
+      if (o.foot_model == FootModel::ThreePoint) {
+        for (int k = 0; k < 3; ++k) {
+          const MaterialPoint mp = material_point(model, m, i, k < 2 ? foot : toes, sp[k]);
+          ContactPoint cp;
+          cp.side = side;
+          cp.position = sp[k];
+          cp.velocity = mp.v;
+          cp.gap_m = sp[k].y() - ground;
+          cp.jac_normal = mp.jy;
+          cp.jac_tangent = mp.jx;
+          fc.points.push_back(std::move(cp));
+        }
+        continue;
+      }
+      // Model 2: D at arc fraction s of A -> B -> C, at the lowest sole point's height (Eq. 2).
+      const double s = o.cop.fraction(fc.foot_inclination_rad[side]);
+      fc.cop_fraction[side] = s;
+      const double l1 = (sp[1] - sp[0]).norm(), l2 = (sp[2] - sp[1]).norm();
+      const double along = s * (l1 + l2);
+      const Eigen::Vector2d on = along <= l1 ? sp[0] + (sp[1] - sp[0]) * (l1 > 0 ? along / l1 : 0.0)
+                                             : sp[1] + (sp[2] - sp[1]) * (l2 > 0 ? (along - l1) / l2 : 0.0);
+      const double yD = std::min({sp[0].y(), sp[1].y(), sp[2].y()});
+      const Eigen::Vector2d D(on.x(), yD);
+      // D* is the foot's material point at D.
+      const MaterialPoint mp = material_point(model, m, i, foot, D);
+      const int c = coord::dstar_x(side);
+      m.q(i, c) = D.x();
+      m.q(i, c + 1) = D.y();
+      m.qd(i, c) = mp.v.x();
+      m.qd(i, c + 1) = mp.v.y();
+      m.qdd(i, c) = mp.a.x();
+      m.qdd(i, c + 1) = mp.a.y();
+      ContactPoint cp;
+      cp.side = side;
+      cp.position = D;
+      cp.velocity = mp.v;
+      cp.gap_m = D.y() - ground;
+      cp.jac_normal = Eigen::VectorXd::Zero(coord::kCount);
+      cp.jac_tangent = Eigen::VectorXd::Zero(coord::kCount);
+      cp.jac_normal[c + 1] = 1.0;
+      cp.jac_tangent[c] = 1.0;
+      fc.points.push_back(std::move(cp));
+    }
+  }
+  return out;
+}
+
+}  // namespace kin2grf
+
+namespace kin2grf {
+namespace {
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+double percentile(std::vector<double> v, double p) {
+  std::sort(v.begin(), v.end());
+  return v[static_cast<std::size_t>(p * static_cast<double>(v.size() - 1))];
+}
+std::vector<Eigen::Index> flat_frames(const SagittalLandmarks& lm, int side) {
+  const auto& E = lm.p[landmark(side, 2)];
+  const auto& M = lm.p[landmark(side, 3)];
+  std::vector<double> he(E.col(1).data(), E.col(1).data() + E.rows()), hm(M.col(1).data(), M.col(1).data() + M.rows());
+  const double te = percentile(he, 0.10) + 0.015, tm = percentile(hm, 0.10) + 0.015;
+  std::vector<Eigen::Index> f;
+  for (Eigen::Index i = 0; i < lm.frames(); ++i)
+    if (E(i, 1) < te && M(i, 1) < tm) f.push_back(i);
+  return f;
+}
+Eigen::Matrix2d rot2(double a) {
+  Eigen::Matrix2d R;
+  R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+  return R;
+}
+}  // namespace
+
+std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, double ground) {
+  std::array<int, 2> counts{};
+  for (int side = 0; side < 2; ++side) {
+    const auto f = flat_frames(lm, side);
+    counts[side] = static_cast<int>(f.size());
+    const auto& A = lm.p[landmark(side, 1)];
+    const auto& E = lm.p[landmark(side, 2)];
+    const auto& M = lm.p[landmark(side, 3)];
+    const auto& T = lm.p[landmark(side, 4)];
+    std::vector<double> ang, ax, ay, bx, by, cx, cy;
+    for (auto i : f) {
+      const Eigen::Vector2d a = A.row(i).transpose(), e = E.row(i).transpose(), m = M.row(i).transpose(), t = T.row(i).transpose();
+      const double thf = std::atan2(m.y() - a.y(), m.x() - a.x());
+      const double tht = std::atan2(t.y() - m.y(), t.x() - m.x());
+      ang.push_back(thf);
+      const Eigen::Vector2d la = rot2(-thf) * (Eigen::Vector2d(e.x(), ground) - a);
+      const Eigen::Vector2d lb = rot2(-thf) * (Eigen::Vector2d(m.x(), ground) - a);
+      const Eigen::Vector2d lc = rot2(-tht) * (Eigen::Vector2d(t.x(), ground) - m);
+      ax.push_back(la.x()); ay.push_back(la.y());
+      bx.push_back(lb.x()); by.push_back(lb.y());
+      cx.push_back(lc.x()); cy.push_back(lc.y());
+    }
+    auto& fg = model.feet[side];
+    fg.flat_angle_rad = median_of(ang);
+    fg.heel_local = Eigen::Vector2d(median_of(ax), median_of(ay));
+    fg.mt_local = Eigen::Vector2d(median_of(bx), median_of(by));
+    fg.hallux_local = Eigen::Vector2d(median_of(cx), median_of(cy));
+  }
+  return counts;
+}
+
+double estimate_ground_level(const SagittalLandmarks& lm, std::string& message) {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int side = 0; side < 2; ++side) {
+    const auto f = flat_frames(lm, side);
+    std::vector<double> he, hm;
+    for (auto i : f) {
+      he.push_back(lm.p[landmark(side, 2)](i, 1));
+      hm.push_back(lm.p[landmark(side, 3)](i, 1));
+    }
+    lowest = std::min({lowest, median_of(he), median_of(hm)});
+  }
+  if (lowest >= 0.0 && lowest <= 0.15) {
+    message = "ground level 0 m (lab floor; lowest flat-stance foot landmark " + std::to_string(lowest * 1000).substr(0, 5) + " mm above it)";
+    return 0.0;
+  }
+  message = "ground level " + std::to_string(lowest).substr(0, 6) +
+            " m: the flat-stance foot landmarks are not 0-150 mm above the lab floor, so the lowest of them is taken";
+  return lowest;
+}
+
+}  // namespace kin2grf

@@ -1,0 +1,174 @@
+#include "kin2grf/dynamics/inverse_dynamics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+namespace kin2grf {
+namespace {
+
+constexpr int kRigidRows = 40, kDefRows = 40, kRheoRows = 48, kDStarRows = 56;
+
+}  // namespace
+
+ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
+    : model_(model), options_(options) {
+  mass_ = model.mass_diagonal();
+  gravity_ = model.gravity_force();
+  weight_bilateral_ = Eigen::VectorXd::Ones(kBilateralCount);
+  if (options_.norm == MultiplierNorm::TorqueScaled) {
+    weight_bilateral_.head(kRigidRows).setZero();
+    weight_bilateral_.segment(kDefRows, 16).setConstant(1.0 / options_.torque_length_m);
+    weight_bilateral_.tail(4).setZero();
+  }
+  B_.resize(coord::kCount, kBilateralCount);
+}
+
+Eigen::MatrixXd ContactSolver::bilateral_jacobian(const Eigen::VectorXd& q) const {
+  Eigen::MatrixXd Phi = Eigen::MatrixXd::Zero(kBilateralCount, coord::kCount);
+  int row = 0;
+  auto pt = [&](int k) { return Eigen::Vector2d(q[coord::point_x(k)], q[coord::point_x(k) + 1]); };
+  auto attach = [&](int xcol, const Eigen::Vector2d& X, int P, int s) {
+    const Eigen::Vector2d d = X - pt(P);  // = R(theta) rho
+    Phi(row, xcol) = 1.0;
+    Phi(row, coord::point_x(P)) = -1.0;
+    Phi(row, coord::theta(s)) = d.y();
+    ++row;
+    Phi(row, xcol + 1) = 1.0;
+    Phi(row, coord::point_x(P) + 1) = -1.0;
+    Phi(row, coord::theta(s)) = -d.x();
+    ++row;
+  };
+  for (int s = 0; s < kSegmentCount; ++s) {
+    const Body& b = model_.bodies[s];
+    for (int k = 0; k < 2; ++k)
+      if (b.points[k] >= 0) attach(coord::point_x(b.points[k]), pt(b.points[k]), b.proximal, s);
+    attach(coord::com_x(s), Eigen::Vector2d(q[coord::com_x(s)], q[coord::com_x(s) + 1]), b.proximal, s);
+  }
+  for (int j = 0; j < kJointCount; ++j, ++row) {
+    Phi(row, coord::phi(j)) = 1.0;
+    Phi(row, coord::theta(joint_child(j))) = -1.0;
+    Phi(row, coord::theta(joint_parent(j))) = 1.0;
+  }
+  for (int j = 0; j < kJointCount; ++j, ++row) Phi(row, coord::phi(j)) = 1.0;
+  for (int side = 0; side < 2; ++side) {
+    const int c = coord::dstar_x(side);
+    attach(c, Eigen::Vector2d(q[c], q[c + 1]), landmark(side, 1), segment(side, 2));
+  }
+  return Phi;
+}
+
+FrameSolution ContactSolver::solve(const Eigen::VectorXd& q, const Eigen::VectorXd& qdd, const FrameContacts& fc) {
+  B_ = bilateral_jacobian(q).transpose();
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(B_);
+  const Eigen::VectorXd b = mass_.cwiseProduct(qdd) - gravity_;
+  const int np = static_cast<int>(fc.points.size());
+  const int k = 2 * np;
+  // Columns: b, then (normal, tangent) per contact point.
+  Eigen::MatrixXd X(coord::kCount, 1 + k);
+  X.col(0) = b;
+  for (int j = 0; j < np; ++j) {
+    X.col(1 + 2 * j) = fc.points[static_cast<std::size_t>(j)].jac_normal;
+    X.col(2 + 2 * j) = fc.points[static_cast<std::size_t>(j)].jac_tangent;
+  }
+  const Eigen::MatrixXd QtX = qr.householderQ().transpose() * X;
+  const auto R = qr.matrixQR().topLeftCorner(kBilateralCount, kBilateralCount).triangularView<Eigen::Upper>();
+  const Eigen::MatrixXd BpX = R.solve(QtX.topRows(kBilateralCount));  // B^+ [b C]
+  const Eigen::MatrixXd UtX = QtX.bottomRows(coord::kCount - kBilateralCount);  // U^T [b C]
+  const Eigen::VectorXd wB = weight_bilateral_;
+
+  FrameSolution sol;
+  sol.contact_lambda = Eigen::VectorXd::Zero(k);
+  sol.contact_active.assign(static_cast<std::size_t>(np), true);
+  // The speed gate removes a contact from the candidates before the iterations.
+  std::vector<bool> allowed(static_cast<std::size_t>(np), true);
+  if (options_.speed_gate_mps > 0) {
+    for (int j = 0; j < np; ++j) {
+      const auto& p = fc.points[static_cast<std::size_t>(j)];
+      if (std::abs(p.velocity.x() - options_.belt_velocity_mps) > options_.speed_gate_mps) allowed[static_cast<std::size_t>(j)] = false;
+    }
+  }
+  std::vector<bool> active = allowed;
+  std::set<std::vector<bool>> seen;
+  Eigen::VectorXd lamC = Eigen::VectorXd::Zero(k);
+  for (int it = 0; it < options_.max_iterations; ++it) {
+    seen.insert(active);
+    sol.iterations = it + 1;
+    std::vector<int> cols;
+    for (int j = 0; j < np; ++j)
+      if (active[static_cast<std::size_t>(j)]) { cols.push_back(2 * j); cols.push_back(2 * j + 1); }
+    const int ka = static_cast<int>(cols.size());
+    lamC.setZero();
+    if (ka > 0) {
+      Eigen::MatrixXd A3(UtX.rows(), ka), W(kBilateralCount, ka);
+      for (int c = 0; c < ka; ++c) {
+        A3.col(c) = UtX.col(1 + cols[static_cast<std::size_t>(c)]);
+        W.col(c) = wB.cwiseProduct(BpX.col(1 + cols[static_cast<std::size_t>(c)]));
+      }
+      const Eigen::VectorXd b3 = UtX.col(0);
+      const Eigen::VectorXd w = wB.cwiseProduct(BpX.col(0));
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(A3, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      const auto& sv = svd.singularValues();
+      const double tol = std::max(A3.rows(), A3.cols()) * std::numeric_limits<double>::epsilon() *
+                         (sv.size() ? sv[0] : 0.0);
+      int rank = 0;
+      for (Eigen::Index i = 0; i < sv.size(); ++i)
+        if (sv[i] > tol) ++rank;
+      Eigen::VectorXd lam0 = Eigen::VectorXd::Zero(ka);
+      for (int i = 0; i < rank; ++i)
+        lam0 += svd.matrixV().col(i) * (svd.matrixU().col(i).dot(b3) / sv[i]);
+      Eigen::VectorXd lam = lam0;
+      if (rank < ka) {
+        const Eigen::MatrixXd N = svd.matrixV().rightCols(ka - rank);
+        Eigen::MatrixXd S(ka + kBilateralCount, ka - rank);
+        S << N, W * N;
+        Eigen::VectorXd rhs(ka + kBilateralCount);
+        rhs << -lam0, w - W * lam0;
+        const Eigen::VectorXd z = S.completeOrthogonalDecomposition().solve(rhs);
+        lam = lam0 + N * z;
+      }
+      for (int c = 0; c < ka; ++c) lamC[cols[static_cast<std::size_t>(c)]] = lam[c];
+    }
+    // Re-classify (Eqs. 8-9).
+    std::vector<bool> next(static_cast<std::size_t>(np));
+    for (int j = 0; j < np; ++j) {
+      const double crit = lamC[2 * j] - options_.r_N_per_m * fc.points[static_cast<std::size_t>(j)].gap_m;
+      next[static_cast<std::size_t>(j)] = allowed[static_cast<std::size_t>(j)] && crit > 0;
+    }
+    if (next == active) break;
+    if (seen.count(next)) {
+      sol.cycled = true;
+      break;
+    }
+    active = next;
+    if (it + 1 == options_.max_iterations) sol.capped = true;
+  }
+  sol.contact_lambda = lamC;
+  sol.contact_active = active;
+  // Bilateral multipliers: lambda_B = B^+ (b - C lambda_C); the rheonomic ones are the torques.
+  Eigen::VectorXd lamB = BpX.col(0);
+  for (int c = 0; c < k; ++c)
+    if (lamC[c] != 0.0) lamB -= BpX.col(1 + c) * lamC[c];
+  sol.joint_torque_Nm = lamB.segment<kJointCount>(kRheoRows);
+  for (int side = 0; side < 2; ++side) {
+    double fx = 0, fy = 0, mx = 0;
+    bool any = false;
+    for (int j = 0; j < np; ++j) {
+      const auto& p = fc.points[static_cast<std::size_t>(j)];
+      if (p.side != side || !active[static_cast<std::size_t>(j)]) continue;
+      any = true;
+      fy += lamC[2 * j];
+      fx += lamC[2 * j + 1];
+      mx += lamC[2 * j] * p.position.x();
+    }
+    sol.active[side] = any;
+    sol.force_N[side] = Eigen::Vector2d(fx, fy);
+    if (np == 2) sol.cop_x_m[side] = fc.points[static_cast<std::size_t>(side)].position.x();
+    else sol.cop_x_m[side] = std::abs(fy) > 1e-6 ? mx / fy : std::numeric_limits<double>::quiet_NaN();
+  }
+  (void)kDStarRows;
+  return sol;
+}
+
+}  // namespace kin2grf

@@ -1,0 +1,97 @@
+#include "kin2grf/kinematics/filter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace kin2grf {
+namespace {
+
+struct Biquad {
+  double b0, b1, b2, a1, a2;
+};
+
+Biquad design_lowpass(double rate_hz, double cutoff_hz) {
+  const double K = std::tan(M_PI * cutoff_hz / rate_hz);
+  const double s2 = std::sqrt(2.0);
+  const double norm = 1.0 / (1.0 + s2 * K + K * K);
+  Biquad q;
+  q.b0 = K * K * norm;
+  q.b1 = 2.0 * q.b0;
+  q.b2 = q.b0;
+  q.a1 = 2.0 * (K * K - 1.0) * norm;
+  q.a2 = (1.0 - s2 * K + K * K) * norm;
+  return q;
+}
+
+/// One pass (direct form II transposed), starting from the steady state for x[0].
+void run(const Biquad& q, std::vector<double>& x) {
+  if (x.empty()) return;
+  // Steady state for constant input x0: output x0 (unit DC gain).
+  const double x0 = x[0];
+  double z1 = x0 - q.b0 * x0;          // y = b0 x + z1  -> z1 = x0 (1 - b0)
+  double z2 = q.b2 * x0 - q.a2 * x0;   // z1 = b1 x - a1 y + z2 -> z2 from the second state
+  z1 = q.b1 * x0 - q.a1 * x0 + z2;
+  for (double& v : x) {
+    const double in = v;
+    const double y = q.b0 * in + z1;
+    z1 = q.b1 * in - q.a1 * y + z2;
+    z2 = q.b2 * in - q.a2 * y;
+    v = y;
+  }
+}
+
+}  // namespace
+
+Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, double cutoff_hz) {
+  const Eigen::Index n = x.size();
+  if (n < 2) return x;
+  const double C = std::pow(std::sqrt(2.0) - 1.0, 0.25);  // Winter's two-pass correction
+  const double fc = cutoff_hz / C;
+  if (!(fc > 0) || fc >= 0.5 * rate_hz) {
+    throw std::invalid_argument("butterworth_filtfilt: cut-off " + std::to_string(cutoff_hz) +
+                                " Hz (corrected " + std::to_string(fc) + " Hz) must be below the Nyquist frequency " +
+                                std::to_string(0.5 * rate_hz) + " Hz");
+  }
+  const Biquad q = design_lowpass(rate_hz, fc);
+  const Eigen::Index pad = std::min<Eigen::Index>(n - 1, static_cast<Eigen::Index>(std::ceil(3.0 * rate_hz / cutoff_hz)));
+  std::vector<double> e(static_cast<std::size_t>(n + 2 * pad));
+  for (Eigen::Index i = 0; i < pad; ++i) e[static_cast<std::size_t>(i)] = 2 * x[0] - x[pad - i];
+  for (Eigen::Index i = 0; i < n; ++i) e[static_cast<std::size_t>(pad + i)] = x[i];
+  for (Eigen::Index i = 0; i < pad; ++i) e[static_cast<std::size_t>(pad + n + i)] = 2 * x[n - 1] - x[n - 2 - i];
+  run(q, e);
+  std::reverse(e.begin(), e.end());
+  run(q, e);
+  std::reverse(e.begin(), e.end());
+  Eigen::VectorXd y(n);
+  for (Eigen::Index i = 0; i < n; ++i) y[i] = e[static_cast<std::size_t>(pad + i)];
+  return y;
+}
+
+Eigen::MatrixXd butterworth_filtfilt(const Eigen::MatrixXd& x, double rate_hz, double cutoff_hz) {
+  Eigen::MatrixXd y(x.rows(), x.cols());
+  for (Eigen::Index c = 0; c < x.cols(); ++c) y.col(c) = butterworth_filtfilt(Eigen::VectorXd(x.col(c)), rate_hz, cutoff_hz);
+  return y;
+}
+
+Eigen::MatrixXd central_difference(const Eigen::MatrixXd& x, double dt) {
+  const Eigen::Index n = x.rows();
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(n, x.cols());
+  if (n < 2) return d;
+  for (Eigen::Index i = 1; i + 1 < n; ++i) d.row(i) = (x.row(i + 1) - x.row(i - 1)) / (2 * dt);
+  d.row(0) = (x.row(1) - x.row(0)) / dt;
+  d.row(n - 1) = (x.row(n - 1) - x.row(n - 2)) / dt;
+  return d;
+}
+
+Eigen::MatrixXd second_difference(const Eigen::MatrixXd& x, double dt) {
+  const Eigen::Index n = x.rows();
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(n, x.cols());
+  if (n < 3) return d;
+  for (Eigen::Index i = 1; i + 1 < n; ++i) d.row(i) = (x.row(i + 1) - 2 * x.row(i) + x.row(i - 1)) / (dt * dt);
+  d.row(0) = d.row(1);
+  d.row(n - 1) = d.row(n - 2);
+  return d;
+}
+
+}  // namespace kin2grf

@@ -1,0 +1,174 @@
+#include "kin2grf/kinematics/motion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/kinematics/filter.hpp"
+
+namespace kin2grf {
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+Eigen::Vector2d perp(const Eigen::Vector2d& r) { return Eigen::Vector2d(-r.y(), r.x()); }
+
+double angle_of(const Eigen::Vector2d& d) { return std::atan2(d.y(), d.x()); }
+
+Eigen::Matrix2d rot(double a) {
+  Eigen::Matrix2d R;
+  R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+  return R;
+}
+
+}  // namespace
+
+BodyGeometry measure_geometry(const SagittalLandmarks& lm) {
+  const Eigen::Index n = lm.frames();
+  auto dist = [&](int a, int b) {
+    std::vector<double> v;
+    v.reserve(static_cast<std::size_t>(n));
+    for (Eigen::Index i = 0; i < n; ++i) v.push_back((lm.p[b].row(i) - lm.p[a].row(i)).norm());
+    return median(v);
+  };
+  BodyGeometry g;
+  g.torso = dist(kHip, kShoulder);
+  for (int s = 0; s < 2; ++s) {
+    g.thigh[s] = dist(kHip, landmark(s, 0));
+    g.shank[s] = dist(landmark(s, 0), landmark(s, 1));
+    g.foot[s] = dist(landmark(s, 1), landmark(s, 3));
+    g.toes[s] = dist(landmark(s, 3), landmark(s, 4));
+    std::vector<double> hx, hy;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Vector2d A = lm.p[landmark(s, 1)].row(i).transpose();
+      const Eigen::Vector2d M = lm.p[landmark(s, 3)].row(i).transpose();
+      const Eigen::Vector2d E = lm.p[landmark(s, 2)].row(i).transpose();
+      const Eigen::Vector2d local = rot(-angle_of(M - A)) * (E - A);
+      hx.push_back(local.x());
+      hy.push_back(local.y());
+    }
+    g.heel_local[s] = Eigen::Vector2d(median(hx), median(hy));
+  }
+  return g;
+}
+
+std::array<double, kSegmentCount> length_variation(const SagittalLandmarks& lm, const BodyGeometry& g) {
+  std::array<double, kSegmentCount> out{};
+  auto worst = [&](int a, int b, double L) {
+    double w = 0;
+    for (Eigen::Index i = 0; i < lm.frames(); ++i) w = std::max(w, std::abs((lm.p[b].row(i) - lm.p[a].row(i)).norm() - L) / L);
+    return w;
+  };
+  out[kTorso] = worst(kHip, kShoulder, g.torso);
+  for (int s = 0; s < 2; ++s) {
+    out[segment(s, 0)] = worst(kHip, landmark(s, 0), g.thigh[s]);
+    out[segment(s, 1)] = worst(landmark(s, 0), landmark(s, 1), g.shank[s]);
+    out[segment(s, 2)] = worst(landmark(s, 1), landmark(s, 3), g.foot[s]);
+    out[segment(s, 3)] = worst(landmark(s, 3), landmark(s, 4), g.toes[s]);
+  }
+  return out;
+}
+
+Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm) {
+  const Eigen::Index n = lm.frames();
+  Eigen::MatrixXd x(n, 11);
+  Eigen::MatrixXd theta(n, kSegmentCount);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    auto P = [&](int k) { return Eigen::Vector2d(lm.p[k].row(i).transpose()); };
+    theta(i, kTorso) = angle_of(P(kShoulder) - P(kHip));
+    for (int s = 0; s < 2; ++s) {
+      theta(i, segment(s, 0)) = angle_of(P(landmark(s, 0)) - P(kHip));
+      theta(i, segment(s, 1)) = angle_of(P(landmark(s, 1)) - P(landmark(s, 0)));
+      theta(i, segment(s, 2)) = angle_of(P(landmark(s, 3)) - P(landmark(s, 1)));
+      theta(i, segment(s, 3)) = angle_of(P(landmark(s, 4)) - P(landmark(s, 3)));
+    }
+    x(i, 0) = lm.p[kHip](i, 0);
+    x(i, 1) = lm.p[kHip](i, 1);
+  }
+  // Unwrap each absolute angle over time, then form the joint angles.
+  for (int s = 0; s < kSegmentCount; ++s)
+    for (Eigen::Index i = 1; i < n; ++i) {
+      double d = theta(i, s) - theta(i - 1, s);
+      while (d > M_PI) { theta(i, s) -= 2 * M_PI; d -= 2 * M_PI; }
+      while (d < -M_PI) { theta(i, s) += 2 * M_PI; d += 2 * M_PI; }
+    }
+  x.col(2) = theta.col(kTorso);
+  for (int j = 0; j < kJointCount; ++j) x.col(3 + j) = theta.col(joint_child(j)) - theta.col(joint_parent(j));
+  return x;
+}
+
+ModelMotion reconstruct_motion(const Model& model, const Eigen::MatrixXd& x, const Eigen::MatrixXd& xd,
+                               const Eigen::MatrixXd& xdd, double rate_hz, const Eigen::VectorXd& time_s) {
+  const Eigen::Index n = x.rows();
+  ModelMotion mm;
+  mm.rate_hz = rate_hz;
+  mm.time_s = time_s;
+  mm.q = Eigen::MatrixXd::Zero(n, coord::kCount);
+  mm.qd = Eigen::MatrixXd::Zero(n, coord::kCount);
+  mm.qdd = Eigen::MatrixXd::Zero(n, coord::kCount);
+  // Bodies in an order where the parent comes first (the torso, then each leg down).
+  static constexpr int order[] = {kTorso, kThighR, kShankR, kFootR, kToesR, kThighL, kShankL, kFootL, kToesL};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    std::array<double, kSegmentCount> th{}, w{}, al{};
+    th[kTorso] = x(i, 2); w[kTorso] = xd(i, 2); al[kTorso] = xdd(i, 2);
+    for (int j = 0; j < kJointCount; ++j) {
+      const int c = joint_child(j), p = joint_parent(j);
+      th[c] = th[p] + x(i, 3 + j);
+      w[c] = w[p] + xd(i, 3 + j);
+      al[c] = al[p] + xdd(i, 3 + j);
+    }
+    std::array<Eigen::Vector2d, kLandmarkCount> r, v, a;
+    r[kHip] = Eigen::Vector2d(x(i, 0), x(i, 1));
+    v[kHip] = Eigen::Vector2d(xd(i, 0), xd(i, 1));
+    a[kHip] = Eigen::Vector2d(xdd(i, 0), xdd(i, 1));
+    auto place = [&](const Body& b, int s, const Eigen::Vector2d& local, Eigen::Vector2d& rr, Eigen::Vector2d& vv,
+                     Eigen::Vector2d& aa) {
+      const Eigen::Vector2d d = rot(th[s]) * local;
+      rr = r[b.proximal] + d;
+      vv = v[b.proximal] + w[s] * perp(d);
+      aa = a[b.proximal] + al[s] * perp(d) - w[s] * w[s] * d;
+    };
+    for (int s : order) {
+      const Body& b = model.bodies[s];
+      for (int k = 0; k < 2; ++k)
+        if (b.points[k] >= 0) place(b, s, b.points_local[k], r[b.points[k]], v[b.points[k]], a[b.points[k]]);
+      Eigen::Vector2d rg, vg, ag;
+      place(b, s, b.com_local, rg, vg, ag);
+      mm.q.block<1, 2>(i, coord::com_x(s)) = rg.transpose();
+      mm.qd.block<1, 2>(i, coord::com_x(s)) = vg.transpose();
+      mm.qdd.block<1, 2>(i, coord::com_x(s)) = ag.transpose();
+      mm.q(i, coord::theta(s)) = th[s];
+      mm.qd(i, coord::theta(s)) = w[s];
+      mm.qdd(i, coord::theta(s)) = al[s];
+    }
+    for (int k = 0; k < kLandmarkCount; ++k) {
+      mm.q.block<1, 2>(i, coord::point_x(k)) = r[k].transpose();
+      mm.qd.block<1, 2>(i, coord::point_x(k)) = v[k].transpose();
+      mm.qdd.block<1, 2>(i, coord::point_x(k)) = a[k].transpose();
+    }
+    for (int j = 0; j < kJointCount; ++j) {
+      mm.q(i, coord::phi(j)) = x(i, 3 + j);
+      mm.qd(i, coord::phi(j)) = xd(i, 3 + j);
+      mm.qdd(i, coord::phi(j)) = xdd(i, 3 + j);
+    }
+  }
+  return mm;
+}
+
+ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz) {
+  if (lm.frames() < 8) throw InputError("too few frames (" + std::to_string(lm.frames()) + ") for the kinematics");
+  const double dt = 1.0 / lm.rate_hz;
+  const Eigen::MatrixXd raw = independent_coordinates(lm);
+  const Eigen::MatrixXd x = cutoff_hz > 0 ? butterworth_filtfilt(raw, lm.rate_hz, cutoff_hz) : raw;
+  const Eigen::MatrixXd xd = central_difference(x, dt);
+  const Eigen::MatrixXd xdd = second_difference(x, dt);
+  return reconstruct_motion(model, x, xd, xdd, lm.rate_hz, lm.time_s);
+}
+
+}  // namespace kin2grf

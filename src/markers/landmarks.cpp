@@ -1,0 +1,396 @@
+#include "kin2grf/markers/landmarks.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <set>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/text.hpp"
+
+namespace kin2grf {
+
+const std::vector<std::pair<std::string, std::string>>& builtin_preset_texts();
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+const char* kNames[kLandmarkCount] = {"shoulder", "hip",     "knee_r", "ankle_r", "heel_r", "mt_r",
+                                      "hallux_r", "knee_l", "ankle_l", "heel_l",  "mt_l",   "hallux_l"};
+
+Eigen::MatrixX3d marker(const MarkerTrajectories& m, const std::string& name, const std::string& path,
+                        const std::string& what) {
+  const int k = m.find(name);
+  if (k < 0) throw InputError(path + ": marker '" + name + "' (needed for " + what + ") is not in the trial");
+  return m.positions_m[static_cast<std::size_t>(k)];
+}
+
+Eigen::MatrixX3d mean_of(const MarkerTrajectories& m, const std::vector<std::string>& names, const std::string& path,
+                         const std::string& what) {
+  Eigen::MatrixX3d s = Eigen::MatrixX3d::Zero(m.frames(), 3);
+  for (const auto& n : names) s += marker(m, n, path, what);  // NaN propagates: all must be present
+  return s / static_cast<double>(names.size());
+}
+
+/// Pelvis frame per frame: origin mid-ASIS, x anterior, y superior, z right; PW, PD.
+struct Pelvis {
+  Eigen::MatrixX3d origin, x, y;
+  Eigen::VectorXd width, depth;
+};
+
+Pelvis pelvis(const MarkerTrajectories& m, const std::map<std::string, std::string>& p, const std::string& path) {
+  auto get = [&](const char* key) -> std::string {
+    auto it = p.find(key);
+    return it == p.end() ? "" : it->second;
+  };
+  const Eigen::MatrixX3d ra = marker(m, get("rasis"), path, "the pelvis");
+  const Eigen::MatrixX3d la = marker(m, get("lasis"), path, "the pelvis");
+  Eigen::MatrixX3d back;
+  if (!get("sacrum").empty()) back = marker(m, get("sacrum"), path, "the pelvis");
+  else back = 0.5 * (marker(m, get("rpsis"), path, "the pelvis") + marker(m, get("lpsis"), path, "the pelvis"));
+  Pelvis pv;
+  const Eigen::Index n = m.frames();
+  pv.origin = 0.5 * (ra + la);
+  pv.x.resize(n, 3);
+  pv.y.resize(n, 3);
+  pv.width.resize(n);
+  pv.depth.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Vector3d z = (ra.row(i) - la.row(i)).transpose().normalized();
+    const Eigen::Vector3d t = (pv.origin.row(i) - back.row(i)).transpose();
+    const Eigen::Vector3d x = (t - t.dot(z) * z).normalized();
+    pv.x.row(i) = x.transpose();
+    pv.y.row(i) = z.cross(x).transpose();
+    pv.width[i] = (ra.row(i) - la.row(i)).norm();
+    pv.depth[i] = t.norm();
+  }
+  return pv;
+}
+
+/// Rigid frame of a cluster (>= 3 markers) at frame i: rotation and origin (centroid).
+bool cluster_frame(const std::vector<Eigen::MatrixX3d>& c, Eigen::Index i, Eigen::Matrix3d& R, Eigen::Vector3d& o) {
+  for (const auto& m : c)
+    if (!m.row(i).allFinite()) return false;
+  o.setZero();
+  for (const auto& m : c) o += m.row(i).transpose();
+  o /= static_cast<double>(c.size());
+  const Eigen::Vector3d a = (c[0].row(i).transpose() - o).normalized();
+  Eigen::Vector3d b = c[1].row(i).transpose() - o;
+  Eigen::Vector3d z = a.cross(b);
+  if (z.norm() < 1e-9) return false;
+  z.normalize();
+  R << a, z.cross(a), z;
+  return true;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return kNaN;
+  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+}  // namespace
+
+const char* landmark_name(int id) { return kNames[id]; }
+
+bool MarkerSet::needs_static() const {
+  return std::any_of(rules.begin(), rules.end(), [](const LandmarkRule& r) { return r.kind == "static"; });
+}
+
+std::vector<std::string> MarkerSet::motion_markers() const {
+  std::vector<std::string> out;
+  for (const auto& r : rules) {
+    if (r.kind == "marker" || r.kind == "mean") out.insert(out.end(), r.markers.begin(), r.markers.end());
+    if (r.kind == "static") out.insert(out.end(), r.cluster.begin(), r.cluster.end());
+    for (const auto& [k, v] : r.pelvis) out.push_back(v);
+  }
+  return out;
+}
+
+MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
+  MarkerSet s;
+  try {
+    s.name = j.at("name").get<std::string>();
+    s.description = j.value("description", "");
+    s.signature = j.value("signature", std::vector<std::string>{});
+    const auto& lm = j.at("landmarks");
+    for (int id = 0; id < kLandmarkCount; ++id) {
+      if (!lm.contains(kNames[id])) throw InputError(source + ": landmark '" + kNames[id] + "' has no rule");
+      const auto& r = lm.at(kNames[id]);
+      LandmarkRule rule;
+      if (r.contains("marker")) { rule.kind = "marker"; rule.markers = {r["marker"].get<std::string>()}; }
+      else if (r.contains("mean")) { rule.kind = "mean"; rule.markers = r["mean"].get<std::vector<std::string>>(); }
+      else if (r.contains("harrington")) { rule.kind = "harrington"; rule.pelvis = r["harrington"].get<std::map<std::string, std::string>>(); }
+      else if (r.contains("static")) {
+        rule.kind = "static";
+        rule.markers = r["static"].get<std::vector<std::string>>();
+        rule.cluster = r.at("cluster").get<std::vector<std::string>>();
+        if (rule.cluster.size() < 3) throw InputError(source + ": landmark '" + kNames[id] + "': a cluster needs 3 or more markers");
+      } else if (r.contains("pelvis_up")) {
+        rule.kind = "pelvis_up";
+        rule.value = r["pelvis_up"].get<double>();
+        rule.pelvis = r.at("pelvis").get<std::map<std::string, std::string>>();
+      } else if (r.contains("virtual_hallux")) {
+        rule.kind = "virtual_hallux";
+        rule.value = r["virtual_hallux"].get<double>();
+      } else {
+        throw InputError(source + ": landmark '" + kNames[id] + "': unknown rule " + r.dump());
+      }
+      if ((rule.kind == "marker" || rule.kind == "mean" || rule.kind == "static") && rule.markers.empty())
+        throw InputError(source + ": landmark '" + kNames[id] + "' names no marker");
+      s.rules[static_cast<std::size_t>(id)] = rule;
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(source + ": invalid marker-set file: " + e.what());
+  }
+  return s;
+}
+
+MarkerSet load_marker_set(const std::string& path) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(read_file_text(path));
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path + ": not valid JSON: " + e.what());
+  }
+  return parse_marker_set(j, path);
+}
+
+const std::vector<MarkerSet>& builtin_marker_sets() {
+  static const std::vector<MarkerSet> sets = [] {
+    std::vector<MarkerSet> v;
+    for (const auto& [name, text] : builtin_preset_texts()) v.push_back(parse_marker_set(nlohmann::json::parse(text), name));
+    // Recognition order: the more specific sets first.
+    std::stable_sort(v.begin(), v.end(), [](const MarkerSet& a, const MarkerSet& b) { return a.signature.size() > b.signature.size(); });
+    return v;
+  }();
+  return sets;
+}
+
+const MarkerSet* find_marker_set(const std::string& name) {
+  for (const auto& s : builtin_marker_sets())
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+const MarkerSet* recognise_marker_set(const MarkerTrajectories& m) {
+  for (const auto& s : builtin_marker_sets())
+    if (std::all_of(s.signature.begin(), s.signature.end(), [&](const std::string& n) { return m.find(n) >= 0; })) return &s;
+  return nullptr;
+}
+
+Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m, const MarkerTrajectories* st,
+                              const LandmarkOptions&, const std::string& path) {
+  Landmarks3D out;
+  const Eigen::Index n = m.frames();
+  for (int id = 0; id < kLandmarkCount; ++id) {
+    const LandmarkRule& r = set.rules[static_cast<std::size_t>(id)];
+    const std::string what = std::string("landmark ") + kNames[id];
+    Eigen::MatrixX3d P = Eigen::MatrixX3d::Constant(n, 3, kNaN);
+    if (r.kind == "marker" || r.kind == "mean") {
+      P = mean_of(m, r.markers, path, what);
+    } else if (r.kind == "harrington") {
+      const Pelvis pv = pelvis(m, r.pelvis, path);
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const double ax = -0.24 * pv.depth[i] - 0.0099, ay = -0.30 * pv.width[i] - 0.0109;
+        P.row(i) = pv.origin.row(i) + ax * pv.x.row(i) + ay * pv.y.row(i);
+      }
+    } else if (r.kind == "pelvis_up") {
+      const Pelvis pv = pelvis(m, r.pelvis, path);
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const double ax = -0.24 * pv.depth[i] - 0.0099, ay = -0.30 * pv.width[i] - 0.0109;
+        P.row(i) = pv.origin.row(i) + ax * pv.x.row(i) + (ay + r.value) * pv.y.row(i);
+      }
+      out.messages.push_back("shoulder: no upper-body markers; the torso is taken along the pelvis's superior axis (" +
+                             std::to_string(r.value) + " m), an approximation");
+    } else if (r.kind == "static") {
+      if (!st) {
+        throw InputError(path + ": landmark " + kNames[id] + " of marker set '" + set.name +
+                         "' is a virtual point calibrated on a static trial: give --static STATIC (it needs markers " +
+                         r.markers[0] + (r.markers.size() > 1 ? ", " + r.markers[1] : "") + ")");
+      }
+      // Calibrate: the static point in the cluster frame, median over the static frames.
+      std::vector<Eigen::MatrixX3d> cs, cm;
+      for (const auto& c : r.cluster) {
+        cs.push_back(marker(*st, c, path + " (static)", what));
+        cm.push_back(marker(m, c, path, what));
+      }
+      const Eigen::MatrixX3d sp = mean_of(*st, r.markers, path + " (static)", what);
+      std::vector<double> lx, ly, lz;
+      for (Eigen::Index i = 0; i < st->frames(); ++i) {
+        Eigen::Matrix3d R;
+        Eigen::Vector3d o;
+        if (!sp.row(i).allFinite() || !cluster_frame(cs, i, R, o)) continue;
+        const Eigen::Vector3d l = R.transpose() * (sp.row(i).transpose() - o);
+        lx.push_back(l.x()); ly.push_back(l.y()); lz.push_back(l.z());
+      }
+      if (lx.empty()) throw InputError(path + ": the static trial never shows landmark " + kNames[id] + "'s markers and cluster together");
+      const Eigen::Vector3d local(median(lx), median(ly), median(lz));
+      for (Eigen::Index i = 0; i < n; ++i) {
+        Eigen::Matrix3d R;
+        Eigen::Vector3d o;
+        if (cluster_frame(cm, i, R, o)) P.row(i) = (o + R * local).transpose();
+      }
+    }
+    out.p[static_cast<std::size_t>(id)] = P;  // virtual_hallux stays NaN: built in the sagittal step
+  }
+  return out;
+}
+
+SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajectories& m, const LandmarkOptions& o) {
+  SagittalFrame f;
+  const Axis up = o.up_axis.value_or(m.up_axis);
+  f.up = Eigen::Vector3d::Unit(static_cast<int>(up));
+  auto horizontal = [&](Eigen::Vector3d v) { return Eigen::Vector3d(v - v.dot(f.up) * f.up); };
+  // Progression from the hip's horizontal travel between its first and last defined frames.
+  const auto& hip = lm.p[kHip];
+  Eigen::Index a = -1, b = -1;
+  for (Eigen::Index i = 0; i < hip.rows(); ++i)
+    if (hip.row(i).allFinite()) { if (a < 0) a = i; b = i; }
+  Eigen::Vector3d dir = Eigen::Vector3d::Zero();
+  if (a >= 0 && b > a) {
+    const Eigen::Vector3d d = horizontal((hip.row(b) - hip.row(a)).transpose());
+    const double dur = m.time_s[b] - m.time_s[a];
+    if (d.norm() > 0.5 && d.norm() / dur > 0.2) {
+      dir = d.normalized();
+      f.how = "pelvis travel " + std::to_string(d.norm()) + " m";
+    }
+  }
+  if (dir.norm() == 0) {
+    // Treadmill or stationary: the feet's heel-to-MT direction.
+    Eigen::Vector3d s = Eigen::Vector3d::Zero();
+    for (int side = 0; side < 2; ++side)
+      for (Eigen::Index i = 0; i < hip.rows(); ++i) {
+        const Eigen::Vector3d d = (lm.p[landmark(side, 3)].row(i) - lm.p[landmark(side, 2)].row(i)).transpose();
+        if (d.allFinite()) s += horizontal(d);
+      }
+    if (s.norm() == 0) throw InputError("cannot find the direction of progression (no pelvis travel, no feet)");
+    dir = s.normalized();
+    f.treadmill = true;
+    f.how = "heel-to-toe direction (treadmill or stationary trial)";
+  }
+  if (o.progression_axis) {
+    Eigen::Vector3d ax = Eigen::Vector3d::Unit(static_cast<int>(*o.progression_axis));
+    dir = ax * (ax.dot(dir) >= 0 ? 1.0 : -1.0);
+    f.how += ", axis forced";
+  } else {
+    // Snap to the nearest lab axis when within 10 degrees: labs walk along an axis.
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d ax = Eigen::Vector3d::Unit(k);
+      if (std::abs(ax.dot(dir)) > std::cos(10 * M_PI / 180)) dir = ax * (ax.dot(dir) > 0 ? 1.0 : -1.0);
+    }
+  }
+  if (o.progression_sign) dir *= (*o.progression_sign > 0 ? 1.0 : -1.0) * (dir.sum() >= 0 ? 1.0 : -1.0);
+  f.forward = dir;
+  f.lateral = f.forward.cross(f.up);
+  return f;
+}
+
+SagittalWindow sagittal_landmarks(const Landmarks3D& lm3, const MarkerSet& set, const SagittalFrame& fr,
+                                  const MarkerTrajectories& m, const LandmarkOptions& o, const std::string& path) {
+  SagittalWindow w;
+  const Eigen::Index n = m.frames();
+  std::array<Eigen::MatrixX3d, kLandmarkCount> p = lm3.p;
+  // Fill short gaps (cubic Catmull-Rom between the valid neighbours; linear with one neighbour pair).
+  std::vector<bool> ok(static_cast<std::size_t>(n), true);
+  for (int id = 0; id < kLandmarkCount; ++id) {
+    if (set.rules[static_cast<std::size_t>(id)].kind == "virtual_hallux") continue;
+    auto& P = p[static_cast<std::size_t>(id)];
+    Eigen::Index i = 0;
+    while (i < n) {
+      if (P.row(i).allFinite()) { ++i; continue; }
+      Eigen::Index j = i;
+      while (j < n && !P.row(j).allFinite()) ++j;
+      const Eigen::Index len = j - i;
+      if (i > 0 && j < n && len <= o.max_gap_frames) {
+        // Cubic Hermite between the valid neighbours, tangents by central differences there.
+        const Eigen::Index i0 = i - 1, i1 = j;
+        const double span = static_cast<double>(i1 - i0);
+        const Eigen::RowVector3d p1 = P.row(i0), p2 = P.row(i1);
+        const Eigen::RowVector3d d1 = (i0 > 0 && P.row(i0 - 1).allFinite()) ? Eigen::RowVector3d((p2 - P.row(i0 - 1)) / (span + 1))
+                                                                         : Eigen::RowVector3d((p2 - p1) / span);
+        const Eigen::RowVector3d d2 = (i1 + 1 < n && P.row(i1 + 1).allFinite()) ? Eigen::RowVector3d((P.row(i1 + 1) - p1) / (span + 1))
+                                                                            : Eigen::RowVector3d((p2 - p1) / span);
+        for (Eigen::Index k = i; k < j; ++k) {
+          const double t = static_cast<double>(k - i0) / span, t2 = t * t, t3 = t2 * t;
+          P.row(k) = (2 * t3 - 3 * t2 + 1) * p1 + (t3 - 2 * t2 + t) * span * d1 + (-2 * t3 + 3 * t2) * p2 +
+                     (t3 - t2) * span * d2;
+        }
+        w.messages.push_back(std::string(kNames[id]) + ": filled a gap of " + std::to_string(len) + " frames at frames " +
+                             std::to_string(m.first_frame + i) + "-" + std::to_string(m.first_frame + j - 1));
+      } else {
+        for (Eigen::Index k = i; k < j; ++k) ok[static_cast<std::size_t>(k)] = false;
+      }
+      i = j;
+    }
+  }
+  // The longest run of frames where every landmark is defined.
+  Eigen::Index best_a = 0, best_len = 0;
+  for (Eigen::Index i = 0; i < n;) {
+    if (!ok[static_cast<std::size_t>(i)]) { ++i; continue; }
+    Eigen::Index j = i;
+    while (j < n && ok[static_cast<std::size_t>(j)]) ++j;
+    if (j - i > best_len) { best_len = j - i; best_a = i; }
+    i = j;
+  }
+  if (best_len < 10) {
+    std::string which;
+    for (int id = 0; id < kLandmarkCount; ++id) {
+      if (set.rules[static_cast<std::size_t>(id)].kind == "virtual_hallux") continue;
+      Eigen::Index bad = 0;
+      for (Eigen::Index i = 0; i < n; ++i) bad += !p[static_cast<std::size_t>(id)].row(i).allFinite();
+      if (bad) which += std::string(" ") + kNames[id] + " (" + std::to_string(bad) + " frames)";
+    }
+    throw InputError(path + ": no run of 10 frames where every landmark is defined; missing:" + which);
+  }
+  if (best_len < n) {
+    w.messages.push_back("processing frames " + std::to_string(m.first_frame + best_a) + "-" +
+                         std::to_string(m.first_frame + best_a + best_len - 1) + " of " + std::to_string(m.first_frame) + "-" +
+                         std::to_string(m.first_frame + n - 1) + " (landmarks missing outside, gaps longer than " +
+                         std::to_string(o.max_gap_frames) + " frames end the window)");
+  }
+  w.first = best_a;
+  SagittalLandmarks& s = w.landmarks;
+  s.rate_hz = m.rate_hz;
+  s.time_s = m.time_s.segment(best_a, best_len);
+  for (int id = 0; id < kLandmarkCount; ++id) {
+    s.p[static_cast<std::size_t>(id)].resize(best_len, 2);
+    for (Eigen::Index i = 0; i < best_len; ++i)
+      s.p[static_cast<std::size_t>(id)].row(i) =
+          fr.to_sagittal(p[static_cast<std::size_t>(id)].row(best_a + i).transpose()).transpose();
+  }
+  for (int side = 0; side < 2; ++side) {
+    w.foot_lateral_m[side].resize(best_len);
+    for (Eigen::Index i = 0; i < best_len; ++i)
+      w.foot_lateral_m[side][i] = 0.5 * (p[landmark(side, 2)].row(best_a + i) + p[landmark(side, 3)].row(best_a + i)).dot(fr.lateral.transpose());
+    // Virtual hallux: toes straight along the foot, held at the MT head's foot-flat height.
+    const LandmarkRule& r = set.rules[static_cast<std::size_t>(landmark(side, 4))];
+    if (r.kind != "virtual_hallux") continue;
+    const auto& A = s.p[landmark(side, 1)];
+    const auto& M = s.p[landmark(side, 3)];
+    std::vector<double> hm;
+    for (Eigen::Index i = 0; i < best_len; ++i) hm.push_back(M(i, 1));
+    std::sort(hm.begin(), hm.end());
+    const double flat_h = hm[hm.size() / 10];
+    std::vector<double> flat_ang;
+    for (Eigen::Index i = 0; i < best_len; ++i)
+      if (M(i, 1) < flat_h + 0.01) flat_ang.push_back(std::atan2(M(i, 1) - A(i, 1), M(i, 0) - A(i, 0)));
+    const double th_flat = median(flat_ang);
+    auto& T = s.p[landmark(side, 4)];
+    for (Eigen::Index i = 0; i < best_len; ++i) {
+      const double L = r.value * (M.row(i) - A.row(i)).norm();
+      const double th_f = std::atan2(M(i, 1) - A(i, 1), M(i, 0) - A(i, 0));
+      const double limit = -std::asin(std::clamp((M(i, 1) - flat_h) / L, -1.0, 1.0));
+      const double th_t = std::max(th_f - th_flat, limit);
+      T(i, 0) = M(i, 0) + L * std::cos(th_t);
+      T(i, 1) = M(i, 1) + L * std::sin(th_t);
+    }
+    w.messages.push_back(std::string("hallux_") + (side ? "l" : "r") + ": no hallux marker; virtual toes of " +
+                         std::to_string(r.value) + " x ankle-MT length");
+  }
+  return w;
+}
+
+}  // namespace kin2grf

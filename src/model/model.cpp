@@ -1,0 +1,68 @@
+#include "kin2grf/model/model.hpp"
+
+#include "kin2grf/error.hpp"
+
+namespace kin2grf {
+
+const char* joint_name(int j) {
+  static const char* names[] = {"hip_r", "knee_r", "ankle_r", "mtp_r", "hip_l", "knee_l", "ankle_l", "mtp_l"};
+  return names[j];
+}
+
+const char* segment_name(int s) {
+  static const char* names[] = {"torso", "thigh_r", "shank_r", "foot_r", "toes_r", "thigh_l", "shank_l", "foot_l", "toes_l"};
+  return names[s];
+}
+
+Eigen::VectorXd Model::mass_diagonal() const {
+  Eigen::VectorXd m = Eigen::VectorXd::Zero(coord::kCount);
+  for (int s = 0; s < kSegmentCount; ++s) {
+    m[coord::com_x(s)] = bodies[s].mass_kg;
+    m[coord::com_x(s) + 1] = bodies[s].mass_kg;
+    m[coord::theta(s)] = bodies[s].inertia_kgm2;
+  }
+  return m;
+}
+
+Eigen::VectorXd Model::gravity_force() const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(coord::kCount);
+  for (int s = 0; s < kSegmentCount; ++s) f[coord::com_x(s) + 1] = -bodies[s].mass_kg * gravity_mps2;
+  return f;
+}
+
+Model build_model(const BodyGeometry& g, double mass, const AnthropometricTable& t) {
+  if (!(mass > 0) || mass > 500) throw InputError("body mass " + std::to_string(mass) + " kg is not plausible");
+  Model m;
+  m.body_mass_kg = mass;
+  m.anthropometry = t.name;
+  auto set = [&](int s, int prox, int distal, double L, const SegmentInertia& si) {
+    if (!(L > 0.005) || L > 2.0)
+      throw InputError(std::string("segment ") + segment_name(s) + " length " + std::to_string(L) + " m is not plausible");
+    Body& b = m.bodies[s];
+    b.proximal = prox;
+    b.points[0] = distal;
+    b.points_local[0] = Eigen::Vector2d(L, 0);
+    b.length_m = L;
+    b.com_local = Eigen::Vector2d(si.com_fraction * L, 0);
+    b.mass_kg = si.mass_fraction * mass;
+    const double rho = si.gyration_fraction * L;
+    b.inertia_kgm2 = b.mass_kg * rho * rho;
+  };
+  set(kTorso, kHip, kShoulder, g.torso, t.hat);
+  for (int side = 0; side < 2; ++side) {
+    set(segment(side, 0), kHip, landmark(side, 0), g.thigh[side], t.thigh);
+    set(segment(side, 1), landmark(side, 0), landmark(side, 1), g.shank[side], t.shank);
+    set(segment(side, 2), landmark(side, 1), landmark(side, 3), g.foot[side], t.foot);
+    set(segment(side, 3), landmark(side, 3), landmark(side, 4), g.toes[side], t.toes);
+    Body& foot = m.bodies[segment(side, 2)];
+    foot.points[1] = landmark(side, 2);
+    foot.points_local[1] = g.heel_local[side];
+    // Default sole points (replaced by the contact calibration).
+    m.feet[side].heel_local = g.heel_local[side];
+    m.feet[side].mt_local = Eigen::Vector2d(g.foot[side], 0);
+    m.feet[side].hallux_local = Eigen::Vector2d(g.toes[side], 0);
+  }
+  return m;
+}
+
+}  // namespace kin2grf

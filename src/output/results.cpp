@@ -1,0 +1,96 @@
+#include "kin2grf/output/results.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "kin2grf/io/opensim.hpp"
+
+namespace kin2grf {
+
+void write_grf_mot(const std::string& path, const EstimateResult& r) {
+  const auto plates = as_lab_plates(r);
+  Table t = grf_table(r.time_s, plates[0], plates[1]);
+  t.name = "kin2grf_estimated_grf";
+  t.header["DataType"] = "double";
+  write_sto(path, t);
+}
+
+std::string format_results_csv(const EstimateResult& r) {
+  std::ostringstream os;
+  os << "frame,time_s";
+  for (const char* s : {"r", "l"})
+    os << ",grf_anterior_" << s << "_N,grf_vertical_" << s << "_N,cop_x_" << s << "_m,contact_" << s;
+  os << ",grm_Nm";
+  for (int j = 0; j < kJointCount; ++j) os << ",torque_" << joint_name(j) << "_Nm";
+  for (int j = 0; j < kJointCount; ++j) os << ",force_" << joint_name(j) << "_x_N,force_" << joint_name(j) << "_y_N";
+  os << ",residual_x_N,residual_y_N,residual_moment_Nm,iterations\n";
+  char buf[64];
+  auto num = [&](double v) {
+    if (!std::isfinite(v)) return std::string("");
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return std::string(buf);
+  };
+  for (Eigen::Index i = 0; i < r.time_s.size(); ++i) {
+    os << r.first_frame_number + i << "," << num(r.time_s[i]);
+    for (int s = 0; s < 2; ++s) {
+      const auto& f = r.feet[s];
+      os << "," << num(f.force_N(i, 0)) << "," << num(f.force_N(i, 1)) << "," << num(f.cop_x_m[i]) << ","
+         << (f.contact[static_cast<std::size_t>(i)] ? 1 : 0);
+    }
+    os << "," << num(r.grm_Nm[i]);
+    for (int j = 0; j < kJointCount; ++j) os << "," << num(r.joint_torque_Nm(i, j));
+    for (int j = 0; j < 2 * kJointCount; ++j) os << "," << num(r.joint_force_N(i, j));
+    os << "," << num(r.residual(i, 0)) << "," << num(r.residual(i, 1)) << "," << num(r.residual(i, 2)) << ","
+       << r.iterations[static_cast<std::size_t>(i)] << "\n";
+  }
+  return os.str();
+}
+
+nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings) {
+  using nlohmann::json;
+  json j;
+  j["settings"] = settings;
+  j["marker_set"] = r.marker_set;
+  j["mass_kg"] = r.mass_kg;
+  j["ground_level_m"] = r.ground_level_m;
+  j["progression"] = {{"forward", {r.frame.forward.x(), r.frame.forward.y(), r.frame.forward.z()}},
+                      {"up", {r.frame.up.x(), r.frame.up.y(), r.frame.up.z()}},
+                      {"treadmill", r.frame.treadmill},
+                      {"belt_velocity_mps", r.frame.belt_velocity_mps},
+                      {"how", r.frame.how}};
+  const auto n = r.time_s.size();
+  j["frames"] = {{"first", r.first_frame_number}, {"last", r.first_frame_number + n - 1}, {"count", n}};
+  json contacts = json::object();
+  for (int s = 0; s < 2; ++s) {
+    json iv = json::array();
+    const auto& c = r.feet[s].contact;
+    for (Eigen::Index i = 0; i < n;) {
+      if (!c[static_cast<std::size_t>(i)]) { ++i; continue; }
+      Eigen::Index k = i;
+      while (k < n && c[static_cast<std::size_t>(k)]) ++k;
+      iv.push_back({{"start_s", r.time_s[i]}, {"end_s", r.time_s[k - 1]}});
+      i = k;
+    }
+    contacts[s ? "left" : "right"] = iv;
+  }
+  j["contact_intervals"] = contacts;
+  double mean_it = 0;
+  int max_it = 0;
+  for (int it : r.iterations) { mean_it += it; max_it = std::max(max_it, it); }
+  j["iterations"] = {{"mean", n ? mean_it / static_cast<double>(n) : 0.0}, {"max", max_it},
+                     {"cycled_frames", r.cycled_frames}, {"capped_frames", r.capped_frames}};
+  j["residual_rms"] = {{"x_N", std::sqrt(r.residual.col(0).squaredNorm() / std::max<double>(1, static_cast<double>(n)))},
+                       {"y_N", std::sqrt(r.residual.col(1).squaredNorm() / std::max<double>(1, static_cast<double>(n)))},
+                       {"moment_Nm", std::sqrt(r.residual.col(2).squaredNorm() / std::max<double>(1, static_cast<double>(n)))}};
+  j["timing"] = {{"kinematics_s", r.seconds_kinematics}, {"dynamics_s", r.seconds_dynamics},
+                 {"frames_per_s", static_cast<double>(n) / std::max(1e-9, r.seconds_kinematics + r.seconds_dynamics)}};
+  j["messages"] = r.messages;
+  json seg = json::array();
+  for (int s = 0; s < kSegmentCount; ++s)
+    seg.push_back({{"segment", segment_name(s)}, {"length_m", r.model.bodies[s].length_m}, {"mass_kg", r.model.bodies[s].mass_kg}});
+  j["segments"] = seg;
+  return j;
+}
+
+}  // namespace kin2grf

@@ -1,0 +1,184 @@
+#include "kin2grf/pipeline.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/kinematics/filter.hpp"
+#include "kin2grf/kinematics/motion.hpp"
+
+namespace kin2grf {
+
+EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  EstimateResult r;
+  r.marker_set = set.name;
+  if (o.mass_kg) r.mass_kg = *o.mass_kg;
+  else if (trial.body_mass_kg) r.mass_kg = *trial.body_mass_kg;
+  else throw InputError(trial.path + ": no body mass: the file stores none (PROCESSING:Bodymass); give --mass KG");
+  if (trial.markers.frames() == 0) throw InputError(trial.path + ": the trial has no marker frames");
+  const Landmarks3D lm3 = compute_landmarks(set, trial.markers, static_trial ? &static_trial->markers : nullptr,
+                                            o.landmarks, trial.path);
+  r.messages = lm3.messages;
+  r.frame = detect_sagittal_frame(lm3, trial.markers, o.landmarks);
+  SagittalWindow win = sagittal_landmarks(lm3, set, r.frame, trial.markers, o.landmarks, trial.path);
+  r.messages.insert(r.messages.end(), win.messages.begin(), win.messages.end());
+  r.first_index = win.first;
+  r.first_frame_number = trial.markers.first_frame + static_cast<int>(win.first);
+  r.foot_lateral_m = win.foot_lateral_m;
+  const SagittalLandmarks& lm = win.landmarks;
+  if (2.0 * o.kinematic_cutoff_hz >= lm.rate_hz || 2.0 * o.post_cutoff_hz >= lm.rate_hz)
+    throw InputError(trial.path + ": cut-off frequencies must be below half the marker rate (" + std::to_string(lm.rate_hz) + " Hz)");
+  r.time_s = lm.time_s;
+
+  // Model: fixed segment lengths (medians over the window), anthropometry, contact calibration.
+  const BodyGeometry geom = measure_geometry(lm);
+  r.model = build_model(geom, r.mass_kg, anthropometric_table(o.anthropometry));
+  std::string gmsg;
+  r.ground_level_m = o.ground_level_m ? *o.ground_level_m : estimate_ground_level(lm, gmsg);
+  if (!gmsg.empty()) r.messages.push_back(gmsg);
+  const auto flat = calibrate_contact(r.model, lm, r.ground_level_m);
+  for (int s = 0; s < 2; ++s)
+    if (flat[s] < 3) r.messages.push_back(std::string(s ? "left" : "right") + " foot: only " + std::to_string(flat[s]) +
+                                          " foot-flat frames for the contact calibration");
+
+  ModelMotion motion = compute_motion(r.model, lm, o.kinematic_cutoff_hz);
+  ContactModelOptions co = o.contact;
+  co.ground_level_m = r.ground_level_m;
+  const auto contacts = prepare_contacts(r.model, co, motion);
+  SolverOptions so = o.solver;
+  if (r.frame.treadmill && so.speed_gate_mps > 0) {
+    // Belt velocity: the median horizontal velocity of the lowest sole point over foot-flat-like frames.
+    std::vector<double> v;
+    for (const auto& fc : contacts)
+      for (const auto& p : fc.points)
+        if (p.gap_m < 0.01) v.push_back(p.velocity.x());
+    if (!v.empty()) {
+      std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+      so.belt_velocity_mps = v[v.size() / 2];
+      r.messages.push_back("treadmill: belt velocity " + std::to_string(so.belt_velocity_mps).substr(0, 6) + " m/s");
+    }
+  }
+  r.frame.belt_velocity_mps = so.belt_velocity_mps;
+  const auto t1 = clock::now();
+
+  const Eigen::Index n = motion.frames();
+  ContactSolver solver(r.model, so);
+  const int np = static_cast<int>(contacts.front().points.size());
+  Eigen::MatrixXd lam(n, 2 * np);
+  Eigen::MatrixXd torque(n, kJointCount);
+  std::vector<std::vector<bool>> act(static_cast<std::size_t>(n));
+  r.iterations.resize(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const FrameSolution s = solver.solve(motion.q.row(i).transpose(), motion.qdd.row(i).transpose(), contacts[static_cast<std::size_t>(i)]);
+    lam.row(i) = s.contact_lambda.transpose();
+    torque.row(i) = s.joint_torque_Nm.transpose();
+    act[static_cast<std::size_t>(i)] = s.contact_active;
+    r.iterations[static_cast<std::size_t>(i)] = s.iterations;
+    r.cycled_frames += s.cycled;
+    r.capped_frames += s.capped;
+  }
+  const auto t2 = clock::now();
+  r.seconds_kinematics = std::chrono::duration<double>(t1 - t0).count();
+  r.seconds_dynamics = std::chrono::duration<double>(t2 - t1).count();
+
+  // Final filtering (Sect. 2.6): all multipliers at post_cutoff, then inactive ones back to zero.
+  Eigen::MatrixXd lamf = o.post_cutoff_hz > 0 ? butterworth_filtfilt(lam, motion.rate_hz, o.post_cutoff_hz) : lam;
+  r.joint_torque_Nm = o.post_cutoff_hz > 0 ? butterworth_filtfilt(torque, motion.rate_hz, o.post_cutoff_hz) : torque;
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int j = 0; j < np; ++j)
+      if (!act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;
+
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int side = 0; side < 2; ++side) {
+    FootResult& f = r.feet[side];
+    f.force_N = Eigen::MatrixX2d::Zero(n, 2);
+    f.raw_force_N = Eigen::MatrixX2d::Zero(n, 2);
+    f.cop_x_m = Eigen::VectorXd::Constant(n, nan);
+    f.contact.assign(static_cast<std::size_t>(n), false);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      double mx = 0;
+      for (int j = 0; j < np; ++j) {
+        const auto& p = contacts[static_cast<std::size_t>(i)].points[static_cast<std::size_t>(j)];
+        if (p.side != side) continue;
+        f.force_N(i, 0) += lamf(i, 2 * j + 1);
+        f.force_N(i, 1) += lamf(i, 2 * j);
+        f.raw_force_N(i, 0) += lam(i, 2 * j + 1);
+        f.raw_force_N(i, 1) += lam(i, 2 * j);
+        mx += lamf(i, 2 * j) * p.position.x();
+        if (act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) f.contact[static_cast<std::size_t>(i)] = true;
+      }
+      if (f.contact[static_cast<std::size_t>(i)]) {
+        if (np == 2) f.cop_x_m[i] = contacts[static_cast<std::size_t>(i)].points[static_cast<std::size_t>(side)].position.x();
+        else if (std::abs(f.force_N(i, 1)) > 1e-6) f.cop_x_m[i] = mx / f.force_N(i, 1);
+      }
+    }
+  }
+  // GRM about the reference point, residual and joint forces.
+  r.grm_Nm = Eigen::VectorXd::Zero(n);
+  r.residual = Eigen::MatrixX3d::Zero(n, 3);
+  r.joint_force_N = Eigen::MatrixXd::Zero(n, 2 * kJointCount);
+  const double g = r.model.gravity_mps2;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Eigen::Vector3d kin = Eigen::Vector3d::Zero();  // sum m(a+g), sum of moments about the origin
+    std::array<Eigen::Vector2d, kSegmentCount> seg_force;
+    for (int s = 0; s < kSegmentCount; ++s) {
+      const Body& b = r.model.bodies[s];
+      const Eigen::Vector2d pos(motion.q(i, coord::com_x(s)), motion.q(i, coord::com_x(s) + 1));
+      const Eigen::Vector2d F = b.mass_kg * Eigen::Vector2d(motion.qdd(i, coord::com_x(s)), motion.qdd(i, coord::com_x(s) + 1) + g);
+      seg_force[static_cast<std::size_t>(s)] = F;
+      kin += Eigen::Vector3d(F.x(), F.y(), pos.x() * F.y() - pos.y() * F.x() + b.inertia_kgm2 * motion.qdd(i, coord::theta(s)));
+    }
+    Eigen::Vector3d ext = Eigen::Vector3d::Zero();
+    for (int side = 0; side < 2; ++side) {
+      const auto& f = r.feet[side];
+      if (!f.contact[static_cast<std::size_t>(i)]) continue;
+      const double x = f.cop_x_m[i], y = r.ground_level_m;
+      const double fx = f.force_N(i, 0), fy = f.force_N(i, 1);
+      r.grm_Nm[i] += (x - o.grm_reference_m.x()) * fy - (y - o.grm_reference_m.y()) * fx;
+      ext += Eigen::Vector3d(fx, fy, x * fy - y * fx);
+    }
+    r.residual.row(i) = (kin - ext).transpose();
+    for (int j = 0; j < kJointCount; ++j) {
+      const int side = j / 4, depth = j % 4;
+      Eigen::Vector2d F = Eigen::Vector2d::Zero();
+      for (int k = depth; k < 4; ++k) F += seg_force[static_cast<std::size_t>(segment(side, k))];
+      if (depth <= 2 && r.feet[side].contact[static_cast<std::size_t>(i)]) F -= r.feet[side].force_N.row(i).transpose();
+      r.joint_force_N(i, 2 * j) = F.x();
+      r.joint_force_N(i, 2 * j + 1) = F.y();
+    }
+  }
+  return r;
+}
+
+std::array<ForcePlate, 2> as_lab_plates(const EstimateResult& r) {
+  std::array<ForcePlate, 2> out;
+  const Eigen::Index n = r.time_s.size();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int side = 0; side < 2; ++side) {
+    ForcePlate& p = out[side];
+    p.name = side ? "left" : "right";
+    p.side_hint = side ? Side::Left : Side::Right;
+    p.force_N.resize(n, 3);
+    p.cop_m.resize(n, 3);
+    p.free_moment_Nm = Eigen::MatrixX3d::Zero(n, 3);
+    p.moment_centre_Nm = Eigen::MatrixX3d::Constant(n, 3, nan);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const auto& f = r.feet[side];
+      const Eigen::Vector3d F = f.force_N(i, 0) * r.frame.forward + f.force_N(i, 1) * r.frame.up;
+      p.force_N.row(i) = F.transpose();
+      if (std::isfinite(f.cop_x_m[i])) {
+        const Eigen::Vector3d c = f.cop_x_m[i] * r.frame.forward + r.ground_level_m * r.frame.up +
+                                  r.foot_lateral_m[side][i] * r.frame.lateral;
+        p.cop_m.row(i) = c.transpose();
+      } else {
+        p.cop_m.row(i).setConstant(nan);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace kin2grf
