@@ -10,6 +10,10 @@
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/output/results.hpp"
 #include "kin2grf/pipeline.hpp"
+#include "kin2grf/io/c3d.hpp"
+#include "kin2grf/io/opensim.hpp"
+#include "kin2grf/synth/example.hpp"
+#include <filesystem>
 
 namespace {
 
@@ -23,9 +27,10 @@ int run_info(const std::string& file, bool json, double threshold) {
 }
 
 struct EstimateArgs {
-  std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "paper",
+  std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "torque-scaled",
       anthropometry = "winter", up_axis;
-  double mass = 0, r = 1e4, kin_cutoff = 6, post_cutoff = 12, ground_shift = 0, speed_gate = 0;
+  double mass = 0, r = 1e4, kin_cutoff = 6, post_cutoff = 12, ground_shift = 0, speed_gate = 2.0;
+  bool paper = false;
   std::optional<double> ground_level;
   int max_gap = 10;
 };
@@ -48,6 +53,7 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a) {
       ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
   c->add_option("--anthropometry", a.anthropometry, "winter or de-leva")->capture_default_str();
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
+  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate");
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
   c->add_option("-o,--output", a.out_mot, "OpenSim GRF .mot output");
   c->add_option("--csv", a.out_csv, "Per-frame CSV output (sagittal frame)");
@@ -64,8 +70,8 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
   o.contact.foot_model = a.foot_model == "cop" ? kin2grf::FootModel::Cop : kin2grf::FootModel::ThreePoint;
   o.contact.ground_shift_m = a.ground_shift;
   o.solver.r_N_per_m = a.r;
-  o.solver.norm = a.norm == "paper" ? kin2grf::MultiplierNorm::Paper : kin2grf::MultiplierNorm::TorqueScaled;
-  o.solver.speed_gate_mps = a.speed_gate;
+  o.solver.norm = (a.paper || a.norm == "paper") ? kin2grf::MultiplierNorm::Paper : kin2grf::MultiplierNorm::TorqueScaled;
+  o.solver.speed_gate_mps = a.paper ? 0.0 : a.speed_gate;
   o.landmarks.max_gap_frames = a.max_gap;
   if (!a.up_axis.empty()) {
     const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(a.up_axis[0])));
@@ -77,8 +83,8 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
 
 nlohmann::json settings_json(const EstimateArgs& a) {
   return {{"trial", a.trial}, {"static", a.static_trial}, {"foot_model", a.foot_model}, {"r_N_per_m", a.r},
-          {"kinematic_cutoff_hz", a.kin_cutoff}, {"post_cutoff_hz", a.post_cutoff}, {"norm", a.norm},
-          {"speed_gate_mps", a.speed_gate}, {"anthropometry", a.anthropometry}, {"ground_shift_m", a.ground_shift},
+          {"kinematic_cutoff_hz", a.kin_cutoff}, {"post_cutoff_hz", a.post_cutoff}, {"norm", a.paper ? std::string("paper") : a.norm},
+          {"speed_gate_mps", a.paper ? 0.0 : a.speed_gate}, {"paper_configuration", a.paper}, {"anthropometry", a.anthropometry}, {"ground_shift_m", a.ground_shift},
           {"ground_level_m", a.ground_level ? nlohmann::json(*a.ground_level) : nlohmann::json("auto")}};
 }
 
@@ -118,6 +124,46 @@ int run_estimate(const EstimateArgs& a) {
   return 0;
 }
 
+/// The bundled example: a synthetic squat on two force plates whose signals are the model's own
+/// ground reactions (written by kin2grf's own C3D, TRC and MOT writers).
+int run_make_example(const std::string& dir, double seconds) {
+  std::filesystem::create_directories(dir);
+  kin2grf::SyntheticOptions so;
+  so.duration_s = seconds;
+  kin2grf::Trial t = kin2grf::make_synthetic_trial(so);
+  const auto* set = kin2grf::find_marker_set("kin2grf-example");
+  kin2grf::EstimateOptions eo;
+  const auto r = kin2grf::estimate(t, nullptr, *set, eo);
+  const auto feet = kin2grf::as_lab_plates(r);
+  kin2grf::ForcePlateRecording rec;
+  rec.rate_hz = t.markers.rate_hz;
+  rec.time_s = t.markers.time_s;
+  for (int side = 0; side < 2; ++side) {
+    kin2grf::ForcePlate p = feet[side];
+    p.name = side ? "FP2" : "FP1";
+    p.type = 2;
+    p.has_geometry = true;
+    const double y0 = side ? 0.0 : -0.5;  // right plate at -Y, left at +Y
+    p.corners_m = {Eigen::Vector3d(0.4, y0 + 0.5, 0), Eigen::Vector3d(-0.2, y0 + 0.5, 0), Eigen::Vector3d(-0.2, y0, 0),
+                   Eigen::Vector3d(0.4, y0, 0)};
+    Eigen::Matrix<double, 3, 4> C;
+    for (int c = 0; c < 4; ++c) C.col(c) = p.corners_m[static_cast<std::size_t>(c)];
+    p.lab_R_plate = kin2grf::plate_axes(C);
+    p.centre_m = C.rowwise().mean();
+    p.origin_m = Eigen::Vector3d(0, 0, -0.04);
+    for (Eigen::Index i = 0; i < p.cop_m.rows(); ++i)
+      if (!p.cop_m.row(i).allFinite()) p.cop_m.row(i) = p.centre_m.transpose();
+    rec.plates.push_back(p);
+  }
+  t.plates = rec;
+  const std::string base = (std::filesystem::path(dir) / "example_squat").string();
+  kin2grf::write_c3d(base + ".c3d", t);
+  kin2grf::write_trc(base + ".trc", t.markers);
+  kin2grf::write_grf_mot(base + "_grf.mot", r);
+  std::cout << "wrote " << base << ".c3d, .trc and _grf.mot\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -139,6 +185,12 @@ int main(int argc, char** argv) {
   auto* estimate = app.add_subcommand("estimate", "Estimate GRF, COP, GRM and joint torques from markers");
   add_estimate_options(estimate, est);
 
+  std::string example_dir = "example";
+  double example_seconds = 3.0;
+  auto* make_example = app.add_subcommand("make-example", "Write the synthetic example trial (C3D with plates, TRC, GRF .mot)");
+  make_example->add_option("--out-dir", example_dir, "Output folder")->capture_default_str();
+  make_example->add_option("--seconds", example_seconds, "Duration, s")->capture_default_str();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -147,6 +199,7 @@ int main(int argc, char** argv) {
   try {
     if (*info) return run_info(info_file, info_json, info_threshold);
     if (*estimate) return run_estimate(est);
+    if (*make_example) return run_make_example(example_dir, example_seconds);
   } catch (const kin2grf::InputError& e) {
     std::cerr << "kin2grf: error: " << e.what() << "\n";
     return 2;

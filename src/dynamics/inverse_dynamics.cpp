@@ -110,8 +110,9 @@ FrameSolution ContactSolver::solve(const Eigen::VectorXd& q, const Eigen::Vector
       const Eigen::VectorXd w = wB.cwiseProduct(BpX.col(0));
       Eigen::JacobiSVD<Eigen::MatrixXd> svd(A3, Eigen::ComputeFullU | Eigen::ComputeFullV);
       const auto& sv = svd.singularValues();
-      const double tol = std::max(A3.rows(), A3.cols()) * std::numeric_limits<double>::epsilon() *
-                         (sv.size() ? sv[0] : 0.0);
+      // Singular values below 1e-8 of the largest count as zero: two contacts whose columns
+      // differ only by round-off (feet at the same place) must not create a force couple.
+      const double tol = 1e-8 * (sv.size() ? sv[0] : 0.0);
       int rank = 0;
       for (Eigen::Index i = 0; i < sv.size(); ++i)
         if (sv[i] > tol) ++rank;

