@@ -343,3 +343,19 @@ TEST(Cli, InfoOnMissingFileNamesIt) {
   while (std::fgets(buf, sizeof buf, pipe.get())) out += buf;
   EXPECT_NE(out.find("/nonexistent/trial.c3d"), std::string::npos) << out;
 }
+
+TEST(C3dShared, UnloadedOffsetRemovalZeroesTheIdlePlates) {
+  KIN2GRF_REQUIRE_DATA();
+  const std::string path = test::data_file("opensim_c3d_overground_walk/walking2.c3d");
+  const Trial raw = read_c3d(path);
+  C3dReadOptions o;
+  o.zero_offset = ZeroOffset::Unloaded;
+  const Trial zeroed = read_c3d(path, o);
+  // README: unloaded plates read about -14 N (FP1) and -20 N (FP2) vertical.
+  EXPECT_LT(raw.plates->plates[0].force_N(0, 2), -10.0);
+  EXPECT_NEAR(zeroed.plates->plates[0].force_N(0, 2), 0.0, 2.0);
+  EXPECT_NEAR(zeroed.plates->plates[1].force_N(0, 2), 0.0, 2.0);
+  // The loaded peak rises by about the offset.
+  const double d = zeroed.plates->plates[0].force_N.col(2).maxCoeff() - raw.plates->plates[0].force_N.col(2).maxCoeff();
+  EXPECT_NEAR(d, 14.0, 3.0);
+}

@@ -17,8 +17,10 @@
 
 namespace {
 
-int run_info(const std::string& file, bool json, double threshold) {
+int run_info(const std::string& file, bool json, double threshold, const std::string& zero) {
   kin2grf::LoadOptions lo;
+  if (zero == "zero") lo.c3d.zero_offset = kin2grf::ZeroOffset::ZeroParameter;
+  if (zero == "unloaded") lo.c3d.zero_offset = kin2grf::ZeroOffset::Unloaded;
   const kin2grf::Trial t = kin2grf::load_trial(file, lo);
   const auto s = kin2grf::trial_summary(t, threshold);
   if (json) std::cout << s.dump(2) << "\n";
@@ -178,6 +180,10 @@ int main(int argc, char** argv) {
   auto* info = app.add_subcommand("info", "Describe a recording (C3D, TRC, MOT/STO) before processing it");
   info->add_option("FILE", info_file, "The recording")->required();
   info->add_flag("--json", info_json, "Write the description as JSON (schema in docs/FORMATS.md)");
+  std::string info_zero = "none";
+  info->add_option("--zero-offset", info_zero,
+                   "C3D plate offsets: none, zero (FORCE_PLATFORM:ZERO frames) or unloaded (median of unloaded samples)")
+      ->check(CLI::IsMember({"none", "zero", "unloaded"}))->capture_default_str();
   info->add_option("--load-threshold", info_threshold, "Vertical force (N) above which a plate counts as loaded")
       ->capture_default_str();
 
@@ -197,7 +203,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   try {
-    if (*info) return run_info(info_file, info_json, info_threshold);
+    if (*info) return run_info(info_file, info_json, info_threshold, info_zero);
     if (*estimate) return run_estimate(est);
     if (*make_example) return run_make_example(example_dir, example_seconds);
   } catch (const kin2grf::InputError& e) {
