@@ -1,5 +1,7 @@
 #include "kin2grf/dynamics/contact.hpp"
 
+#include "kin2grf/numeric.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -125,12 +127,6 @@ std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactMod
 
 namespace kin2grf {
 namespace {
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 double percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
   return v[static_cast<std::size_t>(p * static_cast<double>(v.size() - 1))];
@@ -145,6 +141,8 @@ std::vector<Eigen::Index> flat_frames(const SagittalLandmarks& lm, int side) {
     if (E(i, 1) < te && M(i, 1) < tm) f.push_back(i);
   return f;
 }
+/// Median, 0 for no samples (a foot with no flat frames keeps a neutral calibration).
+double median_or_zero(std::vector<double> v) { return v.empty() ? 0.0 : median(std::move(v)); }
 Eigen::Matrix2d rot2(double a) {
   Eigen::Matrix2d R;
   R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
@@ -175,10 +173,10 @@ std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, 
       cx.push_back(lc.x()); cy.push_back(lc.y());
     }
     auto& fg = model.feet[side];
-    fg.flat_angle_rad = median_of(ang);
-    fg.heel_local = Eigen::Vector2d(median_of(ax), median_of(ay));
-    fg.mt_local = Eigen::Vector2d(median_of(bx), median_of(by));
-    fg.hallux_local = Eigen::Vector2d(median_of(cx), median_of(cy));
+    fg.flat_angle_rad = median_or_zero(ang);
+    fg.heel_local = Eigen::Vector2d(median_or_zero(ax), median_or_zero(ay));
+    fg.mt_local = Eigen::Vector2d(median_or_zero(bx), median_or_zero(by));
+    fg.hallux_local = Eigen::Vector2d(median_or_zero(cx), median_or_zero(cy));
   }
   return counts;
 }
@@ -192,7 +190,7 @@ double estimate_ground_level(const SagittalLandmarks& lm, std::string& message) 
       he.push_back(lm.p[landmark(side, 2)](i, 1));
       hm.push_back(lm.p[landmark(side, 3)](i, 1));
     }
-    lowest = std::min({lowest, median_of(he), median_of(hm)});
+    lowest = std::min({lowest, median_or_zero(he), median_or_zero(hm)});
   }
   if (lowest >= 0.0 && lowest <= 0.15) {
     message = "ground level 0 m (lab floor; lowest flat-stance foot landmark " + std::to_string(lowest * 1000).substr(0, 5) + " mm above it)";

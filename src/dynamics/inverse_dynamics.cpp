@@ -8,7 +8,7 @@
 namespace kin2grf {
 namespace {
 
-constexpr int kRigidRows = 40, kDefRows = 40, kRheoRows = 48, kDStarRows = 56;
+constexpr int kRigidRows = 40, kDefRows = 40, kRheoRows = 48;
 
 }  // namespace
 
@@ -168,7 +168,6 @@ FrameSolution ContactSolver::solve(const Eigen::VectorXd& q, const Eigen::Vector
     if (np == 2) sol.cop_x_m[side] = fc.points[static_cast<std::size_t>(side)].position.x();
     else sol.cop_x_m[side] = std::abs(fy) > 1e-6 ? mx / fy : std::numeric_limits<double>::quiet_NaN();
   }
-  (void)kDStarRows;
   return sol;
 }
 

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/numeric.hpp"
 #include "kin2grf/io/text.hpp"
 
 namespace kin2grf {
@@ -33,13 +34,6 @@ double length_unit_scale_channel(const std::string& unit, std::vector<std::strin
   if (u == "cm") return 1e-2;
   warnings.push_back(plate + ": COP channel '" + label + "' has unit '" + unit + "'; assuming mm");
   return 1e-3;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
 }
 
 struct PlateLoads {

@@ -29,9 +29,9 @@ void run(const Biquad& q, std::vector<double>& x) {
   if (x.empty()) return;
   // Steady state for constant input x0: output x0 (unit DC gain).
   const double x0 = x[0];
-  double z1 = x0 - q.b0 * x0;          // y = b0 x + z1  -> z1 = x0 (1 - b0)
-  double z2 = q.b2 * x0 - q.a2 * x0;   // z1 = b1 x - a1 y + z2 -> z2 from the second state
-  z1 = q.b1 * x0 - q.a1 * x0 + z2;
+  const double z2_0 = (q.b2 - q.a2) * x0;
+  double z2 = z2_0;
+  double z1 = (q.b1 - q.a1) * x0 + z2_0;
   for (double& v : x) {
     const double in = v;
     const double y = q.b0 * in + z1;

@@ -5,17 +5,11 @@
 #include <vector>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/numeric.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 
 namespace kin2grf {
 namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 
 Eigen::Vector2d perp(const Eigen::Vector2d& r) { return Eigen::Vector2d(-r.y(), r.x()); }
 

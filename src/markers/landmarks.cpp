@@ -7,6 +7,7 @@
 #include <set>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/numeric.hpp"
 #include "kin2grf/io/text.hpp"
 
 namespace kin2grf {
@@ -82,13 +83,6 @@ bool cluster_frame(const std::vector<Eigen::MatrixX3d>& c, Eigen::Index i, Eigen
   z.normalize();
   R << a, z.cross(a), z;
   return true;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
 }
 
 }  // namespace
