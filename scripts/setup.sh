@@ -3,7 +3,8 @@
 # Safe to run again: it skips apt when every package is already installed.
 set -euo pipefail
 packages=(cmake make g++ clang libclang-rt-14-dev libeigen3-dev libcli11-dev nlohmann-json3-dev
-          libgtest-dev libgmock-dev libbenchmark-dev)
+          libgtest-dev libgmock-dev libbenchmark-dev
+          libjs-chart.js chromium)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

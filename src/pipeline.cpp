@@ -28,7 +28,8 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   r.first_index = win.first;
   r.first_frame_number = trial.markers.first_frame + static_cast<int>(win.first);
   r.foot_lateral_m = win.foot_lateral_m;
-  const SagittalLandmarks& lm = win.landmarks;
+  r.landmarks = win.landmarks;
+  const SagittalLandmarks& lm = r.landmarks;
   if (2.0 * o.kinematic_cutoff_hz >= lm.rate_hz || 2.0 * o.post_cutoff_hz >= lm.rate_hz)
     throw InputError(trial.path + ": cut-off frequencies must be below half the marker rate (" + std::to_string(lm.rate_hz) + " Hz)");
   r.time_s = lm.time_s;
@@ -98,6 +99,8 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     f.raw_force_N = Eigen::MatrixX2d::Zero(n, 2);
     f.cop_x_m = Eigen::VectorXd::Constant(n, nan);
     f.contact.assign(static_cast<std::size_t>(n), false);
+    f.inclination_rad.resize(n);
+    f.sole_m.resize(n, 6);
     for (Eigen::Index i = 0; i < n; ++i) {
       double mx = 0;
       for (int j = 0; j < np; ++j) {
@@ -110,6 +113,9 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
         mx += lamf(i, 2 * j) * p.position.x();
         if (act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) f.contact[static_cast<std::size_t>(i)] = true;
       }
+      f.inclination_rad[i] = contacts[static_cast<std::size_t>(i)].foot_inclination_rad[static_cast<std::size_t>(side)];
+      const auto sole = sole_points(r.model, motion, i, side);
+      for (int k = 0; k < 3; ++k) f.sole_m.block<1, 2>(i, 2 * k) = sole[static_cast<std::size_t>(k)].transpose();
       if (f.contact[static_cast<std::size_t>(i)]) {
         if (np == 2) f.cop_x_m[i] = contacts[static_cast<std::size_t>(i)].points[static_cast<std::size_t>(side)].position.x();
         else if (std::abs(f.force_N(i, 1)) > 1e-6) f.cop_x_m[i] = mx / f.force_N(i, 1);
@@ -119,6 +125,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   // GRM about the reference point, residual and joint forces.
   r.grm_Nm = Eigen::VectorXd::Zero(n);
   r.residual = Eigen::MatrixX3d::Zero(n, 3);
+  r.kinematic_total = Eigen::MatrixX3d::Zero(n, 3);
   r.joint_force_N = Eigen::MatrixXd::Zero(n, 2 * kJointCount);
   const double g = r.model.gravity_mps2;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -141,6 +148,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
       ext += Eigen::Vector3d(fx, fy, x * fy - y * fx);
     }
     r.residual.row(i) = (kin - ext).transpose();
+    r.kinematic_total.row(i) = kin.transpose();
     for (int j = 0; j < kJointCount; ++j) {
       const int side = j / 4, depth = j % 4;
       Eigen::Vector2d F = Eigen::Vector2d::Zero();

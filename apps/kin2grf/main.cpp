@@ -13,15 +13,21 @@
 #include "kin2grf/io/c3d.hpp"
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/synth/example.hpp"
+#include "kin2grf/output/report.hpp"
+#include "kin2grf/validation/validate.hpp"
 #include <filesystem>
 
 namespace {
 
-int run_info(const std::string& file, bool json, double threshold, const std::string& zero) {
+kin2grf::LoadOptions load_options(const std::string& zero) {
   kin2grf::LoadOptions lo;
   if (zero == "zero") lo.c3d.zero_offset = kin2grf::ZeroOffset::ZeroParameter;
   if (zero == "unloaded") lo.c3d.zero_offset = kin2grf::ZeroOffset::Unloaded;
-  const kin2grf::Trial t = kin2grf::load_trial(file, lo);
+  return lo;
+}
+
+int run_info(const std::string& file, bool json, double threshold, const std::string& zero) {
+  const kin2grf::Trial t = kin2grf::load_trial(file, load_options(zero));
   const auto s = kin2grf::trial_summary(t, threshold);
   if (json) std::cout << s.dump(2) << "\n";
   else std::cout << kin2grf::format_summary(s);
@@ -37,7 +43,7 @@ struct EstimateArgs {
   int max_gap = 10;
 };
 
-void add_estimate_options(CLI::App* c, EstimateArgs& a) {
+void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
   c->add_option("TRIAL", a.trial, "Motion trial (C3D or TRC)")->required();
   c->add_option("--static", a.static_trial, "Static calibration trial (for virtual knee/ankle landmarks)");
   c->add_option("--markers", a.markers, "Marker-set preset name or mapping file (JSON); default: recognised");
@@ -57,6 +63,7 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a) {
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
   c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate");
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
+  if (!outputs) return;
   c->add_option("-o,--output", a.out_mot, "OpenSim GRF .mot output");
   c->add_option("--csv", a.out_csv, "Per-frame CSV output (sagittal frame)");
   c->add_option("--json", a.out_json, "JSON summary output");
@@ -90,39 +97,73 @@ nlohmann::json settings_json(const EstimateArgs& a) {
           {"ground_level_m", a.ground_level ? nlohmann::json(*a.ground_level) : nlohmann::json("auto")}};
 }
 
-int run_estimate(const EstimateArgs& a) {
-  const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
+/// The marker set: --markers (preset name or mapping file), else recognised from the names.
+const kin2grf::MarkerSet& resolve_marker_set(const EstimateArgs& a, const kin2grf::Trial& trial, kin2grf::MarkerSet& custom) {
+  if (!a.markers.empty()) {
+    if (const auto* set = kin2grf::find_marker_set(a.markers)) return *set;
+    custom = kin2grf::load_marker_set(a.markers);
+    return custom;
+  }
+  const auto* set = kin2grf::recognise_marker_set(trial.markers);
+  if (!set) {
+    std::string names;
+    for (const auto& s : kin2grf::builtin_marker_sets()) names += " " + s.name;
+    throw kin2grf::InputError(a.trial + ": marker set not recognised (presets:" + names +
+                              "). Give --markers FILE.json with a rule for each landmark: shoulder, hip, knee_r, "
+                              "ankle_r, heel_r, mt_r, hallux_r and the same _l (see docs/MARKERSETS.md)");
+  }
+  std::cerr << "kin2grf: marker set recognised: " << set->name << "\n";
+  return *set;
+}
+
+kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, const kin2grf::Trial& trial) {
   std::optional<kin2grf::Trial> st;
   if (!a.static_trial.empty()) st = kin2grf::load_trial(a.static_trial);
   kin2grf::MarkerSet custom;
-  const kin2grf::MarkerSet* set = nullptr;
-  if (!a.markers.empty()) {
-    set = kin2grf::find_marker_set(a.markers);
-    if (!set) {
-      custom = kin2grf::load_marker_set(a.markers);
-      set = &custom;
-    }
-  } else {
-    set = kin2grf::recognise_marker_set(trial.markers);
-    if (!set) {
-      std::string names;
-      for (const auto& s : kin2grf::builtin_marker_sets()) names += " " + s.name;
-      throw kin2grf::InputError(a.trial + ": marker set not recognised (presets:" + names +
-                                "). Give --markers FILE.json with a rule for each landmark: shoulder, hip, knee_r, "
-                                "ankle_r, heel_r, mt_r, hallux_r and the same _l (see docs/MARKERSETS.md)");
-    }
-    std::cerr << "kin2grf: marker set recognised: " << set->name << "\n";
-  }
-  const auto r = kin2grf::estimate(trial, st ? &*st : nullptr, *set, to_options(a));
+  const kin2grf::MarkerSet& set = resolve_marker_set(a, trial, custom);
+  auto r = kin2grf::estimate(trial, st ? &*st : nullptr, set, to_options(a));
   for (const auto& m : r.messages) std::cerr << "kin2grf: " << m << "\n";
   std::cerr << "kin2grf: " << r.time_s.size() << " frames, mass " << r.mass_kg << " kg, "
             << static_cast<long>(static_cast<double>(r.time_s.size()) / std::max(1e-9, r.seconds_kinematics + r.seconds_dynamics))
             << " frames/s\n";
+  return r;
+}
+
+int run_estimate(const EstimateArgs& a) {
+  const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
+  const auto r = run_estimate_core(a, trial);
   if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r);
   if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::format_results_csv(r));
   if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::results_summary(r, settings_json(a)).dump(2) + "\n");
   if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty())
     std::cout << kin2grf::results_summary(r, settings_json(a)).dump(2) << "\n";
+  return 0;
+}
+
+struct ValidateArgs {
+  EstimateArgs est;
+  std::string plates, out_json, report, zero_offset = "unloaded";
+  kin2grf::ValidationOptions options;
+};
+
+int run_validate(const ValidateArgs& a) {
+  const kin2grf::Trial trial = kin2grf::load_trial(a.est.trial, load_options(a.zero_offset));
+  std::optional<kin2grf::Trial> plates_file;
+  if (!a.plates.empty()) plates_file = kin2grf::load_trial(a.plates, load_options(a.zero_offset));
+  const kin2grf::Trial& source = plates_file ? *plates_file : trial;
+  if (!source.plates || source.plates->plates.empty())
+    throw kin2grf::InputError(source.path + ": no force plates to validate against" +
+                              (plates_file ? std::string() : std::string("; give --plates GRF.mot")));
+  const auto r = run_estimate_core(a.est, trial);
+  const auto v = kin2grf::validate(r, *source.plates, a.options);
+  nlohmann::json settings = settings_json(a.est);
+  settings["plates"] = source.path;
+  settings["threshold_N"] = a.options.threshold_N;
+  settings["zero_offset"] = a.zero_offset;
+  std::cout << kin2grf::format_validation_table(a.est.trial, v);
+  const auto j = kin2grf::validation_json(a.est.trial, r, v, settings);
+  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, j.dump(2) + "\n");
+  if (!a.report.empty()) kin2grf::write_file_text(a.report, kin2grf::validation_report_html(a.est.trial, r, v, j));
   return 0;
 }
 
@@ -191,6 +232,16 @@ int main(int argc, char** argv) {
   auto* estimate = app.add_subcommand("estimate", "Estimate GRF, COP, GRM and joint torques from markers");
   add_estimate_options(estimate, est);
 
+  ValidateArgs val;
+  auto* validate = app.add_subcommand("validate", "Estimate, then compare with the trial's force plates (paper's Eqs. 11-12)");
+  add_estimate_options(validate, val.est, false);
+  validate->add_option("--plates", val.plates, "Measured forces from this file (GRF .mot/.sto or C3D) instead of the trial's plates");
+  validate->add_option("--json", val.out_json, "Validation results as JSON (schema in docs/FORMATS.md)");
+  validate->add_option("--report", val.report, "Self-contained HTML report with plots");
+  validate->add_option("--threshold", val.options.threshold_N, "Stance: measured vertical force above this, N")->capture_default_str();
+  validate->add_option("--zero-offset", val.zero_offset, "C3D plate offsets: none, zero or unloaded")
+      ->check(CLI::IsMember({"none", "zero", "unloaded"}))->capture_default_str();
+
   std::string example_dir = "example";
   double example_seconds = 3.0;
   auto* make_example = app.add_subcommand("make-example", "Write the synthetic example trial (C3D with plates, TRC, GRF .mot)");
@@ -205,6 +256,7 @@ int main(int argc, char** argv) {
   try {
     if (*info) return run_info(info_file, info_json, info_threshold, info_zero);
     if (*estimate) return run_estimate(est);
+    if (*validate) return run_validate(val);
     if (*make_example) return run_make_example(example_dir, example_seconds);
   } catch (const kin2grf::InputError& e) {
     std::cerr << "kin2grf: error: " << e.what() << "\n";

@@ -34,6 +34,8 @@ struct FootResult {
   Eigen::MatrixX2d raw_force_N;  ///< before the post-filter
   Eigen::VectorXd cop_x_m;       ///< along progression; NaN when inactive
   std::vector<bool> contact;
+  Eigen::VectorXd inclination_rad;  ///< theta_A, the paper's foot inclination (contact.hpp)
+  Eigen::MatrixXd sole_m;           ///< N x 6: sole points A, B, C (x, y) in the sagittal frame
 };
 
 struct EstimateResult {
@@ -53,6 +55,10 @@ struct EstimateResult {
   std::vector<int> iterations;
   int cycled_frames = 0, capped_frames = 0;
   std::array<Eigen::VectorXd, 2> foot_lateral_m;
+  SagittalLandmarks landmarks;     ///< the processed window's landmarks (sagittal frame)
+  /// Rigid-body totals from the kinematics alone, N x 3: sum m (a + g) (x, y, N) and the sum of
+  /// moments about the origin (N m). What all external forces together must equal.
+  Eigen::MatrixX3d kinematic_total;
   std::vector<std::string> messages;
   double seconds_kinematics = 0, seconds_dynamics = 0;
 };

@@ -1,0 +1,125 @@
+// kin2grf validation: an estimate against the force plates of the same trial (paper Sect. 3).
+//
+// 1. Measured plates -> marker frames (resample_plates). Each marker frame i averages the plate
+//    samples within half a frame period of its time, force and moment alike; the COP is then
+//    recomputed from the averaged force and moment (averaging COPs would weight unloaded
+//    samples like loaded ones). Everything goes to the estimate's sagittal frame:
+//      F_x = F . forward, F_y = F . up, m_O = M_O . lateral = x F_y - y F_x  (moment about the
+//    lab origin; a plate's free moment is vertical and drops out of the sagittal moment).
+// 2. Stances: runs of frames where a plate's vertical force exceeds the threshold (20 N).
+// 3. Plate-to-foot assignment by distance, not by name: the median over the stance of the
+//    horizontal distance from the measured COP to the foot's heel-hallux segment (lateral
+//    position of the foot from the landmarks). The nearer foot takes the stance if it is within
+//    max_assign_distance_m. Excluded, with a reason: a stance cut by the processed window's ends;
+//    a plate also under the other foot (a sole point of the other foot at ground level, still,
+//    over the plate: a swinging foot's toes skim plates); a foot partly off its plate (a sole
+//    point at ground level more than edge_margin_m outside the plate's edges); a foot on two
+//    plates at once. Without plate geometry (GRF .mot) the last three
+//    cannot be checked, which is said in `notes`.
+// 4. Per stance: vertical and anterior GRF, COP along progression (frames loaded above
+//    cop_min_force_fraction of body weight: a barely loaded plate's COP is noise), and the
+//    sagittal moment about the plate centre (without geometry: about the stance's mean
+//    measured COP). Contact onset/offset: threshold crossings, interpolated, estimate - plate.
+// 5. Total: frames where every plate in use belongs to a kept stance and the plates carry the
+//    whole body (median |sum of plate F_y - sum m (a_y + g)| < 15 % of body weight over each run
+//    of frames with the same plates loaded, sum m(a+g) from the kinematics alone), i.e. every
+//    loaded foot is on a plate. Vertical, anterior and the GRM about the midpoint of the plate
+//    centres in use (without geometry: the mean measured COP over those frames, the belt's
+//    centre on a treadmill).
+#pragma once
+
+#include <Eigen/Dense>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kin2grf/io/trial.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/validation/metrics.hpp"
+
+namespace kin2grf {
+
+/// One plate resampled to the estimate's frames, sagittal frame, SI units.
+struct MeasuredPlate {
+  std::string name;
+  Side side_hint = Side::General;
+  bool has_geometry = false;
+  Eigen::MatrixX2d force_N;        ///< (anterior, vertical); NaN outside the plate recording
+  Eigen::VectorXd moment_origin_Nm;///< sagittal moment about the lab origin
+  Eigen::VectorXd cop_x_m;         ///< NaN where the vertical force is below cop_threshold_N
+  Eigen::VectorXd cop_lateral_m;
+  double surface_y_m = 0.0;        ///< plate surface height in the sagittal frame
+  Eigen::Vector2d centre_m = Eigen::Vector2d::Zero();  ///< (x, lateral) of the surface centre
+  double x_min = 0, x_max = 0, lateral_min = 0, lateral_max = 0;  ///< extent (with geometry)
+};
+
+std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const SagittalFrame& frame,
+                                           const Eigen::VectorXd& frame_time_s, double cop_threshold_N);
+
+struct ValidationOptions {
+  double threshold_N = 20.0;               ///< stance: measured vertical force above this
+  double cop_min_force_fraction = 0.05;    ///< COP compared where vertical > this x body weight
+  double max_assign_distance_m = 0.15;     ///< COP to foot distance for an assignment
+  double ground_contact_height_m = 0.02;   ///< a sole point this close to the ground touches it
+  /// A sole point may lie this far outside a plate edge before the foot counts as partly off:
+  /// A and B are under the heel and MT markers, a few cm behind and beside the loaded area.
+  double edge_margin_m = 0.03;
+  double still_speed_mps = 0.3;            ///< the other foot stands on a plate only when this still
+  double total_mismatch_fraction = 0.15;   ///< of body weight (step 5)
+};
+
+struct ComponentMetrics {
+  std::optional<SeriesMetrics> vertical, anterior, cop, moment;
+};
+
+struct StanceValidation {
+  int foot = 0;                 ///< 0 right, 1 left
+  std::string plate;
+  Eigen::Index first = 0, last = 0;  ///< frames in the estimate's window (inclusive)
+  double assign_distance_m = 0.0;
+  ComponentMetrics metrics;
+  std::optional<double> onset_error_ms, offset_error_ms;  ///< estimate - plate; + = late
+  Eigen::Vector2d moment_reference_m = Eigen::Vector2d::Zero();
+};
+
+struct TotalValidation {
+  std::vector<Eigen::Index> frames;   ///< frames compared (estimate's window)
+  Eigen::Vector2d grm_reference_m = Eigen::Vector2d::Zero();
+  ComponentMetrics metrics;           ///< vertical, anterior, moment = GRM
+  Eigen::VectorXd grm_estimated_Nm, grm_measured_Nm;  ///< over all frames (NaN outside `frames`)
+  Eigen::VectorXd vertical_estimated_N, vertical_measured_N;  ///< likewise
+};
+
+struct ValidationResult {
+  double mass_kg = 0.0;
+  int first_frame_number = 1;  ///< file frame number of the estimate's first frame
+  std::vector<MeasuredPlate> plates;
+  std::vector<StanceValidation> stances;
+  std::optional<TotalValidation> total;
+  std::vector<std::string> excluded;  ///< one reason per excluded stance or window
+  std::vector<std::string> notes;
+  /// Per-frame measured per-foot series (sum of the foot's kept stances; NaN elsewhere).
+  std::array<Eigen::MatrixX2d, 2> measured_force_N;
+  std::array<Eigen::VectorXd, 2> measured_cop_x_m;
+};
+
+ValidationResult validate(const EstimateResult& estimate, const ForcePlateRecording& plates,
+                          const ValidationOptions& options = {});
+
+/// Mean (and SD) over the stances of each component's rRMSE, per foot or all.
+struct MeanMetrics {
+  int n = 0;
+  double vertical = 0, anterior = 0, cop = 0, moment = 0;
+  double vertical_sd = 0, anterior_sd = 0, cop_sd = 0, moment_sd = 0;
+};
+MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot = -1);
+
+/// The `--json` document (schema in docs/FORMATS.md, "validate").
+nlohmann::json validation_json(const std::string& trial, const EstimateResult& e, const ValidationResult& v,
+                               const nlohmann::json& settings);
+
+/// Plain-text table in the layout of the paper's Table 1 (rRMSE %, mean (SD)).
+std::string format_validation_table(const std::string& trial, const ValidationResult& v);
+
+}  // namespace kin2grf

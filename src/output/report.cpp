@@ -1,0 +1,196 @@
+#include "kin2grf/output/report.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace kin2grf {
+
+std::string html_escape(const std::string& s) {
+  std::string o;
+  o.reserve(s.size());
+  for (char c : s) {
+    switch (c) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += c;
+    }
+  }
+  return o;
+}
+
+namespace {
+
+// JSON inside <script>: "</" would close the element.
+std::string script_safe(std::string s) {
+  for (std::size_t p = 0; (p = s.find("</", p)) != std::string::npos; p += 3) s.replace(p, 2, "<\\/");
+  return s;
+}
+
+const char* kScript = R"js(
+const figs = JSON.parse(document.getElementById('kin2grf-data').textContent);
+const shade = {id: 'shade', beforeDatasetsDraw(chart, args, opts) {
+  const {ctx, chartArea: a, scales: {x}} = chart;
+  ctx.save(); ctx.fillStyle = 'rgba(110,110,110,0.13)';
+  for (const [s, e] of (opts.intervals || [])) {
+    const x0 = Math.max(a.left, x.getPixelForValue(s)), x1 = Math.min(a.right, x.getPixelForValue(e));
+    if (x1 > x0) ctx.fillRect(x0, a.top, x1 - x0, a.bottom - a.top);
+  }
+  ctx.restore();
+}};
+const colors = ['#d62728', '#1f77b4', '#2ca02c', '#9467bd', '#ff7f0e', '#8c564b', '#e377c2'];
+let rendered = 0, points = 0;
+figs.forEach((f, i) => {
+  let c = 0;
+  const datasets = f.series.map(s => {
+    points += s.x.length;
+    return {label: s.label, data: s.x.map((x, k) => ({x: x, y: s.y[k]})),
+            borderColor: s.measured ? '#000' : colors[c++ % colors.length],
+            borderWidth: s.measured ? 2 : 1.5, pointRadius: f.log_x ? 3 : 0, spanGaps: false};
+  });
+  new Chart(document.getElementById('fig' + i), {type: 'line', data: {datasets: datasets},
+    options: {animation: false, responsive: true, maintainAspectRatio: false, parsing: true,
+      plugins: {title: {display: true, text: f.title}, shade: {intervals: f.shaded}, legend: {position: 'bottom'}},
+      scales: {x: {type: f.log_x ? 'logarithmic' : 'linear', title: {display: true, text: f.x_label}},
+               y: {title: {display: true, text: f.y_label}}}},
+    plugins: [shade]});
+  rendered++;
+});
+document.body.dataset.chartsRendered = String(rendered);
+document.body.dataset.points = String(points);
+)js";
+
+const char* kStyle = R"css(
+body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; }
+table { border-collapse: collapse; margin: 0.6em 0 1.2em; font-size: 0.9em; }
+td, th { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: right; }
+th { background: #f2f2f2; } td.l, th.l { text-align: left; }
+.fig { height: 300px; max-width: 1100px; margin-bottom: 1.2em; }
+pre { background: #f7f7f7; padding: 0.6em; font-size: 0.85em; overflow-x: auto; }
+)css";
+
+}  // namespace
+
+std::string render_report_html(const Report& r) {
+  nlohmann::json figs = nlohmann::json::array();
+  for (const auto& f : r.figures) {
+    nlohmann::json jf = {{"title", f.title}, {"x_label", f.x_label}, {"y_label", f.y_label}, {"log_x", f.log_x}};
+    jf["shaded"] = nlohmann::json::array();
+    for (const auto& [a, b] : f.shaded) jf["shaded"].push_back({a, b});
+    jf["series"] = nlohmann::json::array();
+    for (const auto& s : f.series) {
+      nlohmann::json y = nlohmann::json::array();
+      for (double v : s.y) y.push_back(std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr));
+      jf["series"].push_back({{"label", s.label}, {"x", s.x}, {"y", y}, {"measured", s.measured}});
+    }
+    figs.push_back(jf);
+  }
+  std::ostringstream os;
+  os << "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" << html_escape(r.title)
+     << "</title>\n<style>" << kStyle << "</style>\n<script>" << chartjs_source() << "</script>\n</head>\n<body>\n<h1>"
+     << html_escape(r.title) << "</h1>\n";
+  for (const auto& s : r.sections_html) os << s << "\n";
+  for (std::size_t i = 0; i < r.figures.size(); ++i) os << "<div class=\"fig\"><canvas id=\"fig" << i << "\"></canvas></div>\n";
+  os << "<script id=\"kin2grf-data\" type=\"application/json\">" << script_safe(figs.dump()) << "</script>\n<script>" << kScript
+     << "</script>\n<p><small>Made by kin2grf " << KIN2GRF_VERSION << "; plots drawn with Chart.js (MIT licence).</small></p>\n"
+     << "</body></html>\n";
+  return os.str();
+}
+
+namespace {
+
+std::string fmt(const nlohmann::json& x, const char* f = "%.1f") {
+  if (!x.is_number()) return "-";
+  char b[32];
+  std::snprintf(b, sizeof b, f, x.get<double>());
+  return b;
+}
+
+std::vector<double> to_vec(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
+
+}  // namespace
+
+std::string validation_report_html(const std::string& trial, const EstimateResult& e, const ValidationResult& v,
+                                   const nlohmann::json& j) {
+  Report rep;
+  rep.title = "kin2grf validation: " + trial;
+  std::ostringstream t;
+  t << "<h2>Errors against the force plates</h2>\n<p>rRMSE and RMSE as in the paper's Eqs. 11-12, per plate stance "
+       "(measured vertical force above the threshold) and in total where every loaded foot stands on a plate. "
+       "COP compared where the plate carries at least 5 % of body weight; moment about the plate centre (total: GRM about "
+       "the midpoint of the plates in use). Timing: estimate minus plate, + = late.</p>\n";
+  t << "<table><tr><th class=l>foot</th><th class=l>plate</th><th>frames</th><th>vertical rRMSE %</th><th>anterior rRMSE %</th>"
+       "<th>COP rRMSE %</th><th>moment rRMSE %</th><th>vertical RMSE N</th><th>anterior RMSE N</th><th>COP RMSE mm</th>"
+       "<th>vertical r</th><th>onset ms</th><th>offset ms</th></tr>\n";
+  for (const auto& s : j["per_foot"]) {
+    t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>())
+      << "</td><td>" << s["frames"][0] << "-" << s["frames"][1] << "</td><td>" << fmt(s["rrmse_percent"]["vertical"]) << "</td><td>"
+      << fmt(s["rrmse_percent"]["anterior"]) << "</td><td>" << fmt(s["rrmse_percent"]["cop"]) << "</td><td>"
+      << fmt(s["rrmse_percent"]["moment"]) << "</td><td>" << fmt(s["rmse"]["vertical_N"]) << "</td><td>"
+      << fmt(s["rmse"]["anterior_N"]) << "</td><td>" << fmt(s["rmse"]["cop_mm"]) << "</td><td>" << fmt(s["r"]["vertical"], "%.3f")
+      << "</td><td>" << fmt(s["timing_ms"]["onset"], "%.0f") << "</td><td>" << fmt(s["timing_ms"]["offset"], "%.0f") << "</td></tr>\n";
+  }
+  if (!j["total"].is_null()) {
+    const auto& s = j["total"];
+    t << "<tr><td class=l>total</td><td class=l>GRM</td><td>" << s["frames_compared"] << " frames</td><td>"
+      << fmt(s["rrmse_percent"]["vertical"]) << "</td><td>" << fmt(s["rrmse_percent"]["anterior"]) << "</td><td>-</td><td>"
+      << fmt(s["rrmse_percent"]["moment"]) << "</td><td>" << fmt(s["rmse"]["vertical_N"]) << "</td><td>"
+      << fmt(s["rmse"]["anterior_N"]) << "</td><td>-</td><td>" << fmt(s["r"]["vertical"], "%.3f") << "</td><td></td><td></td></tr>\n";
+  }
+  t << "<tr><td class=l colspan=3>paper, Table 1 (24 gait trials)</td><td>4.1 (1.1)</td><td>11.2 (1.7)</td><td>-</td>"
+       "<td>5.3 (1.1)</td><td colspan=6></td></tr>\n</table>\n";
+  if (!v.excluded.empty() || !v.notes.empty()) {
+    t << "<h3>Excluded and notes</h3><ul>\n";
+    for (const auto& x : v.excluded) t << "<li>excluded: " << html_escape(x) << "</li>\n";
+    for (const auto& x : v.notes) t << "<li>note: " << html_escape(x) << "</li>\n";
+    t << "</ul>\n";
+  }
+  rep.sections_html.push_back(t.str());
+
+  const std::vector<double> time = to_vec(e.time_s);
+  for (int f = 0; f < 2; ++f) {
+    const std::string foot = f ? "left" : "right";
+    std::vector<std::pair<double, double>> shaded;
+    for (const auto& s : v.stances)
+      if (s.foot == f) shaded.emplace_back(e.time_s[s.first], e.time_s[s.last]);
+    const auto& fe = e.feet[static_cast<std::size_t>(f)];
+    const auto& mf = v.measured_force_N[static_cast<std::size_t>(f)];
+    auto fig = [&](const std::string& what, const std::string& unit, const Eigen::VectorXd& est, const Eigen::VectorXd& meas) {
+      ReportFigure g;
+      g.title = foot + " foot: " + what + " (shaded: plate stances compared)";
+      g.x_label = "time (s)";
+      g.y_label = unit;
+      g.shaded = shaded;
+      g.series.push_back({"force plate", time, to_vec(meas), true});
+      g.series.push_back({"kin2grf estimate", time, to_vec(est), false});
+      rep.figures.push_back(g);
+    };
+    fig("vertical GRF", "N", fe.force_N.col(1), mf.col(1));
+    fig("anterior GRF", "N", fe.force_N.col(0), mf.col(0));
+    fig("COP along progression", "m", fe.cop_x_m, v.measured_cop_x_m[static_cast<std::size_t>(f)]);
+  }
+  if (v.total) {
+    ReportFigure g;
+    g.title = "total vertical GRF (frames where every loaded foot is on a plate)";
+    g.x_label = "time (s)";
+    g.y_label = "N";
+    g.series.push_back({"force plates", time, to_vec(v.total->vertical_measured_N), true});
+    g.series.push_back({"kin2grf estimate", time, to_vec(v.total->vertical_estimated_N), false});
+    rep.figures.push_back(g);
+    ReportFigure m;
+    char b[96];
+    std::snprintf(b, sizeof b, "sagittal GRM about x = %.3f m, y = %.3f m", v.total->grm_reference_m.x(), v.total->grm_reference_m.y());
+    m.title = b;
+    m.x_label = "time (s)";
+    m.y_label = "N m";
+    m.series.push_back({"force plates", time, to_vec(v.total->grm_measured_Nm), true});
+    m.series.push_back({"kin2grf estimate", time, to_vec(v.total->grm_estimated_Nm), false});
+    rep.figures.push_back(m);
+  }
+  rep.sections_html.push_back("<h2>Settings</h2><pre>" + html_escape(j["settings"].dump(2)) + "</pre>");
+  return render_report_html(rep);
+}
+
+}  // namespace kin2grf

@@ -1,0 +1,530 @@
+#include "kin2grf/validation/validate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "kin2grf/numeric.hpp"
+
+namespace kin2grf {
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct Run {
+  Eigen::Index first, last;
+};
+
+std::vector<Run> runs_above(const Eigen::VectorXd& v, double thr) {
+  std::vector<Run> out;
+  Eigen::Index start = -1;
+  for (Eigen::Index i = 0; i <= v.size(); ++i) {
+    const bool on = i < v.size() && std::isfinite(v[i]) && v[i] > thr;
+    if (on && start < 0) start = i;
+    if (!on && start >= 0) {
+      out.push_back({start, i - 1});
+      start = -1;
+    }
+  }
+  return out;
+}
+
+std::string side_name(int foot) { return foot ? "left" : "right"; }
+
+std::string frames_text(const EstimateResult& e, Eigen::Index a, Eigen::Index b) {
+  return "frames " + std::to_string(e.first_frame_number + a) + "-" + std::to_string(e.first_frame_number + b);
+}
+
+double mean_finite(const Eigen::VectorXd& v) {
+  double s = 0;
+  int k = 0;
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (std::isfinite(v[i])) s += v[i], ++k;
+  return k ? s / k : kNaN;
+}
+
+}  // namespace
+
+std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const SagittalFrame& fr,
+                                           const Eigen::VectorXd& t, double cop_threshold_N) {
+  std::vector<MeasuredPlate> out;
+  const Eigen::Index n = t.size();
+  const double dt = n > 1 ? (t[n - 1] - t[0]) / static_cast<double>(n - 1) : 1.0;
+  const Eigen::Index ns = rec.samples();
+  for (const ForcePlate& p : rec.plates) {
+    MeasuredPlate m;
+    m.name = p.name;
+    m.side_hint = p.side_hint;
+    m.has_geometry = p.has_geometry;
+    m.force_N = Eigen::MatrixX2d::Constant(n, 2, kNaN);
+    m.moment_origin_Nm = Eigen::VectorXd::Constant(n, kNaN);
+    m.cop_x_m = Eigen::VectorXd::Constant(n, kNaN);
+    m.cop_lateral_m = Eigen::VectorXd::Constant(n, kNaN);
+    if (p.has_geometry) {
+      m.surface_y_m = p.centre_m.dot(fr.up);
+      m.centre_m = {p.centre_m.dot(fr.forward), p.centre_m.dot(fr.lateral)};
+      m.x_min = m.lateral_min = std::numeric_limits<double>::infinity();
+      m.x_max = m.lateral_max = -m.x_min;
+      for (const auto& c : p.corners_m) {
+        m.x_min = std::min(m.x_min, c.dot(fr.forward)), m.x_max = std::max(m.x_max, c.dot(fr.forward));
+        m.lateral_min = std::min(m.lateral_min, c.dot(fr.lateral)), m.lateral_max = std::max(m.lateral_max, c.dot(fr.lateral));
+      }
+    } else {
+      std::vector<double> h;
+      for (Eigen::Index k = 0; k < ns; ++k)
+        if (p.cop_m.row(k).allFinite() && std::abs(p.force_N.row(k).dot(fr.up.transpose())) > cop_threshold_N)
+          h.push_back(p.cop_m.row(k).dot(fr.up.transpose()));
+      m.surface_y_m = h.empty() ? 0.0 : median(h);
+    }
+    // Per sample: force and the 3D moment about the lab origin, both in the lab frame.
+    auto sample = [&](Eigen::Index k, Eigen::Vector3d& F, Eigen::Vector3d& M, bool& has_cop) {
+      F = p.force_N.row(k).transpose();
+      has_cop = p.cop_m.row(k).allFinite();
+      if (p.has_geometry && p.moment_centre_Nm.row(k).allFinite()) {
+        M = p.moment_centre_Nm.row(k).transpose() + p.centre_m.cross(F);
+      } else if (has_cop) {
+        Eigen::Vector3d T = p.free_moment_Nm.row(k).transpose();
+        if (!T.allFinite()) T.setZero();
+        M = Eigen::Vector3d(p.cop_m.row(k).transpose()).cross(F) + T;
+      } else {
+        M.setZero();  // below the COP threshold: a few newtons at most
+      }
+    };
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double lo = (t[i] - 0.5 * dt - rec.time_s[0]) * rec.rate_hz;
+      const double hi = (t[i] + 0.5 * dt - rec.time_s[0]) * rec.rate_hz;
+      Eigen::Index k0 = static_cast<Eigen::Index>(std::ceil(lo - 1e-6));
+      Eigen::Index k1 = static_cast<Eigen::Index>(std::ceil(hi - 1e-6)) - 1;
+      k0 = std::max<Eigen::Index>(k0, 0);
+      k1 = std::min<Eigen::Index>(k1, ns - 1);
+      if (k1 < k0) continue;
+      Eigen::Vector3d Fs = Eigen::Vector3d::Zero(), Ms = Eigen::Vector3d::Zero();
+      double lat = 0, wlat = 0;
+      for (Eigen::Index k = k0; k <= k1; ++k) {
+        Eigen::Vector3d F, M;
+        bool has_cop = false;
+        sample(k, F, M, has_cop);
+        if (!F.allFinite() || !M.allFinite()) continue;
+        Fs += F, Ms += M;
+        if (has_cop) {
+          const double w = std::abs(F.dot(fr.up));
+          lat += w * p.cop_m.row(k).dot(fr.lateral.transpose()), wlat += w;
+        }
+      }
+      const double cnt = static_cast<double>(k1 - k0 + 1);
+      Fs /= cnt, Ms /= cnt;
+      const double fx = Fs.dot(fr.forward), fy = Fs.dot(fr.up);
+      m.force_N(i, 0) = fx;
+      m.force_N(i, 1) = fy;
+      m.moment_origin_Nm[i] = Ms.dot(fr.lateral);
+      if (fy > cop_threshold_N) {
+        m.cop_x_m[i] = (m.moment_origin_Nm[i] + m.surface_y_m * fx) / fy;  // x F_y - y F_x = m_O
+        if (wlat > 0) m.cop_lateral_m[i] = lat / wlat;
+      }
+    }
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& rec, const ValidationOptions& o) {
+  ValidationResult v;
+  v.mass_kg = e.mass_kg;
+  v.first_frame_number = e.first_frame_number;
+  const double bw = e.mass_kg * e.model.gravity_mps2;
+  const Eigen::Index n = e.time_s.size();
+  v.plates = resample_plates(rec, e.frame, e.time_s, 10.0);
+  const double rate = e.landmarks.rate_hz;
+  const Eigen::Index search = static_cast<Eigen::Index>(std::lround(0.2 * rate));
+  const double ground = e.ground_level_m;
+  for (int f = 0; f < 2; ++f) {
+    v.measured_force_N[static_cast<std::size_t>(f)] = Eigen::MatrixX2d::Constant(n, 2, kNaN);
+    v.measured_cop_x_m[static_cast<std::size_t>(f)] = Eigen::VectorXd::Constant(n, kNaN);
+  }
+  bool noted_geometry = false;
+
+  struct Candidate {
+    int plate;
+    Run run;
+    int foot;
+    double distance;
+    bool kept;
+  };
+  std::vector<Candidate> cands;
+  for (int pi = 0; pi < static_cast<int>(v.plates.size()); ++pi) {
+    const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(pi)];
+    for (const Run& run : runs_above(mp.force_N.col(1), o.threshold_N)) {
+      const std::string where = "plate " + mp.name + " " + frames_text(e, run.first, run.last);
+      if (run.last - run.first < 2) continue;  // a blip, not a stance
+      if (run.first == 0 || run.last == n - 1) {
+        v.excluded.push_back(where + ": stance cut by the processed window's ends");
+        continue;
+      }
+      std::array<double, 2> dist{};
+      for (int f = 0; f < 2; ++f) {
+        std::vector<double> d;
+        const int heel = f ? kHeelL : kHeelR, hal = f ? kHalluxL : kHalluxR;
+        for (Eigen::Index i = run.first; i <= run.last; ++i) {
+          if (!std::isfinite(mp.cop_x_m[i])) continue;
+          const double xa = e.landmarks.p[heel](i, 0), xb = e.landmarks.p[hal](i, 0);
+          const double dx = std::max({0.0, std::min(xa, xb) - mp.cop_x_m[i], mp.cop_x_m[i] - std::max(xa, xb)});
+          const double dl = std::isfinite(mp.cop_lateral_m[i]) ? mp.cop_lateral_m[i] - e.foot_lateral_m[f][i] : 0.0;
+          d.push_back(std::hypot(dx, dl));
+        }
+        dist[static_cast<std::size_t>(f)] = d.empty() ? std::numeric_limits<double>::infinity() : median(d);
+      }
+      const int foot = dist[1] < dist[0] ? 1 : 0;
+      char buf[160];
+      if (!(dist[static_cast<std::size_t>(foot)] <= o.max_assign_distance_m)) {
+        std::snprintf(buf, sizeof buf, ": the COP is %.0f mm from the nearest foot (limit %.0f mm); not assigned",
+                      1000 * dist[static_cast<std::size_t>(foot)], 1000 * o.max_assign_distance_m);
+        v.excluded.push_back(where + buf);
+        continue;
+      }
+      if (mp.side_hint != Side::General && (mp.side_hint == Side::Left) != (foot == 1))
+        v.notes.push_back(where + ": assigned to the " + side_name(foot) + " foot by distance; its column names say " +
+                          to_string(mp.side_hint));
+      bool kept = true;
+      if (mp.has_geometry) {
+        // Sole points at ground level over (other foot) or outside (this foot) the plate.
+        auto count = [&](int f, bool outside) {
+          int k = 0;
+          for (Eigen::Index i = run.first; i <= run.last; ++i) {
+            const double lat = e.foot_lateral_m[f][i];
+            const bool lat_in = lat >= mp.lateral_min && lat <= mp.lateral_max;
+            bool hit = false;
+            for (int s = 0; s < 3; ++s) {
+              const double x = e.feet[static_cast<std::size_t>(f)].sole_m(i, 2 * s);
+              const double y = e.feet[static_cast<std::size_t>(f)].sole_m(i, 2 * s + 1);
+              if (y - ground > o.ground_contact_height_m) continue;
+              const double margin = outside ? o.edge_margin_m : 0.0;
+              const bool x_in = x >= mp.x_min - margin && x <= mp.x_max + margin;
+              // The other foot counts only when standing still: a swinging foot's toes skim the plate.
+              if (!outside) {
+                const Eigen::Index i0 = std::max<Eigen::Index>(i - 1, 0), i1 = std::min<Eigen::Index>(i + 1, n - 1);
+                const auto& sm = e.feet[static_cast<std::size_t>(f)].sole_m;
+                const double vx = (sm(i1, 2 * s) - sm(i0, 2 * s)) * rate / static_cast<double>(i1 - i0);
+                if (std::abs(vx - e.frame.belt_velocity_mps) > o.still_speed_mps) continue;
+              }
+              const bool h = outside ? !(x_in && lat_in) : (x_in && lat_in);
+              hit = hit || h;
+            }
+            k += hit;
+          }
+          return k;
+        };
+        const int other = count(1 - foot, false), off = count(foot, true);
+        if (other >= 3) {
+          v.excluded.push_back(where + ": the " + side_name(1 - foot) + " foot also stands on this plate (" +
+                               std::to_string(other) + " frames)");
+          kept = false;
+        } else if (off >= 3) {
+          v.excluded.push_back(where + ": the " + side_name(foot) + " foot is partly off the plate (" + std::to_string(off) +
+                               " frames with a sole point on the ground outside its edges)");
+          kept = false;
+        }
+      } else if (!noted_geometry) {
+        v.notes.push_back("plates without geometry (GRF .mot): a foot partly off a plate or two feet on one plate cannot be checked");
+        noted_geometry = true;
+      }
+      cands.push_back({pi, run, foot, dist[static_cast<std::size_t>(foot)], kept});
+    }
+  }
+  // A foot on two plates at once.
+  for (std::size_t a = 0; a < cands.size(); ++a)
+    for (std::size_t b = a + 1; b < cands.size(); ++b) {
+      Candidate &ca = cands[a], &cb = cands[b];
+      if (ca.foot != cb.foot || ca.plate == cb.plate) continue;
+      if (ca.run.last < cb.run.first || cb.run.last < ca.run.first) continue;
+      if (ca.kept || cb.kept)
+        v.excluded.push_back("the " + side_name(ca.foot) + " foot stands on plates " + v.plates[static_cast<std::size_t>(ca.plate)].name +
+                             " and " + v.plates[static_cast<std::size_t>(cb.plate)].name + " at once (" +
+                             frames_text(e, std::max(ca.run.first, cb.run.first), std::min(ca.run.last, cb.run.last)) + ")");
+      ca.kept = cb.kept = false;
+    }
+
+  for (const Candidate& c : cands) {
+    if (!c.kept) continue;
+    const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(c.plate)];
+    const FootResult& fe = e.feet[static_cast<std::size_t>(c.foot)];
+    const Eigen::Index a = c.run.first, len = c.run.last - c.run.first + 1;
+    StanceValidation s;
+    s.foot = c.foot;
+    s.plate = mp.name;
+    s.first = c.run.first;
+    s.last = c.run.last;
+    s.assign_distance_m = c.distance;
+    const Eigen::VectorXd mv = mp.force_N.col(1).segment(a, len), ma = mp.force_N.col(0).segment(a, len);
+    s.metrics.vertical = compare_series(fe.force_N.col(1).segment(a, len), mv);
+    s.metrics.anterior = compare_series(fe.force_N.col(0).segment(a, len), ma);
+    Eigen::VectorXd mc = mp.cop_x_m.segment(a, len);
+    for (Eigen::Index i = 0; i < len; ++i)
+      if (!(mv[i] > o.cop_min_force_fraction * bw)) mc[i] = kNaN;
+    s.metrics.cop = compare_series(fe.cop_x_m.segment(a, len), mc);
+    s.moment_reference_m = {mp.has_geometry ? mp.centre_m.x() : mean_finite(mc), mp.surface_y_m};
+    const double rx = s.moment_reference_m.x(), ry = s.moment_reference_m.y();
+    Eigen::VectorXd me(len), mm(len);
+    for (Eigen::Index i = 0; i < len; ++i) {
+      const Eigen::Index k = a + i;
+      const double cx = std::isfinite(fe.cop_x_m[k]) ? fe.cop_x_m[k] : rx;
+      me[i] = (cx - rx) * fe.force_N(k, 1) - (ground - ry) * fe.force_N(k, 0);
+      mm[i] = mp.moment_origin_Nm[k] - (rx * mp.force_N(k, 1) - ry * mp.force_N(k, 0));
+    }
+    s.metrics.moment = compare_series(me, mm);
+    // Contact timing: threshold crossings of the estimate near the plate's, + = estimate late.
+    const Eigen::VectorXd ev = fe.force_N.col(1);
+    const Eigen::VectorXd pv = mp.force_N.col(1);
+    const auto m_on = rising_crossing(pv, e.time_s, o.threshold_N, a - 1, c.run.last);
+    const auto m_off = falling_crossing(pv, e.time_s, o.threshold_N, a, c.run.last + 1);
+    const Eigen::Index from = std::max<Eigen::Index>(0, a - search), to = std::min<Eigen::Index>(n - 1, c.run.last + search);
+    if (m_on && !(ev[from] > o.threshold_N))
+      if (const auto e_on = rising_crossing(ev, e.time_s, o.threshold_N, from, c.run.last)) s.onset_error_ms = 1000 * (*e_on - *m_on);
+    if (m_off && !(ev[to] > o.threshold_N))
+      if (const auto e_off = falling_crossing(ev, e.time_s, o.threshold_N, a, to)) s.offset_error_ms = 1000 * (*e_off - *m_off);
+    for (Eigen::Index i = 0; i < len; ++i) {
+      auto& mf = v.measured_force_N[static_cast<std::size_t>(c.foot)];
+      if (!std::isfinite(mf(a + i, 1))) mf.row(a + i).setZero();
+      mf.row(a + i) += mp.force_N.row(a + i);
+      v.measured_cop_x_m[static_cast<std::size_t>(c.foot)][a + i] = mc[i];
+    }
+    v.stances.push_back(std::move(s));
+  }
+  std::sort(v.stances.begin(), v.stances.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+
+  // Total: every loaded plate in a kept stance, and the plates carrying the whole body.
+  const int np = static_cast<int>(v.plates.size());
+  std::vector<unsigned> mask(static_cast<std::size_t>(n), 0u);
+  std::vector<bool> ok(static_cast<std::size_t>(n), true);
+  for (int pi = 0; pi < np && pi < 32; ++pi)
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (v.plates[static_cast<std::size_t>(pi)].force_N(i, 1) > o.threshold_N) mask[static_cast<std::size_t>(i)] |= 1u << pi;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const unsigned mk = mask[static_cast<std::size_t>(i)];
+    if (mk == 0) ok[static_cast<std::size_t>(i)] = false;
+    for (int pi = 0; pi < np && pi < 32; ++pi) {
+      if (!(mk & (1u << pi))) continue;
+      bool covered = false;
+      for (const Candidate& c : cands)
+        covered = covered || (c.kept && c.plate == pi && i >= c.run.first && i <= c.run.last);
+      if (!covered) ok[static_cast<std::size_t>(i)] = false;
+    }
+  }
+  TotalValidation tv;
+  for (Eigen::Index i = 0; i < n;) {
+    Eigen::Index j = i;
+    // Runs of frames with the same plates loaded and the same estimated contacts (the latter
+    // only splits runs, e.g. where a foot lands beside the plates; acceptance is measured).
+    auto same = [&](Eigen::Index x, Eigen::Index y) {
+      return mask[static_cast<std::size_t>(x)] == mask[static_cast<std::size_t>(y)] &&
+             ok[static_cast<std::size_t>(x)] == ok[static_cast<std::size_t>(y)] &&
+             e.feet[0].contact[static_cast<std::size_t>(x)] == e.feet[0].contact[static_cast<std::size_t>(y)] &&
+             e.feet[1].contact[static_cast<std::size_t>(x)] == e.feet[1].contact[static_cast<std::size_t>(y)];
+    };
+    while (j + 1 < n && same(j + 1, i)) ++j;
+    if (ok[static_cast<std::size_t>(i)]) {
+      std::vector<double> mis;
+      for (Eigen::Index k = i; k <= j; ++k) {
+        double sum = 0;
+        for (int pi = 0; pi < np && pi < 32; ++pi)
+          if (mask[static_cast<std::size_t>(k)] & (1u << pi)) sum += v.plates[static_cast<std::size_t>(pi)].force_N(k, 1);
+        mis.push_back(std::abs(sum - e.kinematic_total(k, 1)));
+      }
+      if (median(mis) < o.total_mismatch_fraction * bw)
+        for (Eigen::Index k = i; k <= j; ++k) tv.frames.push_back(k);
+    }
+    i = j + 1;
+  }
+  if (tv.frames.size() < 10) {
+    v.excluded.push_back("total: no window of 10 frames or more where every loaded foot stands on a kept plate stance");
+    return v;
+  }
+  // GRM reference: midpoint of the plate centres in use (geometry), else the mean measured COP.
+  unsigned used = 0;
+  for (Eigen::Index k : tv.frames) used |= mask[static_cast<std::size_t>(k)];
+  double rx = 0, ry = 0, w = 0;
+  for (int pi = 0; pi < np && pi < 32; ++pi) {
+    if (!(used & (1u << pi))) continue;
+    const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(pi)];
+    if (mp.has_geometry) {
+      rx += mp.centre_m.x();
+    } else {
+      Eigen::VectorXd c(static_cast<Eigen::Index>(tv.frames.size()));
+      for (std::size_t q = 0; q < tv.frames.size(); ++q) c[static_cast<Eigen::Index>(q)] = mp.cop_x_m[tv.frames[q]];
+      rx += mean_finite(c);
+    }
+    ry += mp.surface_y_m;
+    w += 1;
+  }
+  tv.grm_reference_m = {rx / w, ry / w};
+  const Eigen::Index m = static_cast<Eigen::Index>(tv.frames.size());
+  Eigen::VectorXd ev(m), mv(m), ea(m), ma(m), eg(m), mg(m);
+  tv.grm_estimated_Nm = tv.grm_measured_Nm = Eigen::VectorXd::Constant(n, kNaN);
+  tv.vertical_estimated_N = tv.vertical_measured_N = Eigen::VectorXd::Constant(n, kNaN);
+  for (Eigen::Index q = 0; q < m; ++q) {
+    const Eigen::Index k = tv.frames[static_cast<std::size_t>(q)];
+    ev[q] = ea[q] = eg[q] = mv[q] = ma[q] = mg[q] = 0;
+    for (int f = 0; f < 2; ++f) {
+      const FootResult& fe = e.feet[static_cast<std::size_t>(f)];
+      ev[q] += fe.force_N(k, 1), ea[q] += fe.force_N(k, 0);
+      if (std::isfinite(fe.cop_x_m[k]))
+        eg[q] += (fe.cop_x_m[k] - tv.grm_reference_m.x()) * fe.force_N(k, 1) - (ground - tv.grm_reference_m.y()) * fe.force_N(k, 0);
+    }
+    for (int pi = 0; pi < np && pi < 32; ++pi) {
+      if (!(mask[static_cast<std::size_t>(k)] & (1u << pi))) continue;
+      const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(pi)];
+      mv[q] += mp.force_N(k, 1), ma[q] += mp.force_N(k, 0);
+      mg[q] += mp.moment_origin_Nm[k] - (tv.grm_reference_m.x() * mp.force_N(k, 1) - tv.grm_reference_m.y() * mp.force_N(k, 0));
+    }
+    tv.grm_estimated_Nm[k] = eg[q];
+    tv.grm_measured_Nm[k] = mg[q];
+    tv.vertical_estimated_N[k] = ev[q];
+    tv.vertical_measured_N[k] = mv[q];
+  }
+  tv.metrics.vertical = compare_series(ev, mv);
+  tv.metrics.anterior = compare_series(ea, ma);
+  tv.metrics.moment = compare_series(eg, mg);
+  v.total = std::move(tv);
+  return v;
+}
+
+MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
+  MeanMetrics mm;
+  std::array<std::vector<double>, 4> vals;
+  for (const auto& s : stances) {
+    if (foot >= 0 && s.foot != foot) continue;
+    const std::array<const std::optional<SeriesMetrics>*, 4> c = {&s.metrics.vertical, &s.metrics.anterior, &s.metrics.cop,
+                                                                   &s.metrics.moment};
+    for (std::size_t k = 0; k < 4; ++k)
+      if (*c[k] && std::isfinite((*c[k])->rrmse_percent)) vals[k].push_back((*c[k])->rrmse_percent);
+    ++mm.n;
+  }
+  std::array<double*, 4> mean = {&mm.vertical, &mm.anterior, &mm.cop, &mm.moment};
+  std::array<double*, 4> sd = {&mm.vertical_sd, &mm.anterior_sd, &mm.cop_sd, &mm.moment_sd};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const auto& x = vals[k];
+    if (x.empty()) {
+      *mean[k] = *sd[k] = kNaN;
+      continue;
+    }
+    double s = 0;
+    for (double a : x) s += a;
+    *mean[k] = s / static_cast<double>(x.size());
+    double ss = 0;
+    for (double a : x) ss += (a - *mean[k]) * (a - *mean[k]);
+    *sd[k] = x.size() > 1 ? std::sqrt(ss / static_cast<double>(x.size() - 1)) : 0.0;
+  }
+  return mm;
+}
+
+namespace {
+
+nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+nlohmann::json opt(const std::optional<double>& x) { return x ? num(*x) : nlohmann::json(nullptr); }
+
+nlohmann::json component_json(const ComponentMetrics& c, double bw) {
+  auto field = [](const std::optional<SeriesMetrics>& m, auto get) { return m ? num(get(*m)) : nlohmann::json(nullptr); };
+  const auto rr = [](const SeriesMetrics& m) { return m.rrmse_percent; };
+  const auto rm = [](const SeriesMetrics& m) { return m.rmse; };
+  const auto pr = [](const SeriesMetrics& m) { return m.pearson_r; };
+  const auto pk = [](const SeriesMetrics& m) { return m.peak_difference; };
+  nlohmann::json j;
+  j["rrmse_percent"] = {{"vertical", field(c.vertical, rr)}, {"anterior", field(c.anterior, rr)},
+                        {"cop", field(c.cop, rr)}, {"moment", field(c.moment, rr)}};
+  j["rmse"] = {{"vertical_N", field(c.vertical, rm)}, {"anterior_N", field(c.anterior, rm)},
+               {"cop_mm", c.cop ? num(1000 * c.cop->rmse) : nlohmann::json(nullptr)}, {"moment_Nm", field(c.moment, rm)}};
+  j["rmse_percent_bw"] = {{"vertical", c.vertical ? num(100 * c.vertical->rmse / bw) : nlohmann::json(nullptr)},
+                          {"anterior", c.anterior ? num(100 * c.anterior->rmse / bw) : nlohmann::json(nullptr)}};
+  j["r"] = {{"vertical", field(c.vertical, pr)}, {"anterior", field(c.anterior, pr)}, {"cop", field(c.cop, pr)},
+            {"moment", field(c.moment, pr)}};
+  j["peak_difference"] = {{"vertical_N", field(c.vertical, pk)}, {"anterior_N", field(c.anterior, pk)},
+                          {"moment_Nm", field(c.moment, pk)}};
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json validation_json(const std::string& trial, const EstimateResult& e, const ValidationResult& v,
+                               const nlohmann::json& settings) {
+  const double bw = v.mass_kg * e.model.gravity_mps2;
+  nlohmann::json j;
+  j["trial"] = trial;
+  j["mass_kg"] = v.mass_kg;
+  j["settings"] = settings;
+  j["per_foot"] = nlohmann::json::array();
+  for (const auto& s : v.stances) {
+    nlohmann::json x = component_json(s.metrics, bw);
+    x["foot"] = side_name(s.foot);
+    x["plate"] = s.plate;
+    x["frames"] = {e.first_frame_number + s.first, e.first_frame_number + s.last};
+    x["time_s"] = {e.time_s[s.first], e.time_s[s.last]};
+    x["assign_distance_mm"] = 1000 * s.assign_distance_m;
+    x["timing_ms"] = {{"onset", opt(s.onset_error_ms)}, {"offset", opt(s.offset_error_ms)}};
+    j["per_foot"].push_back(x);
+  }
+  if (v.total) {
+    nlohmann::json x = component_json(v.total->metrics, bw);
+    x["frames_compared"] = v.total->frames.size();
+    x["grm_reference_m"] = {v.total->grm_reference_m.x(), v.total->grm_reference_m.y()};
+    j["total"] = x;
+  } else {
+    j["total"] = nullptr;
+  }
+  nlohmann::json means;
+  for (int f = -1; f < 2; ++f) {
+    const MeanMetrics m = mean_rrmse(v.stances, f);
+    means[f < 0 ? "all" : side_name(f)] = {{"stances", m.n},         {"vertical", num(m.vertical)}, {"anterior", num(m.anterior)},
+                                            {"cop", num(m.cop)},      {"moment", num(m.moment)}};
+  }
+  j["mean_rrmse_percent"] = means;
+  j["excluded"] = v.excluded;
+  j["notes"] = v.notes;
+  return j;
+}
+
+std::string format_validation_table(const std::string& trial, const ValidationResult& v) {
+  std::ostringstream os;
+  char buf[256];
+  auto cell = [](const std::optional<SeriesMetrics>& m) {
+    char b[32];
+    if (m && std::isfinite(m->rrmse_percent)) std::snprintf(b, sizeof b, "%9.1f", m->rrmse_percent);
+    else std::snprintf(b, sizeof b, "%9s", "-");
+    return std::string(b);
+  };
+  auto msd = [](double m, double sd) {
+    char b[32];
+    if (std::isfinite(m)) std::snprintf(b, sizeof b, " %5.1f (%4.1f)", m, sd);
+    else std::snprintf(b, sizeof b, " %12s", "-");
+    return std::string(b);
+  };
+  os << "kin2grf validate: " << trial << " (body mass " << v.mass_kg << " kg)\n";
+  os << "rRMSE, % (paper's Eq. 12)      vertical  anterior      COP   moment   frames\n";
+  for (const auto& s : v.stances) {
+    std::snprintf(buf, sizeof buf, "  %-5s foot on %-12s", side_name(s.foot).c_str(), s.plate.c_str());
+    os << buf << cell(s.metrics.vertical) << " " << cell(s.metrics.anterior) << cell(s.metrics.cop) << cell(s.metrics.moment);
+    std::snprintf(buf, sizeof buf, "   %ld-%ld\n", static_cast<long>(v.first_frame_number + s.first),
+                  static_cast<long>(v.first_frame_number + s.last));
+    os << buf;
+  }
+  if (v.stances.empty()) os << "  (no stance on a plate could be compared)\n";
+  const MeanMetrics m = mean_rrmse(v.stances);
+  if (m.n > 0) {
+    std::snprintf(buf, sizeof buf, "  per foot, mean (SD), n = %-3d", m.n);
+    os << buf << msd(m.vertical, m.vertical_sd) << msd(m.anterior, m.anterior_sd) << msd(m.cop, m.cop_sd)
+       << msd(m.moment, m.moment_sd) << "\n";
+  }
+  if (v.total) {
+    std::snprintf(buf, sizeof buf, "  total (GRM), %4zu frames      ", v.total->frames.size());
+    os << buf << cell(v.total->metrics.vertical) << " " << cell(v.total->metrics.anterior) << cell(std::nullopt)
+       << cell(v.total->metrics.moment) << "\n";
+  }
+  os << "  paper, Table 1 (24 gait trials)   4.1 (1.1)  11.2 (1.7)         -    5.3 (1.1)\n";
+  os << "  Fluit et al. (paper's Table 1)    2.7        9.3                -    7.4\n";
+  for (const auto& x : v.excluded) os << "excluded: " << x << "\n";
+  for (const auto& x : v.notes) os << "note: " << x << "\n";
+  return os.str();
+}
+
+}  // namespace kin2grf
