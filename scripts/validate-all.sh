@@ -13,18 +13,8 @@ BIN=build/release/kin2grf
 OUT=out/validation
 rm -rf "$OUT" && mkdir -p "$OUT"
 
-# activity|name|trial and its options (masses: see each data folder's README)
-TRIALS=(
-  "walking|walking2|$DATA/opensim_c3d_overground_walk/walking2.c3d --mass 64.9"
-  "walking|walking5|$DATA/opensim_c3d_overground_walk/walking5.c3d --mass 67.5"
-  "walking|rajagopal-walk|$DATA/rajagopal2016_overground_walk/markers_walk.trc --plates $DATA/rajagopal2016_overground_walk/grf_walk.mot --mass 77.3"
-  "walking|opencap-walking1|$DATA/opencap_dropjump_walk/walking1_markers.trc --plates $DATA/opencap_dropjump_walk/walking1_grf.mot --mass 68.4"
-  "walking|subject01-treadmill|$DATA/opensim_subject01_treadmill_walk/subject01_walk1.trc --static $DATA/opensim_subject01_treadmill_walk/subject01_static.trc --plates $DATA/opensim_subject01_treadmill_walk/subject01_walk1_grf.mot --mass 72.6"
-  "walking|pig-flatfoot-full|$DATA/btk_plugingait_walk/PiG_Motion-FlatFoot-Full.c3d"
-  "walking|pig-motion3|$DATA/btk_plugingait_walk/PiG_Motion3_FF.c3d"
-  "running|rajagopal-run-treadmill|$DATA/rajagopal2016_treadmill_run/motion_capture_run.trc --static $DATA/rajagopal2016_treadmill_run/static_run.trc --plates $DATA/rajagopal2016_treadmill_run/grf_run.mot --mass 72.84"
-  "jump landing|opencap-dropjump|$DATA/opencap_dropjump_walk/DJ1_markers.trc --plates $DATA/opencap_dropjump_walk/DJ1_grf.mot --mass 68.4"
-)
+# scripts/trials.txt: activity|name|TRIAL [options], DATA standing for the data folder.
+mapfile -t TRIALS < <(grep -v '^#' scripts/trials.txt | grep . | sed "s#DATA#$DATA#g")
 for row in "${TRIALS[@]}"; do
   IFS='|' read -r activity name args <<<"$row"
   for config in defaults paper; do

@@ -14,6 +14,9 @@
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/synth/example.hpp"
 #include "kin2grf/output/report.hpp"
+#include "kin2grf/io/cop_function.hpp"
+#include "kin2grf/validation/cop_fit.hpp"
+#include "kin2grf/validation/study.hpp"
 #include "kin2grf/validation/validate.hpp"
 #include <filesystem>
 
@@ -36,9 +39,9 @@ int run_info(const std::string& file, bool json, double threshold, const std::st
 
 struct EstimateArgs {
   std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "torque-scaled",
-      anthropometry = "winter", up_axis;
-  double mass = 0, r = 1e4, kin_cutoff = 6, post_cutoff = 12, ground_shift = 0, speed_gate = 2.0;
-  bool paper = false;
+      anthropometry = "winter", up_axis, cop_function;
+  double mass = 0, r = 1e3, kin_cutoff = 6, post_cutoff = 12, contact_cutoff = 0, ground_shift = 0, speed_gate = 2.0;
+  bool paper = false, r_given = false;
   std::optional<double> ground_level;
   int max_gap = 10;
 };
@@ -50,9 +53,13 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
   c->add_option("--mass", a.mass, "Body mass, kg (default: PROCESSING:Bodymass of a C3D)");
   c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
       ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
-  c->add_option("--r", a.r, "Activation parameter r, N/m (Eq. 8)")->capture_default_str();
+  c->add_option_function<double>(
+       "--r", [&a](double v) { a.r = v, a.r_given = true; },
+       "Activation parameter r, N/m (Eq. 8); default 1000 (from `kin2grf study r`), 10000 with --paper");
   c->add_option("--kinematic-cutoff", a.kin_cutoff, "Kinematics low-pass cut-off, Hz")->capture_default_str();
   c->add_option("--post-cutoff", a.post_cutoff, "Multiplier post-filter cut-off, Hz")->capture_default_str();
+  c->add_option("--contact-cutoff", a.contact_cutoff, "Cut-off of the kinematics deciding contact (gap, sole speed), Hz; 0 = as the dynamics")
+      ->capture_default_str();
   c->add_option("--ground-level", a.ground_level, "Floor height in the lab's up axis, m (default: estimated)");
   c->add_option("--ground-shift", a.ground_shift, "Shift the ground by this much, m (robustness study)")->capture_default_str();
   c->add_option("--speed-gate", a.speed_gate, "Contact allowed only below this sole speed, m/s (0 = off, the paper)")
@@ -60,6 +67,7 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
   c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
       ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
   c->add_option("--anthropometry", a.anthropometry, "winter or de-leva")->capture_default_str();
+  c->add_option("--cop-function", a.cop_function, "Foot model 2's COP function from this JSON (see kin2grf fit-cop)");
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
   c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate");
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
@@ -75,10 +83,13 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
   o.anthropometry = a.anthropometry;
   o.kinematic_cutoff_hz = a.kin_cutoff;
   o.post_cutoff_hz = a.post_cutoff;
+  o.contact_cutoff_hz = a.paper ? 0.0 : a.contact_cutoff;
   o.ground_level_m = a.ground_level;
   o.contact.foot_model = a.foot_model == "cop" ? kin2grf::FootModel::Cop : kin2grf::FootModel::ThreePoint;
   o.contact.ground_shift_m = a.ground_shift;
-  o.solver.r_N_per_m = a.r;
+  if (a.paper) o.contact.cop = kin2grf::CopFunction::paper();
+  if (!a.cop_function.empty()) o.contact.cop = kin2grf::read_cop_function(a.cop_function);
+  o.solver.r_N_per_m = (a.paper && !a.r_given) ? 1e4 : a.r;
   o.solver.norm = (a.paper || a.norm == "paper") ? kin2grf::MultiplierNorm::Paper : kin2grf::MultiplierNorm::TorqueScaled;
   o.solver.speed_gate_mps = a.paper ? 0.0 : a.speed_gate;
   o.landmarks.max_gap_frames = a.max_gap;
@@ -91,9 +102,9 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
 }
 
 nlohmann::json settings_json(const EstimateArgs& a) {
-  return {{"trial", a.trial}, {"static", a.static_trial}, {"foot_model", a.foot_model}, {"r_N_per_m", a.r},
+  return {{"trial", a.trial}, {"static", a.static_trial}, {"foot_model", a.foot_model}, {"r_N_per_m", (a.paper && !a.r_given) ? 1e4 : a.r},
           {"kinematic_cutoff_hz", a.kin_cutoff}, {"post_cutoff_hz", a.post_cutoff}, {"norm", a.paper ? std::string("paper") : a.norm},
-          {"speed_gate_mps", a.paper ? 0.0 : a.speed_gate}, {"paper_configuration", a.paper}, {"anthropometry", a.anthropometry}, {"ground_shift_m", a.ground_shift},
+          {"speed_gate_mps", a.paper ? 0.0 : a.speed_gate}, {"cop_function", !a.cop_function.empty() ? a.cop_function : a.paper ? "paper event angles" : "built-in (fitted)"}, {"paper_configuration", a.paper}, {"anthropometry", a.anthropometry}, {"ground_shift_m", a.ground_shift},
           {"ground_level_m", a.ground_level ? nlohmann::json(*a.ground_level) : nlohmann::json("auto")}};
 }
 
@@ -164,6 +175,192 @@ int run_validate(const ValidateArgs& a) {
   const auto j = kin2grf::validation_json(a.est.trial, r, v, settings);
   if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, j.dump(2) + "\n");
   if (!a.report.empty()) kin2grf::write_file_text(a.report, kin2grf::validation_report_html(a.est.trial, r, v, j));
+  return 0;
+}
+
+/// `study`: one line of a trial list is "activity|name|TRIAL [estimate options] [--plates FILE]".
+struct StudyInput {
+  std::string activity, name;
+  EstimateArgs args;
+  std::string plates;
+};
+
+std::vector<StudyInput> read_trial_list(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw kin2grf::InputError(path + ": cannot open the trial list");
+  std::vector<StudyInput> out;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty() || line[0] == '#') continue;
+    const auto a = line.find('|'), b = line.find('|', a == std::string::npos ? a : a + 1);
+    if (a == std::string::npos || b == std::string::npos)
+      throw kin2grf::InputError(path + ":" + std::to_string(number) + ": expected activity|name|TRIAL [options]");
+    StudyInput si;
+    si.activity = line.substr(0, a);
+    si.name = line.substr(a + 1, b - a - 1);
+    CLI::App parser{"trial"};
+    add_estimate_options(&parser, si.args, false);
+    parser.add_option("--plates", si.plates);
+    try {
+      parser.parse(line.substr(b + 1), false);
+    } catch (const CLI::ParseError& e) {
+      throw kin2grf::InputError(path + ":" + std::to_string(number) + ": " + e.what());
+    }
+    out.push_back(std::move(si));
+  }
+  if (out.empty()) throw kin2grf::InputError(path + ": no trials in the list");
+  return out;
+}
+
+struct StudyArgs {
+  std::string kind, trial_list, out_json, report;
+  std::vector<std::string> trials;
+  EstimateArgs est;
+  std::string plates;
+};
+
+/// Trials of a study or fit, loaded once (the containers are reserved: pointers stay valid).
+struct LoadedTrials {
+  std::vector<kin2grf::Trial> trials, statics, plates;
+  std::vector<kin2grf::MarkerSet> sets;
+  std::vector<kin2grf::StudyTrial> study;
+};
+
+void load_study_trials(const std::vector<StudyInput>& inputs, LoadedTrials& L) {
+  L.trials.reserve(inputs.size()), L.statics.reserve(inputs.size()), L.plates.reserve(inputs.size()), L.sets.reserve(inputs.size());
+  for (const auto& in : inputs) {
+    L.trials.push_back(kin2grf::load_trial(in.args.trial, load_options("unloaded")));
+    kin2grf::StudyTrial x;
+    x.name = in.name;
+    x.activity = in.activity;
+    x.trial = &L.trials.back();
+    if (!in.args.static_trial.empty()) {
+      L.statics.push_back(kin2grf::load_trial(in.args.static_trial));
+      x.static_trial = &L.statics.back();
+    }
+    const kin2grf::Trial* source = x.trial;
+    if (!in.plates.empty()) {
+      L.plates.push_back(kin2grf::load_trial(in.plates, load_options("unloaded")));
+      source = &L.plates.back();
+    }
+    if (!source->plates || source->plates->plates.empty())
+      throw kin2grf::InputError(source->path + ": no force plates; give --plates");
+    x.plates = &*source->plates;
+    kin2grf::MarkerSet custom;
+    L.sets.push_back(resolve_marker_set(in.args, *x.trial, custom));
+    x.marker_set = &L.sets.back();
+    x.options = to_options(in.args);
+    L.study.push_back(x);
+  }
+}
+
+int run_study(const StudyArgs& a) {
+  std::vector<StudyInput> inputs;
+  if (!a.trial_list.empty()) inputs = read_trial_list(a.trial_list);
+  for (const auto& t : a.trials) {
+    StudyInput si;
+    si.activity = "trials";
+    si.name = std::filesystem::path(t).filename().string();
+    si.args = a.est;
+    si.args.trial = t;
+    si.plates = a.plates;
+    inputs.push_back(si);
+  }
+  if (inputs.empty()) throw kin2grf::InputError("study: give TRIAL files or --trial-list FILE");
+  LoadedTrials L;
+  load_study_trials(inputs, L);
+  const auto& st = L.study;
+  std::cerr << "kin2grf: study " << a.kind << " on " << st.size() << " trials\n";
+  const auto res = kin2grf::run_study(a.kind, st);
+  std::cout << kin2grf::format_study_table(res);
+  const auto j = kin2grf::study_json(res);
+  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, j.dump(2) + "\n");
+  if (!a.report.empty()) kin2grf::write_file_text(a.report, kin2grf::study_report_html(res));
+  return 0;
+}
+
+struct FitCopArgs {
+  std::string trial_list, activity = "walking", out;
+  double min_force = 0.2;
+  bool leave_one_out = false, fit_angles = false;
+};
+
+/// fit-cop: the COP function of foot model 2 fitted to the plate COPs of a trial list's stances.
+int run_fit_cop(const FitCopArgs& a) {
+  std::vector<StudyInput> inputs;
+  for (auto& in : read_trial_list(a.trial_list))
+    if (a.activity.empty() || in.activity == a.activity) inputs.push_back(in);
+  if (inputs.empty()) throw kin2grf::InputError(a.trial_list + ": no trial of activity '" + a.activity + "'");
+  LoadedTrials L;
+  load_study_trials(inputs, L);
+  const std::size_t n = L.study.size();
+  std::vector<kin2grf::CopSamples> per(n);
+  // Start (and, without --fit-angles, keep) the paper's event angles.
+  const kin2grf::CopFunction start = kin2grf::CopFunction::paper();
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& t = L.study[k];
+    const auto e = kin2grf::estimate(*t.trial, t.static_trial, *t.marker_set, t.options);
+    const auto v = kin2grf::validate(e, *t.plates);
+    kin2grf::collect_cop_samples(e, v, a.min_force, per[k]);
+    std::cerr << "kin2grf: " << t.name << ": " << per[k].theta_rad.size() << " COP samples\n";
+  }
+  auto pooled = [&](std::size_t skip) {
+    kin2grf::CopSamples all;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (k == skip) continue;
+      all.theta_rad.insert(all.theta_rad.end(), per[k].theta_rad.begin(), per[k].theta_rad.end());
+      all.fraction.insert(all.fraction.end(), per[k].fraction.begin(), per[k].fraction.end());
+    }
+    return all;
+  };
+  auto fit_fn = [&](const kin2grf::CopSamples& smp) {
+    return a.fit_angles ? kin2grf::fit_cop_function_and_angles(smp, start) : kin2grf::fit_cop_function(smp, start);
+  };
+  const auto fit = fit_fn(pooled(n));
+  nlohmann::json j = kin2grf::cop_function_json(fit.function);
+  nlohmann::json prov;
+  prov["command"] = "kin2grf fit-cop --trial-list " + a.trial_list + " --activity " + a.activity;
+  prov["kin2grf_version"] = KIN2GRF_VERSION;
+  prov["trials"] = nlohmann::json::array();
+  for (std::size_t k = 0; k < n; ++k) prov["trials"].push_back({{"name", L.study[k].name}, {"samples", per[k].theta_rad.size()}});
+  prov["samples"] = fit.samples;
+  prov["event_angles"] = a.fit_angles ? "fitted" : "fixed (the paper's)";
+  prov["min_force_fraction_of_body_weight"] = a.min_force;
+  prov["rms_fraction_before"] = fit.rms_fraction_before;
+  prov["rms_fraction_after"] = fit.rms_fraction;
+  prov["start"] = kin2grf::cop_function_json(start);
+  std::printf("COP function fitted on %d samples of %zu trials (%s)\n", fit.samples, n, a.activity.c_str());
+  std::printf("  event angles (rad)   HS %.3f  HO %.3f  MO %.3f  TO %.3f\n", fit.function.delta_hs, fit.function.delta_ho,
+              fit.function.delta_mo, fit.function.delta_to);
+  std::printf("  positions (fraction) HS %.3f  HO %.3f  MO %.3f  TO %.3f   (start %.3f %.3f %.3f %.3f)\n", fit.function.s_hs,
+              fit.function.s_ho, fit.function.s_mo, fit.function.s_to, start.s_hs, start.s_ho, start.s_mo, start.s_to);
+  std::printf("  RMS of F(theta) - s: %.3f (start: %.3f)\n", fit.rms_fraction, fit.rms_fraction_before);
+  if (a.leave_one_out) {
+    // Generalisation: each trial's COP error with the function fitted on the others.
+    std::printf("\nleave-one-trial-out: COP rRMSE %% (mean over the trial's stances)\n%-26s %8s %8s %8s\n", "trial", "start",
+                "all", "others");
+    nlohmann::json loo = nlohmann::json::array();
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto& t = L.study[k];
+      auto cop_rrmse = [&](const kin2grf::CopFunction& f) {
+        auto o = t.options;
+        o.contact.cop = f;
+        const auto e = kin2grf::estimate(*t.trial, t.static_trial, *t.marker_set, o);
+        return kin2grf::mean_rrmse(kin2grf::validate(e, *t.plates).stances).cop;
+      };
+      const auto others = pooled(k);
+      if (others.theta_rad.size() < 20) continue;
+      const auto fk = fit_fn(others);
+      const double r0 = cop_rrmse(start), r1 = cop_rrmse(fit.function), r2 = cop_rrmse(fk.function);
+      std::printf("%-26s %8.1f %8.1f %8.1f\n", t.name.c_str(), r0, r1, r2);
+      loo.push_back({{"trial", t.name}, {"start", r0}, {"all", r1}, {"others", r2}});
+    }
+    prov["leave_one_out_cop_rrmse_percent"] = loo;
+  }
+  j["provenance"] = prov;
+  if (!a.out.empty()) kin2grf::write_file_text(a.out, j.dump(2) + "\n");
   return 0;
 }
 
@@ -242,6 +439,36 @@ int main(int argc, char** argv) {
   validate->add_option("--zero-offset", val.zero_offset, "C3D plate offsets: none, zero or unloaded")
       ->check(CLI::IsMember({"none", "zero", "unloaded"}))->capture_default_str();
 
+  StudyArgs study_args;
+  auto* study = app.add_subcommand("study", "The paper's parameter studies on trials with plates: r, ground-shift, cutoff, "
+                                            "kinematic-cutoff, foot-model");
+  study->add_option("KIND", study_args.kind, "r | ground-shift | cutoff | kinematic-cutoff | contact-cutoff | speed-gate | foot-model")
+      ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "kinematic-cutoff", "contact-cutoff", "speed-gate", "foot-model"}));
+  study->add_option("TRIAL", study_args.trials, "Trials with plates (the options below apply to all of them)");
+  study->add_option("--trial-list", study_args.trial_list,
+                    "File of lines 'activity|name|TRIAL [options]', each trial with its own options");
+  study->add_option("--plates", study_args.plates, "Measured forces for the TRIAL arguments (GRF .mot)");
+  study->add_option("--json", study_args.out_json, "Study results as JSON");
+  study->add_option("--report", study_args.report, "HTML report with the rRMSE-against-setting plots");
+  {
+    // Estimate options for the TRIAL arguments (without outputs; TRIAL is positional above).
+    auto& e = study_args.est;
+    study->add_option("--static", e.static_trial, "Static trial");
+    study->add_option("--markers", e.markers, "Marker-set preset or mapping file");
+    study->add_option("--mass", e.mass, "Body mass, kg");
+    study->add_flag("--paper", e.paper, "The paper's configuration");
+  }
+
+  FitCopArgs fit_args;
+  auto* fit_cop = app.add_subcommand("fit-cop", "Fit foot model 2's COP function to the plate COPs of trials with plates");
+  fit_cop->add_option("--trial-list", fit_args.trial_list, "File of lines 'activity|name|TRIAL [options]'")->required();
+  fit_cop->add_option("--activity", fit_args.activity, "Use the trials of this activity ('' = all)")->capture_default_str();
+  fit_cop->add_option("--min-force", fit_args.min_force, "Frames where the plate carries at least this fraction of body weight")
+      ->capture_default_str();
+  fit_cop->add_flag("--fit-angles", fit_args.fit_angles, "Fit the event angles too (default: the paper's, fixed)");
+  fit_cop->add_flag("--leave-one-out", fit_args.leave_one_out, "Also report each trial's COP error with a fit on the others");
+  fit_cop->add_option("-o,--output", fit_args.out, "Write the fitted function and its provenance (JSON)");
+
   std::string example_dir = "example";
   double example_seconds = 3.0;
   auto* make_example = app.add_subcommand("make-example", "Write the synthetic example trial (C3D with plates, TRC, GRF .mot)");
@@ -257,6 +484,8 @@ int main(int argc, char** argv) {
     if (*info) return run_info(info_file, info_json, info_threshold, info_zero);
     if (*estimate) return run_estimate(est);
     if (*validate) return run_validate(val);
+    if (*study) return run_study(study_args);
+    if (*fit_cop) return run_fit_cop(fit_args);
     if (*make_example) return run_make_example(example_dir, example_seconds);
   } catch (const kin2grf::InputError& e) {
     std::cerr << "kin2grf: error: " << e.what() << "\n";

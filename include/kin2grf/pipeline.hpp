@@ -21,6 +21,9 @@ struct EstimateOptions {
   std::string anthropometry = "winter";
   double kinematic_cutoff_hz = 6.0;        ///< paper: 6 Hz
   double post_cutoff_hz = 12.0;            ///< paper: 12 Hz
+  /// Cut-off for the kinematics that decide contact (gap g_n and sole speed); <= 0: the same
+  /// kinematics as the dynamics (the paper).
+  double contact_cutoff_hz = 0.0;
   std::optional<double> ground_level_m;    ///< else estimate_ground_level
   ContactModelOptions contact;
   SolverOptions solver;
@@ -35,6 +38,7 @@ struct FootResult {
   Eigen::VectorXd cop_x_m;       ///< along progression; NaN when inactive
   std::vector<bool> contact;
   Eigen::VectorXd inclination_rad;  ///< theta_A, the paper's foot inclination (contact.hpp)
+  Eigen::VectorXd gap_m;            ///< normal gap g_n of the foot's lowest contact point
   Eigen::MatrixXd sole_m;           ///< N x 6: sole points A, B, C (x, y) in the sagittal frame
 };
 

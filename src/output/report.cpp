@@ -193,4 +193,34 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   return render_report_html(rep);
 }
 
+std::string study_report_html(const StudyResult& s) {
+  Report rep;
+  rep.title = "kin2grf study: " + s.kind;
+  rep.sections_html.push_back("<pre>" + html_escape(format_study_table(s)) + "</pre>");
+  if (!s.rows.empty()) {
+    const bool numeric = s.kind != "foot-model";
+    for (std::size_t a = 0; a < s.rows.front().cells.size(); ++a) {
+      ReportFigure g;
+      g.title = s.rows.front().cells[a].activity + ": mean rRMSE against " + s.kind;
+      g.x_label = numeric ? s.kind : "foot model (1 = three points, 2 = moving COP)";
+      g.y_label = "rRMSE (%)";
+      g.log_x = s.kind == "r";
+      const std::array<std::string, 5> names = {"vertical", "anterior", "COP", "moment (plate centre)", "total GRM"};
+      for (std::size_t k = 0; k < names.size(); ++k) {
+        ReportSeries series;
+        series.label = names[k];
+        for (const auto& r : s.rows) {
+          const auto& c = r.cells[a];
+          const std::array<double, 5> val = {c.per_foot.vertical, c.per_foot.anterior, c.per_foot.cop, c.per_foot.moment, c.total_grm};
+          series.x.push_back(s.kind == "ground-shift" ? 1000 * r.value : r.value);
+          series.y.push_back(val[k]);
+        }
+        g.series.push_back(series);
+      }
+      rep.figures.push_back(g);
+    }
+  }
+  return render_report_html(rep);
+}
+
 }  // namespace kin2grf

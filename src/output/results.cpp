@@ -20,7 +20,8 @@ std::string format_results_csv(const EstimateResult& r) {
   std::ostringstream os;
   os << "frame,time_s";
   for (const char* s : {"r", "l"})
-    os << ",grf_anterior_" << s << "_N,grf_vertical_" << s << "_N,cop_x_" << s << "_m,contact_" << s;
+    os << ",grf_anterior_" << s << "_N,grf_vertical_" << s << "_N,cop_x_" << s << "_m,contact_" << s << ",gap_" << s
+       << "_m,foot_inclination_" << s << "_rad,grf_vertical_unfiltered_" << s << "_N";
   os << ",grm_Nm";
   for (int j = 0; j < kJointCount; ++j) os << ",torque_" << joint_name(j) << "_Nm";
   for (int j = 0; j < kJointCount; ++j) os << ",force_" << joint_name(j) << "_x_N,force_" << joint_name(j) << "_y_N";
@@ -36,7 +37,8 @@ std::string format_results_csv(const EstimateResult& r) {
     for (int s = 0; s < 2; ++s) {
       const auto& f = r.feet[s];
       os << "," << num(f.force_N(i, 0)) << "," << num(f.force_N(i, 1)) << "," << num(f.cop_x_m[i]) << ","
-         << (f.contact[static_cast<std::size_t>(i)] ? 1 : 0);
+         << (f.contact[static_cast<std::size_t>(i)] ? 1 : 0) << "," << num(f.gap_m[i]) << "," << num(f.inclination_rad[i]) << ","
+         << num(f.raw_force_N(i, 1));
     }
     os << "," << num(r.grm_Nm[i]);
     for (int j = 0; j < kJointCount; ++j) os << "," << num(r.joint_torque_Nm(i, j));

@@ -383,6 +383,20 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
     tv.vertical_estimated_N[k] = ev[q];
     tv.vertical_measured_N[k] = mv[q];
   }
+  {
+    double num = 0, den = 0;
+    for (Eigen::Index q = 0; q < m; ++q) {
+      const double k = e.kinematic_total(tv.frames[static_cast<std::size_t>(q)], 1) / e.mass_kg;  // per kg
+      num += mv[q] * k, den += k * k;
+    }
+    tv.implied_mass_kg = den > 0 ? num / den : kNaN;
+    if (std::abs(tv.implied_mass_kg - e.mass_kg) > 0.03 * e.mass_kg) {
+      char b[200];
+      std::snprintf(b, sizeof b, "the plates imply a body mass of %.1f kg over the total window, %+.1f %% from the %.1f kg used",
+                    tv.implied_mass_kg, 100 * (tv.implied_mass_kg / e.mass_kg - 1), e.mass_kg);
+      v.notes.push_back(b);
+    }
+  }
   tv.metrics.vertical = compare_series(ev, mv);
   tv.metrics.anterior = compare_series(ea, ma);
   tv.metrics.moment = compare_series(eg, mg);
@@ -468,6 +482,7 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     nlohmann::json x = component_json(v.total->metrics, bw);
     x["frames_compared"] = v.total->frames.size();
     x["grm_reference_m"] = {v.total->grm_reference_m.x(), v.total->grm_reference_m.y()};
+    x["implied_mass_kg"] = num(v.total->implied_mass_kg);
     j["total"] = x;
   } else {
     j["total"] = nullptr;

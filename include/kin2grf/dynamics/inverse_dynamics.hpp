@@ -37,7 +37,7 @@ enum class MultiplierNorm {
 };
 
 struct SolverOptions {
-  double r_N_per_m = 1e4;      ///< activation parameter r (Eq. 8)
+  double r_N_per_m = 1e3;      ///< activation parameter r (Eq. 8); default from `kin2grf study r`
   int max_iterations = 20;
   MultiplierNorm norm = MultiplierNorm::Paper;
   double torque_length_m = 0.9;

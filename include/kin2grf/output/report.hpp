@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "kin2grf/pipeline.hpp"
+#include "kin2grf/validation/study.hpp"
 #include "kin2grf/validation/validate.hpp"
 
 namespace kin2grf {
@@ -47,5 +48,8 @@ std::string html_escape(const std::string& s);
 /// table, exclusions and the settings.
 std::string validation_report_html(const std::string& trial, const EstimateResult& e, const ValidationResult& v,
                                    const nlohmann::json& validation);
+
+/// study's report: per activity, mean rRMSE of each component against the setting.
+std::string study_report_html(const StudyResult& study);
 
 }  // namespace kin2grf

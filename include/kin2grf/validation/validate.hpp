@@ -89,6 +89,9 @@ struct TotalValidation {
   ComponentMetrics metrics;           ///< vertical, anterior, moment = GRM
   Eigen::VectorXd grm_estimated_Nm, grm_measured_Nm;  ///< over all frames (NaN outside `frames`)
   Eigen::VectorXd vertical_estimated_N, vertical_measured_N;  ///< likewise
+  /// Body mass that makes the kinematic vertical total fit the plates best (least squares over
+  /// `frames`; the kinematic total is linear in the mass): a check on the mass given.
+  double implied_mass_kg = 0.0;
 };
 
 struct ValidationResult {

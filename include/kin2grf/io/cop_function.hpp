@@ -1,0 +1,20 @@
+// kin2grf I/O: the COP function of foot model 2 as JSON (written by `kin2grf fit-cop`, read by
+// `--cop-function`). Fields: delta_hs, delta_ho, delta_mo, delta_to (rad), s_hs, s_ho, s_mo,
+// s_to (arc fractions of the sole A -> B -> C, 0..1); any other field (e.g. "provenance") is kept
+// for the reader and ignored here.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "kin2grf/dynamics/contact.hpp"
+
+namespace kin2grf {
+
+nlohmann::json cop_function_json(const CopFunction& f);
+/// Throws InputError naming the file and the field when a field is missing, not a number, out
+/// of range, or the event angles are not increasing.
+CopFunction cop_function_from_json(const nlohmann::json& j, const std::string& path);
+CopFunction read_cop_function(const std::string& path);
+
+}  // namespace kin2grf

@@ -1,0 +1,42 @@
+// kin2grf validation: fitting the COP function x_D = F(theta_A) of foot model 2 (paper Eq. 2,
+// Sect. 2.3) to force-plate COPs.
+//
+// Samples: on the kept plate stances of validate(), every frame where the plate carries at least
+// min_force_fraction of body weight gives (theta_A, s_measured): the foot inclination and the
+// arc fraction along the sole polyline A -> B -> C of the point whose x is the measured COP
+// (clamped to [0, 1]). With the event angles fixed, F is linear in the four event positions
+// (s_HS, s_HO, s_MO, s_TO): each sample's F value is a weighted sum of two of them (half-cosine or
+// linear weights), so the fit is an ordinary linear least-squares problem, solved by QR.
+#pragma once
+
+#include <vector>
+
+#include "kin2grf/dynamics/contact.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/validation/validate.hpp"
+
+namespace kin2grf {
+
+struct CopSamples {
+  std::vector<double> theta_rad, fraction;
+};
+
+/// Append the samples of one validated trial.
+void collect_cop_samples(const EstimateResult& e, const ValidationResult& v, double min_force_fraction, CopSamples& out);
+
+struct CopFit {
+  CopFunction function;
+  int samples = 0;
+  double rms_fraction = 0.0;          ///< RMS of F(theta) - s over the samples
+  double rms_fraction_before = 0.0;   ///< the same for the starting function
+};
+
+/// Least-squares event positions for the event angles of `start` (its positions are only the
+/// reference for rms_fraction_before). Throws InputError with fewer than 20 samples.
+CopFit fit_cop_function(const CopSamples& samples, const CopFunction& start);
+
+/// Also the event angles: a coordinate search (steps of 0.01 rad, order kept) around `start`'s,
+/// each candidate with its least-squares positions. Not the paper's fixed angles: for studies.
+CopFit fit_cop_function_and_angles(const CopSamples& samples, const CopFunction& start);
+
+}  // namespace kin2grf

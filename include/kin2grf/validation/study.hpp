@@ -1,0 +1,60 @@
+// kin2grf validation: the paper's parameter studies (Sect. 4) on any trials with plates.
+//
+// A study runs estimate + validate on every trial for each value of one setting and reports the
+// mean per-stance rRMSE (vertical, anterior, COP, moment about the plate centre) and the mean
+// total-GRM rRMSE, per activity. Kinds:
+//   r             activation parameter r of Eq. 8, 10^1 .. 10^6 N/m (paper: Fig. 7 discussion)
+//   ground-shift  the ground moved by -1 cm, 0, +1 cm (paper: robustness to the ground level)
+//   cutoff        the post-filter cut-off (paper: 12 Hz)
+//   kinematic-cutoff  the marker/coordinate low-pass cut-off (paper: 6 Hz)
+//   foot-model    model 1 (three points) against model 2 (moving COP) (paper: Fig. 6)
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "kin2grf/io/trial.hpp"
+#include "kin2grf/markers/landmarks.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/validation/validate.hpp"
+
+namespace kin2grf {
+
+/// One trial of a study, loaded, with its own options (mass etc.).
+struct StudyTrial {
+  std::string name, activity;
+  const Trial* trial = nullptr;
+  const Trial* static_trial = nullptr;
+  const ForcePlateRecording* plates = nullptr;
+  const MarkerSet* marker_set = nullptr;
+  EstimateOptions options;
+};
+
+struct StudyCell {
+  std::string activity;
+  int trials = 0;
+  MeanMetrics per_foot;
+  double total_grm = 0.0;  ///< mean over trials with a total window; NaN if none
+  int total_trials = 0;
+};
+
+struct StudyRow {
+  std::string label;  ///< the setting's value as text
+  double value = 0.0;
+  std::vector<StudyCell> cells;  ///< per activity, then "all"
+};
+
+struct StudyResult {
+  std::string kind;
+  std::vector<StudyRow> rows;
+  std::vector<std::string> failures;  ///< trial + value + error, for runs that threw InputError
+};
+
+/// The kinds above; throws InputError for another.
+StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& trials);
+
+nlohmann::json study_json(const StudyResult& s);
+std::string format_study_table(const StudyResult& s);
+
+}  // namespace kin2grf

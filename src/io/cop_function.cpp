@@ -1,0 +1,42 @@
+#include "kin2grf/io/cop_function.hpp"
+
+#include <cmath>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/text.hpp"
+
+namespace kin2grf {
+
+nlohmann::json cop_function_json(const CopFunction& f) {
+  return {{"delta_hs", f.delta_hs}, {"delta_ho", f.delta_ho}, {"delta_mo", f.delta_mo}, {"delta_to", f.delta_to},
+          {"s_hs", f.s_hs},         {"s_ho", f.s_ho},         {"s_mo", f.s_mo},         {"s_to", f.s_to}};
+}
+
+CopFunction cop_function_from_json(const nlohmann::json& j, const std::string& path) {
+  CopFunction f;
+  auto get = [&](const char* key, double& out, bool fraction) {
+    if (!j.is_object() || !j.contains(key)) throw InputError(path + ": COP function: missing field '" + key + "'");
+    if (!j[key].is_number()) throw InputError(path + ": COP function: field '" + key + "' is not a number");
+    out = j[key].get<double>();
+    if (!std::isfinite(out) || (fraction && (out < 0 || out > 1)))
+      throw InputError(path + ": COP function: field '" + key + "' must be " + (fraction ? "within 0..1" : "finite"));
+  };
+  get("delta_hs", f.delta_hs, false), get("delta_ho", f.delta_ho, false), get("delta_mo", f.delta_mo, false),
+      get("delta_to", f.delta_to, false);
+  get("s_hs", f.s_hs, true), get("s_ho", f.s_ho, true), get("s_mo", f.s_mo, true), get("s_to", f.s_to, true);
+  if (!(f.delta_hs < f.delta_ho && f.delta_ho < f.delta_mo && f.delta_mo < f.delta_to))
+    throw InputError(path + ": COP function: the event angles must increase (delta_hs < delta_ho < delta_mo < delta_to)");
+  return f;
+}
+
+CopFunction read_cop_function(const std::string& path) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(read_file_text(path));
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path + ": not valid JSON: " + e.what());
+  }
+  return cop_function_from_json(j, path);
+}
+
+}  // namespace kin2grf

@@ -1,0 +1,117 @@
+#include "kin2grf/validation/cop_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "kin2grf/error.hpp"
+
+namespace kin2grf {
+namespace {
+
+/// F(theta) = w . (s_hs, s_ho, s_mo, s_to): the weights of CopFunction::fraction.
+Eigen::Vector4d weights(const CopFunction& f, double th) {
+  Eigen::Vector4d w = Eigen::Vector4d::Zero();
+  auto hc = [](double u) { return 0.5 * (1.0 - std::cos(M_PI * u)); };
+  if (th <= f.delta_hs) {
+    w[0] = 1;
+  } else if (th <= f.delta_ho) {
+    const double c = hc((th - f.delta_hs) / (f.delta_ho - f.delta_hs));
+    w[0] = 1 - c, w[1] = c;
+  } else if (th <= f.delta_mo) {
+    const double c = hc((th - f.delta_ho) / (f.delta_mo - f.delta_ho));
+    w[1] = 1 - c, w[2] = c;
+  } else if (th <= f.delta_to) {
+    const double c = (th - f.delta_mo) / (f.delta_to - f.delta_mo);
+    w[2] = 1 - c, w[3] = c;
+  } else {
+    w[3] = 1;
+  }
+  return w;
+}
+
+}  // namespace
+
+void collect_cop_samples(const EstimateResult& e, const ValidationResult& v, double min_force_fraction, CopSamples& out) {
+  const double bw = e.mass_kg * e.model.gravity_mps2;
+  for (const auto& s : v.stances) {
+    const FootResult& f = e.feet[static_cast<std::size_t>(s.foot)];
+    const MeasuredPlate* mp = nullptr;
+    for (const auto& p : v.plates)
+      if (p.name == s.plate) mp = &p;
+    if (!mp) continue;
+    for (Eigen::Index i = s.first; i <= s.last; ++i) {
+      if (!(mp->force_N(i, 1) > min_force_fraction * bw) || !std::isfinite(mp->cop_x_m[i])) continue;
+      const Eigen::Vector2d A(f.sole_m(i, 0), f.sole_m(i, 1)), B(f.sole_m(i, 2), f.sole_m(i, 3)), C(f.sole_m(i, 4), f.sole_m(i, 5));
+      const double l1 = (B - A).norm(), l2 = (C - B).norm(), x = mp->cop_x_m[i];
+      if (l1 + l2 <= 0 || !(B.x() > A.x()) || !(C.x() >= B.x())) continue;  // a sole that does not point forward
+      double along;
+      if (x <= A.x()) along = 0;
+      else if (x <= B.x()) along = l1 * (x - A.x()) / (B.x() - A.x());
+      else if (x < C.x()) along = l1 + l2 * (x - B.x()) / (C.x() - B.x());
+      else along = l1 + l2;
+      out.theta_rad.push_back(f.inclination_rad[i]);
+      out.fraction.push_back(along / (l1 + l2));
+    }
+  }
+}
+
+CopFit fit_cop_function(const CopSamples& smp, const CopFunction& start) {
+  const Eigen::Index n = static_cast<Eigen::Index>(smp.theta_rad.size());
+  if (n < 20) throw InputError("COP fit: only " + std::to_string(n) + " samples (need 20 or more loaded plate-stance frames)");
+  Eigen::MatrixXd W(n, 4);
+  Eigen::VectorXd y(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    W.row(i) = weights(start, smp.theta_rad[static_cast<std::size_t>(i)]).transpose();
+    y[i] = smp.fraction[static_cast<std::size_t>(i)];
+  }
+  // Events no sample reaches keep their starting position (a tiny ridge towards it).
+  const double ridge = 1e-6;
+  Eigen::MatrixXd Wa(n + 4, 4);
+  Eigen::VectorXd ya(n + 4);
+  Wa << W, ridge * Eigen::Matrix4d::Identity();
+  ya << y, ridge * Eigen::Vector4d(start.s_hs, start.s_ho, start.s_mo, start.s_to);
+  const Eigen::Vector4d s = Wa.colPivHouseholderQr().solve(ya);
+  CopFit fit;
+  fit.function = start;
+  fit.function.s_hs = std::clamp(s[0], 0.0, 1.0);
+  fit.function.s_ho = std::clamp(s[1], 0.0, 1.0);
+  fit.function.s_mo = std::clamp(s[2], 0.0, 1.0);
+  fit.function.s_to = std::clamp(s[3], 0.0, 1.0);
+  fit.samples = static_cast<int>(n);
+  double e0 = 0, e1 = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double th = smp.theta_rad[static_cast<std::size_t>(i)];
+    e0 += std::pow(start.fraction(th) - y[i], 2);
+    e1 += std::pow(fit.function.fraction(th) - y[i], 2);
+  }
+  fit.rms_fraction_before = std::sqrt(e0 / static_cast<double>(n));
+  fit.rms_fraction = std::sqrt(e1 / static_cast<double>(n));
+  return fit;
+}
+
+CopFit fit_cop_function_and_angles(const CopSamples& smp, const CopFunction& start) {
+  CopFit best = fit_cop_function(smp, start);
+  const double before = best.rms_fraction_before;
+  for (double step : {0.08, 0.04, 0.02, 0.01}) {
+    bool improved = true;
+    while (improved) {
+      improved = false;
+      for (int k = 0; k < 4; ++k)
+        for (double d : {-step, step}) {
+          CopFunction f = best.function;
+          double* a[4] = {&f.delta_hs, &f.delta_ho, &f.delta_mo, &f.delta_to};
+          *a[k] += d;
+          if (!(f.delta_hs < f.delta_ho && f.delta_ho < f.delta_mo && f.delta_mo < f.delta_to)) continue;
+          const CopFit c = fit_cop_function(smp, f);
+          if (c.rms_fraction < best.rms_fraction - 1e-6) {
+            best = c;
+            improved = true;
+          }
+        }
+    }
+  }
+  best.rms_fraction_before = before;
+  return best;
+}
+
+}  // namespace kin2grf
