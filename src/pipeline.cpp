@@ -41,7 +41,9 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   std::string gmsg;
   r.ground_level_m = o.ground_level_m ? *o.ground_level_m : estimate_ground_level(lm, gmsg);
   if (!gmsg.empty()) r.messages.push_back(gmsg);
-  const auto flat = calibrate_contact(r.model, lm, r.ground_level_m);
+  std::string cmsg;
+  const auto flat = calibrate_contact(r.model, lm, r.ground_level_m, &cmsg);
+  if (!cmsg.empty()) r.messages.push_back(cmsg);
   for (int s = 0; s < 2; ++s)
     if (flat[s] < 3) r.messages.push_back(std::string(s ? "left" : "right") + " foot: only " + std::to_string(flat[s]) +
                                           " foot-flat frames for the contact calibration");

@@ -374,28 +374,7 @@ int run_make_example(const std::string& dir, double seconds) {
   const auto* set = kin2grf::find_marker_set("kin2grf-example");
   kin2grf::EstimateOptions eo;
   const auto r = kin2grf::estimate(t, nullptr, *set, eo);
-  const auto feet = kin2grf::as_lab_plates(r);
-  kin2grf::ForcePlateRecording rec;
-  rec.rate_hz = t.markers.rate_hz;
-  rec.time_s = t.markers.time_s;
-  for (int side = 0; side < 2; ++side) {
-    kin2grf::ForcePlate p = feet[side];
-    p.name = side ? "FP2" : "FP1";
-    p.type = 2;
-    p.has_geometry = true;
-    const double y0 = side ? 0.0 : -0.5;  // right plate at -Y, left at +Y
-    p.corners_m = {Eigen::Vector3d(0.4, y0 + 0.5, 0), Eigen::Vector3d(-0.2, y0 + 0.5, 0), Eigen::Vector3d(-0.2, y0, 0),
-                   Eigen::Vector3d(0.4, y0, 0)};
-    Eigen::Matrix<double, 3, 4> C;
-    for (int c = 0; c < 4; ++c) C.col(c) = p.corners_m[static_cast<std::size_t>(c)];
-    p.lab_R_plate = kin2grf::plate_axes(C);
-    p.centre_m = C.rowwise().mean();
-    p.origin_m = Eigen::Vector3d(0, 0, -0.04);
-    for (Eigen::Index i = 0; i < p.cop_m.rows(); ++i)
-      if (!p.cop_m.row(i).allFinite()) p.cop_m.row(i) = p.centre_m.transpose();
-    rec.plates.push_back(p);
-  }
-  t.plates = rec;
+  t.plates = kin2grf::example_plates(r, t, 0);
   const std::string base = (std::filesystem::path(dir) / "example_squat").string();
   kin2grf::write_c3d(base + ".c3d", t);
   kin2grf::write_trc(base + ".trc", t.markers);

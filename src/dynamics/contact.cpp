@@ -150,8 +150,9 @@ Eigen::Matrix2d rot2(double a) {
 }
 }  // namespace
 
-std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, double ground) {
+std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, double ground, std::string* message) {
   std::array<int, 2> counts{};
+  std::array<double, 2> heel_height{};
   for (int side = 0; side < 2; ++side) {
     const auto f = flat_frames(lm, side);
     counts[side] = static_cast<int>(f.size());
@@ -172,11 +173,27 @@ std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, 
       bx.push_back(lb.x()); by.push_back(lb.y());
       cx.push_back(lc.x()); cy.push_back(lc.y());
     }
+    std::vector<double> hh;
+    for (auto i : f) hh.push_back(E(i, 1) - ground);
+    heel_height[static_cast<std::size_t>(side)] = median_or_zero(hh);
     auto& fg = model.feet[side];
     fg.flat_angle_rad = median_or_zero(ang);
     fg.heel_local = Eigen::Vector2d(median_or_zero(ax), median_or_zero(ay));
     fg.mt_local = Eigen::Vector2d(median_or_zero(bx), median_or_zero(by));
     fg.hallux_local = Eigen::Vector2d(median_or_zero(cx), median_or_zero(cy));
+  }
+  // A foot that never stands on the floor in the window (a hop on the other leg) has no flat
+  // frames at ground level: it takes the other foot's sole geometry instead of a sole drawn
+  // down to the floor beneath it.
+  for (int side = 0; side < 2; ++side) {
+    const int other = 1 - side;
+    if (heel_height[static_cast<std::size_t>(side)] > heel_height[static_cast<std::size_t>(other)] + 0.03) {
+      model.feet[side] = model.feet[other];
+      if (message)
+        *message = std::string(side ? "left" : "right") + " foot never stands on the floor (heel landmark " +
+                   std::to_string(static_cast<int>(1000 * heel_height[static_cast<std::size_t>(side)])) +
+                   " mm above it at its lowest): its sole geometry is taken from the " + (side ? "right" : "left") + " foot";
+    }
   }
   return counts;
 }

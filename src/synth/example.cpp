@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+#include "kin2grf/io/force_plate.hpp"
+#include "kin2grf/pipeline.hpp"
+
 namespace kin2grf {
 
 Trial make_synthetic_trial(const SyntheticOptions& o) {
@@ -39,10 +42,52 @@ Trial make_synthetic_trial(const SyntheticOptions& o) {
     const Eigen::Vector2d pts[] = {sho, hip, knee, ankle, heel, mt, hallux};
     for (int side = 0; side < 2; ++side) {
       const double y = side == 0 ? -0.1 : 0.1;  // right foot at -Y (Y points left)
-      for (int k = 0; k < 7; ++k) m.positions_m[static_cast<std::size_t>(7 * side + k)].row(i) << pts[k].x(), y, pts[k].y();
+      for (int k = 0; k < 7; ++k) {
+        Eigen::Vector2d p = pts[k];
+        if (side == 1 && k >= 2 && o.left_leg_raised_rad > 0) {
+          // Rotate the left leg about the hip (counter-clockwise: swung forward).
+          const double a = o.left_leg_raised_rad;
+          const Eigen::Vector2d d = p - hip;
+          p = hip + Eigen::Vector2d(std::cos(a) * d.x() - std::sin(a) * d.y(), std::sin(a) * d.x() + std::cos(a) * d.y());
+        }
+        m.positions_m[static_cast<std::size_t>(7 * side + k)].row(i) << p.x(), y, p.y();
+      }
     }
   }
   return t;
+}
+
+ForcePlateRecording example_plates(const EstimateResult& r, const Trial& t, int unloaded_ends) {
+  const auto feet = as_lab_plates(r);
+  ForcePlateRecording rec;
+  rec.rate_hz = t.markers.rate_hz;
+  rec.time_s = r.time_s;
+  for (int side = 0; side < 2; ++side) {
+    ForcePlate p = feet[static_cast<std::size_t>(side)];
+    p.name = side ? "FP2" : "FP1";
+    p.type = 2;
+    p.has_geometry = true;
+    const double y0 = side ? 0.0 : -0.5;  // right plate at -Y, left at +Y
+    p.corners_m = {Eigen::Vector3d(0.4, y0 + 0.5, 0), Eigen::Vector3d(-0.2, y0 + 0.5, 0), Eigen::Vector3d(-0.2, y0, 0),
+                   Eigen::Vector3d(0.4, y0, 0)};
+    Eigen::Matrix<double, 3, 4> C;
+    for (int c = 0; c < 4; ++c) C.col(c) = p.corners_m[static_cast<std::size_t>(c)];
+    p.lab_R_plate = plate_axes(C);
+    p.centre_m = C.rowwise().mean();
+    p.origin_m = Eigen::Vector3d(0, 0, -0.04);
+    const Eigen::Index n = p.force_N.rows();
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (i < unloaded_ends || i >= n - unloaded_ends) {
+        p.force_N.row(i).setZero();
+        p.cop_m.row(i).setConstant(std::nan(""));
+      }
+      if (!p.cop_m.row(i).allFinite()) p.cop_m.row(i) = p.centre_m.transpose();
+      // Moment about the surface centre: the force at the COP (a plate's free moment is zero here).
+      p.moment_centre_Nm.row(i) = (Eigen::Vector3d(p.cop_m.row(i).transpose()) - p.centre_m).cross(Eigen::Vector3d(p.force_N.row(i).transpose())).transpose();
+    }
+    rec.plates.push_back(p);
+  }
+  return rec;
 }
 
 }  // namespace kin2grf

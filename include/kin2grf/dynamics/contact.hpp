@@ -79,8 +79,11 @@ namespace kin2grf {
 /// per foot, the foot-flat frames are those where both the heel and the MT landmark are within
 /// 15 mm of their 10th-percentile height; there, theta_foot,flat is the median foot angle and
 /// A, B (foot frame) and C (toes frame) are the medians of the points at ground level straight
-/// below the heel, MT and hallux landmarks. Returns the number of flat frames per foot.
-std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, double ground_level_m);
+/// below the heel, MT and hallux landmarks. A foot whose flat frames stand more than 30 mm
+/// higher than the other's never touches the floor: it takes the other foot's geometry (and
+/// `message` says so). Returns the number of flat frames per foot.
+std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, double ground_level_m,
+                                     std::string* message = nullptr);
 
 /// Automatic ground level: 0 (the lab floor, where capture systems put it) when the feet's
 /// flat-stance landmarks stand 0-150 mm above it; otherwise the lowest of them (a raised or

@@ -39,11 +39,11 @@ enum class MultiplierNorm {
 struct SolverOptions {
   double r_N_per_m = 1e3;      ///< activation parameter r (Eq. 8); default from `kin2grf study r`
   int max_iterations = 20;
-  MultiplierNorm norm = MultiplierNorm::Paper;
+  MultiplierNorm norm = MultiplierNorm::TorqueScaled;  ///< kin2grf's default; the paper: Paper
   double torque_length_m = 0.9;
   /// A contact point may be active only while its horizontal speed relative to the ground
-  /// (or belt) is below this (m/s); <= 0 disables the gate (the paper).
-  double speed_gate_mps = 0.0;
+  /// (or belt) is below this (m/s); <= 0 disables the gate (the paper). kin2grf's default: 2.
+  double speed_gate_mps = 2.0;
   double belt_velocity_mps = 0.0;  ///< ground velocity along x (treadmill belt), m/s
 };
 

@@ -1,0 +1,260 @@
+// Tests of validate, its metrics, the COP fit and the HTML report.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/cop_function.hpp"
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/io/text.hpp"
+#include "kin2grf/output/report.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/synth/example.hpp"
+#include "kin2grf/validation/cop_fit.hpp"
+#include "kin2grf/validation/metrics.hpp"
+#include "kin2grf/validation/validate.hpp"
+#include "test_support.hpp"
+
+using namespace kin2grf;
+
+TEST(Metrics, RmseAndRrmseOfHandMadeSeries) {
+  // est - meas = (1, -1, 1, -1): RMSE 1. Ranges: est 0..10 -> 10... by construction below.
+  Eigen::VectorXd meas(4), est(4);
+  meas << 0, 4, 8, 10;
+  est << 1, 3, 9, 9;
+  const auto m = compare_series(est, meas);
+  ASSERT_TRUE(m);
+  EXPECT_EQ(m->samples, 4);
+  EXPECT_DOUBLE_EQ(m->rmse, 1.0);
+  // range(est) = 8, range(meas) = 10 -> mean range 9 -> rRMSE = 100/9 %.
+  EXPECT_NEAR(m->rrmse_percent, 100.0 / 9.0, 1e-12);
+  EXPECT_DOUBLE_EQ(m->max_abs_error, 1.0);
+  EXPECT_DOUBLE_EQ(m->peak_difference, -1.0);
+  EXPECT_GT(m->pearson_r, 0.95);
+  EXPECT_LT(m->pearson_r, 1.0);
+  // NaN pairs are left out; identical series give zero error and r = 1.
+  Eigen::VectorXd a(5), b(5);
+  a << 1, 2, NAN, 4, 8;
+  b << 1, 2, 3, NAN, 8;
+  const auto z = compare_series(a, b);
+  ASSERT_TRUE(z);
+  EXPECT_EQ(z->samples, 3);
+  EXPECT_DOUBLE_EQ(z->rmse, 0.0);
+  EXPECT_DOUBLE_EQ(z->rrmse_percent, 0.0);
+  EXPECT_NEAR(z->pearson_r, 1.0, 1e-12);
+  EXPECT_FALSE(compare_series(Eigen::VectorXd::Constant(3, NAN), Eigen::VectorXd::Zero(3)));
+}
+
+TEST(Metrics, ThresholdCrossingsAreInterpolated) {
+  Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(6, 0.0, 0.05), v(6);
+  v << 0, 10, 30, 50, 30, 0;
+  EXPECT_NEAR(*rising_crossing(v, t, 20.0, 0, 5), 0.015, 1e-12);
+  EXPECT_NEAR(*falling_crossing(v, t, 20.0, 0, 5), 0.04 + 0.01 * 10.0 / 30.0, 1e-12);
+  EXPECT_FALSE(rising_crossing(v, t, 60.0, 0, 5));
+}
+
+namespace {
+
+struct Synthetic {
+  Trial trial;
+  EstimateResult estimate;
+  ForcePlateRecording plates;
+};
+
+/// A squat whose "plates" are the estimate's own forces, unloaded for 10 frames at each end so
+/// that the stances begin and end inside the trial.
+Synthetic synthetic_with_exact_plates() {
+  Synthetic s;
+  SyntheticOptions so;
+  s.trial = make_synthetic_trial(so);
+  s.estimate = estimate(s.trial, nullptr, *find_marker_set("kin2grf-example"), {});
+  s.plates = example_plates(s.estimate, s.trial, 10);
+  return s;
+}
+
+}  // namespace
+
+TEST(Validate, ExactPlatesGiveNearZeroError) {
+  const auto s = synthetic_with_exact_plates();
+  const auto v = validate(s.estimate, s.plates);
+  ASSERT_EQ(v.stances.size(), 2u) << (v.excluded.empty() ? "" : v.excluded.front());
+  for (const auto& st : v.stances) {
+    EXPECT_EQ(st.plate, st.foot == 0 ? "FP1" : "FP2") << "FP1 is under the right foot";
+    ASSERT_TRUE(st.metrics.vertical && st.metrics.anterior && st.metrics.cop && st.metrics.moment);
+    EXPECT_LT(st.metrics.vertical->rrmse_percent, 1e-6);
+    EXPECT_LT(st.metrics.anterior->rrmse_percent, 1e-6);
+    EXPECT_LT(st.metrics.cop->rmse, 1e-9);
+    EXPECT_LT(st.metrics.moment->rmse, 1e-6);
+  }
+  ASSERT_TRUE(v.total.has_value());
+  EXPECT_LT(v.total->metrics.vertical->rmse, 1e-6);
+  EXPECT_LT(v.total->metrics.moment->rmse, 1e-6);
+  EXPECT_NEAR(v.total->implied_mass_kg, 70.0, 0.1);  // plates post-filtered, kinematics not
+  EXPECT_TRUE(v.excluded.empty());
+}
+
+TEST(Validate, AssignmentFollowsTheCopNotThePlateName) {
+  auto s = synthetic_with_exact_plates();
+  // Swap the plates' signals: FP1 now carries the left foot's forces (and COP).
+  std::swap(s.plates.plates[0].force_N, s.plates.plates[1].force_N);
+  std::swap(s.plates.plates[0].cop_m, s.plates.plates[1].cop_m);
+  std::swap(s.plates.plates[0].moment_centre_Nm, s.plates.plates[1].moment_centre_Nm);
+  std::swap(s.plates.plates[0].corners_m, s.plates.plates[1].corners_m);
+  std::swap(s.plates.plates[0].centre_m, s.plates.plates[1].centre_m);
+  const auto v = validate(s.estimate, s.plates);
+  ASSERT_EQ(v.stances.size(), 2u);
+  for (const auto& st : v.stances) EXPECT_EQ(st.plate, st.foot == 0 ? "FP2" : "FP1");
+}
+
+TEST(Validate, ShiftedPlateIsNotAssignedAndSaysWhy) {
+  auto s = synthetic_with_exact_plates();
+  // Move FP1's measured COP 40 cm forward (as a plate registered in the wrong place would).
+  auto& p = s.plates.plates[0];
+  for (Eigen::Index i = 0; i < p.cop_m.rows(); ++i) p.cop_m(i, 0) += 0.4;
+  p.moment_centre_Nm.setConstant(NAN);  // let the COP speak
+  const auto v = validate(s.estimate, s.plates);
+  ASSERT_EQ(v.stances.size(), 1u);
+  EXPECT_EQ(v.stances[0].plate, "FP2");
+  ASSERT_FALSE(v.excluded.empty());
+  EXPECT_NE(v.excluded[0].find("FP1"), std::string::npos) << v.excluded[0];
+  EXPECT_NE(v.excluded[0].find("from the nearest foot"), std::string::npos) << v.excluded[0];
+}
+
+TEST(Validate, FootPartlyOffItsPlateIsExcluded) {
+  auto s = synthetic_with_exact_plates();
+  // Shrink FP1 so that the right heel (x = -0.05 m) stands 5 cm behind its rear edge.
+  auto& p = s.plates.plates[0];
+  for (auto& c : p.corners_m)
+    if (c.x() < 0) c.x() = 0.0;
+  p.centre_m.x() = 0.2;
+  const auto v = validate(s.estimate, s.plates);
+  ASSERT_EQ(v.stances.size(), 1u);
+  EXPECT_EQ(v.stances[0].plate, "FP2");
+  bool said = false;
+  for (const auto& x : v.excluded) said = said || x.find("partly off") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
+TEST(CopFit, RecoversTheEventPositionsOfNoiseFreeSamples) {
+  CopFunction truth = CopFunction::paper();
+  truth.s_hs = 0.1, truth.s_ho = 0.35, truth.s_mo = 0.7, truth.s_to = 0.95;
+  CopSamples smp;
+  for (int k = 0; k <= 200; ++k) {
+    const double th = -0.5 + 1.7 * k / 200.0;
+    smp.theta_rad.push_back(th);
+    smp.fraction.push_back(truth.fraction(th));
+  }
+  const auto fit = fit_cop_function(smp, CopFunction::paper());
+  EXPECT_NEAR(fit.function.s_hs, 0.1, 1e-5);
+  EXPECT_NEAR(fit.function.s_ho, 0.35, 1e-5);
+  EXPECT_NEAR(fit.function.s_mo, 0.7, 1e-5);
+  EXPECT_NEAR(fit.function.s_to, 0.95, 1e-5);
+  EXPECT_LT(fit.rms_fraction, 1e-6);
+  CopSamples few;
+  few.theta_rad = {0.0};
+  few.fraction = {0.5};
+  EXPECT_THROW(fit_cop_function(few, CopFunction::paper()), InputError);
+}
+
+TEST(CopFit, JsonRoundTripAndFieldErrors) {
+  const CopFunction f = CopFunction::paper();
+  const CopFunction g = cop_function_from_json(cop_function_json(f), "x.json");
+  EXPECT_DOUBLE_EQ(g.s_mo, f.s_mo);
+  EXPECT_DOUBLE_EQ(g.delta_to, f.delta_to);
+  auto j = cop_function_json(f);
+  j.erase("s_ho");
+  try {
+    (void)cop_function_from_json(j, "cop.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cop.json"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("s_ho"), std::string::npos);
+  }
+  j = cop_function_json(f);
+  j["delta_mo"] = 2.0;  // after delta_to
+  EXPECT_THROW((void)cop_function_from_json(j, "cop.json"), InputError);
+}
+
+TEST(Report, RendersInHeadlessChromium) {
+  const char* candidates[] = {"/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"};
+  std::string browser;
+  for (const char* c : candidates)
+    if (std::filesystem::exists(c)) browser = c;
+  if (browser.empty()) GTEST_SKIP() << "no Chromium found (scripts/setup.sh installs Debian's chromium)";
+  const auto s = synthetic_with_exact_plates();
+  const auto v = validate(s.estimate, s.plates);
+  const auto j = validation_json("synthetic", s.estimate, v, nlohmann::json::object());
+  const auto dir = test::temp_dir("report");
+  const auto html = dir / "report.html";
+  write_file_text(html.string(), validation_report_html("synthetic", s.estimate, v, j));
+  const std::string cmd = browser + " --headless --no-sandbox --disable-gpu --user-data-dir=" + (dir / "profile").string() +
+                          " --dump-dom file://" + html.string() + " 2>/dev/null";
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  ASSERT_TRUE(pipe);
+  std::string dom;
+  char buf[4096];
+  while (std::size_t k = std::fread(buf, 1, sizeof buf, pipe.get())) dom.append(buf, k);
+  // 3 figures per foot and 2 totals, each drawn by Chart.js (the script sets the attribute
+  // only after every chart was constructed).
+  EXPECT_NE(dom.find("data-charts-rendered=\"8\""), std::string::npos) << dom.substr(0, 400);
+  const auto p = dom.find("data-points=\"");
+  ASSERT_NE(p, std::string::npos);
+  EXPECT_GT(std::stoi(dom.substr(p + 13)), 1000);
+}
+
+// Regression guards on the development walking and running trials: the mean per-stance vertical rRMSE
+// stays within 25 % (+1 point) of what was measured when the guard was set (docs/VALIDATION.md),
+// and every kept plate stance is found in contact at mid-stance by the estimate.
+TEST(SharedValidate, TrialsStayWithinTheirMeasuredErrors) {
+  KIN2GRF_REQUIRE_DATA();
+  struct Case {
+    const char* trial;
+    const char* plates;
+    double mass;
+    const char* static_trial;
+    double measured_vertical;
+    double min_contact_fraction = 0.8;  ///< of each plate stance's frames estimated in contact
+  };
+  const Case cases[] = {
+      {"opensim_c3d_overground_walk/walking2.c3d", nullptr, 64.9, nullptr, 8.7},
+      {"opensim_c3d_overground_walk/walking5.c3d", nullptr, 67.5, nullptr, 9.8},
+      {"rajagopal2016_overground_walk/markers_walk.trc", "rajagopal2016_overground_walk/grf_walk.mot", 85.27, nullptr, 6.6},
+      {"opencap_dropjump_walk/walking1_markers.trc", "opencap_dropjump_walk/walking1_grf.mot", 75.7, nullptr, 6.8},
+      {"opensim_subject01_treadmill_walk/subject01_walk1.trc", "opensim_subject01_treadmill_walk/subject01_walk1_grf.mot", 72.6,
+       "opensim_subject01_treadmill_walk/subject01_static.trc", 4.4},
+      {"rajagopal2016_treadmill_run/motion_capture_run.trc", "rajagopal2016_treadmill_run/grf_run.mot", 72.84,
+       "rajagopal2016_treadmill_run/static_run.trc", 6.3},
+      // The drop jump is where the method does badly (docs/VALIDATION.md says why); guarded all the same.
+      // Both feet land side by side: the estimate alternates between them (docs/VALIDATION.md).
+      {"opencap_dropjump_walk/DJ1_markers.trc", "opencap_dropjump_walk/DJ1_grf.mot", 75.7, nullptr, 58.0, 0.2},
+      {"btk_plugingait_walk/PiG_Motion-FlatFoot-Full.c3d", nullptr, 0, nullptr, 15.3},
+      {"btk_plugingait_walk/PiG_Motion3_FF.c3d", nullptr, 0, nullptr, 18.8},
+  };
+  LoadOptions lo;
+  lo.c3d.zero_offset = ZeroOffset::Unloaded;
+  for (const auto& c : cases) {
+    const Trial t = load_trial(test::data_file(c.trial), lo);
+    std::unique_ptr<Trial> st, pl;
+    if (c.static_trial) st = std::make_unique<Trial>(load_trial(test::data_file(c.static_trial)));
+    if (c.plates) pl = std::make_unique<Trial>(load_trial(test::data_file(c.plates)));
+    EstimateOptions eo;
+    if (c.mass > 0) eo.mass_kg = c.mass;
+    const auto e = estimate(t, st.get(), *recognise_marker_set(t.markers), eo);
+    const auto v = validate(e, pl ? *pl->plates : *t.plates);
+    ASSERT_FALSE(v.stances.empty()) << c.trial;
+    for (const auto& s : v.stances) {
+      int in_contact = 0;
+      for (Eigen::Index i = s.first; i <= s.last; ++i) in_contact += e.feet[static_cast<std::size_t>(s.foot)].contact[static_cast<std::size_t>(i)];
+      EXPECT_GE(in_contact, c.min_contact_fraction * static_cast<double>(s.last - s.first + 1)) << c.trial << " " << s.plate;
+    }
+    const double vertical = mean_rrmse(v.stances).vertical;
+    EXPECT_LT(vertical, 1.25 * c.measured_vertical + 1.0) << c.trial;
+    EXPECT_GT(vertical, 0.5) << c.trial << ": suspiciously exact";
+  }
+}
