@@ -7,7 +7,11 @@
 #include <string>
 
 #include "kin2grf/io/c3d.hpp"
+#include "kin2grf/io/load.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/synth/example.hpp"
 
 namespace {
 
@@ -32,6 +36,78 @@ void BM_ReadC3dWalking2(benchmark::State& state) {
   state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_ReadC3dWalking2)->Unit(benchmark::kMillisecond);
+
+/// A trial to run the method on: Rajagopal's overground walk (shared data) or, without the
+/// data, the synthetic squat (always available).
+struct Workload {
+  kin2grf::Trial trial;
+  const kin2grf::MarkerSet* set = nullptr;
+  kin2grf::EstimateOptions options;
+  bool ok = false;
+};
+
+Workload workload(bool real) {
+  Workload w;
+  if (real) {
+    const std::string path = data_file("rajagopal2016_overground_walk/markers_walk.trc");
+    if (!std::filesystem::exists(path)) return w;
+    w.trial = kin2grf::load_trial(path);
+    w.options.mass_kg = 85.27;
+    w.set = kin2grf::recognise_marker_set(w.trial.markers);
+  } else {
+    kin2grf::SyntheticOptions so;
+    so.duration_s = 10.0;
+    w.trial = kin2grf::make_synthetic_trial(so);
+    w.set = kin2grf::find_marker_set("kin2grf-example");
+  }
+  w.ok = w.set != nullptr;
+  return w;
+}
+
+/// The per-frame contact problem alone (Eqs. 5-10 with the active-set iterations): motion and
+/// contact points prepared once, ContactSolver::solve timed over every frame.
+void BM_ContactSolvePerFrame(benchmark::State& state) {
+  const Workload w = workload(state.range(0) == 1);
+  if (!w.ok) {
+    state.SkipWithError("shared data not found");
+    return;
+  }
+  const auto r = kin2grf::estimate(w.trial, nullptr, *w.set, w.options);
+  kin2grf::ModelMotion motion = kin2grf::compute_motion(r.model, r.landmarks, w.options.kinematic_cutoff_hz);
+  kin2grf::ContactModelOptions co = w.options.contact;
+  co.ground_level_m = r.ground_level_m;
+  const auto contacts = kin2grf::prepare_contacts(r.model, co, motion);
+  kin2grf::ContactSolver solver(r.model, w.options.solver);
+  const Eigen::Index n = motion.frames();
+  long frames = 0;
+  for (auto _ : state) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      auto s = solver.solve(motion.q.row(i).transpose(), motion.qdd.row(i).transpose(), contacts[static_cast<std::size_t>(i)]);
+      benchmark::DoNotOptimize(s);
+    }
+    frames += n;
+  }
+  state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_ContactSolvePerFrame)->Arg(0)->Arg(1)->ArgNames({"real"})->Unit(benchmark::kMillisecond);
+
+/// The whole method on a loaded trial: landmarks, sagittal frame, model, kinematics, contact
+/// solve, post-filter, outputs in memory (file reading excluded; see BM_ReadC3dWalking2).
+void BM_EstimatePipeline(benchmark::State& state) {
+  const Workload w = workload(state.range(0) == 1);
+  if (!w.ok) {
+    state.SkipWithError("shared data not found");
+    return;
+  }
+  long frames = 0;
+  for (auto _ : state) {
+    const auto r = kin2grf::estimate(w.trial, nullptr, *w.set, w.options);
+    frames += r.time_s.size();
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_EstimatePipeline)->Arg(0)->Arg(1)->ArgNames({"real"})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

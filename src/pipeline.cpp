@@ -86,7 +86,9 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   Eigen::MatrixXd torque(n, kJointCount);
   std::vector<std::vector<bool>> act(static_cast<std::size_t>(n));
   r.iterations.resize(static_cast<std::size_t>(n));
+  const Eigen::Index step = std::max<Eigen::Index>(1, n / 100);
   for (Eigen::Index i = 0; i < n; ++i) {
+    if (o.progress && i % step == 0) o.progress(static_cast<long>(i), static_cast<long>(n));
     const FrameSolution s = solver.solve(motion.q.row(i).transpose(), motion.qdd.row(i).transpose(), contacts[static_cast<std::size_t>(i)]);
     lam.row(i) = s.contact_lambda.transpose();
     torque.row(i) = s.joint_torque_Nm.transpose();
@@ -95,6 +97,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     r.cycled_frames += s.cycled;
     r.capped_frames += s.capped;
   }
+  if (o.progress) o.progress(static_cast<long>(n), static_cast<long>(n));
   const auto t2 = clock::now();
   r.seconds_kinematics = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_dynamics = std::chrono::duration<double>(t2 - t1).count();

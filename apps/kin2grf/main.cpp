@@ -1,5 +1,8 @@
 // kin2grf command line: a thin front end that wires the library's steps together and prints.
 #include <CLI/CLI.hpp>
+#include <unistd.h>
+
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -21,6 +24,8 @@
 #include <filesystem>
 
 namespace {
+
+constexpr long kProgressFrames = 20000;  ///< inputs at least this long report progress
 
 kin2grf::LoadOptions load_options(const std::string& zero) {
   kin2grf::LoadOptions lo;
@@ -132,7 +137,21 @@ kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, const kin2grf::
   if (!a.static_trial.empty()) st = kin2grf::load_trial(a.static_trial);
   kin2grf::MarkerSet custom;
   const kin2grf::MarkerSet& set = resolve_marker_set(a, trial, custom);
-  auto r = kin2grf::estimate(trial, st ? &*st : nullptr, set, to_options(a));
+  auto options = to_options(a);
+  if (trial.markers.frames() >= kProgressFrames) {
+    // Long inputs: progress on stderr, on one line when stderr is a terminal.
+    const bool tty = isatty(fileno(stderr)) != 0;
+    options.progress = [tty, last = -1](long done, long all) mutable {
+      const int pct = static_cast<int>(100 * done / std::max(1L, all));
+      if (pct / 10 == last / 10 && pct != 100 && !tty) return;
+      if (pct == last) return;
+      last = pct;
+      std::fprintf(stderr, tty ? "\rkin2grf: contact solve %3d %% (%ld of %ld frames)" : "kin2grf: contact solve %3d %% (%ld of %ld frames)\n",
+                   pct, done, all);
+      if (tty && pct == 100) std::fputc('\n', stderr);
+    };
+  }
+  auto r = kin2grf::estimate(trial, st ? &*st : nullptr, set, options);
   for (const auto& m : r.messages) std::cerr << "kin2grf: " << m << "\n";
   std::cerr << "kin2grf: " << r.time_s.size() << " frames, mass " << r.mass_kg << " kg, "
             << static_cast<long>(static_cast<double>(r.time_s.size()) / std::max(1e-9, r.seconds_kinematics + r.seconds_dynamics))

@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <array>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +31,9 @@ struct EstimateOptions {
   LandmarkOptions landmarks;
   /// GRM reference point in the sagittal frame (x along progression, y up), m.
   Eigen::Vector2d grm_reference_m = Eigen::Vector2d::Zero();
+  /// Called with (frames solved, frames in all) every 1 % of the contact solve; empty: none.
+  /// The core prints nothing itself: the front end decides what to show.
+  std::function<void(long, long)> progress;
 };
 
 struct FootResult {
