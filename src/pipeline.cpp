@@ -30,8 +30,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   r.foot_lateral_m = win.foot_lateral_m;
   r.landmarks = win.landmarks;
   const SagittalLandmarks& lm = r.landmarks;
-  if (2.0 * o.kinematic_cutoff_hz >= lm.rate_hz || 2.0 * o.post_cutoff_hz >= lm.rate_hz ||
-      2.0 * o.contact_cutoff_hz >= lm.rate_hz)
+  if (2.0 * o.kinematic_cutoff_hz >= lm.rate_hz || 2.0 * o.post_cutoff_hz >= lm.rate_hz)
     throw InputError(trial.path + ": cut-off frequencies must be below half the marker rate (" + std::to_string(lm.rate_hz) + " Hz)");
   r.time_s = lm.time_s;
 
@@ -51,18 +50,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   ModelMotion motion = compute_motion(r.model, lm, o.kinematic_cutoff_hz);
   ContactModelOptions co = o.contact;
   co.ground_level_m = r.ground_level_m;
-  auto contacts = prepare_contacts(r.model, co, motion);
-  if (o.contact_cutoff_hz > 0 && o.contact_cutoff_hz != o.kinematic_cutoff_hz) {
-    // Contact decisions from less smoothed kinematics: a 6 Hz filter rounds the heel's landing
-    // and puts the foot on the ground before it gets there.
-    ModelMotion fast = compute_motion(r.model, lm, o.contact_cutoff_hz);
-    const auto fc = prepare_contacts(r.model, co, fast);
-    for (std::size_t i = 0; i < contacts.size(); ++i)
-      for (std::size_t j = 0; j < contacts[i].points.size(); ++j) {
-        contacts[i].points[j].gap_m = fc[i].points[j].gap_m;
-        contacts[i].points[j].velocity = fc[i].points[j].velocity;
-      }
-  }
+  const auto contacts = prepare_contacts(r.model, co, motion);
   SolverOptions so = o.solver;
   if (r.frame.treadmill && so.speed_gate_mps > 0) {
     // Belt velocity: the median horizontal velocity of the lowest sole point over foot-flat-like frames.

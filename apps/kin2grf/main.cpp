@@ -45,7 +45,7 @@ int run_info(const std::string& file, bool json, double threshold, const std::st
 struct EstimateArgs {
   std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "torque-scaled",
       anthropometry = "winter", up_axis, cop_function;
-  double mass = 0, r = 1e3, kin_cutoff = 6, post_cutoff = 12, contact_cutoff = 0, ground_shift = 0, speed_gate = 2.0;
+  double mass = 0, r = 1e3, kin_cutoff = 6, post_cutoff = 12, ground_shift = 0, speed_gate = 2.0;
   bool paper = false, r_given = false;
   std::optional<double> ground_level;
   int max_gap = 10;
@@ -63,8 +63,6 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
        "Activation parameter r, N/m (Eq. 8); default 1000 (from `kin2grf study r`), 10000 with --paper");
   c->add_option("--kinematic-cutoff", a.kin_cutoff, "Kinematics low-pass cut-off, Hz")->capture_default_str();
   c->add_option("--post-cutoff", a.post_cutoff, "Multiplier post-filter cut-off, Hz")->capture_default_str();
-  c->add_option("--contact-cutoff", a.contact_cutoff, "Cut-off of the kinematics deciding contact (gap, sole speed), Hz; 0 = as the dynamics")
-      ->capture_default_str();
   c->add_option("--ground-level", a.ground_level, "Floor height in the lab's up axis, m (default: estimated)");
   c->add_option("--ground-shift", a.ground_shift, "Shift the ground by this much, m (robustness study)")->capture_default_str();
   c->add_option("--speed-gate", a.speed_gate, "Contact allowed only below this sole speed, m/s (0 = off, the paper)")
@@ -88,7 +86,6 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
   o.anthropometry = a.anthropometry;
   o.kinematic_cutoff_hz = a.kin_cutoff;
   o.post_cutoff_hz = a.post_cutoff;
-  o.contact_cutoff_hz = a.paper ? 0.0 : a.contact_cutoff;
   o.ground_level_m = a.ground_level;
   o.contact.foot_model = a.foot_model == "cop" ? kin2grf::FootModel::Cop : kin2grf::FootModel::ThreePoint;
   o.contact.ground_shift_m = a.ground_shift;
@@ -439,9 +436,9 @@ int main(int argc, char** argv) {
 
   StudyArgs study_args;
   auto* study = app.add_subcommand("study", "The paper's parameter studies on trials with plates: r, ground-shift, cutoff, "
-                                            "kinematic-cutoff, foot-model");
-  study->add_option("KIND", study_args.kind, "r | ground-shift | cutoff | kinematic-cutoff | contact-cutoff | speed-gate | foot-model")
-      ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "kinematic-cutoff", "contact-cutoff", "speed-gate", "foot-model"}));
+                                            "kinematic-cutoff, speed-gate, foot-model");
+  study->add_option("KIND", study_args.kind, "r | ground-shift | cutoff | kinematic-cutoff | speed-gate | foot-model")
+      ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "kinematic-cutoff", "speed-gate", "foot-model"}));
   study->add_option("TRIAL", study_args.trials, "Trials with plates (the options below apply to all of them)");
   study->add_option("--trial-list", study_args.trial_list,
                     "File of lines 'activity|name|TRIAL [options]', each trial with its own options");

@@ -22,9 +22,6 @@ struct EstimateOptions {
   std::string anthropometry = "winter";
   double kinematic_cutoff_hz = 6.0;        ///< paper: 6 Hz
   double post_cutoff_hz = 12.0;            ///< paper: 12 Hz
-  /// Cut-off for the kinematics that decide contact (gap g_n and sole speed); <= 0: the same
-  /// kinematics as the dynamics (the paper).
-  double contact_cutoff_hz = 0.0;
   std::optional<double> ground_level_m;    ///< else estimate_ground_level
   ContactModelOptions contact;
   SolverOptions solver;

@@ -41,11 +41,6 @@ std::vector<Setting> settings_for(const std::string& kind) {
       std::snprintf(b, sizeof b, "%.0f Hz", f);
       s.push_back({b, f, [f](EstimateOptions& o) { o.kinematic_cutoff_hz = f; }});
     }
-  } else if (kind == "contact-cutoff") {
-    for (double f : {0.0, 8.0, 10.0, 12.0, 15.0, 20.0}) {
-      std::snprintf(b, sizeof b, f > 0 ? "%.0f Hz" : "as dynamics", f);
-      s.push_back({b, f, [f](EstimateOptions& o) { o.contact_cutoff_hz = f; }});
-    }
   } else if (kind == "speed-gate") {
     for (double v : {0.0, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0}) {
       std::snprintf(b, sizeof b, v > 0 ? "%.2f m/s" : "off", v);
@@ -55,7 +50,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
     s.push_back({"three-point (model 1)", 1, [](EstimateOptions& o) { o.contact.foot_model = FootModel::ThreePoint; }});
     s.push_back({"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }});
   } else {
-    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, contact-cutoff, speed-gate, foot-model)");
+    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, speed-gate, foot-model)");
   }
   return s;
 }

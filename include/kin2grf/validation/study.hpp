@@ -7,6 +7,7 @@
 //   ground-shift  the ground moved by -1 cm, 0, +1 cm (paper: robustness to the ground level)
 //   cutoff        the post-filter cut-off (paper: 12 Hz)
 //   kinematic-cutoff  the marker/coordinate low-pass cut-off (paper: 6 Hz)
+//   speed-gate    kin2grf's contact speed gate, off .. 3 m/s (not in the paper)
 //   foot-model    model 1 (three points) against model 2 (moving COP) (paper: Fig. 6)
 #pragma once
 
