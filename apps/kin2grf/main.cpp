@@ -44,9 +44,9 @@ int run_info(const std::string& file, bool json, double threshold, const std::st
 
 struct EstimateArgs {
   std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "torque-scaled",
-      anthropometry = "winter", up_axis, cop_function;
+      anthropometry = "de-leva", up_axis, cop_function;
   double mass = 0, r = 1e3, kin_cutoff = 6, post_cutoff = 12, ground_shift = 0, speed_gate = 2.0;
-  bool paper = false, r_given = false;
+  bool paper = false, r_given = false, anthropometry_given = false;
   std::optional<double> ground_level;
   int max_gap = 10;
 };
@@ -69,7 +69,10 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
       ->capture_default_str();
   c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
       ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
-  c->add_option("--anthropometry", a.anthropometry, "winter or de-leva")->capture_default_str();
+  c->add_option_function<std::string>(
+       "--anthropometry", [&a](const std::string& v) { a.anthropometry = v, a.anthropometry_given = true; },
+       "winter or de-leva; default de-leva, winter with --paper")
+      ->check(CLI::IsMember({"winter", "de-leva"}));
   c->add_option("--cop-function", a.cop_function, "Foot model 2's COP function from this JSON (see kin2grf fit-cop)");
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
   c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate");
@@ -83,7 +86,7 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
 kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
   kin2grf::EstimateOptions o;
   if (a.mass > 0) o.mass_kg = a.mass;
-  o.anthropometry = a.anthropometry;
+  o.anthropometry = (a.paper && !a.anthropometry_given) ? "winter" : a.anthropometry;
   o.kinematic_cutoff_hz = a.kin_cutoff;
   o.post_cutoff_hz = a.post_cutoff;
   o.ground_level_m = a.ground_level;
@@ -106,7 +109,7 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
 nlohmann::json settings_json(const EstimateArgs& a) {
   return {{"trial", a.trial}, {"static", a.static_trial}, {"foot_model", a.foot_model}, {"r_N_per_m", (a.paper && !a.r_given) ? 1e4 : a.r},
           {"kinematic_cutoff_hz", a.kin_cutoff}, {"post_cutoff_hz", a.post_cutoff}, {"norm", a.paper ? std::string("paper") : a.norm},
-          {"speed_gate_mps", a.paper ? 0.0 : a.speed_gate}, {"cop_function", !a.cop_function.empty() ? a.cop_function : a.paper ? "paper event angles" : "built-in (fitted)"}, {"paper_configuration", a.paper}, {"anthropometry", a.anthropometry}, {"ground_shift_m", a.ground_shift},
+          {"speed_gate_mps", a.paper ? 0.0 : a.speed_gate}, {"cop_function", !a.cop_function.empty() ? a.cop_function : a.paper ? "paper event angles" : "built-in (fitted)"}, {"paper_configuration", a.paper}, {"anthropometry", (a.paper && !a.anthropometry_given) ? std::string("winter") : a.anthropometry}, {"ground_shift_m", a.ground_shift},
           {"ground_level_m", a.ground_level ? nlohmann::json(*a.ground_level) : nlohmann::json("auto")}};
 }
 

@@ -19,7 +19,7 @@ namespace kin2grf {
 
 struct EstimateOptions {
   std::optional<double> mass_kg;           ///< else PROCESSING:Bodymass; none -> error
-  std::string anthropometry = "winter";
+  std::string anthropometry = "de-leva";  ///< kin2grf's default; the paper cites Winter (--paper)
   double kinematic_cutoff_hz = 6.0;        ///< paper: 6 Hz
   double post_cutoff_hz = 12.0;            ///< paper: 12 Hz
   std::optional<double> ground_level_m;    ///< else estimate_ground_level
