@@ -15,6 +15,25 @@ using namespace kin2grf;
 
 namespace {
 
+/// The synthetic trial's markers are the landmarks themselves (x forward, z up).
+SagittalLandmarks synthetic_landmarks(const Trial& t) {
+  SagittalLandmarks lm;
+  lm.rate_hz = t.markers.rate_hz;
+  lm.time_s = t.markers.time_s;
+  for (int k = 0; k < kLandmarkCount; ++k) lm.p[k].resize(lm.frames(), 2);
+  for (int side = 0; side < 2; ++side)
+    for (int k = 2; k < 7; ++k) {
+      const auto& P = t.markers.positions_m[static_cast<std::size_t>(7 * side + k)];
+      lm.p[landmark(side, k - 2)].col(0) = P.col(0);
+      lm.p[landmark(side, k - 2)].col(1) = P.col(2);
+    }
+  for (int k : {0, 1}) {  // shoulder, hip
+    lm.p[k].col(0) = t.markers.positions_m[static_cast<std::size_t>(k)].col(0);
+    lm.p[k].col(1) = t.markers.positions_m[static_cast<std::size_t>(k)].col(2);
+  }
+  return lm;
+}
+
 EstimateResult run(const SyntheticOptions& so, EstimateOptions eo = {}) {
   const Trial t = make_synthetic_trial(so);
   return estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
@@ -49,21 +68,7 @@ TEST(Kinematics, ReconstructionSatisfiesTheBilateralConstraints) {
   SyntheticOptions so;
   const auto r = run(so);
   // Rebuild the motion and check Phi(q) ~ 0 via Phi_q qd = 0 and finite differences of q.
-  SagittalLandmarks lm;
-  lm.rate_hz = 100;
-  lm.time_s = t.markers.time_s;
-  for (int k = 0; k < kLandmarkCount; ++k) lm.p[k].resize(lm.frames(), 2);
-  const int order[] = {0, 1, 2, 3, 4, 5, 6};
-  for (int side = 0; side < 2; ++side)
-    for (int k = 2; k < 7; ++k) {
-      const auto& P = t.markers.positions_m[static_cast<std::size_t>(7 * side + order[k])];
-      lm.p[landmark(side, k - 2)].col(0) = P.col(0);
-      lm.p[landmark(side, k - 2)].col(1) = P.col(2);
-    }
-  lm.p[kShoulder].col(0) = t.markers.positions_m[0].col(0);
-  lm.p[kShoulder].col(1) = t.markers.positions_m[0].col(2);
-  lm.p[kHip].col(0) = t.markers.positions_m[1].col(0);
-  lm.p[kHip].col(1) = t.markers.positions_m[1].col(2);
+  const SagittalLandmarks lm = synthetic_landmarks(t);
   ModelMotion mm = compute_motion(r.model, lm, 6.0);
   ContactModelOptions co;
   (void)prepare_contacts(r.model, co, mm);
@@ -182,24 +187,7 @@ TEST(Estimate, PrescribedSingleSupportRecoversTheExactContactForce) {
   }
 
   // One frame, forward dynamics: [M -A^T; A 0] [qdd; mu] = [f; c].
-  ModelMotion mm;
-  {
-    SagittalLandmarks lm;
-    lm.rate_hz = 100;
-    lm.time_s = t.markers.time_s;
-    for (int k = 0; k < kLandmarkCount; ++k) lm.p[k].resize(lm.frames(), 2);
-    for (int side = 0; side < 2; ++side)
-      for (int k = 2; k < 7; ++k) {
-        const auto& P = t.markers.positions_m[static_cast<std::size_t>(7 * side + k)];
-        lm.p[landmark(side, k - 2)].col(0) = P.col(0);
-        lm.p[landmark(side, k - 2)].col(1) = P.col(2);
-      }
-    lm.p[kShoulder].col(0) = t.markers.positions_m[0].col(0);
-    lm.p[kShoulder].col(1) = t.markers.positions_m[0].col(2);
-    lm.p[kHip].col(0) = t.markers.positions_m[1].col(0);
-    lm.p[kHip].col(1) = t.markers.positions_m[1].col(2);
-    mm = compute_motion(r.model, lm, 6.0);
-  }
+  ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
   ContactModelOptions co;
   auto contacts = prepare_contacts(r.model, co, mm);
   const Eigen::Index i = 120;

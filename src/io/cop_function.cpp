@@ -29,14 +29,6 @@ CopFunction cop_function_from_json(const nlohmann::json& j, const std::string& p
   return f;
 }
 
-CopFunction read_cop_function(const std::string& path) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(read_file_text(path));
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path + ": not valid JSON: " + e.what());
-  }
-  return cop_function_from_json(j, path);
-}
+CopFunction read_cop_function(const std::string& path) { return cop_function_from_json(read_json_file(path), path); }
 
 }  // namespace kin2grf

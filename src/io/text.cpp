@@ -85,4 +85,12 @@ std::string extension(const std::string& path) {
   return ext.empty() ? "" : to_lower(ext.substr(1));
 }
 
+nlohmann::json read_json_file(const std::string& path) {
+  try {
+    return nlohmann::json::parse(read_file_text(path));
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path + ": not valid JSON: " + e.what());
+  }
+}
+
 }  // namespace kin2grf

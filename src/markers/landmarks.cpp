@@ -144,15 +144,7 @@ MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
   return s;
 }
 
-MarkerSet load_marker_set(const std::string& path) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(read_file_text(path));
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path + ": not valid JSON: " + e.what());
-  }
-  return parse_marker_set(j, path);
-}
+MarkerSet load_marker_set(const std::string& path) { return parse_marker_set(read_json_file(path), path); }
 
 const std::vector<MarkerSet>& builtin_marker_sets() {
   static const std::vector<MarkerSet> sets = [] {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -17,6 +18,8 @@ std::vector<std::string> split(std::string_view s, std::string_view delims, bool
 std::vector<std::uint8_t> read_file_bytes(const std::string& path);
 std::string read_file_text(const std::string& path);
 void write_file_text(const std::string& path, const std::string& text);
+/// A JSON file; InputError naming the file (and the parser's position) when it is not JSON.
+nlohmann::json read_json_file(const std::string& path);
 /// Strict number parse ("nan"/"NaN" accepted as NaN, empty -> NaN when allow_empty).
 bool parse_double(std::string_view s, double& out);
 /// Lower-case file extension without the dot ("c3d", "trc", "mot", "sto").
