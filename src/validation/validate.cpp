@@ -93,7 +93,7 @@ std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const
         M.setZero();  // below the COP threshold: a few newtons at most
       }
     };
-    for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index i = 0; i < n && ns > 0; ++i) {
       const double lo = (t[i] - 0.5 * dt - rec.time_s[0]) * rec.rate_hz;
       const double hi = (t[i] + 0.5 * dt - rec.time_s[0]) * rec.rate_hz;
       Eigen::Index k0 = static_cast<Eigen::Index>(std::ceil(lo - 1e-6));
@@ -103,18 +103,19 @@ std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const
       if (k1 < k0) continue;
       Eigen::Vector3d Fs = Eigen::Vector3d::Zero(), Ms = Eigen::Vector3d::Zero();
       double lat = 0, wlat = 0;
+      int cnt = 0;
       for (Eigen::Index k = k0; k <= k1; ++k) {
         Eigen::Vector3d F, M;
         bool has_cop = false;
         sample(k, F, M, has_cop);
         if (!F.allFinite() || !M.allFinite()) continue;
-        Fs += F, Ms += M;
+        Fs += F, Ms += M, ++cnt;
         if (has_cop) {
           const double w = std::abs(F.dot(fr.up));
           lat += w * p.cop_m.row(k).dot(fr.lateral.transpose()), wlat += w;
         }
       }
-      const double cnt = static_cast<double>(k1 - k0 + 1);
+      if (cnt == 0) continue;  // no valid sample in this frame: stays NaN
       Fs /= cnt, Ms /= cnt;
       const double fx = Fs.dot(fr.forward), fy = Fs.dot(fr.up);
       m.force_N(i, 0) = fx;
@@ -145,6 +146,11 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
     v.measured_cop_x_m[static_cast<std::size_t>(f)] = Eigen::VectorXd::Constant(n, kNaN);
   }
   bool noted_geometry = false;
+  bool any_plate_data = false;
+  for (const auto& mp : v.plates) any_plate_data = any_plate_data || mp.force_N.col(1).array().isFinite().any();
+  if (!any_plate_data)
+    v.notes.push_back("the plate recording does not overlap the processed frames (" + frames_text(e, 0, n - 1) +
+                      "): check that markers and plates share one clock");
 
   struct Candidate {
     int plate;
@@ -159,8 +165,9 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
     for (const Run& run : runs_above(mp.force_N.col(1), o.threshold_N)) {
       const std::string where = "plate " + mp.name + " " + frames_text(e, run.first, run.last);
       if (run.last - run.first < 2) continue;  // a blip, not a stance
-      if (run.first == 0 || run.last == n - 1) {
-        v.excluded.push_back(where + ": stance cut by the processed window's ends");
+      if (run.first == 0 || run.last == n - 1 || !std::isfinite(mp.force_N(run.first - 1, 1)) ||
+          !std::isfinite(mp.force_N(run.last + 1, 1))) {
+        v.excluded.push_back(where + ": stance cut by the processed window's ends or the plate recording's");
         continue;
       }
       std::array<double, 2> dist{};
