@@ -22,7 +22,13 @@ ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
     weight_bilateral_.segment(kDefRows, 16).setConstant(1.0 / options_.torque_length_m);
     weight_bilateral_.tail(4).setZero();
   }
-  B_.resize(coord::kCount, kBilateralCount);
+  // The sparsity pattern does not depend on q: take it from a generic configuration (no
+  // coordinate zero, so no structural entry vanishes) and order the columns once.
+  Eigen::VectorXd generic(coord::kCount);
+  for (int i = 0; i < coord::kCount; ++i) generic[i] = 0.37 + 0.113 * i;
+  B_ = bilateral_jacobian(generic).transpose().sparseView();
+  B_.makeCompressed();
+  qr_.analyzePattern(B_);
 }
 
 Eigen::MatrixXd ContactSolver::bilateral_jacobian(const Eigen::VectorXd& q) const {
@@ -60,22 +66,44 @@ Eigen::MatrixXd ContactSolver::bilateral_jacobian(const Eigen::VectorXd& q) cons
 }
 
 FrameSolution ContactSolver::solve(const Eigen::VectorXd& q, const Eigen::VectorXd& qdd, const FrameContacts& fc) {
-  B_ = bilateral_jacobian(q).transpose();
-  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(B_);
+  const Eigen::MatrixXd Bd = bilateral_jacobian(q).transpose();
+  if (options_.dense_factorisation) return solve_dense(Bd, qdd, fc);
+  for (int c = 0; c < B_.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(B_, c); it; ++it) it.valueRef() = Bd(it.row(), it.col());
+  qr_.factorize(B_);
+  if (qr_.info() != Eigen::Success || qr_.rank() < kBilateralCount) return solve_dense(Bd, qdd, fc);
+  // Columns: b, then (normal, tangent) per contact point.
+  const Eigen::MatrixXd X = contact_columns(qdd, fc);
+  const Eigen::MatrixXd QtX = qr_.matrixQ().transpose() * X;
+  const Eigen::MatrixXd BpX = qr_.solve(X);  // B^+ [b C] (B has full column rank)
+  const Eigen::MatrixXd UtX = QtX.bottomRows(coord::kCount - kBilateralCount);  // U^T [b C]
+  return solve_reduced(BpX, UtX, fc);
+}
+
+FrameSolution ContactSolver::solve_dense(const Eigen::MatrixXd& Bd, const Eigen::VectorXd& qdd, const FrameContacts& fc) {
+  // Rank-revealing dense fallback (a degenerate geometry the sparse factorisation flags).
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Bd);
+  const Eigen::MatrixXd X = contact_columns(qdd, fc);
+  const Eigen::MatrixXd QtX = qr.householderQ().transpose() * X;
+  const Eigen::MatrixXd BpX = Bd.completeOrthogonalDecomposition().solve(X);
+  return solve_reduced(BpX, QtX.bottomRows(coord::kCount - qr.rank()), fc);
+}
+
+Eigen::MatrixXd ContactSolver::contact_columns(const Eigen::VectorXd& qdd, const FrameContacts& fc) const {
   const Eigen::VectorXd b = mass_.cwiseProduct(qdd) - gravity_;
   const int np = static_cast<int>(fc.points.size());
-  const int k = 2 * np;
-  // Columns: b, then (normal, tangent) per contact point.
-  Eigen::MatrixXd X(coord::kCount, 1 + k);
+  Eigen::MatrixXd X(coord::kCount, 1 + 2 * np);
   X.col(0) = b;
   for (int j = 0; j < np; ++j) {
     X.col(1 + 2 * j) = fc.points[static_cast<std::size_t>(j)].jac_normal;
     X.col(2 + 2 * j) = fc.points[static_cast<std::size_t>(j)].jac_tangent;
   }
-  const Eigen::MatrixXd QtX = qr.householderQ().transpose() * X;
-  const auto R = qr.matrixQR().topLeftCorner(kBilateralCount, kBilateralCount).triangularView<Eigen::Upper>();
-  const Eigen::MatrixXd BpX = R.solve(QtX.topRows(kBilateralCount));  // B^+ [b C]
-  const Eigen::MatrixXd UtX = QtX.bottomRows(coord::kCount - kBilateralCount);  // U^T [b C]
+  return X;
+}
+
+FrameSolution ContactSolver::solve_reduced(const Eigen::MatrixXd& BpX, const Eigen::MatrixXd& UtX, const FrameContacts& fc) {
+  const int np = static_cast<int>(fc.points.size());
+  const int k = 2 * np;
   const Eigen::VectorXd wB = weight_bilateral_;
 
   FrameSolution sol;
