@@ -82,6 +82,28 @@ TEST(Kinematics, ReconstructionSatisfiesTheBilateralConstraints) {
   }
 }
 
+TEST(Kinematics, ReconstructedPositionsKeepTheSegmentLengths) {
+  SyntheticOptions so;
+  so.left_leg_raised_rad = 0.3;
+  const Trial t = make_synthetic_trial(so);
+  const auto r = run(so);
+  const ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
+  // Position level: every landmark attached to a body stays at its body-fixed place, so the
+  // distance to the proximal landmark is the same in every frame (fixed-length model).
+  for (int s = 0; s < kSegmentCount; ++s) {
+    const Body& b = r.model.bodies[s];
+    for (int k = 0; k < 2; ++k) {
+      if (b.points[k] < 0) continue;
+      const double L = b.points_local[k].norm();
+      for (Eigen::Index i = 0; i < mm.frames(); i += 13) {
+        const Eigen::Vector2d p(mm.q(i, coord::point_x(b.points[k])), mm.q(i, coord::point_x(b.points[k]) + 1));
+        const Eigen::Vector2d o(mm.q(i, coord::point_x(b.proximal)), mm.q(i, coord::point_x(b.proximal) + 1));
+        EXPECT_NEAR((p - o).norm(), L, 1e-12) << "segment " << s << " frame " << i;
+      }
+    }
+  }
+}
+
 TEST(Estimate, QuietStandingCarriesBodyWeightUnderTheCentreOfMass) {
   SyntheticOptions so;
   so.squat_depth = 0.0;

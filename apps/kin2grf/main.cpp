@@ -48,6 +48,7 @@ struct EstimateArgs {
   double mass = 0, r = 1e3, kin_cutoff = 6, post_cutoff = 12, ground_shift = 0, speed_gate = 2.0;
   bool paper = false, r_given = false, anthropometry_given = false;
   std::optional<double> ground_level;
+  std::vector<double> grm_reference;
   int max_gap = 10;
 };
 
@@ -64,6 +65,9 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
   c->add_option("--kinematic-cutoff", a.kin_cutoff, "Kinematics low-pass cut-off, Hz")->capture_default_str();
   c->add_option("--post-cutoff", a.post_cutoff, "Multiplier post-filter cut-off, Hz")->capture_default_str();
   c->add_option("--ground-level", a.ground_level, "Floor height in the lab's up axis, m (default: estimated)");
+  c->add_option("--grm-reference", a.grm_reference,
+                 "GRM reference point in the sagittal frame: along progression and up from the lab origin, m (default 0 0)")
+      ->expected(2);
   c->add_option("--ground-shift", a.ground_shift, "Shift the ground by this much, m (robustness study)")->capture_default_str();
   c->add_option("--speed-gate", a.speed_gate, "Contact allowed only below this sole speed, m/s (0 = off, the paper)")
       ->capture_default_str();
@@ -92,6 +96,7 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
   o.ground_level_m = a.ground_level;
   o.contact.foot_model = a.foot_model == "cop" ? kin2grf::FootModel::Cop : kin2grf::FootModel::ThreePoint;
   o.contact.ground_shift_m = a.ground_shift;
+  if (a.grm_reference.size() == 2) o.grm_reference_m = Eigen::Vector2d(a.grm_reference[0], a.grm_reference[1]);
   if (a.paper) o.contact.cop = kin2grf::CopFunction::paper();
   if (!a.cop_function.empty()) o.contact.cop = kin2grf::read_cop_function(a.cop_function);
   o.solver.r_N_per_m = (a.paper && !a.r_given) ? 1e4 : a.r;
@@ -109,7 +114,7 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
 nlohmann::json settings_json(const EstimateArgs& a) {
   return {{"trial", a.trial}, {"static", a.static_trial}, {"foot_model", a.foot_model}, {"r_N_per_m", (a.paper && !a.r_given) ? 1e4 : a.r},
           {"kinematic_cutoff_hz", a.kin_cutoff}, {"post_cutoff_hz", a.post_cutoff}, {"norm", a.paper ? std::string("paper") : a.norm},
-          {"speed_gate_mps", a.paper ? 0.0 : a.speed_gate}, {"cop_function", !a.cop_function.empty() ? a.cop_function : a.paper ? "paper event angles" : "built-in (fitted)"}, {"paper_configuration", a.paper}, {"anthropometry", (a.paper && !a.anthropometry_given) ? std::string("winter") : a.anthropometry}, {"ground_shift_m", a.ground_shift},
+          {"speed_gate_mps", a.paper ? 0.0 : a.speed_gate}, {"cop_function", !a.cop_function.empty() ? a.cop_function : a.paper ? "paper event angles" : "built-in (fitted)"}, {"paper_configuration", a.paper}, {"anthropometry", (a.paper && !a.anthropometry_given) ? std::string("winter") : a.anthropometry}, {"ground_shift_m", a.ground_shift}, {"grm_reference_m", a.grm_reference.size() == 2 ? nlohmann::json(a.grm_reference) : nlohmann::json({0.0, 0.0})},
           {"ground_level_m", a.ground_level ? nlohmann::json(*a.ground_level) : nlohmann::json("auto")}};
 }
 
