@@ -18,8 +18,8 @@ CopFunction cop_function_from_json(const nlohmann::json& j, const std::string& p
     if (!j.is_object() || !j.contains(key)) throw InputError(path + ": COP function: missing field '" + key + "'");
     if (!j[key].is_number()) throw InputError(path + ": COP function: field '" + key + "' is not a number");
     out = j[key].get<double>();
-    if (!std::isfinite(out) || (fraction && (out < 0 || out > 1)))
-      throw InputError(path + ": COP function: field '" + key + "' must be " + (fraction ? "within 0..1" : "finite"));
+    if (!std::isfinite(out) || (fraction && (out < 0 || out > 1.25)))
+      throw InputError(path + ": COP function: field '" + key + "' must be " + (fraction ? "within 0..1.25" : "finite"));
   };
   get("delta_hs", f.delta_hs, false), get("delta_ho", f.delta_ho, false), get("delta_mo", f.delta_mo, false),
       get("delta_to", f.delta_to, false);

@@ -1,6 +1,5 @@
 #include "kin2grf/markers/landmarks.hpp"
 
-#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
@@ -187,23 +186,19 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
       }
     } else if (r.kind == "pelvis_up") {
       const Pelvis pv = pelvis(m, r.pelvis, path);
-      // The trunk stands upright on average while the pelvis is tilted forward by 10-15 deg: the
-      // torso follows the pelvis's superior axis rotated so that its mean is the lab vertical
-      // (the pelvis's oscillations kept, its static tilt removed).
-      Eigen::Vector3d mean_axis = Eigen::Vector3d::Zero();
-      for (Eigen::Index i = 0; i < n; ++i)
-        if (pv.y.row(i).allFinite()) mean_axis += pv.y.row(i).transpose();
+      // Without upper-body markers the torso is a rigid upright segment above the hip centre:
+      // the pelvis's tilt (10-15 deg forward) and its oscillations are not the trunk's, and a
+      // torso that follows them adds spurious moments of the heavy HAT segment (measured:
+      // docs/METHOD-NOTES.md).
       Eigen::Vector3d up = Eigen::Vector3d::Zero();
       up[static_cast<int>(options.up_axis.value_or(m.up_axis))] = 1.0;
-      Eigen::Matrix3d level = Eigen::Matrix3d::Identity();
-      if (mean_axis.norm() > 0) level = Eigen::Quaterniond::FromTwoVectors(mean_axis.normalized(), up).toRotationMatrix();
       for (Eigen::Index i = 0; i < n; ++i) {
         const double ax = -0.24 * pv.depth[i] - 0.0099, ay = -0.30 * pv.width[i] - 0.0109;
         const Eigen::Vector3d base = pv.origin.row(i).transpose() + ax * pv.x.row(i).transpose() + ay * pv.y.row(i).transpose();
-        P.row(i) = (base + r.value * (level * pv.y.row(i).transpose())).transpose();
+        P.row(i) = (base + r.value * up).transpose();
       }
-      out.messages.push_back("shoulder: no upper-body markers; the torso (" + std::to_string(r.value).substr(0, 4) +
-                             " m) follows the pelvis's superior axis with its mean tilt removed (upright on average), an approximation");
+      out.messages.push_back("shoulder: no upper-body markers; the torso is a rigid upright segment of " +
+                             std::to_string(r.value).substr(0, 4) + " m above the hip centre, an approximation");
     } else if (r.kind == "static") {
       if (!st) {
         throw InputError(path + ": landmark " + kNames[id] + " of marker set '" + set.name +

@@ -47,8 +47,9 @@ void collect_cop_samples(const EstimateResult& e, const ValidationResult& v, dou
       double along;
       if (x <= A.x()) along = 0;
       else if (x <= B.x()) along = l1 * (x - A.x()) / (B.x() - A.x());
-      else if (x < C.x()) along = l1 + l2 * (x - B.x()) / (C.x() - B.x());
+      else if (C.x() > B.x()) along = l1 + l2 * (x - B.x()) / (C.x() - B.x());  // beyond C: extrapolated
       else along = l1 + l2;
+      along = std::min(along, kMaxFraction * (l1 + l2));
       out.theta_rad.push_back(f.inclination_rad[i]);
       out.fraction.push_back(along / (l1 + l2));
     }
@@ -73,10 +74,10 @@ CopFit fit_cop_function(const CopSamples& smp, const CopFunction& start) {
   const Eigen::Vector4d s = Wa.colPivHouseholderQr().solve(ya);
   CopFit fit;
   fit.function = start;
-  fit.function.s_hs = std::clamp(s[0], 0.0, 1.0);
-  fit.function.s_ho = std::clamp(s[1], 0.0, 1.0);
-  fit.function.s_mo = std::clamp(s[2], 0.0, 1.0);
-  fit.function.s_to = std::clamp(s[3], 0.0, 1.0);
+  fit.function.s_hs = std::clamp(s[0], 0.0, kMaxFraction);
+  fit.function.s_ho = std::clamp(s[1], 0.0, kMaxFraction);
+  fit.function.s_mo = std::clamp(s[2], 0.0, kMaxFraction);
+  fit.function.s_to = std::clamp(s[3], 0.0, kMaxFraction);
   fit.samples = static_cast<int>(n);
   double e0 = 0, e1 = 0;
   for (Eigen::Index i = 0; i < n; ++i) {

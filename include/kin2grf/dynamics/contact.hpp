@@ -27,20 +27,22 @@ namespace kin2grf {
 
 enum class FootModel { Cop, ThreePoint };
 
-/// x_D = F(theta_A) of the paper: event angles (rad) and the COP's arc fraction at each event.
+/// x_D = F(theta_A) of the paper: event angles (rad) and the COP's arc fraction at each event
+/// (0 at A, 1 at C; up to 1.25 extends the sole beyond C along B -> C: the hallux landmark is a
+/// marker on the toe and the COP rolls on to the toe tip).
 ///
 /// The defaults are kin2grf's fit to the plate COPs of the 7 development walking trials
 /// (932 frames of 13 plate stances loaded above 20 % body weight; event angles and positions
-/// both fitted; RMS of F - s 0.056 against 0.100 for the paper's angles; leave-one-trial-out
-/// COP rRMSE 6.3 % against 9.9 %). Provenance and the command that remakes it:
+/// both fitted; RMS of F - s 0.060 against 0.098 with the paper's angles; leave-one-trial-out
+/// COP rRMSE 6.3 % against 9.7 %). Provenance and the command that remakes it:
 /// data/cop-function/walking-fitted.json and docs/METHOD-NOTES.md. paper() keeps the paper's
 /// event angles (-0.3, 0, 0.15, 1 rad) with positions fitted for them (--paper).
 struct CopFunction {
-  double delta_hs = -0.21, delta_ho = -0.07, delta_mo = 0.09, delta_to = 1.08;
-  double s_hs = 0.137, s_ho = 0.243, s_mo = 0.773, s_to = 0.979;
+  double delta_hs = -0.20, delta_ho = -0.06, delta_mo = 0.08, delta_to = 1.08;
+  double s_hs = 0.138, s_ho = 0.260, s_mo = 0.761, s_to = 1.012;
   [[nodiscard]] double fraction(double theta_a) const;
   /// The paper's event angles; positions fitted with those angles fixed (same data).
-  static CopFunction paper() { return {-0.3, 0.0, 0.15, 1.0, 0.052, 0.453, 0.840, 0.918}; }
+  static CopFunction paper() { return {-0.3, 0.0, 0.15, 1.0, 0.052, 0.453, 0.837, 0.944}; }
 };
 
 /// One potential contact point this frame (model 2: D*, model 1: A, B or C).

@@ -1,6 +1,6 @@
 // kin2grf I/O: the COP function of foot model 2 as JSON (written by `kin2grf fit-cop`, read by
 // `--cop-function`). Fields: delta_hs, delta_ho, delta_mo, delta_to (rad), s_hs, s_ho, s_mo,
-// s_to (arc fractions of the sole A -> B -> C, 0..1); any other field (e.g. "provenance") is kept
+// s_to (arc fractions of the sole A -> B -> C: 0 at A, 1 at C, up to 1.25 beyond C); any other field (e.g. "provenance") is kept
 // for the reader and ignored here.
 #pragma once
 

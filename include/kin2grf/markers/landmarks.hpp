@@ -13,9 +13,8 @@
 //       a virtual landmark: the mean of the static markers, expressed in the cluster's frame in
 //       the static trial, carried by the cluster (least-squares rigid fit) in the motion trial.
 //   {"pelvis_up": 0.50}                       shoulder fallback when a set has no upper-body
-//       markers: the hip moved by the given length along the pelvis's superior axis rotated so
-//       that its mean over the trial is the lab vertical (an approximation: the trunk upright on
-//       average, following the pelvis's oscillations, without its forward tilt).
+//       markers: the given length straight up (lab vertical) from the hip centre: a rigid
+//       upright torso (an approximation; the pelvis's tilt and oscillations are not the trunk's).
 //   {"virtual_hallux": 0.30}                  hallux fallback: a toes segment of that fraction of
 //       the ankle-MT length, straight along the foot in swing, held at the MT head's foot-flat
 //       height while the heel rises (the toes stay on the ground at push-off).

@@ -4,7 +4,8 @@
 // Samples: on the kept plate stances of validate(), every frame where the plate carries at least
 // min_force_fraction of body weight gives (theta_A, s_measured): the foot inclination and the
 // arc fraction along the sole polyline A -> B -> C of the point whose x is the measured COP
-// (clamped to [0, 1]). With the event angles fixed, F is linear in the four event positions
+// (0 behind A; beyond C the polyline is extended along B -> C, up to kMaxFraction: the hallux
+// landmark is a marker on the toe, and the COP rolls on to the toe tip at push-off). With the event angles fixed, F is linear in the four event positions
 // (s_HS, s_HO, s_MO, s_TO): each sample's F value is a weighted sum of two of them (half-cosine or
 // linear weights), so the fit is an ordinary linear least-squares problem, solved by QR.
 #pragma once
@@ -16,6 +17,9 @@
 #include "kin2grf/validation/validate.hpp"
 
 namespace kin2grf {
+
+/// Largest arc fraction: C plus a quarter of the sole beyond it.
+inline constexpr double kMaxFraction = 1.25;
 
 struct CopSamples {
   std::vector<double> theta_rad, fraction;
