@@ -319,67 +319,37 @@ int run_fit_cop(const FitCopArgs& a) {
   if (inputs.empty()) throw kin2grf::InputError(a.trial_list + ": no trial of activity '" + a.activity + "'");
   LoadedTrials L;
   load_study_trials(inputs, L);
-  const std::size_t n = L.study.size();
-  std::vector<kin2grf::CopSamples> per(n);
   // Start (and, without --fit-angles, keep) the paper's event angles.
   const kin2grf::CopFunction start = kin2grf::CopFunction::paper();
-  for (std::size_t k = 0; k < n; ++k) {
-    const auto& t = L.study[k];
-    const auto e = kin2grf::estimate(*t.trial, t.static_trial, *t.marker_set, t.options);
-    const auto v = kin2grf::validate(e, *t.plates);
-    kin2grf::collect_cop_samples(e, v, a.min_force, per[k]);
-    std::cerr << "kin2grf: " << t.name << ": " << per[k].theta_rad.size() << " COP samples\n";
-  }
-  auto pooled = [&](std::size_t skip) {
-    kin2grf::CopSamples all;
-    for (std::size_t k = 0; k < n; ++k) {
-      if (k == skip) continue;
-      all.theta_rad.insert(all.theta_rad.end(), per[k].theta_rad.begin(), per[k].theta_rad.end());
-      all.fraction.insert(all.fraction.end(), per[k].fraction.begin(), per[k].fraction.end());
-    }
-    return all;
-  };
-  auto fit_fn = [&](const kin2grf::CopSamples& smp) {
-    return a.fit_angles ? kin2grf::fit_cop_function_and_angles(smp, start) : kin2grf::fit_cop_function(smp, start);
-  };
-  const auto fit = fit_fn(pooled(n));
+  const auto res = kin2grf::fit_cop_on_trials(L.study, start, a.min_force, a.fit_angles, a.leave_one_out);
+  const auto& fit = res.fit;
   nlohmann::json j = kin2grf::cop_function_json(fit.function);
   nlohmann::json prov;
-  prov["command"] = "kin2grf fit-cop --trial-list " + a.trial_list + " --activity " + a.activity;
+  prov["command"] = "kin2grf fit-cop --trial-list " + a.trial_list + " --activity " + a.activity +
+                    (a.fit_angles ? " --fit-angles" : "") + (a.leave_one_out ? " --leave-one-out" : "");
   prov["kin2grf_version"] = KIN2GRF_VERSION;
   prov["trials"] = nlohmann::json::array();
-  for (std::size_t k = 0; k < n; ++k) prov["trials"].push_back({{"name", L.study[k].name}, {"samples", per[k].theta_rad.size()}});
+  for (std::size_t k = 0; k < L.study.size(); ++k)
+    prov["trials"].push_back({{"name", L.study[k].name}, {"samples", res.samples_per_trial[k]}});
   prov["samples"] = fit.samples;
   prov["event_angles"] = a.fit_angles ? "fitted" : "fixed (the paper's)";
   prov["min_force_fraction_of_body_weight"] = a.min_force;
   prov["rms_fraction_before"] = fit.rms_fraction_before;
   prov["rms_fraction_after"] = fit.rms_fraction;
   prov["start"] = kin2grf::cop_function_json(start);
-  std::printf("COP function fitted on %d samples of %zu trials (%s)\n", fit.samples, n, a.activity.c_str());
+  std::printf("COP function fitted on %d samples of %zu trials (%s)\n", fit.samples, L.study.size(), a.activity.c_str());
   std::printf("  event angles (rad)   HS %.3f  HO %.3f  MO %.3f  TO %.3f\n", fit.function.delta_hs, fit.function.delta_ho,
               fit.function.delta_mo, fit.function.delta_to);
   std::printf("  positions (fraction) HS %.3f  HO %.3f  MO %.3f  TO %.3f   (start %.3f %.3f %.3f %.3f)\n", fit.function.s_hs,
               fit.function.s_ho, fit.function.s_mo, fit.function.s_to, start.s_hs, start.s_ho, start.s_mo, start.s_to);
   std::printf("  RMS of F(theta) - s: %.3f (start: %.3f)\n", fit.rms_fraction, fit.rms_fraction_before);
   if (a.leave_one_out) {
-    // Generalisation: each trial's COP error with the function fitted on the others.
     std::printf("\nleave-one-trial-out: COP rRMSE %% (mean over the trial's stances)\n%-26s %8s %8s %8s\n", "trial", "start",
                 "all", "others");
     nlohmann::json loo = nlohmann::json::array();
-    for (std::size_t k = 0; k < n; ++k) {
-      const auto& t = L.study[k];
-      auto cop_rrmse = [&](const kin2grf::CopFunction& f) {
-        auto o = t.options;
-        o.contact.cop = f;
-        const auto e = kin2grf::estimate(*t.trial, t.static_trial, *t.marker_set, o);
-        return kin2grf::mean_rrmse(kin2grf::validate(e, *t.plates).stances).cop;
-      };
-      const auto others = pooled(k);
-      if (others.theta_rad.size() < 20) continue;
-      const auto fk = fit_fn(others);
-      const double r0 = cop_rrmse(start), r1 = cop_rrmse(fit.function), r2 = cop_rrmse(fk.function);
-      std::printf("%-26s %8.1f %8.1f %8.1f\n", t.name.c_str(), r0, r1, r2);
-      loo.push_back({{"trial", t.name}, {"start", r0}, {"all", r1}, {"others", r2}});
+    for (const auto& l : res.leave_one_out) {
+      std::printf("%-26s %8.1f %8.1f %8.1f\n", l.trial.c_str(), l.start, l.all, l.others);
+      loo.push_back({{"trial", l.trial}, {"start", l.start}, {"all", l.all}, {"others", l.others}});
     }
     prov["leave_one_out_cop_rrmse_percent"] = loo;
   }

@@ -115,4 +115,44 @@ CopFit fit_cop_function_and_angles(const CopSamples& smp, const CopFunction& sta
   return best;
 }
 
+CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const CopFunction& start, double min_force,
+                                 bool fit_angles, bool leave_one_out) {
+  const std::size_t n = trials.size();
+  std::vector<CopSamples> per(n);
+  CopFitOnTrials out;
+  // The samples depend on the kinematics only (sole points, inclination, kept stances), not on
+  // the COP function the estimate ran with.
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& t = trials[k];
+    const auto e = estimate(*t.trial, t.static_trial, *t.marker_set, t.options);
+    collect_cop_samples(e, validate(e, *t.plates), min_force, per[k]);
+    out.samples_per_trial.push_back(per[k].theta_rad.size());
+  }
+  auto pooled = [&](std::size_t skip) {
+    CopSamples all;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (k == skip) continue;
+      all.theta_rad.insert(all.theta_rad.end(), per[k].theta_rad.begin(), per[k].theta_rad.end());
+      all.fraction.insert(all.fraction.end(), per[k].fraction.begin(), per[k].fraction.end());
+    }
+    return all;
+  };
+  auto fit_fn = [&](const CopSamples& smp) { return fit_angles ? fit_cop_function_and_angles(smp, start) : fit_cop_function(smp, start); };
+  out.fit = fit_fn(pooled(n));
+  if (!leave_one_out) return out;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& t = trials[k];
+    const auto others = pooled(k);
+    if (others.theta_rad.size() < 20) continue;
+    auto cop_rrmse = [&](const CopFunction& f) {
+      EstimateOptions o = t.options;
+      o.contact.cop = f;
+      const auto e = estimate(*t.trial, t.static_trial, *t.marker_set, o);
+      return mean_rrmse(validate(e, *t.plates).stances).cop;
+    };
+    out.leave_one_out.push_back({t.name, cop_rrmse(start), cop_rrmse(out.fit.function), cop_rrmse(fit_fn(others).function)});
+  }
+  return out;
+}
+
 }  // namespace kin2grf

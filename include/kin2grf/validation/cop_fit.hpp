@@ -14,6 +14,7 @@
 
 #include "kin2grf/dynamics/contact.hpp"
 #include "kin2grf/pipeline.hpp"
+#include "kin2grf/validation/study.hpp"
 #include "kin2grf/validation/validate.hpp"
 
 namespace kin2grf {
@@ -42,5 +43,20 @@ CopFit fit_cop_function(const CopSamples& samples, const CopFunction& start);
 /// Also the event angles: a coordinate search (steps of 0.01 rad, order kept) around `start`'s,
 /// each candidate with its least-squares positions. Not the paper's fixed angles: for studies.
 CopFit fit_cop_function_and_angles(const CopSamples& samples, const CopFunction& start);
+
+/// fit-cop on a set of trials with plates: samples from each trial's kept stances (estimated
+/// with the trial's own options), one pooled fit and, on request, leave-one-trial-out: each
+/// trial's mean COP rRMSE with the starting function, the pooled fit and a fit on the others.
+struct CopFitOnTrials {
+  CopFit fit;
+  std::vector<std::size_t> samples_per_trial;
+  struct LeaveOneOut {
+    std::string trial;
+    double start = 0, all = 0, others = 0;
+  };
+  std::vector<LeaveOneOut> leave_one_out;
+};
+CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const CopFunction& start, double min_force_fraction,
+                                 bool fit_angles, bool leave_one_out);
 
 }  // namespace kin2grf
