@@ -181,6 +181,15 @@ TEST(CopFit, JsonRoundTripAndFieldErrors) {
   EXPECT_THROW((void)cop_function_from_json(j, "cop.json"), InputError);
 }
 
+TEST(CopFit, BuiltInDefaultIsTheCommittedFit) {
+  // The built-in COP function (contact.hpp) is the fit stored with its provenance.
+  const CopFunction f = read_cop_function(std::string(KIN2GRF_SOURCE_DIR) + "/data/cop-function/walking-fitted.json");
+  const CopFunction d;
+  for (auto [a, b] : {std::pair{f.delta_hs, d.delta_hs}, {f.delta_ho, d.delta_ho}, {f.delta_mo, d.delta_mo}, {f.delta_to, d.delta_to},
+                      {f.s_hs, d.s_hs}, {f.s_ho, d.s_ho}, {f.s_mo, d.s_mo}, {f.s_to, d.s_to}})
+    EXPECT_NEAR(a, b, 5e-4);
+}
+
 TEST(Report, RendersInHeadlessChromium) {
   const char* candidates[] = {"/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"};
   std::string browser;
