@@ -3,25 +3,25 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/c3d.hpp"
+#include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/load.hpp"
+#include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/summary.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/output/report.hpp"
 #include "kin2grf/output/results.hpp"
 #include "kin2grf/pipeline.hpp"
-#include "kin2grf/io/c3d.hpp"
-#include "kin2grf/io/opensim.hpp"
 #include "kin2grf/synth/example.hpp"
-#include "kin2grf/output/report.hpp"
-#include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/validation/cop_fit.hpp"
 #include "kin2grf/validation/study.hpp"
 #include "kin2grf/validation/validate.hpp"
-#include <filesystem>
 
 namespace {
 
@@ -111,11 +111,27 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
   return o;
 }
 
+/// The settings a run used, from the resolved options (what --paper and the defaults made of them).
 nlohmann::json settings_json(const EstimateArgs& a) {
-  return {{"trial", a.trial}, {"static", a.static_trial}, {"foot_model", a.foot_model}, {"r_N_per_m", (a.paper && !a.r_given) ? 1e4 : a.r},
-          {"kinematic_cutoff_hz", a.kin_cutoff}, {"post_cutoff_hz", a.post_cutoff}, {"norm", a.paper ? std::string("paper") : a.norm},
-          {"speed_gate_mps", a.paper ? 0.0 : a.speed_gate}, {"cop_function", !a.cop_function.empty() ? a.cop_function : a.paper ? "paper event angles" : "built-in (fitted)"}, {"paper_configuration", a.paper}, {"anthropometry", (a.paper && !a.anthropometry_given) ? std::string("winter") : a.anthropometry}, {"ground_shift_m", a.ground_shift}, {"grm_reference_m", a.grm_reference.size() == 2 ? nlohmann::json(a.grm_reference) : nlohmann::json({0.0, 0.0})},
-          {"ground_level_m", a.ground_level ? nlohmann::json(*a.ground_level) : nlohmann::json("auto")}};
+  const kin2grf::EstimateOptions o = to_options(a);
+  const auto& c = o.contact.cop;
+  return {{"trial", a.trial},
+          {"static", a.static_trial},
+          {"paper_configuration", a.paper},
+          {"foot_model", a.foot_model},
+          {"cop_function", {{"source", !a.cop_function.empty() ? a.cop_function : a.paper ? "paper event angles" : "built-in fit"},
+                            {"delta_rad", {c.delta_hs, c.delta_ho, c.delta_mo, c.delta_to}},
+                            {"s", {c.s_hs, c.s_ho, c.s_mo, c.s_to}}}},
+          {"r_N_per_m", o.solver.r_N_per_m},
+          {"norm", o.solver.norm == kin2grf::MultiplierNorm::Paper ? "paper" : "torque-scaled"},
+          {"speed_gate_mps", o.solver.speed_gate_mps},
+          {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
+          {"post_cutoff_hz", o.post_cutoff_hz},
+          {"anthropometry", o.anthropometry},
+          {"ground_level_m", o.ground_level_m ? nlohmann::json(*o.ground_level_m) : nlohmann::json("auto")},
+          {"ground_shift_m", o.contact.ground_shift_m},
+          {"grm_reference_m", {o.grm_reference_m.x(), o.grm_reference_m.y()}},
+          {"max_gap_frames", o.landmarks.max_gap_frames}};
 }
 
 /// The marker set: --markers (preset name or mapping file), else recognised from the names.
