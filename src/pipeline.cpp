@@ -1,6 +1,7 @@
 #include "kin2grf/pipeline.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 
@@ -61,7 +62,11 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     if (!v.empty()) {
       std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
       so.belt_velocity_mps = v[v.size() / 2];
-      r.messages.push_back("treadmill: belt velocity " + std::to_string(so.belt_velocity_mps).substr(0, 6) + " m/s");
+      char b[128];
+      std::snprintf(b, sizeof b, std::abs(so.belt_velocity_mps) < 0.05 ? "no progression (stationary trial): ground velocity %.2f m/s"
+                                                                       : "treadmill: belt velocity %.3f m/s",
+                    so.belt_velocity_mps);
+      r.messages.push_back(b);
     }
   }
   r.frame.belt_velocity_mps = so.belt_velocity_mps;
