@@ -134,6 +134,17 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
       }
     }
   }
+  {
+    bool any = false;
+    for (int side = 0; side < 2; ++side)
+      for (bool c : r.feet[side].contact) any = any || c;
+    if (!any) {
+      char b[200];
+      std::snprintf(b, sizeof b, "no stance: neither foot touches the ground (%.3f m) in the processed window; the GRF is zero "
+                                 "throughout (check --ground-level)", r.ground_level_m);
+      r.messages.push_back(b);
+    }
+  }
   // GRM about the reference point, residual and joint forces.
   r.grm_Nm = Eigen::VectorXd::Zero(n);
   r.residual = Eigen::MatrixX3d::Zero(n, 3);

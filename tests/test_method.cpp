@@ -142,6 +142,18 @@ TEST(Estimate, BallisticFlightHasNoGroundReaction) {
   EXPECT_NEAR(r.feet[0].force_N(30, 1) + r.feet[1].force_N(30, 1), 70 * 9.81, 0.01 * 70 * 9.81);
 }
 
+TEST(Estimate, TrialWithNoStanceSaysSo) {
+  Trial t = make_synthetic_trial({});
+  for (auto& p : t.markers.positions_m) p.col(2).array() += 0.5;  // the whole body 50 cm up
+  EstimateOptions eo;
+  eo.ground_level_m = 0.0;  // the lab floor
+  const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
+  EXPECT_EQ(r.feet[0].force_N.cwiseAbs().maxCoeff() + r.feet[1].force_N.cwiseAbs().maxCoeff(), 0.0);
+  bool said = false;
+  for (const auto& m : r.messages) said = said || m.find("no stance") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
 TEST(Estimate, NoBodyMassIsAClearError) {
   Trial t = make_synthetic_trial({});
   t.body_mass_kg.reset();

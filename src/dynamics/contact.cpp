@@ -150,10 +150,33 @@ Eigen::Matrix2d rot2(double a) {
 }
 }  // namespace
 
-std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, double ground, std::string* message) {
+std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, double ground_level, std::string* message) {
   std::array<int, 2> counts{};
   std::array<double, 2> heel_height{};
+  // Heel landmarks stand 20-90 mm above the floor in foot-flat stance. When both feet's flat
+  // frames stand higher than kMaxHeelHeight, neither foot stands on this floor in the window:
+  // the soles are placed kNominalHeelHeight below the heel landmarks instead of being drawn
+  // down to the floor (which would invent a stance).
+  constexpr double kMaxHeelHeight = 0.15, kNominalHeelHeight = 0.04;
+  std::array<double, 2> sole{ground_level, ground_level};
+  {
+    std::array<double, 2> h{};
+    for (int side = 0; side < 2; ++side) {
+      std::vector<double> hh;
+      for (auto i : flat_frames(lm, side)) hh.push_back(lm.p[landmark(side, 2)](i, 1));
+      h[static_cast<std::size_t>(side)] = median_or_zero(hh);
+    }
+    if (std::min(h[0], h[1]) - ground_level > kMaxHeelHeight) {
+      for (int side = 0; side < 2; ++side) sole[static_cast<std::size_t>(side)] = h[static_cast<std::size_t>(side)] - kNominalHeelHeight;
+      if (message)
+        *message = "neither foot stands on the floor in the processed window (heel landmarks " +
+                   std::to_string(static_cast<int>(1000 * (std::min(h[0], h[1]) - ground_level))) +
+                   " mm above it at their lowest): soles placed " + std::to_string(static_cast<int>(1000 * kNominalHeelHeight)) +
+                   " mm below the heel landmarks";
+    }
+  }
   for (int side = 0; side < 2; ++side) {
+    const double ground = sole[static_cast<std::size_t>(side)];
     const auto f = flat_frames(lm, side);
     counts[side] = static_cast<int>(f.size());
     const auto& A = lm.p[landmark(side, 1)];
@@ -174,7 +197,7 @@ std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, 
       cx.push_back(lc.x()); cy.push_back(lc.y());
     }
     std::vector<double> hh;
-    for (auto i : f) hh.push_back(E(i, 1) - ground);
+    for (auto i : f) hh.push_back(E(i, 1) - ground_level);
     heel_height[static_cast<std::size_t>(side)] = median_or_zero(hh);
     auto& fg = model.feet[side];
     fg.flat_angle_rad = median_or_zero(ang);
@@ -185,7 +208,7 @@ std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, 
   // A foot that never stands on the floor in the window (a hop on the other leg) has no flat
   // frames at ground level: it takes the other foot's sole geometry instead of a sole drawn
   // down to the floor beneath it.
-  for (int side = 0; side < 2; ++side) {
+  for (int side = 0; side < 2 && sole[0] == ground_level; ++side) {
     const int other = 1 - side;
     if (heel_height[static_cast<std::size_t>(side)] > heel_height[static_cast<std::size_t>(other)] + 0.03) {
       model.feet[side] = model.feet[other];

@@ -82,8 +82,10 @@ namespace kin2grf {
 /// 15 mm of their 10th-percentile height; there, theta_foot,flat is the median foot angle and
 /// A, B (foot frame) and C (toes frame) are the medians of the points at ground level straight
 /// below the heel, MT and hallux landmarks. A foot whose flat frames stand more than 30 mm
-/// higher than the other's never touches the floor: it takes the other foot's geometry (and
-/// `message` says so). Returns the number of flat frames per foot.
+/// higher than the other's never touches the floor: it takes the other foot's geometry. When
+/// both feet's heel landmarks stay more than 150 mm above the floor, neither foot stands on it:
+/// the soles go 40 mm below the heel landmarks (no stance is invented). `message` says which.
+/// Returns the number of flat frames per foot.
 std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, double ground_level_m,
                                      std::string* message = nullptr);
 
