@@ -507,43 +507,51 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
 }
 
 std::string format_validation_table(const std::string& trial, const ValidationResult& v) {
+  // Columns: a 30-character label, then four 12-character cells (value, or mean (SD)).
   std::ostringstream os;
   char buf[256];
-  auto cell = [](const std::optional<SeriesMetrics>& m) {
-    char b[32];
-    if (m && std::isfinite(m->rrmse_percent)) std::snprintf(b, sizeof b, "%9.1f", m->rrmse_percent);
-    else std::snprintf(b, sizeof b, "%9s", "-");
+  auto text = [](const std::string& t) {
+    char b[40];
+    std::snprintf(b, sizeof b, "%12s", t.c_str());
     return std::string(b);
   };
-  auto msd = [](double m, double sd) {
-    char b[32];
-    if (std::isfinite(m)) std::snprintf(b, sizeof b, " %5.1f (%4.1f)", m, sd);
-    else std::snprintf(b, sizeof b, " %12s", "-");
+  auto cell = [&](const std::optional<SeriesMetrics>& m) {
+    char b[40];
+    if (!(m && std::isfinite(m->rrmse_percent))) return text("-");
+    std::snprintf(b, sizeof b, "%.1f", m->rrmse_percent);
+    return text(b);
+  };
+  auto msd = [&](double mean, double sd) {
+    char b[40];
+    if (!std::isfinite(mean)) return text("-");
+    std::snprintf(b, sizeof b, "%.1f (%.1f)", mean, sd);
+    return text(b);
+  };
+  auto label = [](const std::string& l) {
+    char b[64];
+    std::snprintf(b, sizeof b, "  %-28s", l.c_str());
     return std::string(b);
   };
   os << "kin2grf validate: " << trial << " (body mass " << v.mass_kg << " kg)\n";
-  os << "rRMSE, % (paper's Eq. 12)      vertical  anterior      COP   moment   frames\n";
+  os << label("rRMSE % (paper's Eq. 12)") << text("vertical") << text("anterior") << text("COP") << text("moment")
+     << "   frames\n";
   for (const auto& s : v.stances) {
-    std::snprintf(buf, sizeof buf, "  %-5s foot on %-12s", side_name(s.foot).c_str(), s.plate.c_str());
-    os << buf << cell(s.metrics.vertical) << " " << cell(s.metrics.anterior) << cell(s.metrics.cop) << cell(s.metrics.moment);
+    os << label(side_name(s.foot) + " foot on " + s.plate) << cell(s.metrics.vertical) << cell(s.metrics.anterior)
+       << cell(s.metrics.cop) << cell(s.metrics.moment);
     std::snprintf(buf, sizeof buf, "   %ld-%ld\n", static_cast<long>(v.first_frame_number + s.first),
                   static_cast<long>(v.first_frame_number + s.last));
     os << buf;
   }
   if (v.stances.empty()) os << "  (no stance on a plate could be compared)\n";
   const MeanMetrics m = mean_rrmse(v.stances);
-  if (m.n > 0) {
-    std::snprintf(buf, sizeof buf, "  per foot, mean (SD), n = %-3d", m.n);
-    os << buf << msd(m.vertical, m.vertical_sd) << msd(m.anterior, m.anterior_sd) << msd(m.cop, m.cop_sd)
-       << msd(m.moment, m.moment_sd) << "\n";
-  }
-  if (v.total) {
-    std::snprintf(buf, sizeof buf, "  total (GRM), %4zu frames      ", v.total->frames.size());
-    os << buf << cell(v.total->metrics.vertical) << " " << cell(v.total->metrics.anterior) << cell(std::nullopt)
-       << cell(v.total->metrics.moment) << "\n";
-  }
-  os << "  paper, Table 1 (24 gait trials)   4.1 (1.1)  11.2 (1.7)         -    5.3 (1.1)\n";
-  os << "  Fluit et al. (paper's Table 1)    2.7        9.3                -    7.4\n";
+  if (m.n > 0)
+    os << label("per foot, mean (SD), n = " + std::to_string(m.n)) << msd(m.vertical, m.vertical_sd)
+       << msd(m.anterior, m.anterior_sd) << msd(m.cop, m.cop_sd) << msd(m.moment, m.moment_sd) << "\n";
+  if (v.total)
+    os << label("total, GRM (" + std::to_string(v.total->frames.size()) + " frames)") << cell(v.total->metrics.vertical)
+       << cell(v.total->metrics.anterior) << text("-") << cell(v.total->metrics.moment) << "\n";
+  os << label("paper, Table 1 (24 gait)") << text("4.1 (1.1)") << text("11.2 (1.7)") << text("-") << text("5.3 (1.1)") << "\n";
+  os << label("Fluit et al. (paper's Tab. 1)") << text("2.7") << text("9.3") << text("-") << text("7.4") << "\n";
   for (const auto& x : v.excluded) os << "excluded: " << x << "\n";
   for (const auto& x : v.notes) os << "note: " << x << "\n";
   return os.str();
