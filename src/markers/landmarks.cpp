@@ -1,6 +1,5 @@
 #include "kin2grf/markers/landmarks.hpp"
 
-
 #include <algorithm>
 #include <cmath>
 #include <fstream>
