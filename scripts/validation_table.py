@@ -70,8 +70,8 @@ print("| jump landing | an independent implementation (METHOD.md) | | 52 | 31 | 
 print("\nMean (SD) over stances; total GRM: mean (SD) over the trials that have a total window.\n")
 
 print("## Per trial and foot (defaults)\n")
-print("| activity | trial | foot | plate | frames | vertical | anterior | COP | moment | vertical RMSE %BW | onset ms | offset ms | `--paper` vertical / anterior / COP |")
-print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+print("| activity | trial | foot | plate | frames | vertical | anterior | COP | moment | vertical RMSE %BW | onset ms | offset ms | lag ms | `--paper` vertical / anterior / COP |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 for a, name, _ in rows:
     j, p = load(name, "defaults"), load(name, "paper")
     pmap = {(s["foot"], s["plate"], tuple(s["frames"])): s for s in p["per_foot"]}
@@ -82,13 +82,14 @@ for a, name, _ in rows:
         print(f"| {a} | {name} | {s['foot']} | {s['plate']} | {s['frames'][0]}-{s['frames'][1]} | "
               f"{f1(s['rrmse_percent']['vertical'])} | {f1(s['rrmse_percent']['anterior'])} | {f1(s['rrmse_percent']['cop'])} | "
               f"{f1(s['rrmse_percent']['moment'])} | {f1(s['rmse_percent_bw']['vertical'])} | "
-              f"{'-' if t['onset'] is None else round(t['onset'])} | {'-' if t['offset'] is None else round(t['offset'])} | {paper} |")
+              f"{'-' if t['onset'] is None else round(t['onset'])} | {'-' if t['offset'] is None else round(t['offset'])} | "
+              f"{'-' if t.get('vertical_lag') is None else round(t['vertical_lag'])} | {paper} |")
     if j["total"] is not None:
         t = j["total"]
         pt = p["total"]
         paper = "-" if pt is None else f"GRM {f1(pt['rrmse_percent']['moment'])}"
         print(f"| {a} | {name} | total | GRM | {t['frames_compared']} frames | {f1(t['rrmse_percent']['vertical'])} | "
-              f"{f1(t['rrmse_percent']['anterior'])} | | {f1(t['rrmse_percent']['moment'])} | | | | {paper} |")
+              f"{f1(t['rrmse_percent']['anterior'])} | | {f1(t['rrmse_percent']['moment'])} | | | | | {paper} |")
 
 print("\n## Excluded stances and notes (defaults)\n")
 for a, name, args in rows:

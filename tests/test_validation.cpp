@@ -99,6 +99,29 @@ TEST(Validate, ExactPlatesGiveNearZeroError) {
   EXPECT_TRUE(v.excluded.empty());
 }
 
+TEST(Validate, LagOfDelayedPlatesIsMeasured) {
+  auto s = synthetic_with_exact_plates();
+  const auto v0 = validate(s.estimate, s.plates);
+  ASSERT_FALSE(v0.stances.empty());
+  ASSERT_TRUE(v0.stances[0].vertical_lag_ms.has_value());
+  EXPECT_NEAR(*v0.stances[0].vertical_lag_ms, 0.0, 1.0);
+  // Plates recorded 2 frames (20 ms) late: the estimate leads them, a lag of -20 ms.
+  for (auto& p : s.plates.plates) {
+    const Eigen::Index n = p.force_N.rows();
+    Eigen::MatrixX3d F = Eigen::MatrixX3d::Zero(n, 3), C = p.cop_m, M = Eigen::MatrixX3d::Zero(n, 3);
+    F.bottomRows(n - 2) = p.force_N.topRows(n - 2);
+    C.bottomRows(n - 2) = p.cop_m.topRows(n - 2);
+    M.bottomRows(n - 2) = p.moment_centre_Nm.topRows(n - 2);
+    p.force_N = F, p.cop_m = C, p.moment_centre_Nm = M;
+  }
+  const auto v = validate(s.estimate, s.plates);
+  ASSERT_FALSE(v.stances.empty());
+  for (const auto& st : v.stances) {
+    ASSERT_TRUE(st.vertical_lag_ms.has_value());
+    EXPECT_NEAR(*st.vertical_lag_ms, -20.0, 3.0);
+  }
+}
+
 TEST(Validate, AssignmentFollowsTheCopNotThePlateName) {
   auto s = synthetic_with_exact_plates();
   // Swap the plates' signals: FP1 now carries the left foot's forces (and COP).

@@ -291,6 +291,31 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
       if (const auto e_on = rising_crossing(ev, e.time_s, o.threshold_N, from, c.run.last)) s.onset_error_ms = 1000 * (*e_on - *m_on);
     if (m_off && !(ev[to] > o.threshold_N))
       if (const auto e_off = falling_crossing(ev, e.time_s, o.threshold_N, a, to)) s.offset_error_ms = 1000 * (*e_off - *m_off);
+    {
+      // Lag: RMSE of est(i + k) against plate(i) over the stance for shifts k of up to 60 ms.
+      const int kmax = static_cast<int>(std::lround(0.06 * rate));
+      std::vector<double> err;
+      for (int k = -kmax; k <= kmax; ++k) {
+        double se = 0;
+        int cnt = 0;
+        for (Eigen::Index i = a; i <= c.run.last; ++i) {
+          const Eigen::Index j = i + k;
+          if (j < 0 || j >= n) continue;
+          se += std::pow(ev[j] - pv[i], 2), ++cnt;
+        }
+        err.push_back(cnt ? std::sqrt(se / cnt) : std::numeric_limits<double>::infinity());
+      }
+      const auto best = static_cast<int>(std::min_element(err.begin(), err.end()) - err.begin());
+      if (best > 0 && best + 1 < static_cast<int>(err.size())) {
+        const double y0 = err[static_cast<std::size_t>(best - 1)], y1 = err[static_cast<std::size_t>(best)],
+                     y2 = err[static_cast<std::size_t>(best + 1)];
+        const double den = y0 - 2 * y1 + y2;
+        const double frac = den > 0 ? 0.5 * (y0 - y2) / den : 0.0;
+        // est(i + k) matching plate(i): with est(t) = plate(t + L) (the estimate leading by L),
+        // k = -L, so k itself is the lag (negative when the estimate leads).
+        s.vertical_lag_ms = 1000.0 * (best - kmax + frac) / rate;
+      }
+    }
     for (Eigen::Index i = 0; i < len; ++i) {
       auto& mf = v.measured_force_N[static_cast<std::size_t>(c.foot)];
       if (!std::isfinite(mf(a + i, 1))) mf.row(a + i).setZero();
@@ -482,7 +507,7 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     x["frames"] = {e.first_frame_number + s.first, e.first_frame_number + s.last};
     x["time_s"] = {e.time_s[s.first], e.time_s[s.last]};
     x["assign_distance_mm"] = 1000 * s.assign_distance_m;
-    x["timing_ms"] = {{"onset", opt(s.onset_error_ms)}, {"offset", opt(s.offset_error_ms)}};
+    x["timing_ms"] = {{"onset", opt(s.onset_error_ms)}, {"offset", opt(s.offset_error_ms)}, {"vertical_lag", opt(s.vertical_lag_ms)}};
     j["per_foot"].push_back(x);
   }
   if (v.total) {

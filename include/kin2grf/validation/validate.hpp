@@ -80,6 +80,10 @@ struct StanceValidation {
   double assign_distance_m = 0.0;
   ComponentMetrics metrics;
   std::optional<double> onset_error_ms, offset_error_ms;  ///< estimate - plate; + = late
+  /// Time shift of the estimate's vertical force that best matches the plate over the stance
+  /// (least RMSE over shifts of up to 60 ms, parabolic refinement between frames); + = the
+  /// estimate lags, - = it leads.
+  std::optional<double> vertical_lag_ms;
   Eigen::Vector2d moment_reference_m = Eigen::Vector2d::Zero();
 };
 
