@@ -1,13 +1,14 @@
 #include "kin2grf/pipeline.hpp"
 
 #include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
 
@@ -60,8 +61,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
       for (const auto& p : fc.points)
         if (p.gap_m < 0.01) v.push_back(p.velocity.x());
     if (!v.empty()) {
-      std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-      so.belt_velocity_mps = v[v.size() / 2];
+      so.belt_velocity_mps = median(v);
       char b[128];
       std::snprintf(b, sizeof b, std::abs(so.belt_velocity_mps) < 0.05 ? "no progression (stationary trial): ground velocity %.2f m/s"
                                                                        : "treadmill: belt velocity %.3f m/s",
@@ -126,7 +126,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
         if (act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) f.contact[static_cast<std::size_t>(i)] = true;
       }
       f.inclination_rad[i] = contacts[static_cast<std::size_t>(i)].foot_inclination_rad[static_cast<std::size_t>(side)];
-      const auto sole = sole_points(r.model, motion, i, side);
+      const auto& sole = contacts[static_cast<std::size_t>(i)].sole[static_cast<std::size_t>(side)];
       for (int k = 0; k < 3; ++k) f.sole_m.block<1, 2>(i, 2 * k) = sole[static_cast<std::size_t>(k)].transpose();
       if (f.contact[static_cast<std::size_t>(i)]) {
         if (np == 2) f.cop_x_m[i] = contacts[static_cast<std::size_t>(i)].points[static_cast<std::size_t>(side)].position.x();

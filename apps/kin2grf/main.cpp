@@ -112,8 +112,7 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
 }
 
 /// The settings a run used, from the resolved options (what --paper and the defaults made of them).
-nlohmann::json settings_json(const EstimateArgs& a) {
-  const kin2grf::EstimateOptions o = to_options(a);
+nlohmann::json settings_json(const EstimateArgs& a, const kin2grf::EstimateOptions& o) {
   const auto& c = o.contact.cop;
   return {{"trial", a.trial},
           {"static", a.static_trial},
@@ -153,12 +152,11 @@ const kin2grf::MarkerSet& resolve_marker_set(const EstimateArgs& a, const kin2gr
   return *set;
 }
 
-kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, const kin2grf::Trial& trial) {
+kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, kin2grf::EstimateOptions options, const kin2grf::Trial& trial) {
   std::optional<kin2grf::Trial> st;
   if (!a.static_trial.empty()) st = kin2grf::load_trial(a.static_trial);
   kin2grf::MarkerSet custom;
   const kin2grf::MarkerSet& set = resolve_marker_set(a, trial, custom);
-  auto options = to_options(a);
   if (trial.markers.frames() >= kProgressFrames) {
     // Long inputs: progress on stderr, on one line when stderr is a terminal.
     const bool tty = isatty(fileno(stderr)) != 0;
@@ -182,12 +180,13 @@ kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, const kin2grf::
 
 int run_estimate(const EstimateArgs& a) {
   const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
-  const auto r = run_estimate_core(a, trial);
+  const auto options = to_options(a);
+  const auto r = run_estimate_core(a, options, trial);
   if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r);
   if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::format_results_csv(r));
-  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::results_summary(r, settings_json(a)).dump(2) + "\n");
+  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::results_summary(r, settings_json(a, options)).dump(2) + "\n");
   if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty())
-    std::cout << kin2grf::results_summary(r, settings_json(a)).dump(2) << "\n";
+    std::cout << kin2grf::results_summary(r, settings_json(a, options)).dump(2) << "\n";
   return 0;
 }
 
@@ -205,9 +204,10 @@ int run_validate(const ValidateArgs& a) {
   if (!source.plates || source.plates->plates.empty())
     throw kin2grf::InputError(source.path + ": no force plates to validate against" +
                               (plates_file ? std::string() : std::string("; give --plates GRF.mot")));
-  const auto r = run_estimate_core(a.est, trial);
+  const auto options = to_options(a.est);
+  const auto r = run_estimate_core(a.est, options, trial);
   const auto v = kin2grf::validate(r, *source.plates, a.options);
-  nlohmann::json settings = settings_json(a.est);
+  nlohmann::json settings = settings_json(a.est, options);
   settings["plates"] = source.path;
   settings["threshold_N"] = a.options.threshold_N;
   settings["zero_offset"] = a.zero_offset;

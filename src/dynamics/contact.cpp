@@ -75,6 +75,7 @@ std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactMod
     for (int side = 0; side < 2; ++side) {
       const int foot = segment(side, 2), toes = segment(side, 3);
       const auto sp = sole_points(model, m, i, side);
+      fc.sole[static_cast<std::size_t>(side)] = sp;
       fc.foot_inclination_rad[side] = -(m.q(i, coord::theta(foot)) - model.feet[side].flat_angle_rad);
       if (o.foot_model == FootModel::ThreePoint) {
         for (int k = 0; k < 3; ++k) {

@@ -32,7 +32,13 @@ ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
 }
 
 Eigen::MatrixXd ContactSolver::bilateral_jacobian(const Eigen::VectorXd& q) const {
-  Eigen::MatrixXd Phi = Eigen::MatrixXd::Zero(kBilateralCount, coord::kCount);
+  Eigen::MatrixXd Phi(kBilateralCount, coord::kCount);
+  fill_bilateral_jacobian(q, Phi);
+  return Phi;
+}
+
+void ContactSolver::fill_bilateral_jacobian(const Eigen::VectorXd& q, Eigen::MatrixXd& Phi) const {
+  Phi.setZero(kBilateralCount, coord::kCount);
   int row = 0;
   auto pt = [&](int k) { return Eigen::Vector2d(q[coord::point_x(k)], q[coord::point_x(k) + 1]); };
   auto attach = [&](int xcol, const Eigen::Vector2d& X, int P, int s) {
@@ -62,20 +68,25 @@ Eigen::MatrixXd ContactSolver::bilateral_jacobian(const Eigen::VectorXd& q) cons
     const int c = coord::dstar_x(side);
     attach(c, Eigen::Vector2d(q[c], q[c + 1]), landmark(side, 1), segment(side, 2));
   }
-  return Phi;
 }
 
 FrameSolution ContactSolver::solve(const Eigen::VectorXd& q, const Eigen::VectorXd& qdd, const FrameContacts& fc) {
-  const Eigen::MatrixXd Bd = bilateral_jacobian(q).transpose();
-  if (options_.dense_factorisation) return solve_dense(Bd, qdd, fc);
+  fill_bilateral_jacobian(q, Phi_);  // reused buffer: no allocation per frame
+  if (options_.dense_factorisation) return solve_dense(Phi_.transpose(), qdd, fc);
+  // B = Phi^T: B(i, j) = Phi(j, i) on the fixed sparsity pattern.
   for (int c = 0; c < B_.outerSize(); ++c)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(B_, c); it; ++it) it.valueRef() = Bd(it.row(), it.col());
+    for (Eigen::SparseMatrix<double>::InnerIterator it(B_, c); it; ++it) it.valueRef() = Phi_(it.col(), it.row());
   qr_.factorize(B_);
-  if (qr_.info() != Eigen::Success || qr_.rank() < kBilateralCount) return solve_dense(Bd, qdd, fc);
-  // Columns: b, then (normal, tangent) per contact point.
+  if (qr_.info() != Eigen::Success || qr_.rank() < kBilateralCount) return solve_dense(Phi_.transpose(), qdd, fc);
+  // Columns: b, then (normal, tangent) per contact point. One application of Q^T serves both
+  // parts: B^+ X = P R^-1 (Q^T X)_top (B P = Q R, full column rank) and U^T X = (Q^T X)_bottom.
   const Eigen::MatrixXd X = contact_columns(qdd, fc);
   const Eigen::MatrixXd QtX = qr_.matrixQ().transpose() * X;
-  const Eigen::MatrixXd BpX = qr_.solve(X);  // B^+ [b C] (B has full column rank)
+  const Eigen::MatrixXd Rinv_QtX = qr_.matrixR()
+                                       .topLeftCorner(kBilateralCount, kBilateralCount)
+                                       .template triangularView<Eigen::Upper>()
+                                       .solve(QtX.topRows(kBilateralCount));
+  const Eigen::MatrixXd BpX = qr_.colsPermutation() * Rinv_QtX;  // B^+ [b C]
   const Eigen::MatrixXd UtX = QtX.bottomRows(coord::kCount - kBilateralCount);  // U^T [b C]
   return solve_reduced(BpX, UtX, fc);
 }
@@ -193,8 +204,6 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::MatrixXd& BpX, const Eig
     }
     sol.active[side] = any;
     sol.force_N[side] = Eigen::Vector2d(fx, fy);
-    if (np == 2) sol.cop_x_m[side] = fc.points[static_cast<std::size_t>(side)].position.x();
-    else sol.cop_x_m[side] = std::abs(fy) > 1e-6 ? mx / fy : std::numeric_limits<double>::quiet_NaN();
   }
   return sol;
 }

@@ -52,23 +52,6 @@ BodyGeometry measure_geometry(const SagittalLandmarks& lm) {
   return g;
 }
 
-std::array<double, kSegmentCount> length_variation(const SagittalLandmarks& lm, const BodyGeometry& g) {
-  std::array<double, kSegmentCount> out{};
-  auto worst = [&](int a, int b, double L) {
-    double w = 0;
-    for (Eigen::Index i = 0; i < lm.frames(); ++i) w = std::max(w, std::abs((lm.p[b].row(i) - lm.p[a].row(i)).norm() - L) / L);
-    return w;
-  };
-  out[kTorso] = worst(kHip, kShoulder, g.torso);
-  for (int s = 0; s < 2; ++s) {
-    out[segment(s, 0)] = worst(kHip, landmark(s, 0), g.thigh[s]);
-    out[segment(s, 1)] = worst(landmark(s, 0), landmark(s, 1), g.shank[s]);
-    out[segment(s, 2)] = worst(landmark(s, 1), landmark(s, 3), g.foot[s]);
-    out[segment(s, 3)] = worst(landmark(s, 3), landmark(s, 4), g.toes[s]);
-  }
-  return out;
-}
-
 Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm) {
   const Eigen::Index n = lm.frames();
   Eigen::MatrixXd x(n, 11);

@@ -137,7 +137,7 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
   v.first_frame_number = e.first_frame_number;
   const double bw = e.mass_kg * e.model.gravity_mps2;
   const Eigen::Index n = e.time_s.size();
-  v.plates = resample_plates(rec, e.frame, e.time_s, 10.0);
+  v.plates = resample_plates(rec, e.frame, e.time_s, rec.cop_threshold_N);
   const double rate = e.landmarks.rate_hz;
   const Eigen::Index search = static_cast<Eigen::Index>(std::lround(0.2 * rate));
   const double ground = e.ground_level_m;

@@ -58,6 +58,7 @@ struct FrameContacts {
   std::vector<ContactPoint> points;  ///< model 2: [D*_R, D*_L]; model 1: [A_R,B_R,C_R,A_L,B_L,C_L]
   std::array<double, 2> foot_inclination_rad{};  ///< theta_A per side
   std::array<double, 2> cop_fraction{};          ///< model 2: s = F(theta_A)
+  std::array<std::array<Eigen::Vector2d, 3>, 2> sole{};  ///< sole points A, B, C per side (sole_points)
 };
 
 struct ContactModelOptions {

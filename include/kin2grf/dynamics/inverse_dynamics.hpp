@@ -56,7 +56,6 @@ struct SolverOptions {
 
 struct FrameSolution {
   std::array<Eigen::Vector2d, 2> force_N{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};  ///< per foot (x, y)
-  std::array<double, 2> cop_x_m{0.0, 0.0};  ///< NaN when the foot carries no load
   std::array<bool, 2> active{false, false};
   Eigen::Matrix<double, kJointCount, 1> joint_torque_Nm = Eigen::Matrix<double, kJointCount, 1>::Zero();
   Eigen::VectorXd contact_lambda;           ///< per contact point (n, t) pairs
@@ -76,12 +75,14 @@ class ContactSolver {
   [[nodiscard]] Eigen::MatrixXd bilateral_jacobian(const Eigen::VectorXd& q) const;
 
  private:
+  void fill_bilateral_jacobian(const Eigen::VectorXd& q, Eigen::MatrixXd& Phi) const;
   Eigen::MatrixXd contact_columns(const Eigen::VectorXd& qdd, const FrameContacts& contacts) const;
   FrameSolution solve_reduced(const Eigen::MatrixXd& BpX, const Eigen::MatrixXd& UtX, const FrameContacts& contacts);
   FrameSolution solve_dense(const Eigen::MatrixXd& B, const Eigen::VectorXd& qdd, const FrameContacts& contacts);
   const Model& model_;
   SolverOptions options_;
   Eigen::VectorXd mass_, gravity_, weight_bilateral_;
+  Eigen::MatrixXd Phi_;            ///< the frame's bilateral Jacobian (60 x 63), reused
   Eigen::SparseMatrix<double> B_;  ///< Phi_q^T with the structural pattern of every frame
   Eigen::SparseQR<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> qr_;
 };

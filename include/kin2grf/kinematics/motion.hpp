@@ -31,9 +31,6 @@ struct SagittalLandmarks {
 /// place in the foot frame.
 BodyGeometry measure_geometry(const SagittalLandmarks& lm);
 
-/// Per-frame relative variation of the landmark distances (for the report): max |L - median| / median.
-std::array<double, kSegmentCount> length_variation(const SagittalLandmarks& lm, const BodyGeometry& g);
-
 /// Columns: 0 hip x, 1 hip y, 2 torso angle, 3..10 joint angles phi_j (unwrapped), N x 11.
 Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm);
 
