@@ -8,6 +8,8 @@
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/io/load.hpp"
+#include "kin2grf/io/text.hpp"
+#include "kin2grf/error.hpp"
 #include "kin2grf/synth/example.hpp"
 #include "test_support.hpp"
 
@@ -282,5 +284,55 @@ TEST(Solver, SparseAndDenseFactorisationsAgree) {
       EXPECT_LT((a.contact_lambda - b.contact_lambda).cwiseAbs().maxCoeff(), 1e-6) << "frame " << i;
       EXPECT_LT((a.joint_torque_Nm - b.joint_torque_Nm).cwiseAbs().maxCoeff(), 1e-6) << "frame " << i;
     }
+  }
+}
+
+// A torso without trunk markers (pelvis_up) sways fore-aft by sway_gain times the hip centre's
+// oscillation about its slow trend: 1 is rigid with the hip, 0 holds the shoulder on the trend.
+TEST(Landmarks, UprightTorsoSwaysByItsGain) {
+  SyntheticOptions so;
+  so.squat_depth = 0.0;  // quiet standing, plus a 2 Hz, 2 cm fore-aft sway of the whole body
+  Trial t = make_synthetic_trial(so);
+  const Eigen::Index n = t.markers.frames();
+  const Eigen::ArrayXd sway = 0.02 * (2.0 * M_PI * 2.0 * t.markers.time_s.array()).sin();
+  for (auto& p : t.markers.positions_m) p.col(0).array() += sway;
+  // Pelvis markers about the hip-centre midpoint (lab: X forward, Y left, Z up).
+  const Eigen::MatrixX3d hip = 0.5 * (t.markers.positions_m[static_cast<std::size_t>(t.markers.find("RHJC"))] +
+                                      t.markers.positions_m[static_cast<std::size_t>(t.markers.find("LHJC"))]);
+  const std::pair<const char*, Eigen::RowVector3d> pelvis[] = {{"RASI", {0.06, -0.12, 0.08}}, {"LASI", {0.06, 0.12, 0.08}},
+                                                               {"RPSI", {-0.10, -0.05, 0.10}}, {"LPSI", {-0.10, 0.05, 0.10}}};
+  for (const auto& [name, offset] : pelvis) {
+    t.markers.names.emplace_back(name);
+    t.markers.descriptions.emplace_back();
+    t.markers.positions_m.push_back(hip.rowwise() + offset);
+  }
+  auto shoulder_x = [&](double gain) {
+    nlohmann::json j = read_json_file(std::string(KIN2GRF_SOURCE_DIR) + "/data/presets/kin2grf-example.json");
+    j["landmarks"]["shoulder"] = {{"pelvis_up", 0.5}, {"sway_gain", gain},
+                                  {"pelvis", {{"rasis", "RASI"}, {"lasis", "LASI"}, {"rpsis", "RPSI"}, {"lpsis", "LPSI"}}}};
+    const MarkerSet set = parse_marker_set(j, "test");
+    const auto e = estimate(t, nullptr, set, {});
+    return Eigen::VectorXd(e.landmarks.p[kShoulder].col(0));
+  };
+  const Eigen::VectorXd rigid = shoulder_x(1.0), half = shoulder_x(0.5), still = shoulder_x(0.0);
+  ASSERT_EQ(rigid.size(), n);
+  // Away from the ends (the trend filter's edges): the rigid torso carries the whole sway, the
+  // half-gain torso half of it, the zero-gain torso none.
+  double worst_half = 0, worst_still = 0;
+  for (Eigen::Index i = n / 5; i < n - n / 5; ++i) {
+    worst_half = std::max(worst_half, std::abs((rigid[i] - half[i]) - 0.5 * sway[i]));
+    worst_still = std::max(worst_still, std::abs((rigid[i] - still[i]) - sway[i]));
+  }
+  EXPECT_LT(worst_half, 1e-3);
+  EXPECT_LT(worst_still, 2e-3);
+  // A gain outside 0-1.5 is refused, naming the landmark.
+  nlohmann::json bad = read_json_file(std::string(KIN2GRF_SOURCE_DIR) + "/data/presets/kin2grf-example.json");
+  bad["landmarks"]["shoulder"] = {{"pelvis_up", 0.5}, {"sway_gain", 3.0}, {"pelvis", {{"rasis", "RASI"}, {"lasis", "LASI"}, {"rpsis", "RPSI"}, {"lpsis", "LPSI"}}}};
+  try {
+    (void)parse_marker_set(bad, "bad.json");
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("sway_gain"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("shoulder"), std::string::npos) << e.what();
   }
 }

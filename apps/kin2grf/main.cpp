@@ -45,7 +45,10 @@ int run_info(const std::string& file, bool json, double threshold, const std::st
 struct EstimateArgs {
   std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "torque-scaled",
       anthropometry = "de-leva", up_axis, cop_function;
-  double mass = 0, r = 1e3, kin_cutoff = 6, post_cutoff = 12, ground_shift = 0, speed_gate = 2.0;
+  // Numerical defaults come from the library's option structs (one source for CLI and API).
+  double mass = 0, r = kin2grf::SolverOptions{}.r_N_per_m, kin_cutoff = kin2grf::EstimateOptions{}.kinematic_cutoff_hz,
+         post_cutoff = kin2grf::EstimateOptions{}.post_cutoff_hz, ground_shift = 0,
+         speed_gate = kin2grf::SolverOptions{}.speed_gate_mps;
   bool paper = false, r_given = false, anthropometry_given = false;
   std::optional<double> ground_level;
   std::vector<double> grm_reference;

@@ -9,6 +9,7 @@
 #include "kin2grf/error.hpp"
 #include "kin2grf/numeric.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/kinematics/filter.hpp"
 
 namespace kin2grf {
 
@@ -103,6 +104,10 @@ std::vector<std::string> MarkerSet::motion_markers() const {
   return out;
 }
 
+namespace {
+constexpr double kTrunkTrendCutoffHz = 0.5;
+}  // namespace
+
 MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
   MarkerSet s;
   try {
@@ -125,6 +130,10 @@ MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
       } else if (r.contains("pelvis_up")) {
         rule.kind = "pelvis_up";
         rule.value = r["pelvis_up"].get<double>();
+        rule.sway_gain = r.value("sway_gain", kTrunkSwayGain);
+        if (!(rule.sway_gain >= 0.0 && rule.sway_gain <= 1.5))
+          throw InputError(source + ": landmark '" + kNames[id] + "': sway_gain " + std::to_string(rule.sway_gain) +
+                           " is outside 0-1.5 (0.5: measured walking; 1: a rigid upright torso)");
         rule.pelvis = r.at("pelvis").get<std::map<std::string, std::string>>();
       } else if (r.contains("virtual_hallux")) {
         rule.kind = "virtual_hallux";
@@ -185,10 +194,11 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
       }
     } else if (r.kind == "pelvis_up") {
       const Pelvis pv = pelvis(m, r.pelvis, path);
-      // Without upper-body markers the torso is a rigid upright segment above the hip centre:
-      // the pelvis's tilt (10-15 deg forward) and its oscillations are not the trunk's, and a
-      // torso that follows them adds spurious moments of the heavy HAT segment (measured:
-      // docs/METHOD-NOTES.md).
+      // Without upper-body markers the torso is an upright segment above the hip centre: the
+      // pelvis's tilt (10-15 deg forward) and its oscillations are not the trunk's, and a torso
+      // that follows them adds spurious moments of the heavy HAT segment (measured:
+      // docs/METHOD-NOTES.md). Its fore-aft sway (sway_gain) is applied in sagittal_landmarks,
+      // where gaps are filled and the progression axis is known.
       Eigen::Vector3d up = Eigen::Vector3d::Zero();
       up[static_cast<int>(options.up_axis.value_or(m.up_axis))] = 1.0;
       for (Eigen::Index i = 0; i < n; ++i) {
@@ -196,8 +206,9 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
         const Eigen::Vector3d base = pv.origin.row(i).transpose() + ax * pv.x.row(i).transpose() + ay * pv.y.row(i).transpose();
         P.row(i) = (base + r.value * up).transpose();
       }
-      out.messages.push_back("shoulder: no upper-body markers; the torso is a rigid upright segment of " +
-                             std::to_string(r.value).substr(0, 4) + " m above the hip centre, an approximation");
+      out.messages.push_back("shoulder: no upper-body markers; the torso is an upright segment of " +
+                             std::to_string(r.value).substr(0, 4) + " m above the hip centre, its top swaying by " +
+                             std::to_string(r.sway_gain).substr(0, 4) + " x the hip's fore-aft oscillation, an approximation");
     } else if (r.kind == "static") {
       if (!st) {
         throw InputError(path + ": landmark " + kNames[id] + " of marker set '" + set.name +
@@ -382,6 +393,18 @@ SagittalWindow sagittal_landmarks(const Landmarks3D& lm3, const MarkerSet& set, 
     }
     w.messages.push_back(std::string("hallux_") + (side ? "l" : "r") + ": no hallux marker; virtual toes of " +
                          std::to_string(r.value) + " x ankle-MT length");
+  }
+  // Torso without trunk markers: the shoulder point sways fore-aft by sway_gain times the hip
+  // centre's oscillation about its own slow progression (a 0.5 Hz zero-lag trend, below the
+  // step frequency), instead of rigidly with the hip. The trunk's attenuation of the pelvis's
+  // fore-aft accelerations is measured (kTrunkSwayGain); its vertical motion is the hip's (a
+  // gain of 0.97-1.03 on the same trials), so only x changes.
+  const LandmarkRule& sr = set.rules[kShoulder];
+  if (sr.kind == "pelvis_up" && sr.sway_gain != 1.0) {
+    auto& S = s.p[kShoulder];
+    const Eigen::VectorXd hx = s.p[kHip].col(0);
+    const Eigen::VectorXd trend = butterworth_filtfilt(hx, s.rate_hz, kTrunkTrendCutoffHz);
+    S.col(0) += (sr.sway_gain - 1.0) * (hx - trend);
   }
   return w;
 }

@@ -46,8 +46,9 @@ struct SolverOptions {
   MultiplierNorm norm = MultiplierNorm::TorqueScaled;  ///< kin2grf's default; the paper: Paper
   double torque_length_m = 0.9;
   /// A contact point may be active only while its horizontal speed relative to the ground
-  /// (or belt) is below this (m/s); <= 0 disables the gate (the paper). kin2grf's default: 2.
-  double speed_gate_mps = 2.0;
+  /// (or belt) is below this (m/s); <= 0 disables the gate (the paper). kin2grf's default: 1.5
+  /// (`kin2grf study speed-gate`: walking flat from 0.5 to 3 m/s, running best at 1-1.5 m/s).
+  double speed_gate_mps = 1.5;
   double belt_velocity_mps = 0.0;  ///< ground velocity along x (treadmill belt), m/s
   /// Dense rank-revealing factorisation instead of the sparse one (the fallback when the sparse
   /// factorisation reports a rank below 60; selectable to cross-check them).

@@ -43,7 +43,17 @@ struct LandmarkRule {
   std::vector<std::string> cluster;  ///< static: tracking cluster
   std::map<std::string, std::string> pelvis;  ///< harrington / pelvis_up: rasis, lasis, rpsis, lpsis | sacrum
   double value = 0.0;                ///< pelvis_up length (m), virtual_hallux fraction
+  /// pelvis_up: the shoulder point's horizontal sway as a fraction of the hip centre's (see
+  /// kTrunkSwayGain); 1 keeps the torso rigidly upright.
+  double sway_gain = 0.0;
 };
+
+/// The horizontal acceleration of the shoulder point (acromia) as a fraction of the hip
+/// centre's, in walking: measured on the 6 development walking trials with trunk markers
+/// (5 labs), 0.28-0.67, mean 0.48 (docs/METHOD-NOTES.md, "torso without trunk markers"). A rigid
+/// upright torso (gain 1) gives the heavy HAT segment the pelvis's whole fore-aft oscillation,
+/// which over-brakes the body at heel strike and moves load to the leading foot too early.
+inline constexpr double kTrunkSwayGain = 0.5;
 
 struct MarkerSet {
   std::string name;
