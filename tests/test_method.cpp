@@ -336,3 +336,27 @@ TEST(Landmarks, UprightTorsoSwaysByItsGain) {
     EXPECT_NE(std::string(e.what()).find("shoulder"), std::string::npos) << e.what();
   }
 }
+
+// Feet side by side (a staggered squat, 3 cm apart): the sagittal moment equation cannot split
+// the load, and fitting it anyway alternates the load between the feet. With kin2grf's
+// side-by-side rule both feet share it; without it (the paper) one foot takes nearly all.
+TEST(Estimate, FeetSideBySideShareTheLoad) {
+  Trial t = make_synthetic_trial({});
+  for (std::size_t k = 0; k < t.markers.names.size(); ++k)
+    if (t.markers.names[k][0] == 'L' && t.markers.names[k] != "LHJC" && t.markers.names[k] != "LSHO")
+      t.markers.positions_m[k].col(0).array() += 0.03;
+  auto worst_share = [&](double split_m) {
+    EstimateOptions eo;
+    eo.solver.min_split_distance_m = split_m;
+    const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
+    double worst = 0.5;
+    for (Eigen::Index i = 10; i < r.time_s.size() - 10; ++i) {
+      const double fr = r.feet[0].raw_force_N(i, 1), fl = r.feet[1].raw_force_N(i, 1);
+      if (fr + fl < 100) continue;
+      worst = std::max(worst, std::max(fr, fl) / (fr + fl));
+    }
+    return worst;
+  };
+  EXPECT_LT(worst_share(SolverOptions{}.min_split_distance_m), 0.65);
+  EXPECT_GT(worst_share(0.0), 0.9);
+}

@@ -155,19 +155,39 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::MatrixXd& BpX, const Eig
       int rank = 0;
       for (Eigen::Index i = 0; i < sv.size(); ++i)
         if (sv[i] > tol) ++rank;
-      Eigen::VectorXd lam0 = Eigen::VectorXd::Zero(ka);
-      for (int i = 0; i < rank; ++i)
-        lam0 += svd.matrixV().col(i) * (svd.matrixU().col(i).dot(b3) / sv[i]);
-      Eigen::VectorXd lam = lam0;
-      if (rank < ka) {
-        const Eigen::MatrixXd N = svd.matrixV().rightCols(ka - rank);
-        Eigen::MatrixXd S(ka + kBilateralCount, ka - rank);
+      // Fit the first r singular directions exactly; the remaining freedom by the minimum norm.
+      auto fit = [&](int r) {
+        Eigen::VectorXd lam0 = Eigen::VectorXd::Zero(ka);
+        for (int i = 0; i < r; ++i) lam0 += svd.matrixV().col(i) * (svd.matrixU().col(i).dot(b3) / sv[i]);
+        if (r == ka) return lam0;
+        const Eigen::MatrixXd N = svd.matrixV().rightCols(ka - r);
+        Eigen::MatrixXd S(ka + kBilateralCount, ka - r);
         S << N, W * N;
         Eigen::VectorXd rhs(ka + kBilateralCount);
         rhs << -lam0, w - W * lam0;
         const Eigen::VectorXd z = S.completeOrthogonalDecomposition().solve(rhs);
-        lam = lam0 + N * z;
+        return Eigen::VectorXd(lam0 + N * z);
+      };
+      // Feet side by side: with all 3 global directions fitted, the weakest is the moment that
+      // only a couple between the feet can make (its singular value shrinks with their distance
+      // along x and height); fade it out of the fit. Feet exactly together already leave it out.
+      double keep = 1.0;
+      if (options_.min_split_distance_m > 0 && rank == UtX.rows()) {
+        std::array<bool, 2> side_on{false, false};
+        double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
+        for (int j = 0; j < np; ++j) {
+          if (!active[static_cast<std::size_t>(j)]) continue;
+          const auto& p = fc.points[static_cast<std::size_t>(j)];
+          side_on[static_cast<std::size_t>(p.side)] = true;
+          xmin = std::min(xmin, p.position.x()), xmax = std::max(xmax, p.position.x());
+        }
+        if (side_on[0] && side_on[1]) {
+          const double u = std::clamp(2.0 * (xmax - xmin) / options_.min_split_distance_m - 1.0, 0.0, 1.0);
+          keep = u * u * (3.0 - 2.0 * u);  // smoothstep: 0 below half the distance, 1 above it
+        }
       }
+      Eigen::VectorXd lam = fit(rank);
+      if (keep < 1.0) lam = keep * lam + (1.0 - keep) * fit(rank - 1);
       for (int c = 0; c < ka; ++c) lamC[cols[static_cast<std::size_t>(c)]] = lam[c];
     }
     // Re-classify (Eqs. 8-9).

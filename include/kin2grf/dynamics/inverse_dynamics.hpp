@@ -21,6 +21,7 @@
 // Semi-smooth Newton / active-set iterations (Fig. 5): start with every contact active, solve,
 // reclassify, repeat until the set repeats; a set seen before ends the loop (cycle guard, the
 // last solution is kept) and so does the iteration cap.
+// Feet side by side (kin2grf, not the paper): see SolverOptions::min_split_distance_m.
 #pragma once
 
 #include <Eigen/Dense>
@@ -50,6 +51,17 @@ struct SolverOptions {
   /// (`kin2grf study speed-gate`: walking flat from 0.5 to 3 m/s, running best at 1-1.5 m/s).
   double speed_gate_mps = 1.5;
   double belt_velocity_mps = 0.0;  ///< ground velocity along x (treadmill belt), m/s
+  /// Feet side by side: when both feet are in contact and all their active points lie within
+  /// this distance along progression (m), the sagittal moment equation cannot tell how the load
+  /// is split between them (F_R x_R + F_L x_L = M with x_R ~ x_L), and fitting it anyway hands one
+  /// foot the whole load and the other a negative force. The moment direction of the 3-equation
+  /// fit (its weakest singular direction) is then faded out (smoothstep from 1 at this distance
+  /// to 0 at half of it) and the minimum norm shares the load. 0 disables (the paper).
+  /// kin2grf's default 0.15 m: a moment error of 20-30 N m (a few % of the walking GRM range)
+  /// moves F_R - F_L by dM / d, 150-200 N at that distance. Walking double support keeps its
+  /// feet 0.37-0.57 m apart (the 7 development trials) and is not affected; the drop jump's
+  /// side-by-side landing (0-9 cm) goes from 58 to 17 % vertical (`kin2grf study split-distance`).
+  double min_split_distance_m = 0.15;
   /// Dense rank-revealing factorisation instead of the sparse one (the fallback when the sparse
   /// factorisation reports a rank below 60; selectable to cross-check them).
   bool dense_factorisation = false;
