@@ -73,10 +73,10 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
       ->expected(2);
   c->add_option("--ground-shift", a.ground_shift, "Shift the ground by this much, m (robustness study)")->capture_default_str();
   c->add_option("--speed-gate", a.speed_gate, "Contact allowed only below this sole speed, m/s (0 = off, the paper)")
-      ->capture_default_str();
+      ->check(CLI::Range(0.0, 20.0))->capture_default_str();
   c->add_option("--split-distance", a.split_distance,
                 "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)")
-      ->capture_default_str();
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
       ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
   c->add_option_function<std::string>(
