@@ -73,7 +73,7 @@ void BM_ContactSolvePerFrame(benchmark::State& state) {
     return;
   }
   const auto r = kin2grf::estimate(w.trial, nullptr, *w.set, w.options);
-  kin2grf::ModelMotion motion = kin2grf::compute_motion(r.model, r.landmarks, w.options.kinematic_cutoff_hz);
+  kin2grf::ModelMotion motion = kin2grf::compute_motion(r.model, r.landmarks, w.options.kinematic_cutoff_hz, w.options.torso_length);
   kin2grf::ContactModelOptions co = w.options.contact;
   co.ground_level_m = r.ground_level_m;
   const auto contacts = kin2grf::prepare_contacts(r.model, co, motion);

@@ -49,7 +49,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     if (flat[s] < 3) r.messages.push_back(std::string(s ? "left" : "right") + " foot: only " + std::to_string(flat[s]) +
                                           " foot-flat frames for the contact calibration");
 
-  ModelMotion motion = compute_motion(r.model, lm, o.kinematic_cutoff_hz);
+  ModelMotion motion = compute_motion(r.model, lm, o.kinematic_cutoff_hz, o.torso_length);
   ContactModelOptions co = o.contact;
   co.ground_level_m = r.ground_level_m;
   const auto contacts = prepare_contacts(r.model, co, motion);

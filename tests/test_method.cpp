@@ -360,3 +360,38 @@ TEST(Estimate, FeetSideBySideShareTheLoad) {
   EXPECT_LT(worst_share(SolverOptions{}.min_split_distance_m), 0.65);
   EXPECT_GT(worst_share(0.0), 0.9);
 }
+
+// The torso takes its measured hip-shoulder length (TorsoLength::Measured): the shoulders
+// moving 2 cm up and down against the hip make the reconstructed torso follow, and its points'
+// accelerations are the second derivatives of their positions (the k' and k'' terms).
+TEST(Kinematics, MeasuredTorsoLengthIsFollowedAndDifferentiated) {
+  Trial t = make_synthetic_trial({});
+  const auto r = run({});
+  const Eigen::ArrayXd bob = 0.02 * (2.0 * M_PI * 1.5 * t.markers.time_s.array()).sin();
+  for (const char* s : {"RSHO", "LSHO"}) t.markers.positions_m[static_cast<std::size_t>(t.markers.find(s))].col(2).array() += bob;
+  const SagittalLandmarks lm = synthetic_landmarks(t);
+  const ModelMotion measured = compute_motion(r.model, lm, 6.0, TorsoLength::Measured);
+  const ModelMotion fixed = compute_motion(r.model, lm, 6.0, TorsoLength::Fixed);
+  const double dt = 1.0 / lm.rate_hz, L0 = r.model.bodies[kTorso].length_m;
+  auto point = [](const Eigen::MatrixXd& q, int col, Eigen::Index i) {
+    return Eigen::Vector2d(q(i, col), q(i, col + 1));
+  };
+  double worst_len = 0, worst_acc = 0, fixed_spread = 0, acc_scale = 0;
+  const int sh = coord::point_x(kShoulder), hip = coord::point_x(kHip), com = coord::com_x(kTorso);
+  for (Eigen::Index i = 20; i < measured.frames() - 20; ++i) {
+    const double len = (point(measured.q, sh, i) - point(measured.q, hip, i)).norm();
+    const double truth = (lm.p[kShoulder].row(i) - lm.p[kHip].row(i)).norm();
+    worst_len = std::max(worst_len, std::abs(len - truth));
+    fixed_spread = std::max(fixed_spread, std::abs((point(fixed.q, sh, i) - point(fixed.q, hip, i)).norm() - L0));
+    // Second central difference of the torso COM position against its reconstructed acceleration.
+    const Eigen::Vector2d fd = (point(measured.q, com, i + 1) - 2 * point(measured.q, com, i) +
+                                point(measured.q, com, i - 1)) / (dt * dt);
+    const Eigen::Vector2d a(measured.qdd(i, com), measured.qdd(i, com + 1));
+    worst_acc = std::max(worst_acc, (fd - a).norm());
+    acc_scale = std::max(acc_scale, a.norm());
+  }
+  EXPECT_LT(worst_len, 2e-3);           // follows the measured length (6 Hz filtered, 1.5 Hz bob)
+  EXPECT_LT(fixed_spread, 1e-12);       // the paper's rigid torso does not
+  EXPECT_LT(worst_acc, 0.02 * acc_scale);  // the scaled kinematics are differentiated consistently
+  EXPECT_GT(acc_scale, 0.5);
+}

@@ -44,7 +44,7 @@ int run_info(const std::string& file, bool json, double threshold, const std::st
 
 struct EstimateArgs {
   std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "torque-scaled",
-      anthropometry = "de-leva", up_axis, cop_function;
+      anthropometry = "de-leva", up_axis, cop_function, torso_length = "measured";
   // Numerical defaults come from the library's option structs (one source for CLI and API).
   double mass = 0, r = kin2grf::SolverOptions{}.r_N_per_m, kin_cutoff = kin2grf::EstimateOptions{}.kinematic_cutoff_hz,
          post_cutoff = kin2grf::EstimateOptions{}.post_cutoff_hz, ground_shift = 0,
@@ -77,6 +77,9 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
   c->add_option("--split-distance", a.split_distance,
                 "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  c->add_option("--torso-length", a.torso_length,
+                "measured (the hip-shoulder distance of each frame, filtered) or fixed (its median, the paper's rigid HAT)")
+      ->check(CLI::IsMember({"measured", "fixed"}))->capture_default_str();
   c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
       ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
   c->add_option_function<std::string>(
@@ -85,7 +88,7 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
       ->check(CLI::IsMember({"winter", "de-leva"}));
   c->add_option("--cop-function", a.cop_function, "Foot model 2's COP function from this JSON (see kin2grf fit-cop)");
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
-  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split");
+  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length");
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
   if (!outputs) return;
   c->add_option("-o,--output", a.out_mot, "OpenSim GRF .mot output");
@@ -109,6 +112,7 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
   o.solver.norm = (a.paper || a.norm == "paper") ? kin2grf::MultiplierNorm::Paper : kin2grf::MultiplierNorm::TorqueScaled;
   o.solver.speed_gate_mps = a.paper ? 0.0 : a.speed_gate;
   o.solver.min_split_distance_m = a.paper ? 0.0 : a.split_distance;
+  o.torso_length = (a.paper || a.torso_length == "fixed") ? kin2grf::TorsoLength::Fixed : kin2grf::TorsoLength::Measured;
   o.landmarks.max_gap_frames = a.max_gap;
   if (!a.up_axis.empty()) {
     const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(a.up_axis[0])));
@@ -132,6 +136,7 @@ nlohmann::json settings_json(const EstimateArgs& a, const kin2grf::EstimateOptio
           {"norm", o.solver.norm == kin2grf::MultiplierNorm::Paper ? "paper" : "torque-scaled"},
           {"speed_gate_mps", o.solver.speed_gate_mps},
           {"min_split_distance_m", o.solver.min_split_distance_m},
+          {"torso_length", o.torso_length == kin2grf::TorsoLength::Fixed ? "fixed" : "measured"},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"post_cutoff_hz", o.post_cutoff_hz},
           {"anthropometry", o.anthropometry},
@@ -438,9 +443,9 @@ int main(int argc, char** argv) {
 
   StudyArgs study_args;
   auto* study = app.add_subcommand("study", "The paper's parameter studies on trials with plates: r, ground-shift, cutoff, "
-                                            "kinematic-cutoff, speed-gate, split-distance, foot-model");
-  study->add_option("KIND", study_args.kind, "r | ground-shift | cutoff | kinematic-cutoff | speed-gate | split-distance | foot-model")
-      ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "kinematic-cutoff", "speed-gate", "split-distance", "foot-model"}));
+                                            "kinematic-cutoff, speed-gate, split-distance, torso-length, foot-model");
+  study->add_option("KIND", study_args.kind, "r | ground-shift | cutoff | kinematic-cutoff | speed-gate | split-distance | torso-length | foot-model")
+      ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "kinematic-cutoff", "speed-gate", "split-distance", "torso-length", "foot-model"}));
   study->add_option("TRIAL", study_args.trials, "Trials with plates (the options below apply to all of them)");
   study->add_option("--trial-list", study_args.trial_list,
                     "File of lines 'activity|name|TRIAL [options]', each trial with its own options");

@@ -12,6 +12,7 @@
 #include "kin2grf/dynamics/contact.hpp"
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
 #include "kin2grf/io/trial.hpp"
+#include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/markers/landmarks.hpp"
 #include "kin2grf/model/model.hpp"
 
@@ -22,6 +23,8 @@ struct EstimateOptions {
   std::string anthropometry = "de-leva";  ///< kin2grf's default; the paper cites Winter (--paper)
   double kinematic_cutoff_hz = 6.0;        ///< paper: 6 Hz
   double post_cutoff_hz = 12.0;            ///< paper: 12 Hz
+  /// The torso's hip-shoulder length: measured per frame (kin2grf) or fixed (the paper).
+  TorsoLength torso_length = TorsoLength::Measured;
   std::optional<double> ground_level_m;    ///< else estimate_ground_level
   ContactModelOptions contact;
   SolverOptions solver;

@@ -54,7 +54,7 @@ BodyGeometry measure_geometry(const SagittalLandmarks& lm) {
 
 Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm) {
   const Eigen::Index n = lm.frames();
-  Eigen::MatrixXd x(n, 11);
+  Eigen::MatrixXd x(n, 12);
   Eigen::MatrixXd theta(n, kSegmentCount);
   for (Eigen::Index i = 0; i < n; ++i) {
     auto P = [&](int k) { return Eigen::Vector2d(lm.p[k].row(i).transpose()); };
@@ -67,6 +67,7 @@ Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm) {
     }
     x(i, 0) = lm.p[kHip](i, 0);
     x(i, 1) = lm.p[kHip](i, 1);
+    x(i, 11) = (P(kShoulder) - P(kHip)).norm();
   }
   // Unwrap each absolute angle over time, then form the joint angles.
   for (int s = 0; s < kSegmentCount; ++s)
@@ -104,12 +105,24 @@ ModelMotion reconstruct_motion(const Model& model, const Eigen::MatrixXd& x, con
     r[kHip] = Eigen::Vector2d(x(i, 0), x(i, 1));
     v[kHip] = Eigen::Vector2d(xd(i, 0), xd(i, 1));
     a[kHip] = Eigen::Vector2d(xdd(i, 0), xdd(i, 1));
+    // The torso's points scale with its measured length (column 11, when given): d = k e with
+    // e = R(theta) rho, so d' = k' e + k e' and d'' = k'' e + 2 k' e' + k e''.
+    double ks = 1, ksd = 0, ksdd = 0;  // k, k', k''
+    if (x.cols() > 11) {
+      const double L0 = model.bodies[kTorso].length_m;
+      ks = x(i, 11) / L0, ksd = xd(i, 11) / L0, ksdd = xdd(i, 11) / L0;
+    }
     auto place = [&](const Body& b, int s, const Eigen::Vector2d& local, Eigen::Vector2d& rr, Eigen::Vector2d& vv,
                      Eigen::Vector2d& aa) {
-      const Eigen::Vector2d d = rot(th[s]) * local;
-      rr = r[b.proximal] + d;
-      vv = v[b.proximal] + w[s] * perp(d);
-      aa = a[b.proximal] + al[s] * perp(d) - w[s] * w[s] * d;
+      const Eigen::Vector2d e = rot(th[s]) * local;
+      const Eigen::Vector2d ed = w[s] * perp(e), edd = al[s] * perp(e) - w[s] * w[s] * e;
+      if (s != kTorso || x.cols() <= 11) {
+        rr = r[b.proximal] + e, vv = v[b.proximal] + ed, aa = a[b.proximal] + edd;
+        return;
+      }
+      rr = r[b.proximal] + ks * e;
+      vv = v[b.proximal] + ksd * e + ks * ed;
+      aa = a[b.proximal] + ksdd * e + 2 * ksd * ed + ks * edd;
     };
     for (int s : order) {
       const Body& b = model.bodies[s];
@@ -138,10 +151,11 @@ ModelMotion reconstruct_motion(const Model& model, const Eigen::MatrixXd& x, con
   return mm;
 }
 
-ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz) {
+ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz, TorsoLength torso) {
   if (lm.frames() < 8) throw InputError("too few frames (" + std::to_string(lm.frames()) + ") for the kinematics");
   const double dt = 1.0 / lm.rate_hz;
-  const Eigen::MatrixXd raw = independent_coordinates(lm);
+  Eigen::MatrixXd raw = independent_coordinates(lm);
+  if (torso == TorsoLength::Fixed) raw.conservativeResize(Eigen::NoChange, 11);
   const Eigen::MatrixXd x = cutoff_hz > 0 ? butterworth_filtfilt(raw, lm.rate_hz, cutoff_hz) : raw;
   const Eigen::MatrixXd xd = central_difference(x, dt);
   const Eigen::MatrixXd xdd = second_difference(x, dt);

@@ -51,11 +51,14 @@ std::vector<Setting> settings_for(const std::string& kind) {
       std::snprintf(b, sizeof b, d > 0 ? "%.2f m" : "off", d);
       s.push_back({b, d, [d](EstimateOptions& o) { o.solver.min_split_distance_m = d; }});
     }
+  } else if (kind == "torso-length") {
+    s.push_back({"fixed (the paper)", 0, [](EstimateOptions& o) { o.torso_length = TorsoLength::Fixed; }});
+    s.push_back({"measured", 1, [](EstimateOptions& o) { o.torso_length = TorsoLength::Measured; }});
   } else if (kind == "foot-model") {
     s.push_back({"three-point (model 1)", 1, [](EstimateOptions& o) { o.contact.foot_model = FootModel::ThreePoint; }});
     s.push_back({"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }});
   } else {
-    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, speed-gate, split-distance, foot-model)");
+    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, speed-gate, split-distance, torso-length, foot-model)");
   }
   return s;
 }

@@ -7,6 +7,13 @@
 //   r_X = r_P + R(theta) rho_X,  v_X = v_P + w k x (r_X - r_P),
 //   a_X = a_P + alpha k x (r_X - r_P) - w^2 (r_X - r_P),
 // so q, qd, qdd satisfy the bilateral constraints (and their time derivatives) to round-off.
+// Exception (kin2grf's default, not the paper's): the torso (HAT) may take its measured,
+// filtered hip-shoulder length L(t) instead of the fixed median, its points scaled by
+// k = L(t) / L0 (d = k R rho; d'' = k'' e + 2 k' e' + k e''). The shoulders move up and down
+// against the hip by 2-3 cm in running (spine, shoulder girdle), and the HAT is 60 % of the
+// body mass: with a fixed length its vertical momentum misses that motion (running vertical
+// 5.8 -> see docs/METHOD-NOTES.md). The bilateral constraints then hold with a time-varying
+// torso length (a rheonomic constraint like the joint drivers); their Jacobian is unchanged.
 // Contact constraints play no part here (the paper's decoupling).
 #pragma once
 
@@ -31,7 +38,8 @@ struct SagittalLandmarks {
 /// place in the foot frame.
 BodyGeometry measure_geometry(const SagittalLandmarks& lm);
 
-/// Columns: 0 hip x, 1 hip y, 2 torso angle, 3..10 joint angles phi_j (unwrapped), N x 11.
+/// Columns: 0 hip x, 1 hip y, 2 torso angle, 3..10 joint angles phi_j (unwrapped), 11 the
+/// hip-shoulder distance (m), N x 12.
 Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm);
 
 struct ModelMotion {
@@ -41,13 +49,19 @@ struct ModelMotion {
   [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
 };
 
-/// Forward kinematics of the fixed-length chain from the independent coordinates and their
-/// first and second time derivatives (N x 11 each).
+/// Forward kinematics of the chain from the independent coordinates and their first and second
+/// time derivatives (N x 11: fixed lengths; N x 12: the torso takes column 11's length).
 ModelMotion reconstruct_motion(const Model& model, const Eigen::MatrixXd& x, const Eigen::MatrixXd& xd,
                                const Eigen::MatrixXd& xdd, double rate_hz, const Eigen::VectorXd& time_s);
 
+enum class TorsoLength {
+  Measured,  ///< the filtered hip-shoulder distance of each frame (kin2grf's default)
+  Fixed      ///< the median over the trial (the paper's rigid model)
+};
+
 /// The whole kinematic step: independent coordinates, filter at cutoff_hz, differentiate,
 /// reconstruct.
-ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz);
+ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz,
+                           TorsoLength torso = TorsoLength::Measured);
 
 }  // namespace kin2grf
