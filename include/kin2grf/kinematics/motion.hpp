@@ -12,7 +12,7 @@
 // k = L(t) / L0 (d = k R rho; d'' = k'' e + 2 k' e' + k e''). The shoulders move up and down
 // against the hip by 2-3 cm in running (spine, shoulder girdle), and the HAT is 60 % of the
 // body mass: with a fixed length its vertical momentum misses that motion (running vertical
-// 5.8 -> see docs/METHOD-NOTES.md). The bilateral constraints then hold with a time-varying
+// 5.8 -> 4.3 %, docs/METHOD-NOTES.md). The bilateral constraints then hold with a time-varying
 // torso length (a rheonomic constraint like the joint drivers); their Jacobian is unchanged.
 // Contact constraints play no part here (the paper's decoupling).
 #pragma once
