@@ -42,9 +42,12 @@ int run_info(const std::string& file, bool json, double threshold, const std::st
   return 0;
 }
 
+const char* torso_length_name(kin2grf::TorsoLength t) { return t == kin2grf::TorsoLength::Fixed ? "fixed" : "measured"; }
+
 struct EstimateArgs {
   std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "torque-scaled",
-      anthropometry = "de-leva", up_axis, cop_function, torso_length = "measured";
+      anthropometry = kin2grf::EstimateOptions{}.anthropometry, up_axis, cop_function,
+      torso_length = torso_length_name(kin2grf::EstimateOptions{}.torso_length);
   // Numerical defaults come from the library's option structs (one source for CLI and API).
   double mass = 0, r = kin2grf::SolverOptions{}.r_N_per_m, kin_cutoff = kin2grf::EstimateOptions{}.kinematic_cutoff_hz,
          post_cutoff = kin2grf::EstimateOptions{}.post_cutoff_hz, ground_shift = 0,
@@ -136,7 +139,7 @@ nlohmann::json settings_json(const EstimateArgs& a, const kin2grf::EstimateOptio
           {"norm", o.solver.norm == kin2grf::MultiplierNorm::Paper ? "paper" : "torque-scaled"},
           {"speed_gate_mps", o.solver.speed_gate_mps},
           {"min_split_distance_m", o.solver.min_split_distance_m},
-          {"torso_length", o.torso_length == kin2grf::TorsoLength::Fixed ? "fixed" : "measured"},
+          {"torso_length", torso_length_name(o.torso_length)},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"post_cutoff_hz", o.post_cutoff_hz},
           {"anthropometry", o.anthropometry},

@@ -115,7 +115,7 @@ Eigen::MatrixXd ContactSolver::contact_columns(const Eigen::VectorXd& qdd, const
 FrameSolution ContactSolver::solve_reduced(const Eigen::MatrixXd& BpX, const Eigen::MatrixXd& UtX, const FrameContacts& fc) {
   const int np = static_cast<int>(fc.points.size());
   const int k = 2 * np;
-  const Eigen::VectorXd wB = weight_bilateral_;
+  const Eigen::VectorXd& wB = weight_bilateral_;
 
   FrameSolution sol;
   sol.contact_lambda = Eigen::VectorXd::Zero(k);

@@ -116,13 +116,12 @@ ModelMotion reconstruct_motion(const Model& model, const Eigen::MatrixXd& x, con
                      Eigen::Vector2d& aa) {
       const Eigen::Vector2d e = rot(th[s]) * local;
       const Eigen::Vector2d ed = w[s] * perp(e), edd = al[s] * perp(e) - w[s] * w[s] * e;
-      if (s != kTorso || x.cols() <= 11) {
-        rr = r[b.proximal] + e, vv = v[b.proximal] + ed, aa = a[b.proximal] + edd;
-        return;
-      }
-      rr = r[b.proximal] + ks * e;
-      vv = v[b.proximal] + ksd * e + ks * ed;
-      aa = a[b.proximal] + ksdd * e + 2 * ksd * ed + ks * edd;
+      // Other bodies: k = 1, k' = k'' = 0 (exactly the fixed-length forward kinematics).
+      const bool scaled = s == kTorso;
+      const double k0 = scaled ? ks : 1.0, k1 = scaled ? ksd : 0.0, k2 = scaled ? ksdd : 0.0;
+      rr = r[b.proximal] + k0 * e;
+      vv = v[b.proximal] + k1 * e + k0 * ed;
+      aa = a[b.proximal] + k2 * e + 2 * k1 * ed + k0 * edd;
     };
     for (int s : order) {
       const Body& b = model.bodies[s];
