@@ -359,3 +359,40 @@ TEST(C3dShared, UnloadedOffsetRemovalZeroesTheIdlePlates) {
   const double d = zeroed.plates->plates[0].force_N.col(2).maxCoeff() - raw.plates->plates[0].force_N.col(2).maxCoeff();
   EXPECT_NEAR(d, 14.0, 3.0);
 }
+
+TEST(C3dQuirks, PointsAtTheOriginAreMissingWhateverTheResidual) {
+  // Several exporters write a gap as (0, 0, 0) with a residual of 0 or 65535 instead of -1.
+  Trial t = small_trial();
+  t.markers.positions_m[0].row(7).setZero();
+  for (const bool float_data : {true, false}) {
+    C3dWriteOptions o;
+    o.float_data = float_data;
+    o.analog_samples_per_frame = 4;
+    const Trial back = read_c3d_bytes(write_c3d_bytes(t, o), "zeros.c3d");
+    EXPECT_TRUE(back.markers.positions_m[0].row(7).array().isNaN().all()) << float_data;
+    EXPECT_TRUE(back.markers.positions_m[0].row(8).allFinite()) << float_data;
+  }
+}
+
+TEST(C3dQuirks, ForcePlatformGroupWithoutAnalogDataGivesNoPlatesAndANote) {
+  // RBDS001static.c3d: the lab's FORCE_PLATFORM description is kept in a marker-only file.
+  Trial t = small_trial();
+  t.plates.reset();
+  t.events.clear();  // EVENT:USED would come after FORCE_PLATFORM:USED
+  auto bytes = write_c3d_bytes(t, {});
+  // The writer puts FORCE_PLATFORM last: patch its USED (int16 after name, offset, type, ndims).
+  const std::string key = "USED";
+  std::size_t at = std::string::npos;
+  for (std::size_t i = 1; i + key.size() + 6 < bytes.size(); ++i)
+    if (bytes[i - 1] == 4 && std::equal(key.begin(), key.end(), bytes.begin() + static_cast<long>(i) + 1)) at = i;
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t data = at + 1 + key.size() + 2 + 1 + 1;
+  ASSERT_EQ(bytes[data], 0);
+  bytes[data] = 2;
+  ASSERT_EQ(read_c3d_header(bytes, "fp.c3d").find("FORCE_PLATFORM:USED")->numbers.at(0), 2.0);
+  const Trial back = read_c3d_bytes(bytes, "fp.c3d");
+  EXPECT_FALSE(back.plates.has_value() && !back.plates->plates.empty());
+  EXPECT_EQ(back.markers.names.size(), 3u);
+  ASSERT_FALSE(back.warnings.empty());
+  EXPECT_NE(back.warnings.back().find("FORCE_PLATFORM:USED = 2"), std::string::npos) << back.warnings.back();
+}

@@ -423,7 +423,9 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
         z = static_cast<std::int16_t>(b.u16_unchecked(o + 4)) * scale;
         res = static_cast<std::int16_t>(b.u16_unchecked(o + 6));
       }
-      if (res < 0 || !finite_all({x, y, z})) {
+      // Missing: a negative residual (the specification), and a point at exactly (0, 0, 0),
+      // which several exporters write for a gap whatever the residual (65535 included).
+      if (res < 0 || !finite_all({x, y, z}) || (x == 0 && y == 0 && z == 0)) {
         P.row(i).setConstant(kNaN);
       } else {
         P(i, 0) = x * to_m; P(i, 1) = y * to_m; P(i, 2) = z * to_m;
@@ -479,11 +481,13 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
 
   // ---- Force plates -----------------------------------------------------------------------
   const int nplates = count_value(number(f, "FORCE_PLATFORM:USED", 0));
-  if (nplates > 0) {
-    if (nchannels == 0) {
-      throw InputError(path + ": FORCE_PLATFORM:USED = " + std::to_string(nplates) +
-                       " but there are no analog channels (ANALOG:USED = 0)");
-    }
+  if (nplates > 0 && analog.values.size() == 0) {
+    // A static or marker-only export often keeps the lab's FORCE_PLATFORM description with no
+    // analog data (e.g. RBDS001static.c3d). The markers are still good: no plates, and a note.
+    t.warnings.push_back(path + ": FORCE_PLATFORM:USED = " + std::to_string(nplates) +
+                         " but the file holds no analog data (ANALOG:USED = " +
+                         std::to_string(nchannels) + "); the force plates are not read");
+  } else if (nplates > 0) {
     std::vector<PlateDescription> descs_fp;
     const auto* types = f.find("FORCE_PLATFORM:TYPE");
     const auto* corners = f.find("FORCE_PLATFORM:CORNERS");

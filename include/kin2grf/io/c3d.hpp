@@ -5,7 +5,7 @@
 //  - processor types Intel (84), DEC/VAX (85, VAX F-floats, little-endian integers) and
 //    SGI/MIPS (86, big-endian IEEE);
 //  - float and scaled-integer point data (POINT:SCALE < 0 means float), residual word
-//    (negative = invalid -> NaN), POINT:UNITS mm/cm/m, LABELS + LABELS2.., DESCRIPTIONS,
+//    (negative = invalid -> NaN; a point at exactly (0,0,0) is missing too), POINT:UNITS mm/cm/m, LABELS + LABELS2.., DESCRIPTIONS,
 //    a first frame other than 1, frame counts above 65535 (TRIAL:ACTUAL_START/END_FIELD);
 //  - analog data signed or unsigned (ANALOG:FORMAT), OFFSET, SCALE, GEN_SCALE, integer or float;
 //  - FORCE_PLATFORM types 1, 2, 3 (Kistler 8 channels) and 4 (CAL_MATRIX), CORNERS, ORIGIN,
