@@ -396,3 +396,65 @@ TEST(C3dQuirks, ForcePlatformGroupWithoutAnalogDataGivesNoPlatesAndANote) {
   ASSERT_FALSE(back.warnings.empty());
   EXPECT_NE(back.warnings.back().find("FORCE_PLATFORM:USED = 2"), std::string::npos) << back.warnings.back();
 }
+
+namespace {
+/// small_trial() in a Y-up lab: (x, y, z) -> (x, z, -y), plates included.
+Trial small_trial_y_up() {
+  Trial t = small_trial();
+  Eigen::Matrix3d R;
+  R << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+  for (auto& P : t.markers.positions_m) P = (P * R.transpose()).eval();
+  for (auto& p : t.plates->plates) {
+    for (auto& c : p.corners_m) c = R * c;
+    p.centre_m = R * p.centre_m;
+    Eigen::Matrix<double, 3, 4> C;
+    for (int c = 0; c < 4; ++c) C.col(c) = p.corners_m[static_cast<std::size_t>(c)];
+    p.lab_R_plate = plate_axes(C);
+    p.force_N = (p.force_N * R.transpose()).eval();
+    p.cop_m = (p.cop_m * R.transpose()).eval();
+    p.free_moment_Nm = (p.free_moment_Nm * R.transpose()).eval();
+  }
+  return t;
+}
+}  // namespace
+
+TEST(C3dQuirks, YUpLabIsFoundFromThePlatesAndItsOffsetsFromThePlateNormal) {
+  // RBDS001runT35.c3d: a Y-up C3D. Before, the unloaded-offset search looked at the lab Z force
+  // (lateral there), found the plate "unloaded" throughout and subtracted half the load.
+  C3dWriteOptions o;
+  o.analog_samples_per_frame = 4;
+  const auto bytes = write_c3d_bytes(small_trial_y_up(), o);
+  const std::string path = ::testing::TempDir() + "/yup.c3d";
+  { std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<long>(bytes.size())); }
+  LoadOptions lo;
+  lo.c3d.zero_offset = ZeroOffset::Unloaded;
+  const Trial t = load_trial(path, lo);
+  EXPECT_EQ(t.markers.up_axis, Axis::Y);
+  EXPECT_EQ(t.plates->up_axis, Axis::Y);
+  EXPECT_NEAR(t.plates->plates[0].force_N.col(1).maxCoeff(), 700.0, 1.0);
+  bool warned = false;
+  for (const auto& w : t.warnings) warned = warned || w.find("up axis") != std::string::npos;
+  EXPECT_TRUE(warned);
+  std::remove(path.c_str());
+}
+
+TEST(UpAxis, MarkersTellTheVerticalWhereTheFileDoesNot) {
+  // A standing body: 1.0-1.7 m tall, 0.4 m wide, 0.3 m deep; the file claims Y up.
+  Trial t;
+  t.markers.rate_hz = 100;
+  t.markers.time_s = Eigen::VectorXd::LinSpaced(50, 0, 0.49);
+  t.markers.up_axis = Axis::Y;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int k = 0; k < 12; ++k) {
+    const Eigen::RowVector3d p(0.3 * u(rng), 0.4 * u(rng) - 0.2, 0.05 + 1.5 * k / 11.0);
+    t.markers.names.emplace_back(1, static_cast<char>('A' + k));
+    t.markers.positions_m.push_back(p.replicate(50, 1));
+  }
+  std::string why;
+  ASSERT_EQ(up_axis_from_data(t, &why), Axis::Z);
+  EXPECT_NE(why.find("spread"), std::string::npos);
+  // Too few markers or a cloud with no dominant axis: no verdict, the file's axis stays.
+  for (auto& P : t.markers.positions_m) P.col(0) *= 6.0;
+  EXPECT_FALSE(up_axis_from_data(t).has_value());
+}

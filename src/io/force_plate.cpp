@@ -115,7 +115,6 @@ ForcePlateRecording compute_plates(const AnalogData& analog,
   const Eigen::Index n = analog.values.rows();
   rec.time_s.resize(n);
   for (Eigen::Index i = 0; i < n; ++i) rec.time_s[i] = analog.first_time_s + static_cast<double>(i) / analog.rate_hz;
-  const int up = static_cast<int>(proc.up_axis);
   for (const auto& d : plates) {
     ForcePlate fp;
     fp.name = d.name;
@@ -161,10 +160,12 @@ ForcePlateRecording compute_plates(const AnalogData& analog,
           warnings.push_back(d.name + ": FORCE_PLATFORM:ZERO gives no valid frame range; offsets not removed");
         }
       } else {
-        const Eigen::MatrixX3d Flab = L.F * fp.lab_R_plate.transpose();
+        // Unloaded: the force normal to the plate (its own z axis) is small. The plate's axis,
+        // not the lab's up axis: a Y-up lab (RBDS001runT35.c3d) would otherwise take the lateral
+        // force for the load and subtract half the body weight as an "offset".
         std::vector<Eigen::Index> idx;
         for (Eigen::Index i = 0; i < n; ++i)
-          if (std::abs(Flab(i, up)) < proc.unloaded_threshold_N) idx.push_back(i);
+          if (std::abs(L.F(i, 2)) < proc.unloaded_threshold_N) idx.push_back(i);
         if (idx.size() >= 10) {
           for (Eigen::Index c = 0; c < ch.cols(); ++c) {
             std::vector<double> v;
@@ -191,7 +192,7 @@ ForcePlateRecording compute_plates(const AnalogData& analog,
     for (Eigen::Index i = 0; i < n; ++i) {
       const Eigen::Vector3d F = L.F.row(i).transpose();
       const Eigen::Vector3d Mc = L.Mc.row(i).transpose();
-      if (!(std::abs(fp.force_N(i, up)) >= proc.cop_threshold_N) || std::abs(F.z()) < 1e-12) {
+      if (!(std::abs(F.z()) >= proc.cop_threshold_N)) {
         fp.cop_m.row(i).setConstant(kNaN);
         fp.free_moment_Nm.row(i).setConstant(kNaN);
         continue;

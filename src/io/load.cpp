@@ -1,12 +1,84 @@
 #include "kin2grf/io/load.hpp"
 
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <limits>
+
 #include "kin2grf/error.hpp"
+#include "kin2grf/numeric.hpp"
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/text.hpp"
 
 namespace kin2grf {
 
-Trial load_trial(const std::string& path, const LoadOptions& options) {
+std::optional<Axis> up_axis_from_data(const Trial& t, std::string* why) {
+  if (t.plates) {
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    for (const auto& p : t.plates->plates)
+      if (p.has_geometry) normal += p.lab_R_plate.col(2).cwiseAbs();
+    Eigen::Index a = 0;
+    if (normal.maxCoeff(&a) > 0) {
+      if (why) *why = "the force plates' normal";
+      return static_cast<Axis>(a);
+    }
+  }
+  const auto& m = t.markers;
+  const Eigen::Index n = m.frames();
+  if (m.positions_m.size() < 4 || n == 0) return std::nullopt;
+  std::array<std::vector<double>, 3> spread;
+  std::array<long, 3> positive{0, 0, 0}, valid{0, 0, 0};
+  const Eigen::Index step = std::max<Eigen::Index>(1, n / 200);  // 200 frames are plenty
+  std::array<std::vector<double>, 3> c;
+  for (Eigen::Index i = 0; i < n; i += step) {
+    for (auto& v : c) v.clear();
+    for (const auto& P : m.positions_m) {
+      if (!P.row(i).allFinite()) continue;
+      for (int a = 0; a < 3; ++a) c[a].push_back(P(i, a)), positive[a] += P(i, a) > 0, ++valid[a];
+    }
+    if (c[0].size() < 4) continue;
+    // 10th-90th percentile, so that a stray or unlabelled point far from the body does not count.
+    for (int a = 0; a < 3; ++a) {
+      std::sort(c[a].begin(), c[a].end());
+      const std::size_t k = c[a].size() - 1;
+      spread[a].push_back(c[a][static_cast<std::size_t>(0.9 * static_cast<double>(k) + 0.5)] -
+                          c[a][static_cast<std::size_t>(0.1 * static_cast<double>(k) + 0.5)]);
+    }
+  }
+  if (spread[0].size() < 3) return std::nullopt;
+  std::array<double, 3> med{};
+  for (int a = 0; a < 3; ++a) med[a] = median(spread[a]);
+  const int best = static_cast<int>(std::max_element(med.begin(), med.end()) - med.begin());
+  double next = 0;
+  for (int a = 0; a < 3; ++a)
+    if (a != best) next = std::max(next, med[a]);
+  if (med[best] < 1.3 * next || med[best] > 2.5 || 5 * positive[best] < 4 * valid[best]) return std::nullopt;
+  if (why) {
+    char b[160];
+    std::snprintf(b, sizeof b, "the markers' spread (median %.2f m along %s against %.2f m across)", med[best],
+                  to_string(static_cast<Axis>(best)), next);
+    *why = b;
+  }
+  return static_cast<Axis>(best);
+}
+
+namespace {
+
+/// Use the data's up axis where the file's convention disagrees, and say so.
+void check_up_axis(Trial& t) {
+  std::string why;
+  const auto a = up_axis_from_data(t, &why);
+  if (!a) return;
+  const bool has_markers = !t.markers.names.empty();
+  const Axis file_axis = has_markers ? t.markers.up_axis : t.plates ? t.plates->up_axis : *a;
+  if (*a != file_axis)
+    t.warnings.push_back(std::string("up axis: the file's convention is ") + to_string(file_axis) + " but " + why +
+                         " say " + to_string(*a) + "; " + to_string(*a) + " is used (override with --up-axis)");
+  if (has_markers) t.markers.up_axis = *a;
+  if (t.plates) t.plates->up_axis = *a;
+}
+
+Trial load_by_extension(const std::string& path, const LoadOptions& options) {
   const std::string ext = extension(path);
   if (ext == "c3d") {
     C3dReadOptions o = options.c3d;
@@ -32,6 +104,14 @@ Trial load_trial(const std::string& path, const LoadOptions& options) {
     return t;
   }
   throw InputError(path + ": unknown file type '." + ext + "' (kin2grf reads .c3d, .trc, .mot, .sto)");
+}
+
+}  // namespace
+
+Trial load_trial(const std::string& path, const LoadOptions& options) {
+  Trial t = load_by_extension(path, options);
+  check_up_axis(t);
+  return t;
 }
 
 }  // namespace kin2grf

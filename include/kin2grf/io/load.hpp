@@ -1,6 +1,7 @@
 // kin2grf I/O: open any supported recording by its extension (.c3d, .trc, .mot, .sto).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "kin2grf/io/c3d.hpp"
@@ -13,6 +14,17 @@ struct LoadOptions {
   double cop_threshold_N = 10.0;  ///< also used for GRF .mot files
 };
 
+/// Open a recording. The lab's up axis is then checked against the data (check_up_axis): where
+/// the file's convention (C3D: Z, TRC: Y) disagrees, the data's axis is used, with a warning.
 Trial load_trial(const std::string& path, const LoadOptions& options = {});
+
+/// The lab up axis the data show, or nothing when they do not tell:
+///  - force plates with geometry: the axis along the plates' normal (a plate lies on the floor);
+///  - else markers: the axis of the largest spread across the markers of a frame (median over
+///    frames), when it exceeds the next by 30 % and the markers stand mostly on its positive side
+///    (a body is taller than it is wide or deep; a stride is shorter than the pelvis-foot height
+///    only by a little, hence the median, not the maximum).
+/// `why` says which evidence decided.
+std::optional<Axis> up_axis_from_data(const Trial& t, std::string* why = nullptr);
 
 }  // namespace kin2grf
