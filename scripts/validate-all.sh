@@ -13,10 +13,10 @@ BIN=build/release/kin2grf
 OUT=out/validation
 rm -rf "$OUT" && mkdir -p "$OUT"
 
-# scripts/trials.txt: activity|name|TRIAL [options], DATA standing for the data folder.
+# scripts/trials.txt: activity|lab|name|TRIAL [options], DATA standing for the data folder.
 mapfile -t TRIALS < <(grep -v '^#' scripts/trials.txt | grep . | sed "s#DATA#$DATA#g")
 for row in "${TRIALS[@]}"; do
-  IFS='|' read -r activity name args <<<"$row"
+  IFS='|' read -r activity lab name args <<<"$row"
   for config in defaults paper; do
     extra=""
     [ "$config" = paper ] && extra="--paper"
@@ -25,7 +25,7 @@ for row in "${TRIALS[@]}"; do
       echo "validate-all: $name ($config) failed:" >&2; cat "$OUT/$name.$config.log" >&2; exit 1
     fi
   done
-  echo "$activity|$name|$args" >>"$OUT/trials.txt"
+  echo "$activity|$lab|$name|$args" >>"$OUT/trials.txt"
   echo "validated $name"
 done
 /usr/bin/python3 scripts/validation_table.py "$OUT" "$DATA" "$(git rev-parse --short HEAD)$(git diff --quiet HEAD -- src include data || echo '+local changes')" >docs/VALIDATION.md

@@ -9,7 +9,9 @@ import statistics
 import sys
 
 out, data, commit = sys.argv[1], sys.argv[2], sys.argv[3]
-rows = [line.rstrip("\n").split("|", 2) for line in open(os.path.join(out, "trials.txt"))]
+rows = [line.rstrip("\n").split("|", 3) for line in open(os.path.join(out, "trials.txt"))]
+lab_of = {r[2]: r[1] for r in rows}
+rows = [(a, name, args) for a, _, name, args in rows]
 
 
 def load(name, config):

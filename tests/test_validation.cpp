@@ -18,6 +18,7 @@
 #include "kin2grf/synth/example.hpp"
 #include "kin2grf/validation/cop_fit.hpp"
 #include "kin2grf/validation/metrics.hpp"
+#include "kin2grf/validation/study.hpp"
 #include "kin2grf/validation/validate.hpp"
 #include "test_support.hpp"
 
@@ -267,6 +268,10 @@ TEST(SharedValidate, TrialsStayWithinTheirMeasuredErrors) {
       {"opencap_dropjump_walk/DJ1_markers.trc", "opencap_dropjump_walk/DJ1_grf.mot", 75.7, nullptr, 14.9},
       {"btk_plugingait_walk/PiG_Motion-FlatFoot-Full.c3d", nullptr, 0, nullptr, 14.3},
       {"btk_plugingait_walk/PiG_Motion3_FF.c3d", nullptr, 0, nullptr, 11.0},
+      // Fukuchi 2017 (RBDS001): a Y-up C3D whose up axis comes from its plate, and its TRC/MOT export.
+      {"ufabc_rbds001_treadmill_run/RBDS001runT35.c3d", nullptr, 62, "ufabc_rbds001_treadmill_run/RBDS001static.c3d", 4.1},
+      {"ufabc_rbds001_treadmill_run/RBDS001runT25_markers.trc", "ufabc_rbds001_treadmill_run/RBDS001runT25_grf.mot", 62,
+       "ufabc_rbds001_treadmill_run/RBDS001static.c3d", 4.5},
   };
   LoadOptions lo;
   lo.c3d.zero_offset = ZeroOffset::Unloaded;
@@ -289,4 +294,41 @@ TEST(SharedValidate, TrialsStayWithinTheirMeasuredErrors) {
     EXPECT_LT(vertical, 1.25 * c.measured_vertical + 1.0) << c.trial;
     EXPECT_GT(vertical, 0.5) << c.trial << ": suspiciously exact";
   }
+}
+
+namespace {
+StudyTrialResult fake_trial(const char* name, const char* lab, double rrmse) {
+  StanceValidation st;
+  SeriesMetrics m;
+  m.rrmse_percent = rrmse;
+  st.metrics.vertical = st.metrics.anterior = st.metrics.cop = m;
+  return StudyTrialResult{name, "walking", lab, {st}, std::nan(""), false};
+}
+}  // namespace
+
+// Leave-one-lab-out: lab A fits setting "low", labs B and C fit "high". In-sample picks "high"
+// (two labs of three); with B or C held out, the other two labs tie and the first setting is kept,
+// so B and C are scored at "low" and A at "high": the held-out figure shows what a lab unlike the
+// others would meet, where the in-sample one hides it.
+TEST(Study, LeaveOneLabOutScoresEachLabAtTheOthersChoice) {
+  StudyResult s;
+  s.kind = "test";
+  s.rows = {{"low", 0, {}}, {"high", 1, {}}};
+  s.per_trial = {{fake_trial("a1", "A", 2), fake_trial("b1", "B", 10), fake_trial("c1", "C", 10)},
+                 {fake_trial("a1", "A", 8), fake_trial("b1", "B", 4), fake_trial("c1", "C", 4)}};
+  const CrossValidation cv = cross_validate(s);
+  EXPECT_EQ(cv.in_sample_choice, "high");
+  ASSERT_EQ(cv.lab_choice.size(), 3u);
+  EXPECT_EQ(cv.lab_choice[0].second, "high");  // without A
+  EXPECT_EQ(cv.lab_choice[1].second, "low");   // without B: A (2) + C (10) = 6 against A (8) + C (4) = 6: tie, first kept
+  EXPECT_EQ(cv.lab_choice[2].second, "low");
+  ASSERT_EQ(cv.cells.size(), 1u);
+  EXPECT_NEAR(cv.cells[0].in_sample.vertical, (8 + 4 + 4) / 3.0, 1e-12);
+  EXPECT_NEAR(cv.cells[0].held_out.vertical, (8 + 10 + 10) / 3.0, 1e-12);  // worse than in-sample, as it should be
+  EXPECT_EQ(cv.cells[0].worst_trial, "b1");
+  // One lab only: refused with a message that says how to name labs.
+  StudyResult one = s;
+  for (auto& row : one.per_trial)
+    for (auto& t : row) t.lab.assign(1, 'A');
+  EXPECT_THROW((void)cross_validate(one), InputError);
 }

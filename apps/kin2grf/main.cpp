@@ -234,9 +234,10 @@ int run_validate(const ValidateArgs& a) {
   return 0;
 }
 
-/// `study`: one line of a trial list is "activity|name|TRIAL [estimate options] [--plates FILE]".
+/// `study`: one line of a trial list is "activity|lab|name|TRIAL [estimate options] [--plates FILE]"
+/// (the older "activity|name|TRIAL" is read with each trial its own lab).
 struct StudyInput {
-  std::string activity, name;
+  std::string activity, lab, name;
   EstimateArgs args;
   std::string plates;
 };
@@ -250,17 +251,23 @@ std::vector<StudyInput> read_trial_list(const std::string& path) {
   while (std::getline(in, line)) {
     ++number;
     if (line.empty() || line[0] == '#') continue;
-    const auto a = line.find('|'), b = line.find('|', a == std::string::npos ? a : a + 1);
-    if (a == std::string::npos || b == std::string::npos)
-      throw kin2grf::InputError(path + ":" + std::to_string(number) + ": expected activity|name|TRIAL [options]");
+    std::vector<std::string> fields;
+    std::size_t start = 0;
+    for (std::size_t bar; fields.size() < 3 && (bar = line.find('|', start)) != std::string::npos; start = bar + 1)
+      fields.push_back(line.substr(start, bar - start));
+    if (fields.size() < 2)
+      throw kin2grf::InputError(path + ":" + std::to_string(number) + ": expected activity|lab|name|TRIAL [options]");
     StudyInput si;
-    si.activity = line.substr(0, a);
-    si.name = line.substr(a + 1, b - a - 1);
+    si.activity = fields[0];
+    si.lab = fields[1];  // the old 3-field form: the name is the lab
+    si.name = fields.back();
+    for (const auto& f : fields)
+      if (f.empty()) throw kin2grf::InputError(path + ":" + std::to_string(number) + ": an empty field in activity|lab|name");
     CLI::App parser{"trial"};
     add_estimate_options(&parser, si.args, false);
     parser.add_option("--plates", si.plates);
     try {
-      parser.parse(line.substr(b + 1), false);
+      parser.parse(line.substr(start), false);
     } catch (const CLI::ParseError& e) {
       throw kin2grf::InputError(path + ":" + std::to_string(number) + ": " + e.what());
     }
@@ -271,7 +278,7 @@ std::vector<StudyInput> read_trial_list(const std::string& path) {
 }
 
 struct StudyArgs {
-  std::string kind, trial_list, out_json, report;
+  std::string kind, trial_list, out_json, report, cross_validate;
   std::vector<std::string> trials;
   EstimateArgs est;
   std::string plates;
@@ -291,6 +298,7 @@ void load_study_trials(const std::vector<StudyInput>& inputs, LoadedTrials& L) {
     kin2grf::StudyTrial x;
     x.name = in.name;
     x.activity = in.activity;
+    x.lab = in.lab;
     x.trial = &L.trials.back();
     if (!in.args.static_trial.empty()) {
       L.statics.push_back(kin2grf::load_trial(in.args.static_trial));
@@ -319,6 +327,7 @@ int run_study(const StudyArgs& a) {
     StudyInput si;
     si.activity = "trials";
     si.name = std::filesystem::path(t).filename().string();
+    si.lab = si.name;
     si.args = a.est;
     si.args.trial = t;
     si.plates = a.plates;
@@ -331,7 +340,12 @@ int run_study(const StudyArgs& a) {
   std::cerr << "kin2grf: study " << a.kind << " on " << st.size() << " trials\n";
   const auto res = kin2grf::run_study(a.kind, st);
   std::cout << kin2grf::format_study_table(res);
-  const auto j = kin2grf::study_json(res);
+  auto j = kin2grf::study_json(res);
+  if (!a.cross_validate.empty()) {
+    const auto cv = kin2grf::cross_validate(res);
+    std::cout << kin2grf::format_cross_validation(res, cv);
+    j["cross_validation"] = kin2grf::cross_validation_json(cv);
+  }
   if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, j.dump(2) + "\n");
   if (!a.report.empty()) kin2grf::write_file_text(a.report, kin2grf::study_report_html(res));
   return 0;
@@ -451,7 +465,10 @@ int main(int argc, char** argv) {
       ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "kinematic-cutoff", "speed-gate", "split-distance", "torso-length", "foot-model"}));
   study->add_option("TRIAL", study_args.trials, "Trials with plates (the options below apply to all of them)");
   study->add_option("--trial-list", study_args.trial_list,
-                    "File of lines 'activity|name|TRIAL [options]', each trial with its own options");
+                    "File of lines 'activity|lab|name|TRIAL [options]', each trial with its own options");
+  study->add_option("--cross-validate", study_args.cross_validate,
+                    "Also choose the setting leave-one-lab-out and print in-sample against held-out figures")
+      ->check(CLI::IsMember({"lab"}));
   study->add_option("--plates", study_args.plates, "Measured forces for the TRIAL arguments (GRF .mot)");
   study->add_option("--json", study_args.out_json, "Study results as JSON");
   study->add_option("--report", study_args.report, "HTML report with the rRMSE-against-setting plots");
@@ -466,7 +483,7 @@ int main(int argc, char** argv) {
 
   FitCopArgs fit_args;
   auto* fit_cop = app.add_subcommand("fit-cop", "Fit foot model 2's COP function to the plate COPs of trials with plates");
-  fit_cop->add_option("--trial-list", fit_args.trial_list, "File of lines 'activity|name|TRIAL [options]'")->required();
+  fit_cop->add_option("--trial-list", fit_args.trial_list, "File of lines 'activity|lab|name|TRIAL [options]'")->required();
   fit_cop->add_option("--activity", fit_args.activity, "Use the trials of this activity ('' = all)")->capture_default_str();
   fit_cop->add_option("--min-force", fit_args.min_force, "Frames where the plate carries at least this fraction of body weight")
       ->capture_default_str();

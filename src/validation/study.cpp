@@ -1,6 +1,7 @@
 #include "kin2grf/validation/study.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <functional>
 #include <limits>
@@ -63,6 +64,24 @@ std::vector<Setting> settings_for(const std::string& kind) {
   return s;
 }
 
+/// Pool the stances of one activity ("all": every trial) over the trials `use` accepts.
+StudyCell pool(const std::vector<StudyTrialResult>& trials, const std::string& activity,
+               const std::function<bool(const StudyTrialResult&)>& use) {
+  StudyCell c;
+  c.activity = activity;
+  std::vector<StanceValidation> stances;
+  double sum = 0;
+  for (const auto& t : trials) {
+    if ((activity != "all" && t.activity != activity) || !use(t) || t.failed) continue;
+    ++c.trials;
+    stances.insert(stances.end(), t.stances.begin(), t.stances.end());
+    if (std::isfinite(t.total_grm)) sum += t.total_grm, ++c.total_trials;
+  }
+  c.per_foot = mean_rrmse(stances);
+  c.total_grm = c.total_trials ? sum / c.total_trials : std::numeric_limits<double>::quiet_NaN();
+  return c;
+}
+
 }  // namespace
 
 StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& trials) {
@@ -76,39 +95,134 @@ StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& tr
     StudyRow row;
     row.label = s.label;
     row.value = s.value;
-    std::vector<std::vector<StanceValidation>> stances(activities.size());
-    std::vector<std::vector<double>> totals(activities.size());
-    std::vector<int> ntrials(activities.size(), 0);
+    std::vector<StudyTrialResult> per_trial;
     for (const auto& t : trials) {
+      StudyTrialResult tr{t.name, t.activity, t.lab.empty() ? t.name : t.lab, {}, std::numeric_limits<double>::quiet_NaN(), false};
       EstimateOptions o = t.options;
       s.apply(o);
       try {
         const EstimateResult e = estimate(*t.trial, t.static_trial, *t.marker_set, o);
         const ValidationResult v = validate(e, *t.plates);
-        for (std::size_t a = 0; a < activities.size(); ++a) {
-          if (activities[a] != t.activity && activities[a] != "all") continue;
-          ++ntrials[a];
-          stances[a].insert(stances[a].end(), v.stances.begin(), v.stances.end());
-          if (v.total && v.total->metrics.moment) totals[a].push_back(v.total->metrics.moment->rrmse_percent);
-        }
+        tr.stances = v.stances;
+        if (v.total && v.total->metrics.moment) tr.total_grm = v.total->metrics.moment->rrmse_percent;
       } catch (const InputError& err) {
+        tr.failed = true;
         res.failures.push_back(t.name + " at " + s.label + ": " + err.what());
       }
+      per_trial.push_back(std::move(tr));
     }
-    for (std::size_t a = 0; a < activities.size(); ++a) {
-      StudyCell c;
-      c.activity = activities[a];
-      c.trials = ntrials[a];
-      c.per_foot = mean_rrmse(stances[a]);
-      c.total_trials = static_cast<int>(totals[a].size());
-      double sum = 0;
-      for (double x : totals[a]) sum += x;
-      c.total_grm = totals[a].empty() ? std::numeric_limits<double>::quiet_NaN() : sum / static_cast<double>(totals[a].size());
-      row.cells.push_back(c);
-    }
+    for (const auto& a : activities) row.cells.push_back(pool(per_trial, a, [](const StudyTrialResult&) { return true; }));
     res.rows.push_back(std::move(row));
+    res.per_trial.push_back(std::move(per_trial));
   }
   return res;
+}
+
+CrossValidation cross_validate(const StudyResult& s) {
+  if (s.per_trial.empty() || s.per_trial.front().empty()) throw InputError("cross-validation: the study has no trials");
+  const auto& first = s.per_trial.front();
+  std::vector<std::string> labs, activities;
+  for (const auto& t : first) {
+    if (std::find(labs.begin(), labs.end(), t.lab) == labs.end()) labs.push_back(t.lab);
+    if (std::find(activities.begin(), activities.end(), t.activity) == activities.end()) activities.push_back(t.activity);
+  }
+  if (labs.size() < 2) throw InputError("cross-validation: the trials come from one lab; give each trial its lab (trial list: activity|lab|name|TRIAL)");
+  if (activities.size() > 1) activities.push_back("all");
+  // The setting with the lowest criterion over the trials `use` accepts.
+  auto choose = [&](const std::function<bool(const StudyTrialResult&)>& use) {
+    std::size_t best = 0;
+    double best_score = std::numeric_limits<double>::infinity();
+    for (std::size_t r = 0; r < s.per_trial.size(); ++r) {
+      // Each lab weighs the same, whatever its number of stances (a 30 s treadmill run has 80).
+      double score = 0;
+      int nlabs = 0;
+      bool failed = false;
+      for (const auto& lab : labs) {
+        std::vector<StanceValidation> st;
+        for (const auto& t : s.per_trial[r])
+          if (t.lab == lab && use(t)) {
+            failed = failed || t.failed;
+            st.insert(st.end(), t.stances.begin(), t.stances.end());
+          }
+        if (st.empty()) continue;
+        const MeanMetrics m = mean_rrmse(st);
+        score += (m.vertical + m.anterior + m.cop) / 3.0, ++nlabs;
+      }
+      if (failed || nlabs == 0) continue;  // a setting that breaks a trial is never chosen
+      score /= nlabs;
+      if (score < best_score - 1e-9) best_score = score, best = r;
+    }
+    return best;
+  };
+  CrossValidation cv;
+  const std::size_t all = choose([](const StudyTrialResult&) { return true; });
+  cv.in_sample_choice = s.rows[all].label;
+  // Each trial's held-out result: its lab's choice made on the other labs.
+  std::vector<StudyTrialResult> held;
+  for (const auto& lab : labs) {
+    const std::size_t r = choose([&](const StudyTrialResult& t) { return t.lab != lab; });
+    cv.lab_choice.emplace_back(lab, s.rows[r].label);
+    for (const auto& t : s.per_trial[r])
+      if (t.lab == lab) held.push_back(t);
+  }
+  for (const auto& a : activities) {
+    CrossValidation::Cell c;
+    c.activity = a;
+    const StudyCell in = pool(s.per_trial[all], a, [](const StudyTrialResult&) { return true; });
+    const StudyCell out = pool(held, a, [](const StudyTrialResult&) { return true; });
+    c.in_sample = in.per_foot, c.in_sample_total_grm = in.total_grm;
+    c.held_out = out.per_foot, c.held_out_total_grm = out.total_grm;
+    c.worst_vertical = -1;
+    for (const auto& t : held) {
+      if (a != "all" && t.activity != a) continue;
+      if (t.stances.empty()) continue;
+      const double v = mean_rrmse(t.stances).vertical;
+      if (v > c.worst_vertical) c.worst_vertical = v, c.worst_trial = t.name;
+    }
+    cv.cells.push_back(c);
+  }
+  return cv;
+}
+
+std::string format_cross_validation(const StudyResult& s, const CrossValidation& cv) {
+  std::ostringstream os;
+  char b[256];
+  os << "\nleave-one-lab-out (" << s.kind << "): chosen on all trials: " << cv.in_sample_choice << "\n";
+  for (const auto& [lab, choice] : cv.lab_choice) os << "  without " << lab << ": " << choice << "\n";
+  std::snprintf(b, sizeof b, "%-14s %-10s %9s %9s %9s %10s   %s\n", "activity", "", "vertical", "anterior", "COP", "total GRM",
+                "worst trial (vertical)");
+  os << b;
+  auto tot = [](double x) {
+    char t[32];
+    std::snprintf(t, sizeof t, std::isfinite(x) ? "%.1f" : "-", x);
+    return std::string(t);
+  };
+  for (const auto& c : cv.cells) {
+    std::snprintf(b, sizeof b, "%-14s %-10s %9.1f %9.1f %9.1f %10s\n", c.activity.c_str(), "in-sample", c.in_sample.vertical,
+                  c.in_sample.anterior, c.in_sample.cop, tot(c.in_sample_total_grm).c_str());
+    os << b;
+    std::snprintf(b, sizeof b, "%-14s %-10s %9.1f %9.1f %9.1f %10s   %s %.1f\n", "", "held-out", c.held_out.vertical,
+                  c.held_out.anterior, c.held_out.cop, tot(c.held_out_total_grm).c_str(), c.worst_trial.c_str(), c.worst_vertical);
+    os << b;
+  }
+  return os.str();
+}
+
+nlohmann::json cross_validation_json(const CrossValidation& cv) {
+  auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  auto metrics = [&](const MeanMetrics& m, double grm) {
+    return nlohmann::json{{"stances", m.n}, {"vertical", num(m.vertical)}, {"anterior", num(m.anterior)},
+                          {"cop", num(m.cop)}, {"total_grm", num(grm)}};
+  };
+  nlohmann::json j;
+  j["criterion"] = "mean over labs of the lab's mean per-stance (vertical + anterior + COP) / 3 rRMSE, all activities pooled";
+  j["in_sample_choice"] = cv.in_sample_choice;
+  for (const auto& [lab, choice] : cv.lab_choice) j["choice_without_lab"][lab] = choice;
+  for (const auto& c : cv.cells)
+    j["activities"][c.activity] = {{"in_sample", metrics(c.in_sample, c.in_sample_total_grm)},
+                                   {"held_out", metrics(c.held_out, c.held_out_total_grm)},
+                                   {"worst_trial", {{"name", c.worst_trial}, {"vertical", num(c.worst_vertical)}}}};
+  return j;
 }
 
 nlohmann::json study_json(const StudyResult& s) {

@@ -13,6 +13,7 @@
 //   foot-model    model 1 (three points) against model 2 (moving COP) (paper: Fig. 6)
 #pragma once
 
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -27,6 +28,7 @@ namespace kin2grf {
 /// One trial of a study, loaded, with its own options (mass etc.).
 struct StudyTrial {
   std::string name, activity;
+  std::string lab;  ///< the recording's lab (or data source): the unit of leave-one-lab-out
   const Trial* trial = nullptr;
   const Trial* static_trial = nullptr;
   const ForcePlateRecording* plates = nullptr;
@@ -48,14 +50,48 @@ struct StudyRow {
   std::vector<StudyCell> cells;  ///< per activity, then "all"
 };
 
+/// One trial's result at one setting (mean per-stance rRMSE over the trial's plate stances).
+struct StudyTrialResult {
+  std::string name, activity, lab;
+  std::vector<StanceValidation> stances;
+  double total_grm = std::numeric_limits<double>::quiet_NaN();
+  bool failed = false;
+};
+
+/// Leave-one-lab-out choice of the setting (cross_validate()). The criterion a setting is chosen
+/// by: per lab, the mean over its stances of (vertical + anterior + COP) / 3 rRMSE; then the mean
+/// over the labs, so that each lab weighs the same and all activities are pooled (one default
+/// serves every activity, as kin2grf's defaults do). Ties keep the first (lowest) setting.
+struct CrossValidation {
+  std::string in_sample_choice;                   ///< the setting chosen on every trial
+  std::vector<std::pair<std::string, std::string>> lab_choice;  ///< held lab -> setting chosen without it
+  /// Per activity, then "all": in-sample (every trial at the in-sample choice) and held-out (each
+  /// lab's trials at the choice made without that lab), and the worst trial's vertical rRMSE.
+  struct Cell {
+    std::string activity;
+    MeanMetrics in_sample, held_out;
+    double in_sample_total_grm = 0, held_out_total_grm = 0;
+    std::string worst_trial;  ///< held-out: the trial with the highest mean vertical rRMSE
+    double worst_vertical = 0;
+  };
+  std::vector<Cell> cells;
+};
+
 struct StudyResult {
   std::string kind;
   std::vector<StudyRow> rows;
+  std::vector<std::vector<StudyTrialResult>> per_trial;  ///< [row][trial]
   std::vector<std::string> failures;  ///< trial + value + error, for runs that threw InputError
 };
 
 /// The kinds above; throws InputError for another.
 StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& trials);
+
+/// Leave-one-lab-out: for each lab, the setting with the lowest criterion on the other labs'
+/// trials, scored on that lab's. Needs trials from at least 2 labs (InputError otherwise).
+CrossValidation cross_validate(const StudyResult& s);
+std::string format_cross_validation(const StudyResult& s, const CrossValidation& cv);
+nlohmann::json cross_validation_json(const CrossValidation& cv);
 
 nlohmann::json study_json(const StudyResult& s);
 std::string format_study_table(const StudyResult& s);
