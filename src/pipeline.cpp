@@ -12,6 +12,17 @@
 
 namespace kin2grf {
 
+double progression_speed(const SagittalLandmarks& lm) {
+  const Eigen::Index n = lm.frames();
+  if (n < 3 || lm.rate_hz <= 0) return 0.0;
+  const Eigen::Index h = std::max<Eigen::Index>(1, std::min<Eigen::Index>(static_cast<Eigen::Index>(0.25 * lm.rate_hz), (n - 1) / 2));
+  std::vector<double> v;
+  v.reserve(static_cast<std::size_t>(n));
+  const auto& hip = lm.p[kHip];
+  for (Eigen::Index i = h; i + h < n; ++i) v.push_back(std::abs(hip(i + h, 0) - hip(i - h, 0)) * lm.rate_hz / static_cast<double>(2 * h));
+  return v.empty() ? 0.0 : median(v);
+}
+
 EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
@@ -54,8 +65,9 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   co.ground_level_m = r.ground_level_m;
   const auto contacts = prepare_contacts(r.model, co, motion);
   SolverOptions so = o.solver;
-  if (r.frame.treadmill && so.speed_gate_mps > 0) {
-    // Belt velocity: the median horizontal velocity of the lowest sole point over foot-flat-like frames.
+  if (r.frame.treadmill) {
+    // Belt velocity (always measured, whatever the gate): the median horizontal velocity of the
+    // lowest sole point over foot-flat-like frames.
     std::vector<double> v;
     for (const auto& fc : contacts)
       for (const auto& p : fc.points)
@@ -68,6 +80,16 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
                     so.belt_velocity_mps);
       r.messages.push_back(b);
     }
+  }
+  r.progression_speed_mps = r.frame.treadmill ? std::abs(so.belt_velocity_mps) : progression_speed(lm);
+  so.speed_gate_mps = speed_gate_for(so, r.progression_speed_mps);
+  so.speed_gate_ratio = 0.0;
+  r.speed_gate_mps = so.speed_gate_mps;
+  if (o.solver.speed_gate_ratio > 0) {
+    char b[160];
+    std::snprintf(b, sizeof b, "contact speed gate %.2f m/s (%.2f x the progression speed %.2f m/s, at least %.2f)", so.speed_gate_mps,
+                  o.solver.speed_gate_ratio, r.progression_speed_mps, o.solver.speed_gate_floor_mps);
+    r.messages.push_back(b);
   }
   r.frame.belt_velocity_mps = so.belt_velocity_mps;
   const auto t1 = clock::now();

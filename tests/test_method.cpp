@@ -184,7 +184,6 @@ TEST(SharedEstimate, WalkingTrialsFindTheirStancePhases) {
   const Trial t = load_trial(test::data_file("rajagopal2016_overground_walk/markers_walk.trc"));
   EstimateOptions eo;
   eo.mass_kg = 77.3;
-  eo.solver.speed_gate_mps = 2.0;
   eo.solver.norm = MultiplierNorm::TorqueScaled;
   const auto r = estimate(t, nullptr, *recognise_marker_set(t.markers), eo);
   // Plates: right stance 0.268-1.023 s, left 0.837-1.589 s. Mid-stance must be in contact,
@@ -211,6 +210,7 @@ TEST(Estimate, PrescribedSingleSupportRecoversTheExactContactForce) {
   const Trial t = make_synthetic_trial(so);
   EstimateOptions eo;
   eo.solver.speed_gate_mps = 0.0;
+  eo.solver.speed_gate_ratio = 0.0;
   const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
   // All the load on the right foot, none on the lifted left one.
   for (Eigen::Index i = 10; i < r.time_s.size() - 10; i += 7) {
@@ -394,4 +394,65 @@ TEST(Kinematics, MeasuredTorsoLengthIsFollowedAndDifferentiated) {
   EXPECT_LT(fixed_spread, 1e-12);       // the paper's rigid torso does not
   EXPECT_LT(worst_acc, 0.02 * acc_scale);  // the scaled kinematics are differentiated consistently
   EXPECT_GT(acc_scale, 0.5);
+}
+
+// A slow walker's swing foot (issue 9): 0.4 m/s, the swing foot's sole 8 mm above the floor and
+// moving at 1 m/s, slower than the old fixed 1.5 m/s gate. The kinematics carry a small moment the
+// stance foot alone cannot balance (a torso angular acceleration error, as real marker data do);
+// the least squares then hands the swing foot a share. With the gate relative to the progression
+// speed the swing foot must carry exactly nothing and the stance foot must stay in contact.
+TEST(Solver, SlowWalkSwingFootCarriesNothing) {
+  SyntheticOptions so;
+  so.left_leg_raised_rad = 0.6;
+  const Trial t = make_synthetic_trial(so);
+  EstimateOptions eo;
+  const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
+  ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
+  auto contacts = prepare_contacts(r.model, ContactModelOptions{}, mm);
+  const Eigen::Index i = 120;
+  FrameContacts fc = contacts[static_cast<std::size_t>(i)];
+  ASSERT_EQ(fc.points.size(), 2u);
+  fc.points[0].velocity.setZero();                 // the stance foot's D* is still
+  fc.points[1].gap_m = 0.008;                      // low swing clearance
+  fc.points[1].velocity = Eigen::Vector2d(1.0, 0);  // a slow walker's swing foot
+  const Eigen::VectorXd q = mm.q.row(i).transpose();
+  Eigen::VectorXd qdd = mm.qdd.row(i).transpose();
+  qdd[coord::theta(kTorso)] += 20.0;  // rad/s^2: about 30 N m that no single contact point balances
+
+  SolverOptions fixed;
+  fixed.speed_gate_ratio = 0.0;
+  fixed.speed_gate_mps = 1.5;
+  const FrameSolution before = ContactSolver(r.model, fixed).solve(q, qdd, fc);
+  ASSERT_TRUE(before.active[1]) << "the failure this test guards: the fixed gate lets the swing foot in";
+  ASSERT_GT(before.force_N[1].y(), 20.0);
+
+  SolverOptions rule;  // the defaults: 2 x the progression speed, at least 0.75 m/s
+  rule.speed_gate_mps = speed_gate_for(rule, 0.4);
+  rule.speed_gate_ratio = 0.0;
+  EXPECT_NEAR(rule.speed_gate_mps, 0.8, 1e-12);
+  const FrameSolution after = ContactSolver(r.model, rule).solve(q, qdd, fc);
+  EXPECT_FALSE(after.active[1]);
+  EXPECT_EQ(after.force_N[1].y(), 0.0);
+  EXPECT_EQ(after.force_N[1].x(), 0.0);
+  EXPECT_TRUE(after.active[0]);
+  EXPECT_GT(after.force_N[0].y(), 0.8 * 70 * 9.81);
+}
+
+TEST(Solver, SpeedGateScalesWithTheProgressionSpeed) {
+  SolverOptions o;  // defaults
+  EXPECT_NEAR(speed_gate_for(o, 0.0), 0.75, 1e-12);   // standing, squatting: the floor
+  EXPECT_NEAR(speed_gate_for(o, 1.3), 2.6, 1e-12);    // walking
+  EXPECT_NEAR(speed_gate_for(o, 9.0), 18.0, 1e-12);   // sprinting: the landing foot is not cut
+  EXPECT_NEAR(speed_gate_for(o, -3.5), 7.0, 1e-12);   // a treadmill belt's sign does not matter
+  o.speed_gate_ratio = 0;
+  o.speed_gate_mps = 1.5;
+  EXPECT_NEAR(speed_gate_for(o, 9.0), 1.5, 1e-12);    // a fixed gate stays fixed
+  // The hip's progression speed, through a step's oscillation (+-0.1 m/s at 2 Hz).
+  SagittalLandmarks lm;
+  lm.rate_hz = 100;
+  lm.time_s = Eigen::VectorXd::LinSpaced(400, 0, 3.99);
+  for (auto& p : lm.p) p = Eigen::MatrixX2d::Zero(400, 2);
+  for (Eigen::Index k = 0; k < 400; ++k)
+    lm.p[kHip](k, 0) = 0.4 * lm.time_s[k] + 0.1 / (4 * M_PI) * std::sin(4 * M_PI * lm.time_s[k]);
+  EXPECT_NEAR(progression_speed(lm), 0.4, 0.01);
 }

@@ -51,7 +51,8 @@ struct EstimateArgs {
   // Numerical defaults come from the library's option structs (one source for CLI and API).
   double mass = 0, r = kin2grf::SolverOptions{}.r_N_per_m, kin_cutoff = kin2grf::EstimateOptions{}.kinematic_cutoff_hz,
          post_cutoff = kin2grf::EstimateOptions{}.post_cutoff_hz, ground_shift = 0,
-         speed_gate = kin2grf::SolverOptions{}.speed_gate_mps, split_distance = kin2grf::SolverOptions{}.min_split_distance_m;
+         speed_gate = kin2grf::SolverOptions{}.speed_gate_mps, split_distance = kin2grf::SolverOptions{}.min_split_distance_m,
+         speed_gate_ratio = kin2grf::SolverOptions{}.speed_gate_ratio, speed_gate_floor = kin2grf::SolverOptions{}.speed_gate_floor_mps;
   bool paper = false, r_given = false, anthropometry_given = false;
   std::optional<double> ground_level;
   std::vector<double> grm_reference;
@@ -75,7 +76,15 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
                  "GRM reference point in the sagittal frame: along progression and up from the lab origin, m (default 0 0)")
       ->expected(2);
   c->add_option("--ground-shift", a.ground_shift, "Shift the ground by this much, m (robustness study)")->capture_default_str();
-  c->add_option("--speed-gate", a.speed_gate, "Contact allowed only below this sole speed, m/s (0 = off, the paper)")
+  c->add_option_function<double>(
+       "--speed-gate", [&a](double v) { a.speed_gate = v, a.speed_gate_ratio = 0; },
+       "A fixed speed gate: contact allowed only below this sole speed, m/s (0 = off, the paper); replaces --speed-gate-ratio")
+      ->check(CLI::Range(0.0, 20.0));
+  c->add_option("--speed-gate-ratio", a.speed_gate_ratio,
+                "The speed gate as this multiple of the progression speed (hip or belt), at least --speed-gate-floor; "
+                "0 = the fixed --speed-gate")
+      ->check(CLI::Range(0.0, 20.0))->capture_default_str();
+  c->add_option("--speed-gate-floor", a.speed_gate_floor, "Lowest speed gate with --speed-gate-ratio, m/s")
       ->check(CLI::Range(0.0, 20.0))->capture_default_str();
   c->add_option("--split-distance", a.split_distance,
                 "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)")
@@ -114,6 +123,8 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
   o.solver.r_N_per_m = (a.paper && !a.r_given) ? 1e4 : a.r;
   o.solver.norm = (a.paper || a.norm == "paper") ? kin2grf::MultiplierNorm::Paper : kin2grf::MultiplierNorm::TorqueScaled;
   o.solver.speed_gate_mps = a.paper ? 0.0 : a.speed_gate;
+  o.solver.speed_gate_ratio = a.paper ? 0.0 : a.speed_gate_ratio;
+  o.solver.speed_gate_floor_mps = a.speed_gate_floor;
   o.solver.min_split_distance_m = a.paper ? 0.0 : a.split_distance;
   o.torso_length = (a.paper || a.torso_length == "fixed") ? kin2grf::TorsoLength::Fixed : kin2grf::TorsoLength::Measured;
   o.landmarks.max_gap_frames = a.max_gap;
@@ -138,6 +149,8 @@ nlohmann::json settings_json(const EstimateArgs& a, const kin2grf::EstimateOptio
           {"r_N_per_m", o.solver.r_N_per_m},
           {"norm", o.solver.norm == kin2grf::MultiplierNorm::Paper ? "paper" : "torque-scaled"},
           {"speed_gate_mps", o.solver.speed_gate_mps},
+          {"speed_gate_ratio", o.solver.speed_gate_ratio},
+          {"speed_gate_floor_mps", o.solver.speed_gate_floor_mps},
           {"min_split_distance_m", o.solver.min_split_distance_m},
           {"torso_length", torso_length_name(o.torso_length)},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
@@ -462,7 +475,7 @@ int main(int argc, char** argv) {
   auto* study = app.add_subcommand("study", "The paper's parameter studies on trials with plates: r, ground-shift, cutoff, "
                                             "kinematic-cutoff, speed-gate, split-distance, torso-length, foot-model");
   study->add_option("KIND", study_args.kind, "r | ground-shift | cutoff | kinematic-cutoff | speed-gate | split-distance | torso-length | foot-model")
-      ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "kinematic-cutoff", "speed-gate", "split-distance", "torso-length", "foot-model"}));
+      ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "kinematic-cutoff", "speed-gate", "speed-gate-ratio", "split-distance", "torso-length", "foot-model"}));
   study->add_option("TRIAL", study_args.trials, "Trials with plates (the options below apply to all of them)");
   study->add_option("--trial-list", study_args.trial_list,
                     "File of lines 'activity|lab|name|TRIAL [options]', each trial with its own options");

@@ -51,6 +51,11 @@ struct EstimateResult {
   double mass_kg = 0.0;
   double ground_level_m = 0.0;
   SagittalFrame frame;
+  /// The subject's progression speed (m/s): overground the median over the window of the hip's
+  /// horizontal speed over +-0.25 s (a step's average, not its oscillation); on a treadmill the
+  /// belt's speed.
+  double progression_speed_mps = 0.0;
+  double speed_gate_mps = 0.0;     ///< the contact speed gate used (0: none)
   Model model;
   Eigen::VectorXd time_s;
   Eigen::Index first_index = 0;    ///< first processed frame's index in the trial
@@ -70,6 +75,9 @@ struct EstimateResult {
   std::vector<std::string> messages;
   double seconds_kinematics = 0, seconds_dynamics = 0;
 };
+
+/// The hip's horizontal speed (m/s), median over the window of its displacement over +-0.25 s.
+double progression_speed(const SagittalLandmarks& lm);
 
 EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set,
                         const EstimateOptions& options);

@@ -45,8 +45,15 @@ std::vector<Setting> settings_for(const std::string& kind) {
   } else if (kind == "speed-gate") {
     for (double v : {0.0, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0}) {
       std::snprintf(b, sizeof b, v > 0 ? "%.2f m/s" : "off", v);
-      s.push_back({b, v, [v](EstimateOptions& o) { o.solver.speed_gate_mps = v; }});
+      s.push_back({b, v, [v](EstimateOptions& o) { o.solver.speed_gate_ratio = 0, o.solver.speed_gate_mps = v; }});
     }
+  } else if (kind == "speed-gate-ratio") {
+    s.push_back({"fixed 1.50 m/s", 0, [](EstimateOptions& o) { o.solver.speed_gate_ratio = 0, o.solver.speed_gate_mps = 1.5; }});
+    for (double floor : {0.5, 0.75})
+      for (double k : {1.0, 1.5, 2.0, 3.0}) {
+        std::snprintf(b, sizeof b, "%.1f x speed, >= %.2f", k, floor);
+        s.push_back({b, k, [k, floor](EstimateOptions& o) { o.solver.speed_gate_ratio = k, o.solver.speed_gate_floor_mps = floor; }});
+      }
   } else if (kind == "split-distance") {
     for (double d : {0.0, 0.05, 0.1, 0.15, 0.2}) {
       std::snprintf(b, sizeof b, d > 0 ? "%.2f m" : "off", d);
@@ -59,7 +66,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
     s.push_back({"three-point (model 1)", 1, [](EstimateOptions& o) { o.contact.foot_model = FootModel::ThreePoint; }});
     s.push_back({"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }});
   } else {
-    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, speed-gate, split-distance, torso-length, foot-model)");
+    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, speed-gate, speed-gate-ratio, split-distance, torso-length, foot-model)");
   }
   return s;
 }
