@@ -71,6 +71,28 @@ print("| running | an independent implementation (METHOD.md) | 14 | 6.1 | 21.5 |
 print("| jump landing | an independent implementation (METHOD.md) | | 52 | 31 | 107 | | 79 | 20 |")
 print("\nMean (SD) over stances; total GRM: mean (SD) over the trials that have a total window.\n")
 
+cv_kinds = [k for k in ("speed-gate-ratio", "r", "split-distance", "torso-length")
+            if os.path.exists(os.path.join(out, f"cv-{k}.json"))]
+if cv_kinds:
+    print("## Leave-one-lab-out (the settings chosen from data)\n")
+    print("Each setting below was chosen from the development data. `kin2grf study KIND --cross-validate lab` "
+          "chooses it again for each lab on the other labs' trials (criterion: per lab, mean stance rRMSE of "
+          "vertical, anterior and COP; then the mean over labs) and scores that lab with it. In-sample: every "
+          "trial at the choice made on all trials. Labs are the trial list's second field "
+          f"({len(set(lab_of.values()))} labs). Worst trial: the held-out trial with the highest mean vertical rRMSE. "
+          "The COP function's fit (`fit-cop`) is not yet cross-validated by lab.\n")
+    print("| setting | chosen on all trials | activity | in-sample vertical / anterior / COP, GRM | "
+          "held-out vertical / anterior / COP, GRM | worst held-out trial (vertical) |")
+    print("|---|---|---|---|---|---|")
+    for k in cv_kinds:
+        with open(os.path.join(out, f"cv-{k}.json")) as f:
+            cv = json.load(f)["cross_validation"]
+        for act, c in cv["activities"].items():
+            fmt = lambda m: " / ".join(f1(m[x]) for x in ("vertical", "anterior", "cop")) + f", {f1(m['total_grm'])}"
+            print(f"| {k} | {cv['in_sample_choice']} | {act} | {fmt(c['in_sample'])} | {fmt(c['held_out'])} | "
+                  f"{c['worst_trial']['name']} {f1(c['worst_trial']['vertical'])} |")
+    print()
+
 print("## Per trial and foot (defaults)\n")
 print("| activity | trial | foot | plate | frames | vertical | anterior | COP | moment | vertical RMSE %BW | onset ms | offset ms | lag ms | `--paper` vertical / anterior / COP |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
