@@ -73,7 +73,7 @@ void check_up_axis(Trial& t) {
   const Axis file_axis = has_markers ? t.markers.up_axis : t.plates ? t.plates->up_axis : *a;
   if (*a != file_axis)
     t.warnings.push_back(std::string("up axis: the file's convention is ") + to_string(file_axis) + " but " + why +
-                         " say " + to_string(*a) + "; " + to_string(*a) + " is used (override with --up-axis)");
+                         " say " + to_string(*a) + "; " + to_string(*a) + " is used (an up-axis setting overrides it)");
   if (has_markers) t.markers.up_axis = *a;
   if (t.plates) t.plates->up_axis = *a;
 }

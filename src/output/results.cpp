@@ -60,7 +60,9 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
                       {"up", {r.frame.up.x(), r.frame.up.y(), r.frame.up.z()}},
                       {"treadmill", r.frame.treadmill},
                       {"belt_velocity_mps", r.frame.belt_velocity_mps},
+                      {"speed_mps", r.progression_speed_mps},
                       {"how", r.frame.how}};
+  j["contact_speed_gate_mps"] = r.speed_gate_mps;
   const auto n = r.time_s.size();
   j["frames"] = {{"first", r.first_frame_number}, {"last", r.first_frame_number + n - 1}, {"count", n}};
   json contacts = json::object();
