@@ -1,7 +1,7 @@
 #include "kin2grf/validation/study.hpp"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <limits>
@@ -71,15 +71,14 @@ std::vector<Setting> settings_for(const std::string& kind) {
   return s;
 }
 
-/// Pool the stances of one activity ("all": every trial) over the trials `use` accepts.
-StudyCell pool(const std::vector<StudyTrialResult>& trials, const std::string& activity,
-               const std::function<bool(const StudyTrialResult&)>& use) {
+/// Pool the stances of one activity ("all": every trial) over the trials that ran.
+StudyCell pool(const std::vector<StudyTrialResult>& trials, const std::string& activity) {
   StudyCell c;
   c.activity = activity;
   std::vector<StanceValidation> stances;
   double sum = 0;
   for (const auto& t : trials) {
-    if ((activity != "all" && t.activity != activity) || !use(t) || t.failed) continue;
+    if ((activity != "all" && t.activity != activity) || t.failed) continue;
     ++c.trials;
     stances.insert(stances.end(), t.stances.begin(), t.stances.end());
     if (std::isfinite(t.total_grm)) sum += t.total_grm, ++c.total_trials;
@@ -118,7 +117,7 @@ StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& tr
       }
       per_trial.push_back(std::move(tr));
     }
-    for (const auto& a : activities) row.cells.push_back(pool(per_trial, a, [](const StudyTrialResult&) { return true; }));
+    for (const auto& a : activities) row.cells.push_back(pool(per_trial, a));
     res.rows.push_back(std::move(row));
     res.per_trial.push_back(std::move(per_trial));
   }
@@ -175,8 +174,8 @@ CrossValidation cross_validate(const StudyResult& s) {
   for (const auto& a : activities) {
     CrossValidation::Cell c;
     c.activity = a;
-    const StudyCell in = pool(s.per_trial[all], a, [](const StudyTrialResult&) { return true; });
-    const StudyCell out = pool(held, a, [](const StudyTrialResult&) { return true; });
+    const StudyCell in = pool(s.per_trial[all], a);
+    const StudyCell out = pool(held, a);
     c.in_sample = in.per_foot, c.in_sample_total_grm = in.total_grm;
     c.held_out = out.per_foot, c.held_out_total_grm = out.total_grm;
     c.worst_vertical = -1;
