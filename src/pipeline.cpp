@@ -1,5 +1,6 @@
 #include "kin2grf/pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -63,7 +64,18 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   ModelMotion motion = compute_motion(r.model, lm, o.kinematic_cutoff_hz, o.torso_length);
   ContactModelOptions co = o.contact;
   co.ground_level_m = r.ground_level_m;
-  const auto contacts = prepare_contacts(r.model, co, motion);
+  std::vector<bool> running;
+  if (co.foot_model == FootModel::Cop && co.running_cop) {
+    running = flight_frames(r.model, motion);
+    const auto nrun = std::count(running.begin(), running.end(), true);
+    if (nrun > 0) {
+      char b[160];
+      std::snprintf(b, sizeof b, "running: %ld of %ld frames are near a flight phase and take the running COP function",
+                    static_cast<long>(nrun), static_cast<long>(running.size()));
+      r.messages.push_back(b);
+    }
+  }
+  const auto contacts = prepare_contacts(r.model, co, motion, running);
   SolverOptions so = o.solver;
   if (r.frame.treadmill) {
     // Belt velocity (always measured, whatever the gate): the median horizontal velocity of the

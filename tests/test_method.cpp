@@ -1,6 +1,7 @@
 // Tests of the method's core on synthetic trials of the project's own making.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
@@ -455,4 +456,34 @@ TEST(Solver, SpeedGateScalesWithTheProgressionSpeed) {
   for (Eigen::Index k = 0; k < 400; ++k)
     lm.p[kHip](k, 0) = 0.4 * lm.time_s[k] + 0.1 / (4 * M_PI) * std::sin(4 * M_PI * lm.time_s[k]);
   EXPECT_NEAR(progression_speed(lm), 0.4, 0.01);
+}
+
+// Running frames are told from the kinematics: near a flight the whole body's vertical force
+// sum m (a_y + g) falls to about zero (free fall); standing, squatting and walking never do.
+TEST(Contact, FlightFramesAreFoundFromTheKinematicsAlone) {
+  SyntheticOptions so;
+  so.squat_depth = 0.0;
+  so.flight_height_m = 0.3;  // flight 1.253-1.747 s
+  const Trial t = make_synthetic_trial(so);
+  const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+  ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
+  const auto run = flight_frames(r.model, mm);
+  ASSERT_EQ(run.size(), static_cast<std::size_t>(mm.frames()));
+  for (Eigen::Index i = 0; i < mm.frames(); ++i) {
+    const double time = mm.time_s[i];
+    if (time > 1.3 && time < 1.7) {
+      EXPECT_TRUE(run[static_cast<std::size_t>(i)]) << time;  // in the flight
+    } else if (time < 0.7 || time > 2.3) {
+      EXPECT_FALSE(run[static_cast<std::size_t>(i)]) << time;  // far from it
+    }
+  }
+  for (const double depth : {0.0, 1.0}) {  // quiet standing and squats: never
+    SyntheticOptions sq;
+    sq.squat_depth = depth;
+    const Trial ts = make_synthetic_trial(sq);
+    const auto rs = estimate(ts, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+    ModelMotion ms = compute_motion(rs.model, synthetic_landmarks(ts), 6.0);
+    const auto none = flight_frames(rs.model, ms);
+    EXPECT_EQ(std::count(none.begin(), none.end(), true), 0) << depth;
+  }
 }

@@ -212,6 +212,12 @@ TEST(CopFit, BuiltInDefaultIsTheCommittedFit) {
   for (auto [a, b] : {std::pair{f.delta_hs, d.delta_hs}, {f.delta_ho, d.delta_ho}, {f.delta_mo, d.delta_mo}, {f.delta_to, d.delta_to},
                       {f.s_hs, d.s_hs}, {f.s_ho, d.s_ho}, {f.s_mo, d.s_mo}, {f.s_to, d.s_to}})
     EXPECT_NEAR(a, b, 5e-4);
+  // The running function likewise.
+  const CopFunction fr = read_cop_function(std::string(KIN2GRF_SOURCE_DIR) + "/data/cop-function/running-fitted.json");
+  const CopFunction dr = CopFunction::running();
+  for (auto [a, b] : {std::pair{fr.delta_hs, dr.delta_hs}, {fr.delta_ho, dr.delta_ho}, {fr.delta_mo, dr.delta_mo},
+                      {fr.delta_to, dr.delta_to}, {fr.s_hs, dr.s_hs}, {fr.s_ho, dr.s_ho}, {fr.s_mo, dr.s_mo}, {fr.s_to, dr.s_to}})
+    EXPECT_NEAR(a, b, 5e-4);
 }
 
 TEST(Report, RendersInHeadlessChromium) {

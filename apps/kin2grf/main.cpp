@@ -46,7 +46,7 @@ const char* torso_length_name(kin2grf::TorsoLength t) { return t == kin2grf::Tor
 
 struct EstimateArgs {
   std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "torque-scaled",
-      anthropometry = kin2grf::EstimateOptions{}.anthropometry, up_axis, cop_function,
+      anthropometry = kin2grf::EstimateOptions{}.anthropometry, up_axis, cop_function, running_cop = "builtin",
       torso_length = torso_length_name(kin2grf::EstimateOptions{}.torso_length);
   // Numerical defaults come from the library's option structs (one source for CLI and API).
   double mass = 0, r = kin2grf::SolverOptions{}.r_N_per_m, kin_cutoff = kin2grf::EstimateOptions{}.kinematic_cutoff_hz,
@@ -98,7 +98,11 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
        "--anthropometry", [&a](const std::string& v) { a.anthropometry = v, a.anthropometry_given = true; },
        "winter or de-leva; default de-leva, winter with --paper")
       ->check(CLI::IsMember({"winter", "de-leva"}));
-  c->add_option("--cop-function", a.cop_function, "Foot model 2's COP function from this JSON (see kin2grf fit-cop)");
+  c->add_option("--cop-function", a.cop_function,
+                "Foot model 2's COP function from this JSON (see kin2grf fit-cop); used on every frame unless --running-cop FILE");
+  c->add_option("--running-cop", a.running_cop,
+                "COP function near flight phases (running): builtin (kin2grf's running fit), off, or a JSON file")
+      ->capture_default_str();
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
   c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length");
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
@@ -120,6 +124,10 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
   if (a.grm_reference.size() == 2) o.grm_reference_m = Eigen::Vector2d(a.grm_reference[0], a.grm_reference[1]);
   if (a.paper) o.contact.cop = kin2grf::CopFunction::paper();
   if (!a.cop_function.empty()) o.contact.cop = kin2grf::read_cop_function(a.cop_function);
+  // The running function: kin2grf's own unless the paper's configuration, a user's function for
+  // every frame, or "off" is asked for; a file replaces it.
+  if (a.running_cop == "off" || (a.running_cop == "builtin" && (a.paper || !a.cop_function.empty()))) o.contact.running_cop.reset();
+  else if (a.running_cop != "builtin") o.contact.running_cop = kin2grf::read_cop_function(a.running_cop);
   o.solver.r_N_per_m = (a.paper && !a.r_given) ? 1e4 : a.r;
   o.solver.norm = (a.paper || a.norm == "paper") ? kin2grf::MultiplierNorm::Paper : kin2grf::MultiplierNorm::TorqueScaled;
   o.solver.speed_gate_mps = a.paper ? 0.0 : a.speed_gate;
@@ -146,6 +154,10 @@ nlohmann::json settings_json(const EstimateArgs& a, const kin2grf::EstimateOptio
           {"cop_function", {{"source", !a.cop_function.empty() ? a.cop_function : a.paper ? "paper event angles" : "built-in fit"},
                             {"delta_rad", {c.delta_hs, c.delta_ho, c.delta_mo, c.delta_to}},
                             {"s", {c.s_hs, c.s_ho, c.s_mo, c.s_to}}}},
+          {"running_cop_function", o.contact.running_cop ? nlohmann::json{{"source", a.running_cop == "builtin" ? "built-in running fit" : a.running_cop},
+                                                                         {"delta_rad", {o.contact.running_cop->delta_hs, o.contact.running_cop->delta_ho, o.contact.running_cop->delta_mo, o.contact.running_cop->delta_to}},
+                                                                         {"s", {o.contact.running_cop->s_hs, o.contact.running_cop->s_ho, o.contact.running_cop->s_mo, o.contact.running_cop->s_to}}}
+                                                       : nlohmann::json(nullptr)},
           {"r_N_per_m", o.solver.r_N_per_m},
           {"norm", o.solver.norm == kin2grf::MultiplierNorm::Paper ? "paper" : "torque-scaled"},
           {"speed_gate_mps", o.solver.speed_gate_mps},
@@ -403,14 +415,14 @@ int run_fit_cop(const FitCopArgs& a) {
               fit.function.s_ho, fit.function.s_mo, fit.function.s_to, start.s_hs, start.s_ho, start.s_mo, start.s_to);
   std::printf("  RMS of F(theta) - s: %.3f (start: %.3f)\n", fit.rms_fraction, fit.rms_fraction_before);
   if (a.leave_one_out) {
-    std::printf("\nleave-one-trial-out: COP rRMSE %% (mean over the trial's stances)\n%-26s %8s %8s %8s\n", "trial", "start",
-                "all", "others");
+    std::printf("\nleave-one-lab-out: COP rRMSE %% (mean over the trial's stances; 'other labs': fitted without the trial's lab)\n"
+                "%-26s %8s %8s %11s\n", "trial", "start", "all", "other labs");
     nlohmann::json loo = nlohmann::json::array();
     for (const auto& l : res.leave_one_out) {
-      std::printf("%-26s %8.1f %8.1f %8.1f\n", l.trial.c_str(), l.start, l.all, l.others);
-      loo.push_back({{"trial", l.trial}, {"start", l.start}, {"all", l.all}, {"others", l.others}});
+      std::printf("%-26s %8.1f %8.1f %11.1f\n", l.trial.c_str(), l.start, l.all, l.others);
+      loo.push_back({{"trial", l.trial}, {"start", l.start}, {"all", l.all}, {"other_labs", l.others}});
     }
-    prov["leave_one_out_cop_rrmse_percent"] = loo;
+    prov["leave_one_lab_out_cop_rrmse_percent"] = loo;
   }
   j["provenance"] = prov;
   if (!a.out.empty()) kin2grf::write_file_text(a.out, j.dump(2) + "\n");
@@ -501,7 +513,8 @@ int main(int argc, char** argv) {
   fit_cop->add_option("--min-force", fit_args.min_force, "Frames where the plate carries at least this fraction of body weight")
       ->capture_default_str();
   fit_cop->add_flag("--fit-angles", fit_args.fit_angles, "Fit the event angles too (default: the paper's, fixed)");
-  fit_cop->add_flag("--leave-one-out", fit_args.leave_one_out, "Also report each trial's COP error with a fit on the others");
+  fit_cop->add_flag("--leave-one-out", fit_args.leave_one_out,
+                    "Also report each trial's COP error with a fit on the other labs' trials (leave one lab out)");
   fit_cop->add_option("-o,--output", fit_args.out, "Write the fitted function and its provenance (JSON)");
 
   std::string example_dir = "example";

@@ -66,7 +66,34 @@ std::array<Eigen::Vector2d, 3> sole_points(const Model& model, const ModelMotion
   return {rA + Rf * fg.heel_local, rA + Rf * fg.mt_local, rM + Rt * fg.hallux_local};
 }
 
-std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactModelOptions& o, ModelMotion& m) {
+std::vector<bool> flight_frames(const Model& model, const ModelMotion& m, double flight_fraction, double window_s) {
+  const Eigen::Index n = m.frames();
+  double mass = 0;
+  for (const Body& b : model.bodies) mass += b.mass_kg;
+  const double limit = flight_fraction * mass * model.gravity_mps2;
+  std::vector<bool> flight(static_cast<std::size_t>(n), false), out(static_cast<std::size_t>(n), false);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double fy = 0;
+    for (int s = 0; s < kSegmentCount; ++s)
+      fy += model.bodies[static_cast<std::size_t>(s)].mass_kg * (m.qdd(i, coord::com_x(s) + 1) + model.gravity_mps2);
+    flight[static_cast<std::size_t>(i)] = fy < limit;
+  }
+  const Eigen::Index w = static_cast<Eigen::Index>(std::lround(window_s * m.rate_hz));
+  Eigen::Index last = -1 - w;  // the latest flight frame at or before i
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (flight[static_cast<std::size_t>(i)]) last = i;
+    if (i - last <= w) out[static_cast<std::size_t>(i)] = true;
+  }
+  Eigen::Index next = n + w;  // the earliest flight frame at or after i
+  for (Eigen::Index i = n - 1; i >= 0; --i) {
+    if (flight[static_cast<std::size_t>(i)]) next = i;
+    if (next - i <= w) out[static_cast<std::size_t>(i)] = true;
+  }
+  return out;
+}
+
+std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactModelOptions& o, ModelMotion& m,
+                                            const std::vector<bool>& running) {
   const Eigen::Index n = m.frames();
   std::vector<FrameContacts> out(static_cast<std::size_t>(n));
   const double ground = o.ground_level_m + o.ground_shift_m;
@@ -92,7 +119,8 @@ std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactMod
         continue;
       }
       // Model 2: D at arc fraction s of A -> B -> C, at the lowest sole point's height (Eq. 2).
-      const double s = o.cop.fraction(fc.foot_inclination_rad[side]);
+      const bool run = o.running_cop && static_cast<Eigen::Index>(running.size()) == n && running[static_cast<std::size_t>(i)];
+      const double s = (run ? *o.running_cop : o.cop).fraction(fc.foot_inclination_rad[side]);
       fc.cop_fraction[side] = s;
       const double l1 = (sp[1] - sp[0]).norm(), l2 = (sp[2] - sp[1]).norm();
       const double along = s * (l1 + l2);

@@ -128,10 +128,12 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
     collect_cop_samples(e, validate(e, *t.plates), min_force, per[k]);
     out.samples_per_trial.push_back(per[k].theta_rad.size());
   }
+  // Leave one LAB out: a trial's held-out fit uses no trial of its lab (same lab, same set-up).
+  auto lab = [&](std::size_t k) { return trials[k].lab.empty() ? trials[k].name : trials[k].lab; };
   auto pooled = [&](std::size_t skip) {
     CopSamples all;
     for (std::size_t k = 0; k < n; ++k) {
-      if (k == skip) continue;
+      if (skip < n && lab(k) == lab(skip)) continue;
       all.theta_rad.insert(all.theta_rad.end(), per[k].theta_rad.begin(), per[k].theta_rad.end());
       all.fraction.insert(all.fraction.end(), per[k].fraction.begin(), per[k].fraction.end());
     }
@@ -147,6 +149,7 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
     auto cop_rrmse = [&](const CopFunction& f) {
       EstimateOptions o = t.options;
       o.contact.cop = f;
+      o.contact.running_cop.reset();  // the candidate alone, on every frame
       const auto e = estimate(*t.trial, t.static_trial, *t.marker_set, o);
       return mean_rrmse(validate(e, *t.plates).stances).cop;
     };

@@ -18,6 +18,7 @@
 
 #include <Eigen/Dense>
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "kin2grf/kinematics/motion.hpp"
@@ -43,6 +44,13 @@ struct CopFunction {
   [[nodiscard]] double fraction(double theta_a) const;
   /// The paper's event angles; positions fitted with those angles fixed (same data).
   static CopFunction paper() { return {-0.3, 0.0, 0.15, 1.0, 0.052, 0.453, 0.837, 0.944}; }
+  /// Running (frames near a flight phase, see flight_frames()): the paper's event angles with
+  /// positions fitted to the plate COPs of the development running trials (3 trials, 2 labs,
+  /// 5869 frames; data/cop-function/running-fitted.json). A runner's COP stays on the forefoot
+  /// from mid-stance on (s_HO 0.71 against walking's 0.26) and a forefoot strike lands there.
+  /// Leave-one-lab-out COP rRMSE 9.1 / 6.4 / 6.3 % against 11.5 / 9.7 / 7.7 % with the paper's
+  /// positions (docs/METHOD-NOTES.md). Event angles not fitted: fitting them overfits two labs.
+  static CopFunction running() { return {-0.3, 0.0, 0.15, 1.0, 0.000, 0.709, 0.840, 1.078}; }
 };
 
 /// One potential contact point this frame (model 2: D*, model 1: A, B or C).
@@ -64,6 +72,9 @@ struct FrameContacts {
 struct ContactModelOptions {
   FootModel foot_model = FootModel::Cop;
   CopFunction cop;
+  /// Model 2's function on running frames (prepare_contacts' `running`); none: `cop` everywhere
+  /// (the paper, or a user's own function).
+  std::optional<CopFunction> running_cop = CopFunction::running();
   double ground_level_m = 0.0;  ///< the floor's height in the sagittal frame
   double ground_shift_m = 0.0;  ///< added to the ground (the paper's robustness study)
 };
@@ -71,8 +82,17 @@ struct ContactModelOptions {
 /// World positions of the sole points A, B, C of a foot at frame i.
 std::array<Eigen::Vector2d, 3> sole_points(const Model& model, const ModelMotion& motion, Eigen::Index i, int side);
 
-/// Fill the D* columns of q/qd/qdd (model 2) and return each frame's contact points.
-std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactModelOptions& options, ModelMotion& motion);
+/// Fill the D* columns of q/qd/qdd (model 2) and return each frame's contact points. `running`
+/// (empty, or one flag per frame): frames that take options.running_cop.
+std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactModelOptions& options, ModelMotion& motion,
+                                            const std::vector<bool>& running = {});
+
+/// Running frames: those within `window_s` of a flight frame, where the whole body's vertical
+/// kinematic force sum m (a_y + g) is below `flight_fraction` of body weight. In flight the body
+/// is in free fall (0); walking keeps a foot on the ground and never goes below about 0.4 body
+/// weight (the 7 development walks: 0.42-0.75), a run's 6 Hz-filtered flights reach about -0.2.
+std::vector<bool> flight_frames(const Model& model, const ModelMotion& motion, double flight_fraction = 0.2,
+                                double window_s = 0.4);
 
 }  // namespace kin2grf
 

@@ -45,8 +45,9 @@ CopFit fit_cop_function(const CopSamples& samples, const CopFunction& start);
 CopFit fit_cop_function_and_angles(const CopSamples& samples, const CopFunction& start);
 
 /// fit-cop on a set of trials with plates: samples from each trial's kept stances (estimated
-/// with the trial's own options), one pooled fit and, on request, leave-one-trial-out: each
-/// trial's mean COP rRMSE with the starting function, the pooled fit and a fit on the others.
+/// with the trial's own options), one pooled fit and, on request, leave-one-lab-out: each
+/// trial's mean COP rRMSE with the starting function, the pooled fit and a fit on the other
+/// labs' trials (StudyTrial::lab; a trial without a lab is its own).
 struct CopFitOnTrials {
   CopFit fit;
   std::vector<std::size_t> samples_per_trial;
