@@ -232,12 +232,11 @@ std::array<ForcePlate, 2> as_lab_plates(const EstimateResult& r) {
     p.moment_centre_Nm = Eigen::MatrixX3d::Constant(n, 3, nan);
     for (Eigen::Index i = 0; i < n; ++i) {
       const auto& f = r.feet[side];
-      const Eigen::Vector3d F = f.force_N(i, 0) * r.frame.forward + f.force_N(i, 1) * r.frame.up;
+      const Eigen::Index k = r.first_index + i;  // the trial frame (a turning frame's heading)
+      const Eigen::Vector3d F = f.force_N(i, 0) * r.frame.forward_at(k) + f.force_N(i, 1) * r.frame.up;
       p.force_N.row(i) = F.transpose();
       if (std::isfinite(f.cop_x_m[i])) {
-        const Eigen::Vector3d c = f.cop_x_m[i] * r.frame.forward + r.ground_level_m * r.frame.up +
-                                  r.foot_lateral_m[side][i] * r.frame.lateral;
-        p.cop_m.row(i) = c.transpose();
+        p.cop_m.row(i) = r.frame.to_lab(f.cop_x_m[i], r.ground_level_m, r.foot_lateral_m[side][i], k).transpose();
       } else {
         p.cop_m.row(i).setConstant(nan);
       }

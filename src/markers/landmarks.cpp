@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <set>
 
@@ -243,6 +245,90 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
   return out;
 }
 
+namespace {
+
+/// Turning walks: the body's heading is the direction its feet point (the 0.5 Hz zero-lag trend,
+/// below the step frequency, of the sum of both feet's horizontal heel -> MT directions: the
+/// feet's toe-out cancels between the sides, and unlike the pelvis's path it also holds while the
+/// subject stands or side-steps). When that heading turns by more than kTurnLimitRad over the
+/// trial and the pelvis travels kMinTravelM or more (not a treadmill, not on the spot), the frame
+/// follows it (SagittalFrame); otherwise the fixed frame stays.
+constexpr double kTurnLimitRad = 30 * M_PI / 180;
+constexpr double kMinTravelM = 2.0;  ///< the slow pelvis path's length below which nothing turns
+
+void follow_heading(SagittalFrame& f, const Landmarks3D& lm, double rate_hz) {
+  const auto& hip = lm.p[kHip];
+  const Eigen::Index n = hip.rows();
+  if (n < 10 || rate_hz <= 0) return;
+  // Horizontal basis e1, e2 (e1 x e2 = up): the two lab axes other than the up axis.
+  Eigen::Index ua = 0;
+  f.up.cwiseAbs().maxCoeff(&ua);
+  const Eigen::Vector3d e1 = Eigen::Vector3d::Unit((ua + 1) % 3), e2 = Eigen::Vector3d::Unit((ua + 2) % 3);
+  auto hold = [&](const std::function<bool(Eigen::Index, Eigen::RowVector2d&)>& at) {
+    // Per frame a 2D value; undefined frames hold the nearest defined one before (or after).
+    Eigen::MatrixXd out(n, 2);
+    Eigen::RowVector2d last(kNaN, kNaN), v;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (at(i, v)) last = v;
+      out.row(i) = last;
+    }
+    Eigen::Index first = 0;
+    while (first < n && !out.row(first).allFinite()) ++first;
+    if (first == n) return Eigen::MatrixXd();
+    for (Eigen::Index i = 0; i < first; ++i) out.row(i) = out.row(first);
+    return out;
+  };
+  const Eigen::MatrixXd h = hold([&](Eigen::Index i, Eigen::RowVector2d& v) {
+    if (!hip.row(i).allFinite()) return false;
+    v = {hip.row(i).dot(e1.transpose()), hip.row(i).dot(e2.transpose())};
+    return true;
+  });
+  const Eigen::MatrixXd feet = hold([&](Eigen::Index i, Eigen::RowVector2d& v) {
+    v.setZero();
+    for (int side = 0; side < 2; ++side) {
+      const Eigen::RowVector3d d = lm.p[landmark(side, 3)].row(i) - lm.p[landmark(side, 2)].row(i);
+      const Eigen::RowVector2d dh(d.dot(e1.transpose()), d.dot(e2.transpose()));
+      if (dh.allFinite()) v += dh;  // not normalised: a foot pitched steeply (swing) weighs little
+    }
+    return v.norm() > 0.05;
+  });
+  if (h.rows() == 0 || feet.rows() == 0) return;
+  const Eigen::MatrixXd c = butterworth_filtfilt(h, rate_hz, 0.5);
+  const Eigen::MatrixXd d = butterworth_filtfilt(feet, rate_hz, 0.5);
+  std::vector<double> psi(static_cast<std::size_t>(n));
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double a = std::atan2(d(i, 1), d(i, 0));
+    if (i > 0) a = psi[static_cast<std::size_t>(i - 1)] + std::remainder(a - psi[static_cast<std::size_t>(i - 1)], 2 * M_PI);
+    psi[static_cast<std::size_t>(i)] = a;
+    lo = std::min(lo, a), hi = std::max(hi, a);
+  }
+  if (!(hi - lo > kTurnLimitRad)) return;  // a straight walk: the fixed frame
+  double travel = 0;  // on a treadmill or on the spot the body does not travel: nothing to follow
+  for (Eigen::Index i = 1; i < n; ++i) travel += (c.row(i) - c.row(i - 1)).norm();
+  if (travel < kMinTravelM) return;
+  f.heading.resize(n, 3);
+  f.x_offset_m.resize(n);
+  double arc = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double a = psi[static_cast<std::size_t>(i)];
+    const Eigen::Vector3d hd = std::cos(a) * e1 + std::sin(a) * e2;
+    f.heading.row(i) = hd.transpose();
+    const Eigen::Vector3d ci = c(i, 0) * e1 + c(i, 1) * e2;
+    arc = i == 0 ? ci.dot(hd) : arc + (c.row(i) - c.row(i - 1)).dot(Eigen::RowVector2d(std::cos(a), std::sin(a)));
+    f.x_offset_m[i] = arc - ci.dot(hd);  // so that the path point's x is its arc length
+  }
+  f.treadmill = false;
+  const Eigen::Vector3d mean = f.heading.colwise().mean().transpose();
+  f.forward = mean.norm() > 1e-6 ? Eigen::Vector3d(mean.normalized()) : Eigen::Vector3d(f.heading.row(0).transpose());
+  f.lateral = f.forward.cross(f.up);
+  char b[160];
+  std::snprintf(b, sizeof b, "the heading follows the feet's direction (it turns by %.0f degrees)", (hi - lo) * 180 / M_PI);
+  f.how = b;
+}
+
+}  // namespace
+
 SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajectories& m, const LandmarkOptions& o) {
   SagittalFrame f;
   const Axis up = o.up_axis.value_or(m.up_axis);
@@ -289,6 +375,7 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
   if (o.progression_sign) dir *= (*o.progression_sign > 0 ? 1.0 : -1.0) * (dir.sum() >= 0 ? 1.0 : -1.0);
   f.forward = dir;
   f.lateral = f.forward.cross(f.up);
+  if (!o.progression_axis) follow_heading(f, lm, m.rate_hz);
   return f;
 }
 
@@ -363,12 +450,13 @@ SagittalWindow sagittal_landmarks(const Landmarks3D& lm3, const MarkerSet& set, 
     s.p[static_cast<std::size_t>(id)].resize(best_len, 2);
     for (Eigen::Index i = 0; i < best_len; ++i)
       s.p[static_cast<std::size_t>(id)].row(i) =
-          fr.to_sagittal(p[static_cast<std::size_t>(id)].row(best_a + i).transpose()).transpose();
+          fr.to_sagittal(p[static_cast<std::size_t>(id)].row(best_a + i).transpose(), best_a + i).transpose();
   }
   for (int side = 0; side < 2; ++side) {
     w.foot_lateral_m[side].resize(best_len);
     for (Eigen::Index i = 0; i < best_len; ++i)
-      w.foot_lateral_m[side][i] = 0.5 * (p[landmark(side, 2)].row(best_a + i) + p[landmark(side, 3)].row(best_a + i)).dot(fr.lateral.transpose());
+      w.foot_lateral_m[side][i] =
+          0.5 * (p[landmark(side, 2)].row(best_a + i) + p[landmark(side, 3)].row(best_a + i)).dot(fr.lateral_at(best_a + i).transpose());
     // Virtual hallux: toes straight along the foot, held at the MT head's foot-flat height.
     const LandmarkRule& r = set.rules[static_cast<std::size_t>(landmark(side, 4))];
     if (r.kind != "virtual_hallux") continue;

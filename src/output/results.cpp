@@ -59,6 +59,7 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
   j["progression"] = {{"forward", {r.frame.forward.x(), r.frame.forward.y(), r.frame.forward.z()}},
                       {"up", {r.frame.up.x(), r.frame.up.y(), r.frame.up.z()}},
                       {"treadmill", r.frame.treadmill},
+                      {"turning", r.frame.turning()},
                       {"belt_velocity_mps", r.frame.belt_velocity_mps},
                       {"speed_mps", r.progression_speed_mps},
                       {"how", r.frame.how}};

@@ -49,7 +49,7 @@ double mean_finite(const Eigen::VectorXd& v) {
 }  // namespace
 
 std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const SagittalFrame& fr,
-                                           const Eigen::VectorXd& t, double cop_threshold_N) {
+                                           const Eigen::VectorXd& t, double cop_threshold_N, Eigen::Index first_index) {
   std::vector<MeasuredPlate> out;
   const Eigen::Index n = t.size();
   const double dt = n > 1 ? (t[n - 1] - t[0]) / static_cast<double>(n - 1) : 1.0;
@@ -64,13 +64,26 @@ std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const
     m.cop_x_m = Eigen::VectorXd::Constant(n, kNaN);
     m.cop_lateral_m = Eigen::VectorXd::Constant(n, kNaN);
     if (p.has_geometry) {
+      // The plate's geometry in the frame of the middle of its loaded samples (turning walks).
+      Eigen::Index g = first_index + n / 2;
+      if (fr.turning()) {
+        std::vector<double> loaded;
+        for (Eigen::Index k = 0; k < ns; ++k)
+          if (p.force_N.row(k).dot(fr.up.transpose()) > cop_threshold_N) loaded.push_back(rec.time_s[k]);
+        if (!loaded.empty() && n > 1) {
+          const double tm = loaded[loaded.size() / 2];
+          g = first_index + std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::lround((tm - t[0]) / dt)), 0, n - 1);
+        }
+      }
+      const Eigen::Vector3d fw = fr.forward_at(g), lt = fr.lateral_at(g);
+      const double off = fr.x_offset_at(g);
       m.surface_y_m = p.centre_m.dot(fr.up);
-      m.centre_m = {p.centre_m.dot(fr.forward), p.centre_m.dot(fr.lateral)};
+      m.centre_m = {p.centre_m.dot(fw) + off, p.centre_m.dot(lt)};
       m.x_min = m.lateral_min = std::numeric_limits<double>::infinity();
       m.x_max = m.lateral_max = -m.x_min;
       for (const auto& c : p.corners_m) {
-        m.x_min = std::min(m.x_min, c.dot(fr.forward)), m.x_max = std::max(m.x_max, c.dot(fr.forward));
-        m.lateral_min = std::min(m.lateral_min, c.dot(fr.lateral)), m.lateral_max = std::max(m.lateral_max, c.dot(fr.lateral));
+        m.x_min = std::min(m.x_min, c.dot(fw) + off), m.x_max = std::max(m.x_max, c.dot(fw) + off);
+        m.lateral_min = std::min(m.lateral_min, c.dot(lt)), m.lateral_max = std::max(m.lateral_max, c.dot(lt));
       }
     } else {
       std::vector<double> h;
@@ -112,15 +125,16 @@ std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const
         Fs += F, Ms += M, ++cnt;
         if (has_cop) {
           const double w = std::abs(F.dot(fr.up));
-          lat += w * p.cop_m.row(k).dot(fr.lateral.transpose()), wlat += w;
+          lat += w * p.cop_m.row(k).dot(fr.lateral_at(first_index + i).transpose()), wlat += w;
         }
       }
       if (cnt == 0) continue;  // no valid sample in this frame: stays NaN
       Fs /= cnt, Ms /= cnt;
-      const double fx = Fs.dot(fr.forward), fy = Fs.dot(fr.up);
+      const double fx = Fs.dot(fr.forward_at(first_index + i)), fy = Fs.dot(fr.up);
       m.force_N(i, 0) = fx;
       m.force_N(i, 1) = fy;
-      m.moment_origin_Nm[i] = Ms.dot(fr.lateral);
+      // x = p . f + offset: the offset's share of x F_y (zero without turns).
+      m.moment_origin_Nm[i] = Ms.dot(fr.lateral_at(first_index + i)) + fr.x_offset_at(first_index + i) * fy;
       if (fy > cop_threshold_N) {
         m.cop_x_m[i] = (m.moment_origin_Nm[i] + m.surface_y_m * fx) / fy;  // x F_y - y F_x = m_O
         if (wlat > 0) m.cop_lateral_m[i] = lat / wlat;
@@ -137,7 +151,7 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
   v.first_frame_number = e.first_frame_number;
   const double bw = e.mass_kg * e.model.gravity_mps2;
   const Eigen::Index n = e.time_s.size();
-  v.plates = resample_plates(rec, e.frame, e.time_s, rec.cop_threshold_N);
+  v.plates = resample_plates(rec, e.frame, e.time_s, rec.cop_threshold_N, e.first_index);
   const double rate = e.landmarks.rate_hz;
   const Eigen::Index search = static_cast<Eigen::Index>(std::lround(0.2 * rate));
   const double ground = e.ground_level_m;

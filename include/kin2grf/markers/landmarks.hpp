@@ -24,6 +24,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <array>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -88,6 +89,14 @@ struct Landmarks3D {
 };
 
 /// The sagittal frame: x along progression, y up, origin the lab origin.
+///
+/// A walker who turns (a circuit, a curved path) has no one progression direction: the frame then
+/// follows the heading. Per trial frame i, heading f_i (the direction of the pelvis's slow path, a
+/// 0.5 Hz trend below the step frequency) and x = p . f_i + x_offset_i, where the offset makes
+/// the path's own x its arc length: x measures the distance walked along the path, so
+/// velocities and accelerations along it are those of the 2D model (the centripetal part, across
+/// the plane, is left out, as a sagittal model must). Without turns both per-frame arrays are
+/// empty and the fixed `forward` holds for every frame (bit for bit the straight-line frame).
 struct SagittalFrame {
   Eigen::Vector3d forward = Eigen::Vector3d::UnitX();
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
@@ -95,7 +104,25 @@ struct SagittalFrame {
   bool treadmill = false;           ///< the pelvis does not progress
   double belt_velocity_mps = 0.0;   ///< ground velocity along x on a treadmill (sagittal)
   std::string how;                  ///< how progression was found
+  Eigen::MatrixX3d heading;         ///< N x 3 per trial frame (turning only), lab unit vectors
+  Eigen::VectorXd x_offset_m;       ///< N (turning only)
+  [[nodiscard]] bool turning() const { return heading.rows() > 0; }
+  [[nodiscard]] Eigen::Vector3d forward_at(Eigen::Index i) const {
+    return turning() ? Eigen::Vector3d(heading.row(std::clamp<Eigen::Index>(i, 0, heading.rows() - 1)).transpose()) : forward;
+  }
+  [[nodiscard]] Eigen::Vector3d lateral_at(Eigen::Index i) const { return turning() ? forward_at(i).cross(up) : lateral; }
+  [[nodiscard]] double x_offset_at(Eigen::Index i) const {
+    return turning() ? x_offset_m[std::clamp<Eigen::Index>(i, 0, x_offset_m.size() - 1)] : 0.0;
+  }
   [[nodiscard]] Eigen::Vector2d to_sagittal(const Eigen::Vector3d& p) const { return {p.dot(forward), p.dot(up)}; }
+  /// At trial frame i (the frame the point was seen in).
+  [[nodiscard]] Eigen::Vector2d to_sagittal(const Eigen::Vector3d& p, Eigen::Index i) const {
+    return turning() ? Eigen::Vector2d(p.dot(forward_at(i)) + x_offset_at(i), p.dot(up)) : to_sagittal(p);
+  }
+  /// The lab point at sagittal (x, y) and lateral coordinate l, trial frame i.
+  [[nodiscard]] Eigen::Vector3d to_lab(double x, double y, double l, Eigen::Index i) const {
+    return (x - x_offset_at(i)) * forward_at(i) + y * up + l * lateral_at(i);
+  }
 };
 
 Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& motion,

@@ -5,7 +5,8 @@
 //    recomputed from the averaged force and moment (averaging COPs would weight unloaded
 //    samples like loaded ones). Everything goes to the estimate's sagittal frame:
 //      F_x = F . forward, F_y = F . up, m_O = M_O . lateral = x F_y - y F_x  (moment about the
-//    lab origin; a plate's free moment is vertical and drops out of the sagittal moment).
+//    lab origin; a plate's free moment is vertical and drops out of the sagittal moment). A
+//    turning frame (SagittalFrame) uses each frame's heading and adds x_offset F_y to m_O.
 // 2. Stances: runs of frames where a plate's vertical force exceeds the threshold (20 N).
 // 3. Plate-to-foot assignment by distance, not by name: the median over the stance of the
 //    horizontal distance from the measured COP to the foot's heel-hallux segment (lateral
@@ -54,8 +55,12 @@ struct MeasuredPlate {
   double x_min = 0, x_max = 0, lateral_min = 0, lateral_max = 0;  ///< extent (with geometry)
 };
 
+/// `first_index`: the trial frame of frame_time_s[0] (a turning frame's heading is per trial
+/// frame). With turns, a plate's extent and centre are projected with the heading at the middle
+/// of its loaded samples (a stance turns by a few degrees at most).
 std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const SagittalFrame& frame,
-                                           const Eigen::VectorXd& frame_time_s, double cop_threshold_N);
+                                           const Eigen::VectorXd& frame_time_s, double cop_threshold_N,
+                                           Eigen::Index first_index = 0);
 
 struct ValidationOptions {
   double threshold_N = 20.0;               ///< stance: measured vertical force above this
