@@ -427,10 +427,10 @@ TEST(Solver, SlowWalkSwingFootCarriesNothing) {
   ASSERT_TRUE(before.active[1]) << "the failure this test guards: the fixed gate lets the swing foot in";
   ASSERT_GT(before.force_N[1].y(), 20.0);
 
-  SolverOptions rule;  // the defaults: 2 x the progression speed, at least 0.75 m/s
+  SolverOptions rule;  // the defaults: the progression speed, at least 0.75 m/s
   rule.speed_gate_mps = speed_gate_for(rule, 0.4);
   rule.speed_gate_ratio = 0.0;
-  EXPECT_NEAR(rule.speed_gate_mps, 0.8, 1e-12);
+  EXPECT_NEAR(rule.speed_gate_mps, 0.75, 1e-12);
   const FrameSolution after = ContactSolver(r.model, rule).solve(q, qdd, fc);
   EXPECT_FALSE(after.active[1]);
   EXPECT_EQ(after.force_N[1].y(), 0.0);
@@ -442,9 +442,10 @@ TEST(Solver, SlowWalkSwingFootCarriesNothing) {
 TEST(Solver, SpeedGateScalesWithTheProgressionSpeed) {
   SolverOptions o;  // defaults
   EXPECT_NEAR(speed_gate_for(o, 0.0), 0.75, 1e-12);   // standing, squatting: the floor
-  EXPECT_NEAR(speed_gate_for(o, 1.3), 2.6, 1e-12);    // walking
-  EXPECT_NEAR(speed_gate_for(o, 9.0), 18.0, 1e-12);   // sprinting: the landing foot is not cut
-  EXPECT_NEAR(speed_gate_for(o, -3.5), 7.0, 1e-12);   // a treadmill belt's sign does not matter
+  EXPECT_NEAR(speed_gate_for(o, 0.4), 0.75, 1e-12);   // a slow walk: the floor
+  EXPECT_NEAR(speed_gate_for(o, 1.3), 1.3, 1e-12);    // walking
+  EXPECT_NEAR(speed_gate_for(o, 9.0), 9.0, 1e-12);    // sprinting: the landing foot is not cut
+  EXPECT_NEAR(speed_gate_for(o, -3.5), 3.5, 1e-12);   // a treadmill belt's sign does not matter
   o.speed_gate_ratio = 0;
   o.speed_gate_mps = 1.5;
   EXPECT_NEAR(speed_gate_for(o, 9.0), 1.5, 1e-12);    // a fixed gate stays fixed

@@ -135,32 +135,37 @@ CrossValidation cross_validate(const StudyResult& s) {
   if (labs.size() < 2) throw InputError("cross-validation: the trials come from one lab; give each trial its lab (trial list: activity|lab|name|TRIAL)");
   if (activities.size() > 1) activities.push_back("all");
   // The setting with the lowest criterion over the trials `use` accepts.
+  // The criterion of setting r over the trials `use` accepts; NaN when a trial failed (a setting
+  // that breaks a trial is never chosen) or none has a stance.
+  auto criterion = [&](std::size_t r, const std::function<bool(const StudyTrialResult&)>& use) {
+    // Each lab weighs the same, whatever its number of stances (a 30 s treadmill run has 80).
+    double score = 0;
+    int nlabs = 0;
+    for (const auto& lab : labs) {
+      std::vector<StanceValidation> st;
+      for (const auto& t : s.per_trial[r])
+        if (t.lab == lab && use(t)) {
+          if (t.failed) return std::numeric_limits<double>::quiet_NaN();
+          st.insert(st.end(), t.stances.begin(), t.stances.end());
+        }
+      if (st.empty()) continue;
+      const MeanMetrics m = mean_rrmse(st);
+      score += (m.vertical + m.anterior + m.cop) / 3.0, ++nlabs;
+    }
+    return nlabs ? score / nlabs : std::numeric_limits<double>::quiet_NaN();
+  };
   auto choose = [&](const std::function<bool(const StudyTrialResult&)>& use) {
     std::size_t best = 0;
     double best_score = std::numeric_limits<double>::infinity();
     for (std::size_t r = 0; r < s.per_trial.size(); ++r) {
-      // Each lab weighs the same, whatever its number of stances (a 30 s treadmill run has 80).
-      double score = 0;
-      int nlabs = 0;
-      bool failed = false;
-      for (const auto& lab : labs) {
-        std::vector<StanceValidation> st;
-        for (const auto& t : s.per_trial[r])
-          if (t.lab == lab && use(t)) {
-            failed = failed || t.failed;
-            st.insert(st.end(), t.stances.begin(), t.stances.end());
-          }
-        if (st.empty()) continue;
-        const MeanMetrics m = mean_rrmse(st);
-        score += (m.vertical + m.anterior + m.cop) / 3.0, ++nlabs;
-      }
-      if (failed || nlabs == 0) continue;  // a setting that breaks a trial is never chosen
-      score /= nlabs;
-      if (score < best_score - 1e-9) best_score = score, best = r;
+      const double score = criterion(r, use);
+      if (score < best_score - 1e-9) best_score = score, best = r;  // NaN never wins
     }
     return best;
   };
   CrossValidation cv;
+  for (std::size_t r = 0; r < s.per_trial.size(); ++r)
+    cv.criterion.emplace_back(s.rows[r].label, criterion(r, [](const StudyTrialResult&) { return true; }));
   const std::size_t all = choose([](const StudyTrialResult&) { return true; });
   cv.in_sample_choice = s.rows[all].label;
   // Each trial's held-out result: its lab's choice made on the other labs.
@@ -195,6 +200,12 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
   char b[256];
   os << "\nleave-one-lab-out (" << s.kind << "): chosen on all trials: " << cv.in_sample_choice << "\n";
   for (const auto& [lab, choice] : cv.lab_choice) os << "  without " << lab << ": " << choice << "\n";
+  os << "criterion on all trials (mean over labs of (vertical + anterior + COP) / 3, %):";
+  for (const auto& [label, c] : cv.criterion) {
+    std::snprintf(b, sizeof b, " %s %.2f;", label.c_str(), c);
+    os << b;
+  }
+  os << "\n";
   std::snprintf(b, sizeof b, "%-14s %-10s %9s %9s %9s %10s   %s\n", "activity", "", "vertical", "anterior", "COP", "total GRM",
                 "worst trial (vertical)");
   os << b;
@@ -223,6 +234,7 @@ nlohmann::json cross_validation_json(const CrossValidation& cv) {
   nlohmann::json j;
   j["criterion"] = "mean over labs of the lab's mean per-stance (vertical + anterior + COP) / 3 rRMSE, all activities pooled";
   j["in_sample_choice"] = cv.in_sample_choice;
+  for (const auto& [label, c] : cv.criterion) j["criterion_all_trials"][label] = num(c);
   for (const auto& [lab, choice] : cv.lab_choice) j["choice_without_lab"][lab] = choice;
   for (const auto& c : cv.cells)
     j["activities"][c.activity] = {{"in_sample", metrics(c.in_sample, c.in_sample_total_grm)},

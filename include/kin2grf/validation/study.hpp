@@ -66,6 +66,7 @@ struct StudyTrialResult {
 /// serves every activity, as kin2grf's defaults do). Ties keep the first (lowest) setting.
 struct CrossValidation {
   std::string in_sample_choice;                   ///< the setting chosen on every trial
+  std::vector<std::pair<std::string, double>> criterion;  ///< per setting, on every trial
   std::vector<std::pair<std::string, std::string>> lab_choice;  ///< held lab -> setting chosen without it
   /// Per activity, then "all": in-sample (every trial at the in-sample choice) and held-out (each
   /// lab's trials at the choice made without that lab), and the worst trial's vertical rRMSE.
