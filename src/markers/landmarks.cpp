@@ -88,6 +88,73 @@ bool cluster_frame(const std::vector<Eigen::MatrixX3d>& c, Eigen::Index i, Eigen
   return true;
 }
 
+/// SCoRE (Ehrig et al. 2006, J Biomech 39:2798): the joint centre is the point fixed in both
+/// segments, c1 in the proximal cluster's frame and c2 in the distal one's, by least squares over
+/// every frame where both clusters are seen: sum_i |R1_i c1 + o1_i - R2_i c2 - o2_i|^2 -> min.
+/// A hinge (the knee in gait) leaves the point's place along its axis undetermined: directions of
+/// the normal equations with an eigenvalue below kScoreHingeRatio of the largest take the prior,
+/// the midpoint of the two cluster centroids (on the limb, near the joint), so that the centre
+/// stays on the limb instead of drifting along the axis. Returns the lab positions (N x 3, NaN
+/// where either cluster is missing) and a message with the fit's residual; empty when the
+/// clusters are never seen together in at least 20 frames.
+constexpr double kScoreHingeRatio = 1e-2;
+
+Eigen::MatrixX3d functional_joint_centre(const std::vector<Eigen::MatrixX3d>& prox, const std::vector<Eigen::MatrixX3d>& dist,
+                                         std::string& message) {
+  const Eigen::Index n = prox.front().rows();
+  Eigen::Matrix<double, 6, 6> AtA = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> Atb = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> prior = Eigen::Matrix<double, 6, 1>::Zero();
+  std::vector<Eigen::Index> frames;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Eigen::Matrix3d R1, R2;
+    Eigen::Vector3d o1, o2;
+    if (!cluster_frame(prox, i, R1, o1) || !cluster_frame(dist, i, R2, o2)) continue;
+    Eigen::Matrix<double, 3, 6> A;
+    A << R1, -R2;
+    const Eigen::Vector3d b = o2 - o1;
+    AtA += A.transpose() * A;
+    Atb += A.transpose() * b;
+    const Eigen::Vector3d mid = 0.5 * (o1 + o2);
+    prior.head<3>() += R1.transpose() * (mid - o1);
+    prior.tail<3>() += R2.transpose() * (mid - o2);
+    frames.push_back(i);
+  }
+  if (frames.size() < 20) {
+    message = "the two segments' clusters are seen together in " + std::to_string(frames.size()) +
+              " frames; a functional joint centre needs 20 or more";
+    return {};
+  }
+  prior /= static_cast<double>(frames.size());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(AtA);
+  const double top = es.eigenvalues().maxCoeff();
+  Eigen::Matrix<double, 6, 1> x = prior;
+  const Eigen::Matrix<double, 6, 1> g = Atb - AtA * prior;
+  int dropped = 0;
+  for (int k = 0; k < 6; ++k) {
+    const double lambda = es.eigenvalues()[k];
+    if (lambda > kScoreHingeRatio * top) x += es.eigenvectors().col(k) * (es.eigenvectors().col(k).dot(g) / lambda);
+    else ++dropped;
+  }
+  Eigen::MatrixX3d P = Eigen::MatrixX3d::Constant(n, 3, kNaN);
+  double sq = 0;
+  for (const Eigen::Index i : frames) {
+    Eigen::Matrix3d R1, R2;
+    Eigen::Vector3d o1, o2;
+    cluster_frame(prox, i, R1, o1);
+    cluster_frame(dist, i, R2, o2);
+    const Eigen::Vector3d p1 = R1 * x.head<3>() + o1, p2 = R2 * x.tail<3>() + o2;
+    sq += (p1 - p2).squaredNorm();
+    P.row(i) = (0.5 * (p1 + p2)).transpose();
+  }
+  char b[200];
+  std::snprintf(b, sizeof b, "functional joint centre (SCoRE) from %zu frames, the two segments' points %.1f mm apart (RMS)%s",
+                frames.size(), 1000 * std::sqrt(sq / static_cast<double>(frames.size())),
+                dropped ? "; a hinge: its place along the axis from the limb's midline" : "");
+  message = b;
+  return P;
+}
+
 }  // namespace
 
 const char* landmark_name(int id) { return kNames[id]; }
@@ -101,6 +168,10 @@ std::vector<std::string> MarkerSet::motion_markers() const {
   for (const auto& r : rules) {
     if (r.kind == "marker" || r.kind == "mean") out.insert(out.end(), r.markers.begin(), r.markers.end());
     if (r.kind == "static") out.insert(out.end(), r.cluster.begin(), r.cluster.end());
+    if (r.kind == "functional") {
+      out.insert(out.end(), r.cluster.begin(), r.cluster.end());
+      out.insert(out.end(), r.markers.begin(), r.markers.end());
+    }
     for (const auto& [k, v] : r.pelvis) out.push_back(v);
   }
   return out;
@@ -129,6 +200,14 @@ MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
         rule.markers = r["static"].get<std::vector<std::string>>();
         rule.cluster = r.at("cluster").get<std::vector<std::string>>();
         if (rule.cluster.size() < 3) throw InputError(source + ": landmark '" + kNames[id] + "': a cluster needs 3 or more markers");
+      } else if (r.contains("functional")) {
+        // A joint centre from the motion itself (SCoRE): the point fixed in both segments.
+        rule.kind = "functional";
+        const auto& f = r["functional"];
+        rule.cluster = f.at("proximal").get<std::vector<std::string>>();
+        rule.markers = f.at("distal").get<std::vector<std::string>>();
+        if (rule.cluster.size() < 3 || rule.markers.size() < 3)
+          throw InputError(source + ": landmark '" + kNames[id] + "': a functional joint needs 3 or more markers on each segment");
       } else if (r.contains("pelvis_up")) {
         rule.kind = "pelvis_up";
         rule.value = r["pelvis_up"].get<double>();
@@ -211,6 +290,14 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
       out.messages.push_back("shoulder: no upper-body markers; the torso is an upright segment of " +
                              std::to_string(r.value).substr(0, 4) + " m above the hip centre, its top swaying by " +
                              std::to_string(r.sway_gain).substr(0, 4) + " x the hip's fore-aft oscillation, an approximation");
+    } else if (r.kind == "functional") {
+      std::vector<Eigen::MatrixX3d> prox, dist;
+      for (const auto& c : r.cluster) prox.push_back(marker(m, c, path, what));
+      for (const auto& c : r.markers) dist.push_back(marker(m, c, path, what));
+      std::string msg;
+      P = functional_joint_centre(prox, dist, msg);
+      if (P.rows() == 0) throw InputError(path + ": landmark " + kNames[id] + ": " + msg);
+      out.messages.push_back(std::string(kNames[id]) + ": " + msg);
     } else if (r.kind == "static") {
       if (!st) {
         throw InputError(path + ": landmark " + kNames[id] + " of marker set '" + set.name +
