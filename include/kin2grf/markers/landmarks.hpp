@@ -12,6 +12,11 @@
 //   {"static": ["R.Knee.Lat", "R.Knee.Med"], "cluster": ["R.Thigh.Upper", ...]}
 //       a virtual landmark: the mean of the static markers, expressed in the cluster's frame in
 //       the static trial, carried by the cluster (least-squares rigid fit) in the motion trial.
+//   {"functional": {"proximal": ["RTH1", ..], "distal": ["RTB1", ..]}}
+//       a joint centre from the motion itself, no static trial (SCoRE, Ehrig et al. 2006, J
+//       Biomech 39:2798): the point fixed in both clusters' frames by least squares over the
+//       trial; a hinge's place along its axis (which the motion does not tell, and a sagittal model
+//       does not need) is taken from the midpoint of the two clusters.
 //   {"pelvis_up": 0.50}                       shoulder fallback when a set has no upper-body
 //       markers: the given length straight up (lab vertical) from the hip centre: a rigid
 //       upright torso (an approximation; the pelvis's tilt and oscillations are not the trunk's).
@@ -39,9 +44,9 @@
 namespace kin2grf {
 
 struct LandmarkRule {
-  std::string kind;                  ///< marker, mean, harrington, static, pelvis_up, virtual_hallux
-  std::vector<std::string> markers;  ///< marker / mean / static markers
-  std::vector<std::string> cluster;  ///< static: tracking cluster
+  std::string kind;                  ///< marker, mean, harrington, static, functional, pelvis_up, virtual_hallux
+  std::vector<std::string> markers;  ///< marker / mean / static markers; functional: the distal cluster
+  std::vector<std::string> cluster;  ///< static: tracking cluster; functional: the proximal cluster
   std::map<std::string, std::string> pelvis;  ///< harrington / pelvis_up: rasis, lasis, rpsis, lpsis | sacrum
   double value = 0.0;                ///< pelvis_up length (m), virtual_hallux fraction
   /// pelvis_up: the shoulder point's horizontal sway as a fraction of the hip centre's (see
