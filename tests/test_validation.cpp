@@ -338,3 +338,19 @@ TEST(Study, LeaveOneLabOutScoresEachLabAtTheOthersChoice) {
     for (auto& t : row) t.lab.assign(1, 'A');
   EXPECT_THROW((void)cross_validate(one), InputError);
 }
+
+// A foot standing beside the plates (issue 9): the squat's left plate reads nothing, as if the
+// left foot stood on the floor next to it. The total must not compare those frames, even with the
+// plates-against-kinematics check switched off: the left foot is planted (a sole point on the
+// ground and still) outside every kept stance of that foot, which the kinematics alone tell.
+TEST(Validate, FootBesideThePlatesKeepsTheTotalOut) {
+  auto s = synthetic_with_exact_plates();
+  ValidationOptions o;
+  o.total_mismatch_fraction = 10.0;  // the kinematic-total check off: only the planted-foot rule acts
+  ASSERT_TRUE(validate(s.estimate, s.plates, o).total.has_value()) << "both feet on plates: a total";
+  for (auto& p : s.plates.plates)
+    if (p.name == "FP2") p.force_N.setZero(), p.cop_m.setConstant(std::nan("")), p.moment_centre_Nm.setZero();
+  const auto v = validate(s.estimate, s.plates, o);
+  ASSERT_EQ(v.stances.size(), 1u);
+  EXPECT_FALSE(v.total.has_value()) << v.total->frames.size() << " frames compared";
+}

@@ -1,6 +1,7 @@
 #include "kin2grf/validation/validate.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -44,6 +45,32 @@ double mean_finite(const Eigen::VectorXd& v) {
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (std::isfinite(v[i])) s += v[i], ++k;
   return k ? s / k : kNaN;
+}
+
+/// Per foot and frame: a sole point (A, B or C) within kPlantedGapM of the ground and moving
+/// slower than kPlantedSpeedMps relative to it (or the belt): the foot stands on the floor.
+constexpr double kPlantedGapM = 0.02, kPlantedSpeedMps = 0.3;
+
+std::array<std::vector<bool>, 2> planted_feet(const EstimateResult& e) {
+  const Eigen::Index n = e.time_s.size();
+  std::array<std::vector<bool>, 2> out;
+  for (int side = 0; side < 2; ++side) {
+    auto& o = out[static_cast<std::size_t>(side)];
+    o.assign(static_cast<std::size_t>(n), false);
+    const auto& S = e.feet[static_cast<std::size_t>(side)].sole_m;
+    if (S.rows() != n || n < 3) continue;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index a = std::max<Eigen::Index>(0, i - 1), b = std::min<Eigen::Index>(n - 1, i + 1);
+      const double dt = e.time_s[b] - e.time_s[a];
+      if (!(dt > 0)) continue;
+      for (int k = 0; k < 3; ++k) {
+        const double gap = S(i, 2 * k + 1) - e.ground_level_m;
+        const double vx = (S(b, 2 * k) - S(a, 2 * k)) / dt - e.frame.belt_velocity_mps;
+        if (gap < kPlantedGapM && std::abs(vx) < kPlantedSpeedMps) o[static_cast<std::size_t>(i)] = true;
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -347,9 +374,22 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
   for (int pi = 0; pi < np && pi < 32; ++pi)
     for (Eigen::Index i = 0; i < n; ++i)
       if (v.plates[static_cast<std::size_t>(pi)].force_N(i, 1) > o.threshold_N) mask[static_cast<std::size_t>(i)] |= 1u << pi;
+  // A foot on the floor off the plates, from the kinematics alone (not the estimate's contact
+  // state): a sole point within kPlantedGapM of the ground and slower than kPlantedSpeedMps
+  // (relative to the belt) while no kept stance of that foot covers the frame. The plates then
+  // miss part of the body's load, whatever the other frames of its run say: the frame is left
+  // out of an accepted run (it does not split runs, so it can only remove frames).
+  const auto planted = planted_feet(e);
+  std::vector<bool> off_plate(static_cast<std::size_t>(n), false);
   for (Eigen::Index i = 0; i < n; ++i) {
     const unsigned mk = mask[static_cast<std::size_t>(i)];
     if (mk == 0) ok[static_cast<std::size_t>(i)] = false;
+    for (int side = 0; side < 2; ++side) {
+      if (!planted[static_cast<std::size_t>(side)][static_cast<std::size_t>(i)]) continue;
+      bool on_plate = false;
+      for (const Candidate& c : cands) on_plate = on_plate || (c.kept && c.foot == side && i >= c.run.first && i <= c.run.last);
+      if (!on_plate) off_plate[static_cast<std::size_t>(i)] = true;
+    }
     for (int pi = 0; pi < np && pi < 32; ++pi) {
       if (!(mk & (1u << pi))) continue;
       bool covered = false;
@@ -379,7 +419,8 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
         mis.push_back(std::abs(sum - e.kinematic_total(k, 1)));
       }
       if (median(mis) < o.total_mismatch_fraction * bw)
-        for (Eigen::Index k = i; k <= j; ++k) tv.frames.push_back(k);
+        for (Eigen::Index k = i; k <= j; ++k)
+          if (!off_plate[static_cast<std::size_t>(k)]) tv.frames.push_back(k);
     }
     i = j + 1;
   }

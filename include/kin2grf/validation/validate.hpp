@@ -24,7 +24,9 @@
 // 5. Total: frames where every plate in use belongs to a kept stance and the plates carry the
 //    whole body (median |sum of plate F_y - sum m (a_y + g)| < 15 % of body weight over each run
 //    of frames with the same plates loaded, sum m(a+g) from the kinematics alone), i.e. every
-//    loaded foot is on a plate. Vertical, anterior and the GRM about the midpoint of the plate
+//    loaded foot is on a plate; and no foot stands on the floor off the plates: a frame where a
+//    foot has a sole point within 2 cm of the ground and slower than 0.3 m/s (the kinematics,
+//    not the estimate's contact state) outside every kept stance of that foot is left out. Vertical, anterior and the GRM about the midpoint of the plate
 //    centres in use (without geometry: the mean measured COP over those frames, the belt's
 //    centre on a treadmill).
 #pragma once
