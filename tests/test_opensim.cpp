@@ -66,7 +66,14 @@ TEST(Sto, VersionOneAndOldHeadersAndCountChecks) {
   const Table rt = parse_sto(format_sto(t), "rt.sto");
   EXPECT_EQ(rt.labels, t.labels);
   EXPECT_EQ(rt.data, t.data);
-  EXPECT_THROW(parse_sto("grf\nnRows=3\nnColumns=3\nendheader\ntime\ta\tb\n0\t1\t2\n", "rows.mot"), InputError);
+  // A row count that disagrees with the rows (OpenSim's own examples: datarows 901 over 601 rows)
+  // is read, with a warning.
+  const Table rows = parse_sto("grf\nnRows=3\nnColumns=3\nendheader\ntime\ta\tb\n0\t1\t2\n", "rows.mot");
+  EXPECT_EQ(rows.data.rows(), 1);
+  ASSERT_EQ(rows.warnings.size(), 1u);
+  EXPECT_NE(rows.warnings[0].find("header says 3 rows but 1"), std::string::npos) << rows.warnings[0];
+  EXPECT_THROW(parse_sto("grf\nnRows=1e300\nnColumns=3\nendheader\ntime\ta\tb\n0\t1\t2\n", "huge.mot"), InputError);
+  EXPECT_THROW(parse_sto("grf\nnRows=1\nnColumns=9923372036854775808\nendheader\ntime\ta\tb\n0\t1\t2\n", "cols.mot"), InputError);
   EXPECT_THROW(parse_sto("grf\nnRows=1\nnColumns=4\nendheader\ntime\ta\tb\n0\t1\t2\n", "cols.mot"), InputError);
   EXPECT_THROW(parse_sto("grf\nendheader\ntime\ta\tb\n0\t1\n", "short.mot"), InputError);
   EXPECT_THROW(parse_sto("no header\n0 1 2\n", "nohdr.mot"), InputError);
@@ -112,4 +119,45 @@ TEST(SharedOpenSim, TrcFirstFrameAndUnits) {
   const int rcal = t.markers.find("RCAL");
   ASSERT_GE(rcal, 0);
   EXPECT_LT(std::abs(t.markers.positions_m[static_cast<std::size_t>(rcal)](0, 1)), 1.0) << "metres, not mm";
+}
+
+// Issue 10's crashes and silent errors in text files.
+TEST(Sto, AHugeColumnLabelIsReadWithoutRecursion) {
+  // A 30 KB label overflowed the stack of std::regex_match in grf_from_table.
+  const std::string prefix(30000, 'a');
+  std::string text = "grf\nendheader\ntime";
+  for (const char* c : {"vx", "vy", "vz", "px", "py", "pz"}) text += "\t" + prefix + "ground_force_" + c;
+  text += "\n0\t1\t700\t3\t0.1\t0\t0.2\n0.01\t1\t700\t3\t0.1\t0\t0.2\n";
+  const Table t = parse_sto(text, "long.mot");
+  std::vector<std::string> w;
+  const auto rec = grf_from_table(t, "long.mot", 10.0, w);
+  ASSERT_TRUE(rec.has_value());
+  ASSERT_EQ(rec->plates.size(), 1u);
+  EXPECT_DOUBLE_EQ(rec->plates[0].force_N(0, 1), 700.0);
+}
+
+TEST(Trc, DataRateThatDisagreesWithTheTimeColumnIsCorrected) {
+  MarkerTrajectories m;
+  m.rate_hz = 25;
+  m.first_frame = 1;
+  m.time_s = Eigen::VectorXd::LinSpaced(10, 0, 0.36);  // 0.04 s steps: 25 Hz
+  m.names = {"A"};
+  m.descriptions = {""};
+  m.positions_m = {Eigen::MatrixX3d::Constant(10, 3, 0.5)};
+  std::string text = format_trc(m, "rate.trc");
+  const auto at = text.find("25\t25");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 2, "250");  // DataRate 250 Hz over a 25 Hz Time column
+  std::vector<std::string> w;
+  const auto back = parse_trc(text, "rate.trc", &w);
+  EXPECT_NEAR(back.rate_hz, 25.0, 1e-9);
+  bool warned = false;
+  for (const auto& s : w) warned = warned || s.find("DataRate says 250") != std::string::npos;
+  EXPECT_TRUE(warned);
+  // A Frame# of 1e300 is refused, not cast.
+  std::string bad = format_trc(m, "frame.trc");
+  const auto row = bad.find("\n1\t");
+  ASSERT_NE(row, std::string::npos);
+  bad.replace(row + 1, 1, "1e300");
+  EXPECT_THROW((void)parse_trc(bad, "frame.trc", &w), InputError);
 }

@@ -97,6 +97,7 @@ Trial load_by_extension(const std::string& path, const LoadOptions& options) {
     t.format = ext == "mot" ? "MOT" : "STO";
     t.encoding = "text";
     const Table table = read_sto(path);
+    t.warnings.insert(t.warnings.end(), table.warnings.begin(), table.warnings.end());
     t.plates = grf_from_table(table, path, options.cop_threshold_N, t.warnings);
     if (!t.plates) t.warnings.push_back("no ground_force columns: not a GRF file (" +
                                         std::to_string(table.labels.size()) + " columns)");

@@ -1,10 +1,10 @@
 #include "kin2grf/io/opensim.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <regex>
 #include <sstream>
 
 #include "kin2grf/error.hpp"
@@ -112,8 +112,8 @@ MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
     if (cells.size() < nm * 3 + 2) ++short_rows;
     std::vector<double> r(nm * 3 + 1, kNaN);
     double fr = kNaN;
-    if (!parse_double(cells[0], fr) || !std::isfinite(fr))
-      throw InputError(where(path, li) + ": Frame# '" + cells[0] + "' is not a number");
+    if (!parse_double(cells[0], fr) || !std::isfinite(fr) || std::abs(fr) > 1e9)
+      throw InputError(where(path, li) + ": Frame# '" + cells[0] + "' is not a frame number");
     if (cells.size() < 2 || !parse_double(cells[1], r[0]) || !std::isfinite(r[0]))
       throw InputError(where(path, li) + ": Time is missing or not a number");
     for (std::size_t c = 2; c < cells.size(); ++c) {
@@ -158,6 +158,21 @@ MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
     if (i > 0 && !(m.time_s[i] > m.time_s[i - 1]))
       throw InputError(path + ": Time does not increase at frame " + std::to_string(frames[static_cast<std::size_t>(i)]));
   }
+  if (n >= 3) {
+    // DataRate against the Time column: the samples' own spacing wins (a wrong DataRate scales
+    // every derivative), with a warning.
+    std::vector<double> dts(static_cast<std::size_t>(n - 1));
+    for (Eigen::Index i = 1; i < n; ++i) dts[static_cast<std::size_t>(i - 1)] = m.time_s[i] - m.time_s[i - 1];
+    std::nth_element(dts.begin(), dts.begin() + static_cast<long>(dts.size() / 2), dts.end());
+    const double rate = 1.0 / dts[dts.size() / 2];
+    if (std::isfinite(rate) && std::abs(rate - m.rate_hz) > 0.01 * rate) {
+      if (warnings)
+        warnings->push_back("DataRate says " + fmt(m.rate_hz) + " Hz but the Time column steps by " + fmt(1.0 / rate) +
+                            " s (" + fmt(rate) + " Hz); the Time column's rate is used");
+      m.rate_hz = rate;
+    }
+  }
+  if (!(m.rate_hz > 0 && m.rate_hz < 1e6)) throw InputError(where(path, 2) + ": DataRate " + fmt(m.rate_hz) + " Hz is not a sampling rate");
   return m;
 }
 
@@ -234,7 +249,7 @@ Table parse_sto(const std::string& text, const std::string& path) {
       auto it = t.header.find(k);
       if (it == t.header.end()) continue;
       double v;
-      if (!parse_double(it->second, v) || !std::isfinite(v) || v < 0)
+      if (!parse_double(it->second, v) || !std::isfinite(v) || v < 0 || v > 1e9 || v != std::floor(v))
         throw InputError(path + ": header field " + std::string(k) + " = '" + it->second + "' is not a count");
       return static_cast<long>(v);
     }
@@ -265,8 +280,10 @@ Table parse_sto(const std::string& text, const std::string& path) {
     ++nrows;
   }
   if (nrow_decl >= 0 && nrow_decl != nrows) {
-    throw InputError(path + ": header says " + std::to_string(nrow_decl) + " rows but " +
-                     std::to_string(nrows) + " data rows follow");
+    // OpenSim's own example files have such headers (datarows 901 over 601 rows): the rows are
+    // what the file holds; the header is noted, not trusted.
+    t.warnings.push_back(path + ": header says " + std::to_string(nrow_decl) + " rows but " + std::to_string(nrows) +
+                         " data rows follow; the rows are read");
   }
   t.data.resize(nrows, static_cast<Eigen::Index>(ncol));
   for (long r = 0; r < nrows; ++r)
@@ -297,12 +314,16 @@ void write_sto(const std::string& path, const Table& t) { write_file_text(path, 
 std::optional<ForcePlateRecording> grf_from_table(const Table& t, const std::string& path,
                                                   double cop_threshold_N,
                                                   std::vector<std::string>& warnings) {
-  static const std::regex vre("^(.*)ground_force_(.*)v([xyz])$");
+  // Labels PREFIXground_force_SIDEvx (OpenSim's convention, e.g. "ground_force_vx",
+  // "1_ground_force_vx", "ground_force_1_vx"). Parsed by hand: a regex match recurses per
+  // character and overflowed the stack on a 30 KB label.
   struct Set { std::string prefix, side; };
   std::vector<Set> sets;
+  static const std::string key = "ground_force_";
   for (const auto& l : t.labels) {
-    std::smatch mm;
-    if (std::regex_match(l, mm, vre) && mm[3] == "x") sets.push_back({mm[1], mm[2]});
+    const std::size_t pos = l.rfind(key);
+    if (pos == std::string::npos || l.size() < pos + key.size() + 2 || l.compare(l.size() - 2, 2, "vx") != 0) continue;
+    sets.push_back({l.substr(0, pos), l.substr(pos + key.size(), l.size() - 2 - pos - key.size())});
   }
   if (sets.empty()) return std::nullopt;
   if (t.data.rows() < 2) throw InputError(path + ": a GRF table needs at least 2 rows");

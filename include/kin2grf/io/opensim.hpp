@@ -26,6 +26,7 @@ struct Table {
   Eigen::MatrixXd data;             ///< rows x labels
   std::map<std::string, std::string> header;
   bool in_degrees = false;
+  std::vector<std::string> warnings;  ///< what the reader noticed and read anyway
   [[nodiscard]] int column(const std::string& label) const;  ///< -1 when absent
 };
 
