@@ -24,14 +24,59 @@ double progression_speed(const SagittalLandmarks& lm) {
   return v.empty() ? 0.0 : median(v);
 }
 
+namespace {
+
+void require(bool ok, const std::string& setting, double value, const std::string& allowed) {
+  if (ok) return;
+  char b[64];
+  std::snprintf(b, sizeof b, "%g", value);
+  throw InputError("setting " + setting + " = " + b + ": must be " + allowed);
+}
+
+}  // namespace
+
+void check_options(const EstimateOptions& o) {
+  const auto finite = [](double x) { return std::isfinite(x); };
+  require(finite(o.kinematic_cutoff_hz) && o.kinematic_cutoff_hz > 0, "kinematic cut-off (Hz)", o.kinematic_cutoff_hz,
+          "a number above 0 (paper: 6)");
+  require(finite(o.post_cutoff_hz) && o.post_cutoff_hz >= 0, "post-filter cut-off (Hz)", o.post_cutoff_hz,
+          "0 (no post-filter) or a number above 0 (paper: 12)");
+  require(finite(o.solver.r_N_per_m) && o.solver.r_N_per_m > 0, "activation parameter r (N/m)", o.solver.r_N_per_m,
+          "a number above 0 (kin2grf: 1000, paper: 10000)");
+  require(finite(o.contact.ground_shift_m) && std::abs(o.contact.ground_shift_m) <= 1.0, "ground shift (m)", o.contact.ground_shift_m,
+          "between -1 and 1");
+  if (o.ground_level_m)
+    require(finite(*o.ground_level_m) && std::abs(*o.ground_level_m) <= 10.0, "ground level (m)", *o.ground_level_m, "between -10 and 10");
+  require(o.landmarks.max_gap_frames >= 0 && o.landmarks.max_gap_frames <= 100000, "longest gap filled (frames)",
+          o.landmarks.max_gap_frames, "between 0 and 100000");
+  require(finite(o.solver.speed_gate_mps) && o.solver.speed_gate_mps >= 0 && o.solver.speed_gate_mps <= 20, "speed gate (m/s)",
+          o.solver.speed_gate_mps, "between 0 (none) and 20");
+  require(finite(o.solver.speed_gate_ratio) && o.solver.speed_gate_ratio >= 0 && o.solver.speed_gate_ratio <= 20,
+          "speed gate ratio", o.solver.speed_gate_ratio, "between 0 (a fixed gate) and 20");
+  require(finite(o.solver.speed_gate_floor_mps) && o.solver.speed_gate_floor_mps >= 0 && o.solver.speed_gate_floor_mps <= 20,
+          "speed gate floor (m/s)", o.solver.speed_gate_floor_mps, "between 0 and 20");
+  require(finite(o.solver.min_split_distance_m) && o.solver.min_split_distance_m >= 0 && o.solver.min_split_distance_m <= 1,
+          "split distance (m)", o.solver.min_split_distance_m, "between 0 (none) and 1");
+  require(o.grm_reference_m.allFinite(), "GRM reference (m)", o.grm_reference_m.x() + o.grm_reference_m.y(), "finite");
+  if (o.mass_kg)
+    require(finite(*o.mass_kg) && *o.mass_kg > 0 && (o.allow_unusual_mass || (*o.mass_kg >= kMassRangeKg[0] && *o.mass_kg <= kMassRangeKg[1])),
+            "body mass (kg)", *o.mass_kg, "between 20 and 300 (or allowed as unusual)");
+}
+
 EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
+  check_options(o);
   EstimateResult r;
   r.marker_set = set.name;
   if (o.mass_kg) r.mass_kg = *o.mass_kg;
   else if (trial.body_mass_kg) r.mass_kg = *trial.body_mass_kg;
-  else throw InputError(trial.path + ": no body mass: the file stores none (PROCESSING:Bodymass); give --mass KG");
+  else throw InputError(trial.path + ": no body mass: the file stores none (PROCESSING:Bodymass, SUBJECT(S):WEIGHT); give the mass");
+  if (!o.mass_kg && !o.allow_unusual_mass && !(r.mass_kg >= kMassRangeKg[0] && r.mass_kg <= kMassRangeKg[1])) {
+    char b[200];
+    std::snprintf(b, sizeof b, ": the file's body mass %g kg is outside 20-300 kg; give the mass (or allow an unusual one)", r.mass_kg);
+    throw InputError(trial.path + b);
+  }
   if (trial.markers.frames() == 0) throw InputError(trial.path + ": the trial has no marker frames");
   const Landmarks3D lm3 = compute_landmarks(set, trial.markers, static_trial ? &static_trial->markers : nullptr,
                                             o.landmarks, trial.path);

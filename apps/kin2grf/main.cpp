@@ -2,7 +2,9 @@
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -37,7 +39,7 @@ kin2grf::LoadOptions load_options(const std::string& zero) {
 int run_info(const std::string& file, bool json, double threshold, const std::string& zero) {
   const kin2grf::Trial t = kin2grf::load_trial(file, load_options(zero));
   const auto s = kin2grf::trial_summary(t, threshold);
-  if (json) std::cout << s.dump(2) << "\n";
+  if (json) std::cout << kin2grf::json_text(s);
   else std::cout << kin2grf::format_summary(s);
   return 0;
 }
@@ -49,7 +51,9 @@ struct EstimateArgs {
       anthropometry = kin2grf::EstimateOptions{}.anthropometry, up_axis, cop_function, running_cop = "builtin",
       torso_length = torso_length_name(kin2grf::EstimateOptions{}.torso_length);
   // Numerical defaults come from the library's option structs (one source for CLI and API).
-  double mass = 0, r = kin2grf::SolverOptions{}.r_N_per_m, kin_cutoff = kin2grf::EstimateOptions{}.kinematic_cutoff_hz,
+  std::optional<double> mass;
+  bool force_mass = false;
+  double r = kin2grf::SolverOptions{}.r_N_per_m, kin_cutoff = kin2grf::EstimateOptions{}.kinematic_cutoff_hz,
          post_cutoff = kin2grf::EstimateOptions{}.post_cutoff_hz, ground_shift = 0,
          speed_gate = kin2grf::SolverOptions{}.speed_gate_mps, split_distance = kin2grf::SolverOptions{}.min_split_distance_m,
          speed_gate_ratio = kin2grf::SolverOptions{}.speed_gate_ratio, speed_gate_floor = kin2grf::SolverOptions{}.speed_gate_floor_mps;
@@ -63,7 +67,8 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
   c->add_option("TRIAL", a.trial, "Motion trial (C3D or TRC)")->required();
   c->add_option("--static", a.static_trial, "Static calibration trial (for virtual knee/ankle landmarks)");
   c->add_option("--markers", a.markers, "Marker-set preset name or mapping file (JSON); default: recognised");
-  c->add_option("--mass", a.mass, "Body mass, kg (default: PROCESSING:Bodymass of a C3D)");
+  c->add_option("--mass", a.mass, "Body mass, kg (default: the C3D's PROCESSING:Bodymass or SUBJECT(S):WEIGHT); 20-300");
+  c->add_flag("--force-mass", a.force_mass, "Accept a body mass outside 20-300 kg");
   c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
       ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
   c->add_option_function<double>(
@@ -114,7 +119,8 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
 
 kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
   kin2grf::EstimateOptions o;
-  if (a.mass > 0) o.mass_kg = a.mass;
+  o.mass_kg = a.mass;  // any given value, checked by the library (a negative one is refused, not ignored)
+  o.allow_unusual_mass = a.force_mass;
   o.anthropometry = (a.paper && !a.anthropometry_given) ? "winter" : a.anthropometry;
   o.kinematic_cutoff_hz = a.kin_cutoff;
   o.post_cutoff_hz = a.post_cutoff;
@@ -219,15 +225,23 @@ kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, kin2grf::Estima
   return r;
 }
 
+/// The files a run reads: no output may be one of them.
+std::vector<std::string> inputs_of(const EstimateArgs& a) { return {a.trial, a.static_trial, a.markers, a.cop_function, a.running_cop}; }
+
+void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
+  for (const auto& o : outputs) kin2grf::ensure_not_an_input(o, inputs);
+}
+
 int run_estimate(const EstimateArgs& a) {
+  check_outputs({a.out_mot, a.out_csv, a.out_json}, inputs_of(a));
   const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
   const auto options = to_options(a);
   const auto r = run_estimate_core(a, options, trial);
   if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r);
   if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::format_results_csv(r));
-  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::results_summary(r, settings_json(a, options)).dump(2) + "\n");
+  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(kin2grf::results_summary(r, settings_json(a, options))));
   if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty())
-    std::cout << kin2grf::results_summary(r, settings_json(a, options)).dump(2) << "\n";
+    std::cout << kin2grf::json_text(kin2grf::results_summary(r, settings_json(a, options)));
   return 0;
 }
 
@@ -238,6 +252,13 @@ struct ValidateArgs {
 };
 
 int run_validate(const ValidateArgs& a) {
+  {
+    auto in = inputs_of(a.est);
+    in.push_back(a.plates);
+    check_outputs({a.out_json, a.report}, in);
+  }
+  if (!(std::isfinite(a.options.threshold_N) && a.options.threshold_N > 0))
+    throw kin2grf::InputError("--threshold " + std::to_string(a.options.threshold_N) + ": must be a force above 0 N");
   const kin2grf::Trial trial = kin2grf::load_trial(a.est.trial, load_options(a.zero_offset));
   std::optional<kin2grf::Trial> plates_file;
   if (!a.plates.empty()) plates_file = kin2grf::load_trial(a.plates, load_options(a.zero_offset));
@@ -254,7 +275,7 @@ int run_validate(const ValidateArgs& a) {
   settings["zero_offset"] = a.zero_offset;
   std::cout << kin2grf::format_validation_table(a.est.trial, v);
   const auto j = kin2grf::validation_json(a.est.trial, r, v, settings);
-  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, j.dump(2) + "\n");
+  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(j));
   if (!a.report.empty()) kin2grf::write_file_text(a.report, kin2grf::validation_report_html(a.est.trial, r, v, j));
   return 0;
 }
@@ -346,6 +367,11 @@ void load_study_trials(const std::vector<StudyInput>& inputs, LoadedTrials& L) {
 }
 
 int run_study(const StudyArgs& a) {
+  {
+    std::vector<std::string> in = a.trials;
+    in.push_back(a.trial_list);
+    check_outputs({a.out_json, a.report}, in);
+  }
   std::vector<StudyInput> inputs;
   if (!a.trial_list.empty()) inputs = read_trial_list(a.trial_list);
   for (const auto& t : a.trials) {
@@ -371,7 +397,7 @@ int run_study(const StudyArgs& a) {
     std::cout << kin2grf::format_cross_validation(res, cv);
     j["cross_validation"] = kin2grf::cross_validation_json(cv);
   }
-  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, j.dump(2) + "\n");
+  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(j));
   if (!a.report.empty()) kin2grf::write_file_text(a.report, kin2grf::study_report_html(res));
   return 0;
 }
@@ -384,6 +410,7 @@ struct FitCopArgs {
 
 /// fit-cop: the COP function of foot model 2 fitted to the plate COPs of a trial list's stances.
 int run_fit_cop(const FitCopArgs& a) {
+  check_outputs({a.out}, {a.trial_list});
   std::vector<StudyInput> inputs;
   for (auto& in : read_trial_list(a.trial_list))
     if (a.activity.empty() || in.activity == a.activity) inputs.push_back(in);
@@ -425,13 +452,15 @@ int run_fit_cop(const FitCopArgs& a) {
     prov["leave_one_lab_out_cop_rrmse_percent"] = loo;
   }
   j["provenance"] = prov;
-  if (!a.out.empty()) kin2grf::write_file_text(a.out, j.dump(2) + "\n");
+  if (!a.out.empty()) kin2grf::write_file_text(a.out, kin2grf::json_text(j));
   return 0;
 }
 
 /// The bundled example: a synthetic squat on two force plates whose signals are the model's own
 /// ground reactions (written by kin2grf's own C3D, TRC and MOT writers).
 int run_make_example(const std::string& dir, double seconds) {
+  if (!(std::isfinite(seconds) && seconds >= 1.0 && seconds <= 600.0))
+    throw kin2grf::InputError("--seconds " + std::to_string(seconds) + ": must be between 1 and 600");
   std::filesystem::create_directories(dir);
   kin2grf::SyntheticOptions so;
   so.duration_s = seconds;
@@ -529,12 +558,18 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   try {
-    if (*info) return run_info(info_file, info_json, info_threshold, info_zero);
-    if (*estimate) return run_estimate(est);
-    if (*validate) return run_validate(val);
-    if (*study) return run_study(study_args);
-    if (*fit_cop) return run_fit_cop(fit_args);
-    if (*make_example) return run_make_example(example_dir, example_seconds);
+    int rc = 0;
+    if (*info) rc = run_info(info_file, info_json, info_threshold, info_zero);
+    else if (*estimate) rc = run_estimate(est);
+    else if (*validate) rc = run_validate(val);
+    else if (*study) rc = run_study(study_args);
+    else if (*fit_cop) rc = run_fit_cop(fit_args);
+    else if (*make_example) rc = run_make_example(example_dir, example_seconds);
+    // Standard output closed or full: the output is lost, so the run failed.
+    std::cout.flush();
+    if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout))
+      throw kin2grf::InputError(std::string("cannot write to standard output (") + std::strerror(errno) + ")");
+    return rc;
   } catch (const kin2grf::InputError& e) {
     std::cerr << "kin2grf: error: " << e.what() << "\n";
     return 2;

@@ -19,7 +19,9 @@
 namespace kin2grf {
 
 struct EstimateOptions {
-  std::optional<double> mass_kg;           ///< else PROCESSING:Bodymass; none -> error
+  std::optional<double> mass_kg;           ///< else the file's (C3D PROCESSING/SUBJECT(S)); none -> error
+  /// Body masses outside kMassRangeKg are refused (a file's 0.5 kg, a typo) unless this is set.
+  bool allow_unusual_mass = false;
   std::string anthropometry = "de-leva";  ///< kin2grf's default; the paper cites Winter (--paper)
   double kinematic_cutoff_hz = 6.0;        ///< paper: 6 Hz
   double post_cutoff_hz = 12.0;            ///< paper: 12 Hz
@@ -75,6 +77,13 @@ struct EstimateResult {
   std::vector<std::string> messages;
   double seconds_kinematics = 0, seconds_dynamics = 0;
 };
+
+/// Plausible adult and child body masses (kg): outside, estimate() refuses unless allowed.
+inline constexpr double kMassRangeKg[2] = {20.0, 300.0};
+
+/// Every numeric setting checked before any work: InputError naming the setting, its value and
+/// the allowed range (NaN, infinities, zero or negative cut-offs, r, gaps...). estimate() calls it.
+void check_options(const EstimateOptions& options);
 
 /// The hip's horizontal speed (m/s), median over the window of its displacement over +-0.25 s.
 double progression_speed(const SagittalLandmarks& lm);

@@ -577,10 +577,16 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
     std::sort(t.events.begin(), t.events.end(),
               [](const Event& a, const Event& c) { return a.time_s < c.time_s; });
   }
-  if (const auto* bm = f.find("PROCESSING:BODYMASS"); bm && !bm->numbers.empty() &&
-                                                          std::isfinite(bm->numbers[0]) &&
-                                                          bm->numbers[0] > 0) {
-    t.body_mass_kg = bm->numbers[0];
+  // Body mass where labs store it: Vicon's PROCESSING:Bodymass, then SUBJECT(S):WEIGHT or MASS
+  // (kg). The first positive finite value is taken; its plausibility is the estimate's to judge.
+  for (const char* key : {"PROCESSING:BODYMASS", "PROCESSING:WEIGHT", "SUBJECT:WEIGHT", "SUBJECT:MASS", "SUBJECT:BODYMASS",
+                          "SUBJECTS:WEIGHT", "SUBJECTS:MASS", "SUBJECTS:BODYMASS"}) {
+    const auto* bm = f.find(key);
+    if (bm && !bm->numbers.empty() && std::isfinite(bm->numbers[0]) && bm->numbers[0] > 0) {
+      t.body_mass_kg = bm->numbers[0];
+      if (std::string(key) != "PROCESSING:BODYMASS") t.warnings.push_back(std::string("body mass from ") + key + " (kg)");
+      break;
+    }
   }
   if (const auto* h = f.find("PROCESSING:HEIGHT"); h && !h->numbers.empty() &&
                                                      std::isfinite(h->numbers[0]) && h->numbers[0] > 0) {

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <limits>
 
 #include "kin2grf/error.hpp"
@@ -290,10 +289,7 @@ std::vector<std::uint8_t> write_c3d_bytes(const Trial& trial, const C3dWriteOpti
 
 void write_c3d(const std::string& path, const Trial& trial, const C3dWriteOptions& options) {
   const auto bytes = write_c3d_bytes(trial, options);
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw InputError(path + ": cannot open for writing");
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  if (!out) throw InputError(path + ": write failed");
+  write_file_text(path, std::string(bytes.begin(), bytes.end()));  // through a temporary file
 }
 
 }  // namespace kin2grf

@@ -45,11 +45,23 @@ std::vector<std::string> split(std::string_view s, std::string_view delims, bool
 }
 
 std::vector<std::uint8_t> read_file_bytes(const std::string& path) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a directory, not a file");
+  const auto st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throw InputError(path + ": cannot open file (" + (ec ? ec.message() : std::string("no such file")) + ")");
+  if (fs::is_directory(st)) throw InputError(path + ": is a directory, not a file");
+  // A FIFO, a terminal or /dev/zero has no end to read to: refused before reading.
+  if (!fs::is_regular_file(st)) throw InputError(path + ": is not a regular file (a device, pipe or socket)");
+  const auto size = fs::file_size(path, ec);
+  if (ec) throw InputError(path + ": cannot read its size (" + ec.message() + ")");
+  if (size > kMaxInputBytes)
+    throw InputError(path + ": " + std::to_string(size >> 20) + " MiB, more than the " + std::to_string(kMaxInputBytes >> 20) +
+                     " MiB kin2grf reads");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open file (" + std::strerror(errno) + ")");
-  std::vector<std::uint8_t> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::uint8_t> data(static_cast<std::size_t>(size));
+  in.read(reinterpret_cast<char*>(data.data()), static_cast<std::streamsize>(size));
+  if (in.gcount() != static_cast<std::streamsize>(size)) throw InputError(path + ": read " + std::to_string(in.gcount()) + " of " + std::to_string(size) + " bytes");
   return data;
 }
 
@@ -59,10 +71,44 @@ std::string read_file_text(const std::string& path) {
 }
 
 void write_file_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw InputError(path + ": cannot open for writing (" + std::strerror(errno) + ")");
-  out << text;
-  if (!out) throw InputError(path + ": write failed");
+  // Through a temporary file in the same folder, renamed at the end: a failed or interrupted run
+  // leaves the old file (or none), never half a file.
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path tmp = target.parent_path() / (target.filename().string() + ".kin2grf-tmp");
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw InputError(path + ": cannot open for writing (" + std::strerror(errno) + ")");
+    out << text;
+    out.flush();
+    if (!out) {
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw InputError(path + ": write failed (" + std::strerror(errno) + ")");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw InputError(path + ": cannot replace the file (" + ec.message() + ")");
+  }
+}
+
+void ensure_not_an_input(const std::string& output, const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  for (const auto& in : inputs) {
+    if (in.empty() || output.empty()) continue;
+    std::error_code ec;
+    const bool same = fs::exists(output, ec) && fs::equivalent(output, in, ec);
+    if (same || (!ec && fs::weakly_canonical(output, ec) == fs::weakly_canonical(in, ec)))
+      throw InputError(output + ": is an input of this run (" + in + "); refusing to overwrite it");
+  }
+}
+
+std::string json_text(const nlohmann::json& j) {
+  // Labels and paths come from files: invalid UTF-8 is replaced (U+FFFD), not an internal error.
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 bool parse_double(std::string_view s, double& out) {
@@ -88,7 +134,7 @@ std::string extension(const std::string& path) {
 nlohmann::json read_json_file(const std::string& path) {
   try {
     return nlohmann::json::parse(read_file_text(path));
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // parse errors, and numbers out of range (1e400)
     throw InputError(path + ": not valid JSON: " + e.what());
   }
 }

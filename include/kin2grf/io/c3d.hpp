@@ -10,7 +10,7 @@
 //  - analog data signed or unsigned (ANALOG:FORMAT), OFFSET, SCALE, GEN_SCALE, integer or float;
 //  - FORCE_PLATFORM types 1, 2, 3 (Kistler 8 channels) and 4 (CAL_MATRIX), CORNERS, ORIGIN,
 //    CHANNEL, ZERO; force, moment about the surface centre and COP in the lab frame;
-//  - PROCESSING:Bodymass/Height, SUBJECTS and the EVENT group.
+//  - body mass from PROCESSING:Bodymass or SUBJECT(S):WEIGHT/MASS, PROCESSING:Height, the EVENT group.
 // Every structural field is bounds-checked: bad input throws InputError naming the file and
 // the field or byte offset.
 #pragma once
