@@ -165,8 +165,15 @@ TEST(Estimate, NoBodyMassIsAClearError) {
     (void)estimate(t, nullptr, *find_marker_set("kin2grf-example"), {});
     FAIL() << "expected an error";
   } catch (const std::exception& e) {
-    EXPECT_NE(std::string(e.what()).find("--mass"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("no body mass"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("nomass.c3d"), std::string::npos) << e.what();
   }
+  // A file's implausible mass (0.5 kg) is refused, not used; allowed when asked for.
+  t.body_mass_kg = 0.5;
+  EXPECT_THROW((void)estimate(t, nullptr, *find_marker_set("kin2grf-example"), {}), InputError);
+  EstimateOptions unusual;
+  unusual.allow_unusual_mass = true;
+  EXPECT_NO_THROW((void)estimate(t, nullptr, *find_marker_set("kin2grf-example"), unusual));
 }
 
 TEST(Estimate, MissingMarkerIsNamed) {
