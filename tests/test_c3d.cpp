@@ -2,6 +2,8 @@
 // every encoding, and corrupt files that must give a clear error, never a crash.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -457,4 +459,27 @@ TEST(UpAxis, MarkersTellTheVerticalWhereTheFileDoesNot) {
   // Too few markers or a cloud with no dominant axis: no verdict, the file's axis stays.
   for (auto& P : t.markers.positions_m) P.col(0) *= 6.0;
   EXPECT_FALSE(up_axis_from_data(t).has_value());
+}
+
+TEST(C3dCorrupt, AFrameCountNoDataJustifiesIsRefusedBeforeAllocating) {
+  // TRIAL:ACTUAL_END_FIELD claiming 2^30 frames: before, a file with no points took 23 s and 8 GB.
+  for (const int high : {0x3F, 0x20})  // about 2^30 frames; 2 million (under the 50-million cap)
+  for (const bool with_markers : {false, true}) {
+    Trial t = small_trial();
+    t.plates.reset();
+    t.events.clear();
+    if (!with_markers) t.markers.names.clear(), t.markers.descriptions.clear(), t.markers.positions_m.clear();
+    auto bytes = write_c3d_bytes(t, {});
+    const std::string key = "ACTUAL_END_FIELD";
+    auto it = std::search(bytes.begin(), bytes.end(), key.begin(), key.end());
+    ASSERT_NE(it, bytes.end());
+    // name, offset (2), type (1), ndims (1), dim (1), then two int16: patch the high word.
+    const std::size_t hi = static_cast<std::size_t>(it - bytes.begin()) + key.size() + 2 + 1 + 1 + 1 + 2;
+    bytes[hi] = 0x00;
+    bytes[hi + 1] = static_cast<std::uint8_t>(high);  // x 65536 frames (2^30 and above are ignored as implausible)
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::string msg = expect_input_error(bytes, "frames.c3d");
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+    EXPECT_TRUE(msg.find("frame") != std::string::npos || msg.find("truncated") != std::string::npos) << msg;
+  }
 }

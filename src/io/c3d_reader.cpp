@@ -136,6 +136,14 @@ void parse_parameters(const Bytes& b, std::size_t start, C3dFile& file) {
       for (int d = 0; d < ndims; ++d) {
         const int dim = b.u8(q + 2 + d, "parameter dimension");
         par.dims.push_back(dim);
+        // Checked before it can wrap: 255^8 already exceeds 2^64, and a wrapped product of 0
+        // would pass the bounds check below.
+        if (dim != 0 && count > (end - std::min(end, q)) / static_cast<std::size_t>(dim)) {
+          std::ostringstream os;
+          os << b.path() << ": parameter '" << name << "' at byte " << p << " has dimensions whose product exceeds the "
+             << "parameter section";
+          throw InputError(os.str());
+        }
         count *= static_cast<std::size_t>(dim);
       }
       q += 2 + static_cast<std::size_t>(ndims);
@@ -189,8 +197,13 @@ double number(const C3dFile& f, const std::string& key, double fallback, std::si
   return p->numbers[i];
 }
 
-/// int16 fields that are counts: stored signed, meant unsigned above 32767.
-int count_value(double v) { return v < 0 ? static_cast<int>(v) + 65536 : static_cast<int>(v); }
+/// int16 fields that are counts: stored signed, meant unsigned above 32767. A value that no int16
+/// holds (a float parameter of 1e30, NaN) is -1, which every caller refuses: no cast of an
+/// out-of-range float to int.
+int count_value(double v) {
+  if (!(v >= -32768.0 && v <= 65535.0)) return -1;
+  return v < 0 ? static_cast<int>(v) + 65536 : static_cast<int>(v);
+}
 
 std::vector<std::string> strings_multi(const C3dFile& f, const std::string& group,
                                        const std::string& base) {
@@ -262,18 +275,22 @@ C3dFile read_c3d_header(const std::vector<std::uint8_t>& bytes, const std::strin
   f.point_rate_hz = b.f32(20, "header: frame rate");
   parse_parameters(b, pstart, f);
   // The parameters are authoritative where present.
-  if (const auto* p = f.find("POINT:USED"); p && !p->numbers.empty())
+  if (const auto* p = f.find("POINT:USED"); p && !p->numbers.empty()) {
     f.point_count = count_value(p->numbers[0]);
+    if (f.point_count < 0) throw InputError(path + ": POINT:USED is not a count");
+  }
   if (const auto* p = f.find("POINT:SCALE"); p && !p->numbers.empty()) f.point_scale = p->numbers[0];
   if (const auto* p = f.find("POINT:RATE"); p && !p->numbers.empty()) f.point_rate_hz = p->numbers[0];
   if (const auto* p = f.find("POINT:DATA_START"); p && !p->numbers.empty())
-    f.data_start_block = count_value(p->numbers[0]);
+    f.data_start_block = count_value(p->numbers[0]);  // -1 is refused below (must be 2 or more)
   const auto* s = f.find("TRIAL:ACTUAL_START_FIELD");
   const auto* e = f.find("TRIAL:ACTUAL_END_FIELD");
   if (s && e && s->numbers.size() >= 2 && e->numbers.size() >= 2) {
-    const long first = count_value(s->numbers[0]) + 65536L * count_value(s->numbers[1]);
-    const long last = count_value(e->numbers[0]) + 65536L * count_value(e->numbers[1]);
-    if (first >= 1 && last >= first && last < (1L << 30)) {
+    const int s0 = count_value(s->numbers[0]), s1 = count_value(s->numbers[1]);
+    const int e0 = count_value(e->numbers[0]), e1 = count_value(e->numbers[1]);
+    const long first = s0 + 65536L * s1;
+    const long last = e0 + 65536L * e1;
+    if (std::min({s0, s1, e0, e1}) >= 0 && first >= 1 && last >= first && last < (1L << 30)) {
       f.first_frame = static_cast<int>(first);
       f.last_frame = static_cast<int>(last);
     }
@@ -316,6 +333,7 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
   const int npoints = f.point_count;
   // Analog layout.
   int nchannels = count_value(number(f, "ANALOG:USED", 0));
+  if (nchannels < 0) throw InputError(path + ": ANALOG:USED is not a count");
   double analog_rate = number(f, "ANALOG:RATE", 0);
   int spf = 0;  // analog samples per point frame
   if (nchannels > 0) {
@@ -324,6 +342,8 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
                        " with ANALOG:USED = " + std::to_string(nchannels));
     }
     const double ratio = analog_rate / f.point_rate_hz;
+    if (!(ratio <= 10000.0))  // before any cast: analog at most 10,000 samples per point frame
+      throw InputError(path + ": ANALOG:RATE " + std::to_string(analog_rate) + " Hz is more than 10,000 x POINT:RATE");
     spf = static_cast<int>(std::lround(ratio));
     if (spf < 1 || std::abs(ratio - spf) > 1e-3 * ratio) {
       throw InputError(path + ": ANALOG:RATE " + std::to_string(analog_rate) +
@@ -343,12 +363,15 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
     }
   }
   const int analog_slots = nchannels > 0 ? f.analog_per_frame / spf : 0;  // channels stored
-  if (npoints > 0 || analog_slots > 0) {
-    if (nframes > 50'000'000) throw InputError(path + ": absurd frame count " + std::to_string(nframes));
-  }
   const std::size_t word = f.float_data ? 4 : 2;
   const std::size_t frame_bytes =
-      (static_cast<std::size_t>(npoints) * 4 + static_cast<std::size_t>(analog_slots) * spf) * word;
+      (static_cast<std::size_t>(npoints) * 4 + static_cast<std::size_t>(analog_slots) * static_cast<std::size_t>(spf)) * word;
+  // Frame counts are checked before anything is allocated: against the data the file holds
+  // (below), and, for a file with no point or analog data (nothing to check them against), a
+  // frame count that only a data section could justify.
+  if (nframes > 50'000'000) throw InputError(path + ": absurd frame count " + std::to_string(nframes));
+  if (frame_bytes == 0 && nframes > 1'000'000)
+    throw InputError(path + ": claims " + std::to_string(nframes) + " frames but holds no point or analog data");
   const std::size_t data_start = (static_cast<std::size_t>(f.data_start_block) - 1) * 512;
   const std::size_t needed = frame_bytes * static_cast<std::size_t>(nframes);
   if (data_start > bytes.size() || needed > bytes.size() - data_start) {
@@ -481,6 +504,7 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
 
   // ---- Force plates -----------------------------------------------------------------------
   const int nplates = count_value(number(f, "FORCE_PLATFORM:USED", 0));
+  if (nplates < 0) throw InputError(path + ": FORCE_PLATFORM:USED is not a count");
   if (nplates > 0 && analog.values.size() == 0) {
     // A static or marker-only export often keeps the lab's FORCE_PLATFORM description with no
     // analog data (e.g. RBDS001static.c3d). The markers are still good: no plates, and a note.
@@ -504,7 +528,7 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
       d.name = "FP" + std::to_string(p + 1);
       if (static_cast<int>(types->numbers.size()) <= p)
         throw InputError(path + ": FORCE_PLATFORM:TYPE has no entry for plate " + std::to_string(p + 1));
-      d.type = static_cast<int>(types->numbers[p]);
+      d.type = count_value(types->numbers[p]);
       if (d.type < 1 || d.type > 4) {
         throw InputError(path + ": FORCE_PLATFORM:TYPE[" + std::to_string(p + 1) + "] = " +
                          std::to_string(d.type) + " is not supported (types 1-4 are)");
@@ -523,7 +547,7 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
                          std::to_string(d.type) + ")");
       }
       for (int c = 0; c < nch; ++c) {
-        const int ch = static_cast<int>(channel->numbers[static_cast<std::size_t>(chan_rows * p + c)]);
+        const int ch = count_value(channel->numbers[static_cast<std::size_t>(chan_rows * p + c)]);
         if (ch < 1 || ch > nchannels) {
           throw InputError(path + ": FORCE_PLATFORM:CHANNEL[" + std::to_string(c + 1) + "," +
                            std::to_string(p + 1) + "] = " + std::to_string(ch) +
@@ -553,7 +577,8 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
     proc.cop_threshold_N = options.cop_threshold_N;
     proc.zero_offset = options.zero_offset;
     proc.unloaded_threshold_N = options.unloaded_threshold_N;
-    if (const auto* z = f.find("FORCE_PLATFORM:ZERO"); z && z->numbers.size() >= 2) {
+    if (const auto* z = f.find("FORCE_PLATFORM:ZERO"); z && z->numbers.size() >= 2 && count_value(z->numbers[0]) >= 0 &&
+                                                        count_value(z->numbers[1]) >= 0) {
       proc.zero_first_sample = static_cast<long>((z->numbers[0] - 1) * spf);
       proc.zero_last_sample = static_cast<long>(z->numbers[1] * spf) - 1;
     }

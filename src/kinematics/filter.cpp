@@ -54,7 +54,9 @@ Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, d
                                 std::to_string(0.5 * rate_hz) + " Hz");
   }
   const Biquad q = design_lowpass(rate_hz, fc);
-  const Eigen::Index pad = std::min<Eigen::Index>(n - 1, static_cast<Eigen::Index>(std::ceil(3.0 * rate_hz / cutoff_hz)));
+  // Compared as doubles before the cast: a rate of 1e300 Hz must not overflow Eigen::Index.
+  const double want = std::ceil(3.0 * rate_hz / cutoff_hz);
+  const Eigen::Index pad = want >= static_cast<double>(n - 1) || !(want >= 0) ? n - 1 : static_cast<Eigen::Index>(want);
   std::vector<double> e(static_cast<std::size_t>(n + 2 * pad));
   for (Eigen::Index i = 0; i < pad; ++i) e[static_cast<std::size_t>(i)] = 2 * x[0] - x[pad - i];
   for (Eigen::Index i = 0; i < n; ++i) e[static_cast<std::size_t>(pad + i)] = x[i];
