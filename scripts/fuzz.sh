@@ -1,21 +1,36 @@
 #!/usr/bin/env bash
-# Build the libFuzzer targets with clang and run each for SECONDS (default 30), seeded with a
-# corpus the project makes itself (files written by kin2grf's writers; no shared data copied).
+# Build the libFuzzer targets with clang, the library itself under ASan/UBSan (the `fuzz`
+# preset), and run each parser target for SECONDS (default 30) under -rss_limit_mb=2048, seeded
+# with a corpus the project makes itself (files written by kin2grf's writers; no shared data).
+# Exits non-zero on any crash, leak, timeout or out-of-memory; a reproducer is left in build/fuzz.
+#   bash scripts/fuzz.sh [SECONDS]        (CI runs it for a short time; 600 for the long run)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-30}"
-bash scripts/setup.sh
+bash scripts/setup.sh >/dev/null
 cmake --preset fuzz >/dev/null
 cmake --build --preset fuzz
-cmake --preset dev >/dev/null
-cmake --build --preset dev --target kin2grf_cli
+# The seed corpus is written by the CLI of an ordinary build (the ci one when it exists).
+cli=build/ci/kin2grf
+if [ ! -x "$cli" ]; then
+  cmake --preset dev >/dev/null
+  cmake --build --preset dev --target kin2grf_cli
+  cli=build/dev/kin2grf
+fi
 corpus=build/fuzz/corpus
 mkdir -p "$corpus/c3d" "$corpus/trc" "$corpus/sto"
-./build/dev/kin2grf make-example --seconds 0.5 --out-dir "$corpus/seed" >/dev/null
+"$cli" make-example --seconds 1 --out-dir "$corpus/seed" >/dev/null
 cp "$corpus"/seed/*.c3d "$corpus/c3d/"
 cp "$corpus"/seed/*.trc "$corpus/trc/"
 cp "$corpus"/seed/*.mot "$corpus/sto/"
+status=0
 for t in c3d trc sto; do
   echo "fuzz_$t: ${seconds} s"
-  ./build/fuzz/fuzz/fuzz_$t -max_total_time="$seconds" -max_len=65536 -print_final_stats=1 "$corpus/$t" 2>&1 | tail -4
+  if ! (cd build/fuzz && ./fuzz/fuzz_$t -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
+          -print_final_stats=1 "corpus/$t" >"fuzz_$t.log" 2>&1); then
+    echo "fuzz_$t FAILED:"; tail -40 "build/fuzz/fuzz_$t.log"; status=1
+  else
+    grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "build/fuzz/fuzz_$t.log" | tr '\n' ' '; echo
+  fi
 done
+exit $status

@@ -80,7 +80,12 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   if (trial.markers.frames() == 0) throw InputError(trial.path + ": the trial has no marker frames");
   const Landmarks3D lm3 = compute_landmarks(set, trial.markers, static_trial ? &static_trial->markers : nullptr,
                                             o.landmarks, trial.path);
-  r.messages = lm3.messages;
+  // What the readers noticed (duplicate labels, rows cut short, an up axis corrected...) goes with
+  // the results, so that estimate's and validate's outputs say it too.
+  for (const auto& w : trial.warnings) r.messages.push_back("input: " + w);
+  if (static_trial)
+    for (const auto& w : static_trial->warnings) r.messages.push_back("static trial: " + w);
+  r.messages.insert(r.messages.end(), lm3.messages.begin(), lm3.messages.end());
   r.frame = detect_sagittal_frame(lm3, trial.markers, o.landmarks);
   SagittalWindow win = sagittal_landmarks(lm3, set, r.frame, trial.markers, o.landmarks, trial.path);
   r.messages.insert(r.messages.end(), win.messages.begin(), win.messages.end());

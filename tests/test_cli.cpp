@@ -135,3 +135,17 @@ TEST(CliInput, JsonNumbersOutOfRangeNameTheFile) {
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find(cop.string()), std::string::npos) << r.out;
 }
+
+TEST(CliInput, AMarkerNeededTwiceIsAnErrorNotAGuess) {
+  const auto dir = kin2grf::test::temp_dir("cli_dup");
+  std::string text = kin2grf::read_file_text(example_trc());
+  const auto at = text.find("RMT1");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 4, "RHEE");  // now two RHEE columns: which is the heel?
+  const auto dup = dir / "dup.trc";
+  kin2grf::write_file_text(dup.string(), text);
+  const CliRun r = run("estimate " + dup.string() + " --mass 70 --markers kin2grf-example");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("appears more than once"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("repeated"), std::string::npos) << "the reader's warning is printed too: " << r.out;
+}

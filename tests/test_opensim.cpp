@@ -161,3 +161,24 @@ TEST(Trc, DataRateThatDisagreesWithTheTimeColumnIsCorrected) {
   bad.replace(row + 1, 1, "1e300");
   EXPECT_THROW((void)parse_trc(bad, "frame.trc", &w), InputError);
 }
+
+TEST(Trc, ARepeatedLabelIsNamedNotSilentlyShadowed) {
+  MarkerTrajectories m;
+  m.rate_hz = 100;
+  m.first_frame = 1;
+  m.time_s = Eigen::VectorXd::LinSpaced(5, 0, 0.04);
+  m.names = {"RHEE", "RBIC"};
+  m.descriptions = {"", ""};
+  m.positions_m = {Eigen::MatrixX3d::Constant(5, 3, 0.1), Eigen::MatrixX3d::Constant(5, 3, 1.2)};
+  std::string text = format_trc(m, "dup.trc");
+  const auto at = text.find("RBIC");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 4, "RHEE");
+  std::vector<std::string> w;
+  const auto back = parse_trc(text, "dup.trc", &w);
+  ASSERT_EQ(back.names.size(), 2u);
+  EXPECT_EQ(back.names[0], "RHEE");
+  EXPECT_EQ(back.names[1], "RHEE#2");
+  ASSERT_FALSE(w.empty());
+  EXPECT_NE(w[0].find("repeated"), std::string::npos) << w[0];
+}

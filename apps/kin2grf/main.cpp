@@ -217,12 +217,22 @@ kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, kin2grf::Estima
       if (tty && pct == 100) std::fputc('\n', stderr);
     };
   }
-  auto r = kin2grf::estimate(trial, st ? &*st : nullptr, set, options);
+  std::optional<kin2grf::EstimateResult> res;
+  try {
+    res = kin2grf::estimate(trial, st ? &*st : nullptr, set, options);
+  } catch (const kin2grf::InputError&) {
+    // The readers' warnings travel in the result; when there is none, say them before the error.
+    for (const auto& w : trial.warnings) std::cerr << "kin2grf: input: " << w << "\n";
+    if (st)
+      for (const auto& w : st->warnings) std::cerr << "kin2grf: static trial: " << w << "\n";
+    throw;
+  }
+  auto& r = *res;
   for (const auto& m : r.messages) std::cerr << "kin2grf: " << m << "\n";
   std::cerr << "kin2grf: " << r.time_s.size() << " frames, mass " << r.mass_kg << " kg, "
             << static_cast<long>(static_cast<double>(r.time_s.size()) / std::max(1e-9, r.seconds_kinematics + r.seconds_dynamics))
             << " frames/s\n";
-  return r;
+  return std::move(*res);
 }
 
 /// The files a run reads: no output may be one of them.

@@ -217,7 +217,7 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::MatrixXd& BpX, const Eig
     if (lamC[c] != 0.0) lamB -= BpX.col(1 + c) * lamC[c];
   sol.joint_torque_Nm = lamB.segment<kJointCount>(kRheoRows);
   for (int side = 0; side < 2; ++side) {
-    double fx = 0, fy = 0, mx = 0;
+    double fx = 0, fy = 0;
     bool any = false;
     for (int j = 0; j < np; ++j) {
       const auto& p = fc.points[static_cast<std::size_t>(j)];
@@ -225,7 +225,6 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::MatrixXd& BpX, const Eig
       any = true;
       fy += lamC[2 * j];
       fx += lamC[2 * j + 1];
-      mx += lamC[2 * j] * p.position.x();
     }
     sol.active[side] = any;
     sol.force_N[side] = Eigen::Vector2d(fx, fy);

@@ -27,6 +27,11 @@ Eigen::MatrixX3d marker(const MarkerTrajectories& m, const std::string& name, co
                         const std::string& what) {
   const int k = m.find(name);
   if (k < 0) throw InputError(path + ": marker '" + name + "' (needed for " + what + ") is not in the trial");
+  // The readers rename a repeated label NAME#k: a landmark must not silently take either one.
+  for (const auto& other : m.names)
+    if (other.size() > name.size() + 1 && other.compare(0, name.size() + 1, name + "#") == 0)
+      throw InputError(path + ": marker '" + name + "' (needed for " + what + ") appears more than once in the file (" +
+                       name + ", " + other + "): rename one, or map the landmark to the one meant");
   return m.positions_m[static_cast<std::size_t>(k)];
 }
 
