@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Build with warnings as errors and run the whole test suite, then the reader and corrupt-file
-# tests again under AddressSanitizer/UBSan. This is the README's test command and what CI runs.
+# tests again under AddressSanitizer/UBSan, and the parser fuzzers briefly. This is the README's test
+# command and what CI runs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh

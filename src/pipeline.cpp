@@ -78,16 +78,20 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     throw InputError(trial.path + b);
   }
   if (trial.markers.frames() == 0) throw InputError(trial.path + ": the trial has no marker frames");
-  const Landmarks3D lm3 = compute_landmarks(set, trial.markers, static_trial ? &static_trial->markers : nullptr,
+  MarkerTrajectories markers = trial.markers;
+  std::vector<std::string> cleaning;
+  remove_marker_outliers(markers, cleaning);
+  const Landmarks3D lm3 = compute_landmarks(set, markers, static_trial ? &static_trial->markers : nullptr,
                                             o.landmarks, trial.path);
   // What the readers noticed (duplicate labels, rows cut short, an up axis corrected...) goes with
   // the results, so that estimate's and validate's outputs say it too.
   for (const auto& w : trial.warnings) r.messages.push_back("input: " + w);
   if (static_trial)
     for (const auto& w : static_trial->warnings) r.messages.push_back("static trial: " + w);
+  r.messages.insert(r.messages.end(), cleaning.begin(), cleaning.end());
   r.messages.insert(r.messages.end(), lm3.messages.begin(), lm3.messages.end());
-  r.frame = detect_sagittal_frame(lm3, trial.markers, o.landmarks);
-  SagittalWindow win = sagittal_landmarks(lm3, set, r.frame, trial.markers, o.landmarks, trial.path);
+  r.frame = detect_sagittal_frame(lm3, markers, o.landmarks);
+  SagittalWindow win = sagittal_landmarks(lm3, set, r.frame, markers, o.landmarks, trial.path);
   r.messages.insert(r.messages.end(), win.messages.begin(), win.messages.end());
   r.first_index = win.first;
   r.first_frame_number = trial.markers.first_frame + static_cast<int>(win.first);
@@ -175,6 +179,11 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     r.capped_frames += s.capped;
   }
   if (o.progress) o.progress(static_cast<long>(n), static_cast<long>(n));
+  // No NaN leaves the library: a frame the solve could not make finite is named, not written.
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (!lam.row(i).allFinite() || !torque.row(i).allFinite())
+      throw InputError(trial.path + ": the contact solve gave a non-finite force at frame " +
+                       std::to_string(r.first_frame_number + static_cast<int>(i)) + " (check the markers there)");
   const auto t2 = clock::now();
   r.seconds_kinematics = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_dynamics = std::chrono::duration<double>(t2 - t1).count();

@@ -599,3 +599,26 @@ TEST(Landmarks, FunctionalKneeCentreOfAHingeIsOnItsAxis) {
   for (const auto& s : lm.messages) said = said || s.find("SCoRE") != std::string::npos;
   EXPECT_TRUE(said);
 }
+
+// One sample of one marker 1 m, 10 m or 1e300 m off (issue 10: a 453 N or 12,036 N spike, or NaN
+// in the output): it is a gap, filled like any other, the forces are those of the clean trial,
+// and a message names the marker and frame.
+TEST(Estimate, AMarkerSampleNoBodyCanProduceIsAGap) {
+  const Trial clean = make_synthetic_trial({});
+  const auto a = estimate(clean, nullptr, *find_marker_set("kin2grf-example"), {});
+  for (const double off : {1.0, 10.0, 1e300}) {
+    Trial t = clean;
+    const int k = t.markers.find("RHEE");
+    ASSERT_GE(k, 0);
+    t.markers.positions_m[static_cast<std::size_t>(k)](150, 2) += off;
+    const auto b = estimate(t, nullptr, *find_marker_set("kin2grf-example"), {});
+    ASSERT_EQ(a.time_s.size(), b.time_s.size());
+    for (int side = 0; side < 2; ++side) {
+      EXPECT_TRUE(b.feet[side].force_N.allFinite());
+      EXPECT_LT((a.feet[side].force_N - b.feet[side].force_N).cwiseAbs().maxCoeff(), 0.01 * 70 * 9.81) << off;
+    }
+    bool said = false;
+    for (const auto& m : b.messages) said = said || (m.find("RHEE") != std::string::npos && m.find("no body can") != std::string::npos);
+    EXPECT_TRUE(said) << off;
+  }
+}

@@ -262,6 +262,35 @@ const MarkerSet* recognise_marker_set(const MarkerTrajectories& m) {
   return nullptr;
 }
 
+int remove_marker_outliers(MarkerTrajectories& m, std::vector<std::string>& messages) {
+  const Eigen::Index n = m.frames();
+  const double limit = kMaxMarkerSpeedMps / std::max(m.rate_hz, 1e-9) + 0.02;
+  int removed = 0;
+  for (std::size_t k = 0; k < m.positions_m.size(); ++k) {
+    auto& P = m.positions_m[k];
+    std::vector<Eigen::Index> where;
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (P.row(i).allFinite() && P.row(i).cwiseAbs().maxCoeff() > kMaxLabCoordinateM) P.row(i).setConstant(kNaN), where.push_back(i);
+    for (Eigen::Index i = 1; i + 1 < n; ++i) {
+      if (!P.row(i - 1).allFinite() || !P.row(i).allFinite() || !P.row(i + 1).allFinite()) continue;
+      if ((P.row(i) - P.row(i - 1)).norm() > limit && (P.row(i + 1) - P.row(i)).norm() > limit &&
+          (P.row(i + 1) - P.row(i - 1)).norm() < limit) {
+        P.row(i).setConstant(kNaN);
+        where.push_back(i);
+      }
+    }
+    if (where.empty()) continue;
+    removed += static_cast<int>(where.size());
+    std::string frames;
+    for (std::size_t w = 0; w < where.size() && w < 5; ++w) frames += (w ? ", " : "") + std::to_string(m.first_frame + where[w]);
+    if (where.size() > 5) frames += ", ...";
+    messages.push_back(m.names[k] + ": " + std::to_string(where.size()) + " sample(s) no body can produce (frame " + frames +
+                       ": outside the lab or a one-frame jump faster than " + std::to_string(static_cast<int>(kMaxMarkerSpeedMps)) +
+                       " m/s) treated as gaps");
+  }
+  return removed;
+}
+
 Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m, const MarkerTrajectories* st,
                               const LandmarkOptions& options, const std::string& path) {
   Landmarks3D out;

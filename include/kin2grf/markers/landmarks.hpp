@@ -130,6 +130,15 @@ struct SagittalFrame {
   }
 };
 
+/// Marker samples no body can produce become gaps (filled later like any gap, up to the longest
+/// gap filled), each with a message naming the marker and frame:
+///  - a coordinate beyond kMaxLabCoordinateM (no capture volume is 10 km; 1e300 would overflow);
+///  - a one-frame spike: a sample farther than kMaxMarkerSpeedMps x dt + 2 cm from both neighbours
+///    while the neighbours are within that of each other (a marker does not leave and come back in
+///    two frames faster than a thrown ball). Returns the number of samples removed.
+inline constexpr double kMaxLabCoordinateM = 1e4, kMaxMarkerSpeedMps = 30.0;
+int remove_marker_outliers(MarkerTrajectories& markers, std::vector<std::string>& messages);
+
 Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& motion,
                               const MarkerTrajectories* static_trial, const LandmarkOptions& options,
                               const std::string& path);
