@@ -622,3 +622,33 @@ TEST(Estimate, AMarkerSampleNoBodyCanProduceIsAGap) {
     EXPECT_TRUE(said) << off;
   }
 }
+
+// A full Plug-in Gait file whose LSHO/RSHO labels exist but hold no sample (issue 10): the
+// lower-body preset, which can run it, is chosen, and the reason lists both candidates.
+TEST(Landmarks, PresetRecognitionLooksAtWhichMarkersHoldData) {
+  MarkerTrajectories m;
+  m.rate_hz = 100;
+  m.time_s = Eigen::VectorXd::LinSpaced(50, 0, 0.49);
+  std::vector<std::string> used;
+  for (const char* set : {"plug-in-gait", "plug-in-gait-lower"}) {
+    const auto u = find_marker_set(set)->motion_markers();
+    used.insert(used.end(), u.begin(), u.end());
+    used.insert(used.end(), find_marker_set(set)->signature.begin(), find_marker_set(set)->signature.end());
+  }
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  for (const auto& name : used) {
+    m.names.push_back(name);
+    m.descriptions.emplace_back();
+    const bool empty = name == "LSHO" || name == "RSHO";
+    m.positions_m.push_back(Eigen::MatrixX3d::Constant(50, 3, empty ? std::nan("") : 0.5));
+  }
+  std::string why;
+  const MarkerSet* s = recognise_marker_set(m, &why);
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(s->name, "plug-in-gait-lower") << why;
+  EXPECT_NE(why.find("plug-in-gait 0 frames"), std::string::npos) << why;
+  // With the shoulders holding data, the full set (more markers) is taken.
+  for (std::size_t k = 0; k < m.names.size(); ++k) m.positions_m[k].setConstant(0.5);
+  EXPECT_EQ(recognise_marker_set(m)->name, "plug-in-gait");
+}

@@ -187,7 +187,8 @@ const kin2grf::MarkerSet& resolve_marker_set(const EstimateArgs& a, const kin2gr
     custom = kin2grf::load_marker_set(a.markers);
     return custom;
   }
-  const auto* set = kin2grf::recognise_marker_set(trial.markers);
+  std::string why;
+  const auto* set = kin2grf::recognise_marker_set(trial.markers, &why);
   if (!set) {
     std::string names;
     for (const auto& s : kin2grf::builtin_marker_sets()) names += " " + s.name;
@@ -195,7 +196,7 @@ const kin2grf::MarkerSet& resolve_marker_set(const EstimateArgs& a, const kin2gr
                               "). Give --markers FILE.json with a rule for each landmark: shoulder, hip, knee_r, "
                               "ankle_r, heel_r, mt_r, hallux_r and the same _l (see docs/MARKERSETS.md)");
   }
-  std::cerr << "kin2grf: marker set recognised: " << set->name << "\n";
+  std::cerr << "kin2grf: marker set recognised: " << set->name << " (" << why << ")\n";
   return *set;
 }
 

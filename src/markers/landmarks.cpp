@@ -256,10 +256,37 @@ const MarkerSet* find_marker_set(const std::string& name) {
   return nullptr;
 }
 
-const MarkerSet* recognise_marker_set(const MarkerTrajectories& m) {
-  for (const auto& s : builtin_marker_sets())
-    if (std::all_of(s.signature.begin(), s.signature.end(), [&](const std::string& n) { return m.find(n) >= 0; })) return &s;
-  return nullptr;
+const MarkerSet* recognise_marker_set(const MarkerTrajectories& m, std::string* why) {
+  // Among the presets whose signature markers are in the file, the one whose markers all hold
+  // data in the most frames: a label with no sample (LSHO/RSHO kept empty in a lower-body
+  // capture) does not count as present. Ties go to the set that uses more markers (the more
+  // specific one, e.g. full Plug-in Gait over its lower-body variant).
+  const MarkerSet* best = nullptr;
+  long best_frames = -1;
+  std::size_t best_used = 0;
+  std::string report;
+  for (const auto& s : builtin_marker_sets()) {
+    if (!std::all_of(s.signature.begin(), s.signature.end(), [&](const std::string& n) { return m.find(n) >= 0; })) continue;
+    std::vector<std::string> used = s.motion_markers();
+    std::sort(used.begin(), used.end());
+    used.erase(std::unique(used.begin(), used.end()), used.end());
+    long frames = 0;
+    std::vector<int> idx;
+    bool all_there = true;
+    for (const auto& u : used) {
+      const int k = m.find(u);
+      if (k < 0) all_there = false;
+      else idx.push_back(k);
+    }
+    if (all_there)
+      for (Eigen::Index i = 0; i < m.frames(); ++i)
+        frames += std::all_of(idx.begin(), idx.end(), [&](int k) { return m.positions_m[static_cast<std::size_t>(k)].row(i).allFinite(); });
+    report += (report.empty() ? "" : ", ") + s.name + " " + std::to_string(frames) + " frames";
+    if (frames > best_frames || (frames == best_frames && used.size() > best_used)) best = &s, best_frames = frames, best_used = used.size();
+  }
+  if (best && best_frames == 0) best = nullptr;  // no set has a single complete frame
+  if (why) *why = report.empty() ? "no preset's signature markers are in the file" : "frames with every marker of the set: " + report;
+  return best;
 }
 
 int remove_marker_outliers(MarkerTrajectories& m, std::vector<std::string>& messages) {

@@ -77,8 +77,10 @@ MarkerSet load_marker_set(const std::string& path);
 const std::vector<MarkerSet>& builtin_marker_sets();
 /// Preset by name, or nullptr.
 const MarkerSet* find_marker_set(const std::string& name);
-/// The first built-in set whose signature markers are all present, or nullptr.
-const MarkerSet* recognise_marker_set(const MarkerTrajectories& m);
+/// The built-in set for a trial, or nullptr: among the sets whose signature markers are in the
+/// file, the one whose markers all hold data in the most frames (ties: the one using more
+/// markers). `why`, when given, lists each candidate's count of complete frames.
+const MarkerSet* recognise_marker_set(const MarkerTrajectories& m, std::string* why = nullptr);
 
 struct LandmarkOptions {
   int max_gap_frames = 10;
