@@ -149,3 +149,32 @@ TEST(CliInput, AMarkerNeededTwiceIsAnErrorNotAGuess) {
   EXPECT_NE(r.out.find("appears more than once"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("repeated"), std::string::npos) << "the reader's warning is printed too: " << r.out;
 }
+
+// Every development trial of scripts/trials.txt runs as listed, with no hand edits, and every
+// number it writes is finite (issue 10).
+TEST(CliShared, EveryListedTrialRunsAndWritesFiniteNumbers) {
+  KIN2GRF_REQUIRE_DATA();
+  std::ifstream list(std::string(KIN2GRF_SOURCE_DIR) + "/scripts/trials.txt");
+  ASSERT_TRUE(list);
+  const auto dir = kin2grf::test::temp_dir("cli_all");
+  std::string line;
+  int trials = 0;
+  while (std::getline(list, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::size_t bar = 0;
+    for (int k = 0; k < 3; ++k) bar = line.find('|', bar) + 1;
+    std::string args = line.substr(bar);
+    for (std::size_t p; (p = args.find("DATA")) != std::string::npos;) args.replace(p, 4, kin2grf::test::data_dir());
+    if (const auto p = args.find("--plates "); p != std::string::npos) {
+      const auto e = args.find(' ', p + 9);
+      args.erase(p, e == std::string::npos ? std::string::npos : e - p);
+    }
+    const auto csv = dir / ("t" + std::to_string(trials) + ".csv");
+    const CliRun r = run("estimate " + args + " --csv " + csv.string(), "2>&1 >/dev/null");
+    ++trials;
+    ASSERT_EQ(r.status, 0) << line << "\n" << r.out;
+    const std::string text = kin2grf::read_file_text(csv.string());
+    for (const char* bad : {"nan", "inf"}) EXPECT_EQ(text.find(bad), std::string::npos) << line << ": " << bad << " in the CSV";
+  }
+  EXPECT_GE(trials, 14);
+}
