@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <random>
 #include <sstream>
 
 #include "kin2grf/error.hpp"
@@ -16,6 +17,7 @@ struct Setting {
   std::string label;
   double value;
   std::function<void(EstimateOptions&)> apply;
+  double marker_noise_m = 0.0;  ///< the `noise` study: Gaussian noise added to every marker coordinate
 };
 
 std::vector<Setting> settings_for(const std::string& kind) {
@@ -54,6 +56,13 @@ std::vector<Setting> settings_for(const std::string& kind) {
         std::snprintf(b, sizeof b, "%.1f x speed, >= %.2f", k, floor);
         s.push_back({b, k, [k, floor](EstimateOptions& o) { o.solver.speed_gate_ratio = k, o.solver.speed_gate_floor_mps = floor; }});
       }
+  } else if (kind == "noise") {
+    // Robustness to what real capture does (issue 10): 0, 1, 2, 3 mm of Gaussian noise on every
+    // marker coordinate, seeded (the same noise for every run), the estimate otherwise unchanged.
+    for (double mm : {0.0, 1.0, 2.0, 3.0}) {
+      std::snprintf(b, sizeof b, "%.0f mm noise", mm);
+      s.push_back({b, mm, [](EstimateOptions&) {}, mm / 1000.0});
+    }
   } else if (kind == "split-distance") {
     for (double d : {0.0, 0.05, 0.1, 0.15, 0.2}) {
       std::snprintf(b, sizeof b, d > 0 ? "%.2f m" : "off", d);
@@ -66,7 +75,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
     s.push_back({"three-point (model 1)", 1, [](EstimateOptions& o) { o.contact.foot_model = FootModel::ThreePoint; }});
     s.push_back({"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }});
   } else {
-    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, speed-gate, speed-gate-ratio, split-distance, torso-length, foot-model)");
+    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, speed-gate, speed-gate-ratio, noise, split-distance, torso-length, foot-model)");
   }
   return s;
 }
@@ -107,7 +116,15 @@ StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& tr
       EstimateOptions o = t.options;
       s.apply(o);
       try {
-        const EstimateResult e = estimate(*t.trial, t.static_trial, *t.marker_set, o);
+        Trial noisy;
+        if (s.marker_noise_m > 0) {
+          noisy = *t.trial;
+          std::mt19937 rng(12345);
+          std::normal_distribution<double> g(0.0, s.marker_noise_m);
+          for (auto& P : noisy.markers.positions_m)
+            for (Eigen::Index i = 0; i < P.size(); ++i) P.data()[i] += g(rng);  // NaN stays NaN
+        }
+        const EstimateResult e = estimate(s.marker_noise_m > 0 ? noisy : *t.trial, t.static_trial, *t.marker_set, o);
         const ValidationResult v = validate(e, *t.plates);
         tr.stances = v.stances;
         if (v.total && v.total->metrics.moment) tr.total_grm = v.total->metrics.moment->rrmse_percent;
