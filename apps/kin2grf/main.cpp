@@ -36,8 +36,20 @@ kin2grf::LoadOptions load_options(const std::string& zero) {
   return lo;
 }
 
-int run_info(const std::string& file, bool json, double threshold, const std::string& zero) {
-  const kin2grf::Trial t = kin2grf::load_trial(file, load_options(zero));
+std::optional<kin2grf::Axis> parse_axis(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(text[0])));
+  if (c < 'X' || c > 'Z' || text.size() != 1) throw kin2grf::InputError("--up-axis must be X, Y or Z");
+  return static_cast<kin2grf::Axis>(c - 'X');
+}
+
+int run_info(const std::string& file, bool json, double threshold, const std::string& zero, const std::string& up_axis) {
+  if (!(std::isfinite(threshold) && threshold > 0)) throw kin2grf::InputError("--load-threshold must be a force above 0 N");
+  kin2grf::Trial t = kin2grf::load_trial(file, load_options(zero));
+  if (const auto up = parse_axis(up_axis)) {  // the user's word over the data's
+    t.markers.up_axis = *up;
+    if (t.plates) t.plates->up_axis = *up;
+  }
   const auto s = kin2grf::trial_summary(t, threshold);
   if (json) std::cout << kin2grf::json_text(s);
   else std::cout << kin2grf::format_summary(s);
@@ -142,11 +154,7 @@ kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
   o.solver.min_split_distance_m = a.paper ? 0.0 : a.split_distance;
   o.torso_length = (a.paper || a.torso_length == "fixed") ? kin2grf::TorsoLength::Fixed : kin2grf::TorsoLength::Measured;
   o.landmarks.max_gap_frames = a.max_gap;
-  if (!a.up_axis.empty()) {
-    const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(a.up_axis[0])));
-    if (c < 'X' || c > 'Z' || a.up_axis.size() != 1) throw kin2grf::InputError("--up-axis must be X, Y or Z");
-    o.landmarks.up_axis = static_cast<kin2grf::Axis>(c - 'X');
-  }
+  o.landmarks.up_axis = parse_axis(a.up_axis);
   return o;
 }
 
@@ -251,8 +259,11 @@ int run_estimate(const EstimateArgs& a) {
   if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r);
   if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::format_results_csv(r));
   if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(kin2grf::results_summary(r, settings_json(a, options))));
+  std::cout << kin2grf::format_results_text(r);
+  for (const auto& [file, what] : {std::pair{a.out_mot, "OpenSim GRF"}, {a.out_csv, "per-frame CSV"}, {a.out_json, "JSON summary"}})
+    if (!file.empty()) std::cout << "wrote " << file << " (" << what << ")\n";
   if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty())
-    std::cout << kin2grf::json_text(kin2grf::results_summary(r, settings_json(a, options)));
+    std::cout << "(-o GRF.mot, --csv FILE and --json FILE write the per-frame results and the full summary)\n";
   return 0;
 }
 
@@ -506,6 +517,8 @@ int main(int argc, char** argv) {
   info->add_option("--zero-offset", info_zero,
                    "C3D plate offsets: none, zero (FORCE_PLATFORM:ZERO frames) or unloaded (median of unloaded samples)")
       ->check(CLI::IsMember({"none", "zero", "unloaded"}))->capture_default_str();
+  std::string info_up_axis;
+  info->add_option("--up-axis", info_up_axis, "The lab up axis (X, Y or Z); default: the data's (plates' normal, markers' spread)");
   info->add_option("--load-threshold", info_threshold, "Vertical force (N) above which a plate counts as loaded")
       ->capture_default_str();
 
@@ -570,7 +583,7 @@ int main(int argc, char** argv) {
   }
   try {
     int rc = 0;
-    if (*info) rc = run_info(info_file, info_json, info_threshold, info_zero);
+    if (*info) rc = run_info(info_file, info_json, info_threshold, info_zero, info_up_axis);
     else if (*estimate) rc = run_estimate(est);
     else if (*validate) rc = run_validate(val);
     else if (*study) rc = run_study(study_args);

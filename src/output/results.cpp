@@ -98,4 +98,27 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
   return j;
 }
 
+std::string format_results_text(const EstimateResult& r) {
+  std::ostringstream os;
+  char b[256];
+  const auto n = r.time_s.size();
+  if (n == 0) return "no frames\n";
+  std::snprintf(b, sizeof b, "frames %d-%d (%.3f-%.3f s), body mass %.1f kg, marker set %s\n", r.first_frame_number,
+                r.first_frame_number + static_cast<int>(n) - 1, r.time_s[0], r.time_s[n - 1], r.mass_kg, r.marker_set.c_str());
+  os << b;
+  std::snprintf(b, sizeof b, "progression: %s%s, speed %.2f m/s, contact speed gate %.2f m/s\n", r.frame.how.c_str(),
+                r.frame.treadmill ? " (treadmill)" : "", r.progression_speed_mps, r.speed_gate_mps);
+  os << b;
+  const double bw = r.mass_kg * r.model.gravity_mps2;
+  for (int s = 0; s < 2; ++s) {
+    const auto& f = r.feet[static_cast<std::size_t>(s)];
+    int stances = 0;
+    for (Eigen::Index i = 0; i < n; ++i) stances += f.contact[static_cast<std::size_t>(i)] && (i == 0 || !f.contact[static_cast<std::size_t>(i - 1)]);
+    std::snprintf(b, sizeof b, "%-5s foot: %d contact interval(s), peak vertical %.0f N (%.2f body weights)\n", s ? "left" : "right",
+                  stances, f.force_N.col(1).maxCoeff(), f.force_N.col(1).maxCoeff() / bw);
+    os << b;
+  }
+  return os.str();
+}
+
 }  // namespace kin2grf

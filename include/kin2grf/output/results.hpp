@@ -14,5 +14,8 @@ namespace kin2grf {
 void write_grf_mot(const std::string& path, const EstimateResult& r);
 std::string format_results_csv(const EstimateResult& r);
 nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings);
+/// A few lines for a person: frames, mass, progression, each foot's contact intervals and peak
+/// vertical force (what `estimate` prints).
+std::string format_results_text(const EstimateResult& r);
 
 }  // namespace kin2grf
