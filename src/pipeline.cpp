@@ -80,7 +80,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   if (trial.markers.frames() == 0) throw InputError(trial.path + ": the trial has no marker frames");
   MarkerTrajectories markers = trial.markers;
   std::vector<std::string> cleaning;
-  remove_marker_outliers(markers, cleaning);
+  remove_marker_outliers(markers, set.motion_markers(), cleaning);
   const Landmarks3D lm3 = compute_landmarks(set, markers, static_trial ? &static_trial->markers : nullptr,
                                             o.landmarks, trial.path);
   // What the readers noticed (duplicate labels, rows cut short, an up axis corrected...) goes with

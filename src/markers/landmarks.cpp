@@ -289,11 +289,12 @@ const MarkerSet* recognise_marker_set(const MarkerTrajectories& m, std::string* 
   return best;
 }
 
-int remove_marker_outliers(MarkerTrajectories& m, std::vector<std::string>& messages) {
+int remove_marker_outliers(MarkerTrajectories& m, const std::vector<std::string>& only, std::vector<std::string>& messages) {
   const Eigen::Index n = m.frames();
   const double limit = kMaxMarkerSpeedMps / std::max(m.rate_hz, 1e-9) + 0.02;
   int removed = 0;
   for (std::size_t k = 0; k < m.positions_m.size(); ++k) {
+    if (!only.empty() && std::find(only.begin(), only.end(), m.names[k]) == only.end()) continue;
     auto& P = m.positions_m[k];
     std::vector<Eigen::Index> where;
     for (Eigen::Index i = 0; i < n; ++i)

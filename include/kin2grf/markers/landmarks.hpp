@@ -138,8 +138,9 @@ struct SagittalFrame {
 ///  - a one-frame spike: a sample farther than kMaxMarkerSpeedMps x dt + 2 cm from both neighbours
 ///    while the neighbours are within that of each other (a marker does not leave and come back in
 ///    two frames faster than a thrown ball). Returns the number of samples removed.
+/// `only`: the markers to clean (a set's motion_markers()); empty: all.
 inline constexpr double kMaxLabCoordinateM = 1e4, kMaxMarkerSpeedMps = 30.0;
-int remove_marker_outliers(MarkerTrajectories& markers, std::vector<std::string>& messages);
+int remove_marker_outliers(MarkerTrajectories& markers, const std::vector<std::string>& only, std::vector<std::string>& messages);
 
 Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& motion,
                               const MarkerTrajectories* static_trial, const LandmarkOptions& options,
