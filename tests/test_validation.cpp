@@ -278,6 +278,11 @@ TEST(SharedValidate, TrialsStayWithinTheirMeasuredErrors) {
       {"ufabc_rbds001_treadmill_run/RBDS001runT35.c3d", nullptr, 62, "ufabc_rbds001_treadmill_run/RBDS001static.c3d", 4.1},
       {"ufabc_rbds001_treadmill_run/RBDS001runT25_markers.trc", "ufabc_rbds001_treadmill_run/RBDS001runT25_grf.mot", 62,
        "ufabc_rbds001_treadmill_run/RBDS001static.c3d", 4.5},
+      // A circuit with turns (the heading-following frame) and a cluster set with functional
+      // knee and ankle centres (SCoRE).
+      {"gatech_camargo2021_levelground_fastwalk/levelground_ccw_fast_01_01.trc",
+       "gatech_camargo2021_levelground_fastwalk/levelground_ccw_fast_01_01_grf.mot", 77.8, nullptr, 14.1},
+      {"uwa_control1_fast_walk/Fast_Walking_9.c3d", nullptr, 0, nullptr, 8.6},
   };
   LoadOptions lo;
   lo.c3d.zero_offset = ZeroOffset::Unloaded;
