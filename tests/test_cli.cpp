@@ -11,6 +11,8 @@
 #include <memory>
 #include <string>
 
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/text.hpp"
 #include "test_support.hpp"
 
@@ -177,4 +179,45 @@ TEST(CliShared, EveryListedTrialRunsAndWritesFiniteNumbers) {
     for (const char* bad : {"nan", "inf"}) EXPECT_EQ(text.find(bad), std::string::npos) << line << ": " << bad << " in the CSV";
   }
   EXPECT_GE(trials, 14);
+}
+
+// The OpenSim export (issue 12): the ExternalLoads XML names the .mot beside it and identifiers
+// that are its columns; the .mot covers every marker frame of the trial with the TRC's times, Y
+// up, finite everywhere, the body weight carried on the vertical axis.
+TEST(CliExport, ExternalLoadsMatchTheMotColumnsAndTimes) {
+  const auto dir = kin2grf::test::temp_dir("cli_opensim");
+  const std::string c3d = (example_dir() / "example_squat.c3d").string();
+  const CliRun r = run("estimate " + c3d + " --opensim " + (dir / "os").string() + " --opensim-bodies foot_r foot_l", "2>&1");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::string xml = kin2grf::read_file_text((dir / "os" / "example_squat_external_loads.xml").string());
+  auto tag = [&](const std::string& name, std::size_t from = 0) {
+    const auto a = xml.find("<" + name + ">", from);
+    const auto b = xml.find("</" + name + ">", a);
+    return a == std::string::npos || b == std::string::npos ? std::string() : xml.substr(a + name.size() + 2, b - a - name.size() - 2);
+  };
+  const std::string datafile = tag("datafile");
+  ASSERT_EQ(datafile, "example_squat_grf.mot");
+  EXPECT_EQ(tag("applied_to_body"), "foot_r");
+  EXPECT_NE(xml.find("<applied_to_body>foot_l</applied_to_body>"), std::string::npos);
+  const kin2grf::Table mot = kin2grf::read_sto((dir / "os" / datafile).string());
+  // Every identifier of both forces names three columns of the .mot.
+  int identifiers = 0;
+  for (const char* id : {"force_identifier", "point_identifier", "torque_identifier"})
+    for (std::size_t from = 0; (from = xml.find(std::string("<") + id + ">", from)) != std::string::npos; ++from, ++identifiers) {
+      const std::string prefix = tag(id, from);
+      for (const char axis : {'x', 'y', 'z'}) EXPECT_GE(mot.column(prefix + axis), 0) << prefix << axis;
+    }
+  EXPECT_EQ(identifiers, 6);
+  const kin2grf::Trial trc = kin2grf::load_trial((dir / "os" / "example_squat_markers.trc").string());
+  const kin2grf::Trial orig = kin2grf::load_trial(c3d);
+  ASSERT_EQ(mot.data.rows(), orig.markers.frames()) << "the whole trial, not only the processed window";
+  ASSERT_EQ(trc.markers.frames(), orig.markers.frames());
+  for (Eigen::Index i = 0; i < mot.data.rows(); ++i) EXPECT_NEAR(mot.data(i, 0), trc.markers.time_s[i], 1e-6);
+  EXPECT_TRUE(mot.data.allFinite());
+  EXPECT_EQ(trc.markers.up_axis, kin2grf::Axis::Y);
+  // Quiet-standing frames carry the body weight on Y (the model's own squat: 70 kg).
+  const int vy = mot.column("ground_force_vy"), vy1 = mot.column("1_ground_force_vy");
+  const double mid = mot.data(mot.data.rows() / 2, vy) + mot.data(mot.data.rows() / 2, vy1);
+  EXPECT_GT(mid, 0.5 * 70 * 9.81);
+  EXPECT_NEAR(mot.data.col(mot.column("ground_force_vz")).cwiseAbs().maxCoeff(), 0.0, 1e-9) << "no mediolateral force";
 }

@@ -17,6 +17,7 @@
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/summary.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/output/opensim_export.hpp"
 #include "kin2grf/output/report.hpp"
 #include "kin2grf/output/results.hpp"
 #include "kin2grf/pipeline.hpp"
@@ -59,6 +60,8 @@ int run_info(const std::string& file, bool json, double threshold, const std::st
 const char* torso_length_name(kin2grf::TorsoLength t) { return t == kin2grf::TorsoLength::Fixed ? "fixed" : "measured"; }
 
 struct EstimateArgs {
+  std::string opensim_dir;
+  std::vector<std::string> opensim_bodies;
   std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "torque-scaled",
       anthropometry = kin2grf::EstimateOptions{}.anthropometry, up_axis, cop_function, running_cop = "builtin",
       torso_length = torso_length_name(kin2grf::EstimateOptions{}.torso_length);
@@ -127,6 +130,11 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
   c->add_option("-o,--output", a.out_mot, "OpenSim GRF .mot output");
   c->add_option("--csv", a.out_csv, "Per-frame CSV output (sagittal frame)");
   c->add_option("--json", a.out_json, "JSON summary output");
+  c->add_option("--opensim", a.opensim_dir,
+                "Write FOLDER/TRIAL_grf.mot (whole trial), TRIAL_markers.trc and TRIAL_external_loads.xml in OpenSim's frame "
+                "(Y up, X forward), ready for the ID tool");
+  c->add_option("--opensim-bodies", a.opensim_bodies, "Bodies the right and left forces are applied to (default calcn_r calcn_l)")
+      ->expected(2);
 }
 
 kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
@@ -262,7 +270,17 @@ int run_estimate(const EstimateArgs& a) {
   std::cout << kin2grf::format_results_text(r);
   for (const auto& [file, what] : {std::pair{a.out_mot, "OpenSim GRF"}, {a.out_csv, "per-frame CSV"}, {a.out_json, "JSON summary"}})
     if (!file.empty()) std::cout << "wrote " << file << " (" << what << ")\n";
-  if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty())
+  if (!a.opensim_dir.empty()) {
+    kin2grf::OpenSimExportOptions eo;
+    if (a.opensim_bodies.size() == 2) eo.right_body = a.opensim_bodies[0], eo.left_body = a.opensim_bodies[1];
+    const std::string stem = std::filesystem::path(a.trial).stem().string();
+    for (const char* suffix : {"_grf.mot", "_markers.trc", "_external_loads.xml"})
+      kin2grf::ensure_not_an_input((std::filesystem::path(a.opensim_dir) / (stem + suffix)).string(), inputs_of(a));
+    const auto f = kin2grf::write_opensim_export(a.opensim_dir, stem, trial, r, eo);
+    std::cout << "wrote " << f.grf_mot << ", " << f.markers_trc << " and " << f.external_loads_xml
+              << " (OpenSim: Y up, X forward; sagittal model: no mediolateral force or free moment)\n";
+  }
+  if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty() && a.opensim_dir.empty())
     std::cout << "(-o GRF.mot, --csv FILE and --json FILE write the per-frame results and the full summary)\n";
   return 0;
 }

@@ -1,0 +1,45 @@
+// kin2grf outputs: an estimate ready for OpenSim's inverse dynamics (ID tool) with no hand edits.
+//
+// Three files in one folder, all in OpenSim's frame and one time base:
+//  - STEM_grf.mot: per foot ground_force_v[xyz] (N, on the body), ground_force_p[xyz] (COP, m),
+//    ground_torque_[xyz] (N m, free moment: zero), the left foot's with the prefix "1_"; one row per
+//    marker frame of the WHOLE trial: zero force outside contact and outside the processed window,
+//    and a finite COP everywhere (the foot's nearest contact COP held, zero for a foot that never
+//    touches the ground);
+//  - STEM_markers.trc: every marker of the trial (mm), for OpenSim's scaling and IK;
+//  - STEM_external_loads.xml: an ExternalLoads document applying the two forces to calcn_r and
+//    calcn_l (overridable), expressed in ground, naming the .mot as its datafile.
+// OpenSim's frame: X along the walker's progression (the sagittal frame's forward), Y up, Z to the
+// walker's right (X x Y), origin the lab's. Time: the trial's own time column ((frame - 1) / rate
+// for a C3D, as in the TRC), the same in both data files.
+//
+// What is 2D: kin2grf's model is sagittal. The mediolateral force (Z) and the free moment are zero,
+// and the COP's lateral place is the foot's (its heel-MT midpoint), not a measured one: joint
+// moments about the sagittal axes (flexion-extension) are meaningful, frontal- and transverse-plane
+// moments from inverse dynamics (ab/adduction, rotation) are not.
+#pragma once
+
+#include <string>
+
+#include "kin2grf/io/trial.hpp"
+#include "kin2grf/pipeline.hpp"
+
+namespace kin2grf {
+
+struct OpenSimExportOptions {
+  std::string right_body = "calcn_r";
+  std::string left_body = "calcn_l";
+};
+
+struct OpenSimExportFiles {
+  std::string grf_mot, markers_trc, external_loads_xml;  ///< paths written
+};
+
+/// Write the three files into `dir` (created if needed), names starting with `stem`.
+OpenSimExportFiles write_opensim_export(const std::string& dir, const std::string& stem, const Trial& trial,
+                                        const EstimateResult& estimate, const OpenSimExportOptions& options = {});
+
+/// The ExternalLoads XML text for a .mot file name (exposed for tests).
+std::string external_loads_xml(const std::string& mot_file_name, const OpenSimExportOptions& options);
+
+}  // namespace kin2grf

@@ -1,0 +1,99 @@
+#include "kin2grf/output/opensim_export.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/opensim.hpp"
+#include "kin2grf/io/text.hpp"
+
+namespace kin2grf {
+
+std::string external_loads_xml(const std::string& mot, const OpenSimExportOptions& o) {
+  std::ostringstream os;
+  os << "<?xml version=\"1.0\" encoding=\"UTF-8\" ?>\n"
+     << "<!-- Written by kin2grf " << KIN2GRF_VERSION << ": estimated ground reactions (sagittal model: the mediolateral\n"
+     << "     force and the free moment are zero; frontal- and transverse-plane joint moments are not valid). -->\n"
+     << "<OpenSimDocument Version=\"40000\">\n"
+     << "  <ExternalLoads name=\"kin2grf_external_loads\">\n"
+     << "    <objects>\n";
+  for (const auto& [name, body, prefix] : {std::tuple{"right", o.right_body, ""}, std::tuple{"left", o.left_body, "1_"}}) {
+    os << "      <ExternalForce name=\"" << name << "\">\n"
+       << "        <applied_to_body>" << body << "</applied_to_body>\n"
+       << "        <force_expressed_in_body>ground</force_expressed_in_body>\n"
+       << "        <point_expressed_in_body>ground</point_expressed_in_body>\n"
+       << "        <force_identifier>" << prefix << "ground_force_v</force_identifier>\n"
+       << "        <point_identifier>" << prefix << "ground_force_p</point_identifier>\n"
+       << "        <torque_identifier>" << prefix << "ground_torque_</torque_identifier>\n"
+       << "      </ExternalForce>\n";
+  }
+  os << "    </objects>\n"
+     << "    <groups />\n"
+     << "    <datafile>" << mot << "</datafile>\n"
+     << "  </ExternalLoads>\n"
+     << "</OpenSimDocument>\n";
+  return os.str();
+}
+
+OpenSimExportFiles write_opensim_export(const std::string& dir, const std::string& stem, const Trial& trial,
+                                        const EstimateResult& r, const OpenSimExportOptions& o) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw InputError(dir + ": cannot create the OpenSim export folder (" + ec.message() + ")");
+  // Lab -> OpenSim: rows forward, up, right.
+  Eigen::Matrix3d R;
+  R.row(0) = r.frame.forward.transpose();
+  R.row(1) = r.frame.up.transpose();
+  R.row(2) = r.frame.forward.cross(r.frame.up).transpose();
+  const Eigen::Index N = trial.markers.frames(), n = r.time_s.size();
+  const auto plates = as_lab_plates(r);
+
+  // The GRF over the whole trial.
+  ForcePlate feet[2];
+  for (int side = 0; side < 2; ++side) {
+    ForcePlate& f = feet[side];
+    f.force_N = Eigen::MatrixX3d::Zero(N, 3);
+    f.cop_m = Eigen::MatrixX3d::Constant(N, 3, std::nan(""));
+    f.free_moment_Nm = Eigen::MatrixX3d::Zero(N, 3);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index k = r.first_index + i;
+      if (k < 0 || k >= N || !r.feet[static_cast<std::size_t>(side)].contact[static_cast<std::size_t>(i)]) continue;
+      const auto& p = plates[static_cast<std::size_t>(side)];
+      if (!p.cop_m.row(i).allFinite()) continue;
+      f.force_N.row(k) = (R * p.force_N.row(i).transpose()).transpose();
+      f.cop_m.row(k) = (R * p.cop_m.row(i).transpose()).transpose();
+    }
+    // A finite COP everywhere: the nearest contact COP held (OpenSim applies a zero force there).
+    Eigen::Index last = -1;
+    for (Eigen::Index k = 0; k < N; ++k) {
+      if (f.cop_m.row(k).allFinite()) last = k;
+      else if (last >= 0) f.cop_m.row(k) = f.cop_m.row(last);
+    }
+    Eigen::Index next = -1;
+    for (Eigen::Index k = N - 1; k >= 0; --k) {
+      if (f.cop_m.row(k).allFinite()) next = k;
+      else if (next >= 0) f.cop_m.row(k) = f.cop_m.row(next);
+      else f.cop_m.row(k).setZero();  // a foot that never touches the ground
+    }
+  }
+  Table t = grf_table(trial.markers.time_s, feet[0], feet[1]);
+  t.name = stem + "_grf";
+  t.header["DataType"] = "double";
+  OpenSimExportFiles out;
+  out.grf_mot = (fs::path(dir) / (stem + "_grf.mot")).string();
+  write_file_text(out.grf_mot, format_sto(t));
+
+  MarkerTrajectories m = trial.markers;
+  for (auto& P : m.positions_m) P = (P * R.transpose()).eval();  // NaN stays NaN (a blank in the TRC)
+  m.up_axis = Axis::Y;
+  out.markers_trc = (fs::path(dir) / (stem + "_markers.trc")).string();
+  write_file_text(out.markers_trc, format_trc(m, stem + "_markers.trc"));
+
+  out.external_loads_xml = (fs::path(dir) / (stem + "_external_loads.xml")).string();
+  write_file_text(out.external_loads_xml, external_loads_xml(stem + "_grf.mot", o));
+  return out;
+}
+
+}  // namespace kin2grf
