@@ -9,5 +9,6 @@ cmake --build --preset release
 ./build/release/kin2grf make-example --out-dir out/example
 ./build/release/kin2grf info out/example/example_squat.c3d
 ./build/release/kin2grf estimate out/example/example_squat.c3d -o out/example/estimated_grf.mot \
-  --csv out/example/estimated.csv --json out/example/estimated.json
-echo "Outputs: out/example/estimated_grf.mot (OpenSim GRF), estimated.csv (per frame), estimated.json (summary)"
+  --csv out/example/estimated.csv --json out/example/estimated.json --opensim out/example/opensim
+echo "Outputs: out/example/estimated_grf.mot (GRF, lab frame), estimated.csv (per frame), estimated.json (summary),"
+echo "         out/example/opensim/ (GRF .mot, markers .trc and ExternalLoads .xml for OpenSim's inverse dynamics)"
