@@ -57,13 +57,13 @@ struct SolverOptions {
   /// walker's swing foot (about 1 m/s, 8-12 mm above the floor) take the load, and cuts a
   /// sprinter's landing. The floor keeps standing and squatting trials (v ~ 0) gated only
   /// against feet that really slide. See speed_gate_for() and `kin2grf study speed-gate-ratio`.
-  /// kin2grf's default 1 x v, at least 0.75 m/s. On the 12 development trials (7 labs) it ties
-  /// with the fixed 1.5 m/s (leave-one-lab-out criterion 12.19 against 12.17 %; walking 9.5 %
-  /// vertical for both, running anterior 10.2 against 10.6 %, drop jump 13.6 against 13.9 %),
-  /// which cannot tell them apart: the development data hold no slow walk and no sprint. It is
-  /// the default for its physical reason and for the two held-out failures of the fixed gate
-  /// (issue 9: a 0.4 m/s walk's swing foot took load; a 3.3 m/s run did better with 2 m/s);
-  /// 2 x v let a fast walker's landing foot in 60-90 ms early (docs/METHOD-NOTES.md).
+  /// kin2grf's default 1 x v, at least 0.75 m/s. On the 14 development trials (8 labs) it ties
+  /// with the fixed 1.5 m/s (leave-one-lab-out criterion 12.04 against 12.02 %; walking 9.4 %
+  /// vertical for both, running anterior 10.2 against 10.6 %, drop jump 13.6 against 13.9 %):
+  /// those data cannot tell them apart, holding no slow walk and no sprint. It is the default for
+  /// its physical reason and for the two held-out failures of the fixed gate (issue 9: a 0.4 m/s
+  /// walk's swing foot took load; a 3.3 m/s run did better with 2 m/s); 2 x v let a fast walker's
+  /// landing foot in 60-90 ms early (docs/METHOD-NOTES.md).
   double speed_gate_ratio = 1.0;
   double speed_gate_floor_mps = 0.75;
   double belt_velocity_mps = 0.0;  ///< ground velocity along x (treadmill belt), m/s
