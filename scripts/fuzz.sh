@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Build the libFuzzer targets with clang, the library itself under ASan/UBSan (the `fuzz`
 # preset), and run each parser target for SECONDS (default 30) under -rss_limit_mb=2048, seeded
-# with a corpus the project makes itself (files written by kin2grf's writers; no shared data).
+# with a corpus the project makes itself (files written by kin2grf's writers and the damaged files
+# of tests/corpus; no shared data).
 # Exits non-zero on any crash, leak, timeout or out-of-memory; a reproducer is left in build/fuzz.
 #   bash scripts/fuzz.sh [SECONDS]        (CI runs it for a short time; 600 for the long run)
 set -euo pipefail
@@ -23,6 +24,10 @@ mkdir -p "$corpus/c3d" "$corpus/trc" "$corpus/sto"
 cp "$corpus"/seed/*.c3d "$corpus/c3d/"
 cp "$corpus"/seed/*.trc "$corpus/trc/"
 cp "$corpus"/seed/*.mot "$corpus/sto/"
+# and the committed corpus of damaged files (tests/corpus, from scripts/make_corpus.py)
+cp tests/corpus/*.c3d "$corpus/c3d/"
+cp tests/corpus/*.trc "$corpus/trc/"
+cp tests/corpus/*.mot "$corpus/sto/"
 status=0
 for t in c3d trc sto; do
   echo "fuzz_$t: ${seconds} s"

@@ -7,12 +7,14 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <random>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/c3d.hpp"
+#include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/summary.hpp"
@@ -482,4 +484,41 @@ TEST(C3dCorrupt, AFrameCountNoDataJustifiesIsRefusedBeforeAllocating) {
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
     EXPECT_TRUE(msg.find("frame") != std::string::npos || msg.find("truncated") != std::string::npos) << msg;
   }
+}
+
+// tests/corpus (scripts/make_corpus.py): one damaged file per reader failure of issue 10. Each is
+// read, with the warning that says what was wrong, or refused with a message naming the file;
+// never a crash, a hang or an allocation the file cannot justify (this test also runs under ASan).
+TEST(CorruptCorpus, EachFileIsReadWithAWarningOrRefusedByName) {
+  const std::filesystem::path dir = std::filesystem::path(KIN2GRF_SOURCE_DIR) / "tests" / "corpus";
+  // name -> the warning it must give when read; absent: it must be refused.
+  const std::map<std::string, std::string> read_with = {
+      {"mot_rows_mismatch.mot", "header says"},          {"trc_cut_row.trc", "rows end early"},
+      {"trc_duplicate_label.trc", "repeated"},           {"trc_rate_mismatch.trc", "DataRate says"},
+      {"trc_rate_1e300.trc", "DataRate says"},
+  };
+  int files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string path = e.path().string(), name = e.path().filename().string();
+    SCOPED_TRACE(name);
+    ++files;
+    try {
+      if (e.path().extension() == ".json") {
+        (void)read_cop_function(path);
+      } else {
+        const Trial t = load_trial(path);
+        const auto it = read_with.find(name);
+        ASSERT_NE(it, read_with.end()) << "read without complaint";
+        bool warned = false;
+        for (const auto& w : t.warnings) warned = warned || w.find(it->second) != std::string::npos;
+        EXPECT_TRUE(warned) << "no warning '" << it->second << "'";
+        continue;
+      }
+      ADD_FAILURE() << "read without complaint";
+    } catch (const InputError& err) {
+      EXPECT_EQ(read_with.count(name), 0u) << err.what();
+      EXPECT_NE(std::string(err.what()).find(name), std::string::npos) << "the message must name the file: " << err.what();
+    }
+  }
+  EXPECT_GE(files, 13);
 }
