@@ -106,8 +106,8 @@ std::string format_results_text(const EstimateResult& r) {
   std::snprintf(b, sizeof b, "frames %d-%d (%.3f-%.3f s), body mass %.1f kg, marker set %s\n", r.first_frame_number,
                 r.first_frame_number + static_cast<int>(n) - 1, r.time_s[0], r.time_s[n - 1], r.mass_kg, r.marker_set.c_str());
   os << b;
-  std::snprintf(b, sizeof b, "progression: %s%s, speed %.2f m/s, contact speed gate %.2f m/s\n", r.frame.how.c_str(),
-                r.frame.treadmill ? " (treadmill)" : "", r.progression_speed_mps, r.speed_gate_mps);
+  std::snprintf(b, sizeof b, "progression: %s, speed %.2f m/s, contact speed gate %.2f m/s\n", r.frame.how.c_str(),
+                r.progression_speed_mps, r.speed_gate_mps);
   os << b;
   const double bw = r.mass_kg * r.model.gravity_mps2;
   for (int s = 0; s < 2; ++s) {
