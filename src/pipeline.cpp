@@ -78,9 +78,9 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     throw InputError(trial.path + b);
   }
   if (trial.markers.frames() == 0) throw InputError(trial.path + ": the trial has no marker frames");
-  MarkerTrajectories markers = trial.markers;
   std::vector<std::string> cleaning;
-  remove_marker_outliers(markers, set.motion_markers(), cleaning);
+  const std::optional<MarkerTrajectories> cleaned = without_marker_outliers(trial.markers, set.motion_markers(), cleaning);
+  const MarkerTrajectories& markers = cleaned ? *cleaned : trial.markers;
   const Landmarks3D lm3 = compute_landmarks(set, markers, static_trial ? &static_trial->markers : nullptr,
                                             o.landmarks, trial.path);
   // What the readers noticed (duplicate labels, rows cut short, an up axis corrected...) goes with

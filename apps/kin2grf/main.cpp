@@ -253,14 +253,29 @@ kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, kin2grf::Estima
 }
 
 /// The files a run reads: no output may be one of them.
-std::vector<std::string> inputs_of(const EstimateArgs& a) { return {a.trial, a.static_trial, a.markers, a.cop_function, a.running_cop}; }
+std::vector<std::string> inputs_of(const EstimateArgs& a) {
+  std::vector<std::string> in = {a.trial, a.static_trial, a.markers, a.cop_function};
+  if (a.running_cop != "builtin" && a.running_cop != "off") in.push_back(a.running_cop);
+  return in;
+}
 
 void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
   for (const auto& o : outputs) kin2grf::ensure_not_an_input(o, inputs);
 }
 
+/// The three files of --opensim (write_opensim_export's names), or none.
+std::vector<std::string> opensim_outputs(const EstimateArgs& a) {
+  if (a.opensim_dir.empty()) return {};
+  const std::string stem = std::filesystem::path(a.trial).stem().string();
+  std::vector<std::string> out;
+  for (const char* suffix : {"_grf.mot", "_markers.trc", "_external_loads.xml"})
+    out.push_back((std::filesystem::path(a.opensim_dir) / (stem + suffix)).string());
+  return out;
+}
+
 int run_estimate(const EstimateArgs& a) {
   check_outputs({a.out_mot, a.out_csv, a.out_json}, inputs_of(a));
+  check_outputs(opensim_outputs(a), inputs_of(a));
   const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
   const auto options = to_options(a);
   const auto r = run_estimate_core(a, options, trial);
@@ -273,10 +288,7 @@ int run_estimate(const EstimateArgs& a) {
   if (!a.opensim_dir.empty()) {
     kin2grf::OpenSimExportOptions eo;
     if (a.opensim_bodies.size() == 2) eo.right_body = a.opensim_bodies[0], eo.left_body = a.opensim_bodies[1];
-    const std::string stem = std::filesystem::path(a.trial).stem().string();
-    for (const char* suffix : {"_grf.mot", "_markers.trc", "_external_loads.xml"})
-      kin2grf::ensure_not_an_input((std::filesystem::path(a.opensim_dir) / (stem + suffix)).string(), inputs_of(a));
-    const auto f = kin2grf::write_opensim_export(a.opensim_dir, stem, trial, r, eo);
+    const auto f = kin2grf::write_opensim_export(a.opensim_dir, std::filesystem::path(a.trial).stem().string(), trial, r, eo);
     std::cout << "wrote " << f.grf_mot << ", " << f.markers_trc << " and " << f.external_loads_xml
               << " (OpenSim: Y up, X forward; sagittal model: no mediolateral force or free moment)\n";
   }

@@ -420,11 +420,7 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
       t.model_outputs.push_back(name);
       continue;
     }
-    if (m.find(name) >= 0) {
-      t.warnings.push_back("point label '" + name + "' repeated; the later one is named " + name +
-                           "#" + std::to_string(k + 1));
-      name += "#" + std::to_string(k + 1);
-    }
+    name = unique_label(m.names, name, static_cast<std::size_t>(k), &t.warnings);
     m.names.push_back(name);
     m.descriptions.push_back(k < static_cast<int>(descs.size()) ? descs[k] : "");
     m.positions_m.emplace_back(nframes, 3);

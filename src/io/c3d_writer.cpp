@@ -289,7 +289,7 @@ std::vector<std::uint8_t> write_c3d_bytes(const Trial& trial, const C3dWriteOpti
 
 void write_c3d(const std::string& path, const Trial& trial, const C3dWriteOptions& options) {
   const auto bytes = write_c3d_bytes(trial, options);
-  write_file_text(path, std::string(bytes.begin(), bytes.end()));  // through a temporary file
+  write_file_text(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 }  // namespace kin2grf

@@ -27,14 +27,16 @@ std::optional<Axis> up_axis_from_data(const Trial& t, std::string* why) {
   const Eigen::Index n = m.frames();
   if (m.positions_m.size() < 4 || n == 0) return std::nullopt;
   std::array<std::vector<double>, 3> spread;
-  std::array<long, 3> positive{0, 0, 0}, valid{0, 0, 0};
+  std::array<long, 3> positive{0, 0, 0};
+  long valid = 0;
   const Eigen::Index step = std::max<Eigen::Index>(1, n / 200);  // 200 frames are plenty
   std::array<std::vector<double>, 3> c;
   for (Eigen::Index i = 0; i < n; i += step) {
     for (auto& v : c) v.clear();
     for (const auto& P : m.positions_m) {
       if (!P.row(i).allFinite()) continue;
-      for (int a = 0; a < 3; ++a) c[a].push_back(P(i, a)), positive[a] += P(i, a) > 0, ++valid[a];
+      for (int a = 0; a < 3; ++a) c[a].push_back(P(i, a)), positive[a] += P(i, a) > 0;
+      ++valid;
     }
     if (c[0].size() < 4) continue;
     // 10th-90th percentile, so that a stray or unlabelled point far from the body does not count.
@@ -52,7 +54,7 @@ std::optional<Axis> up_axis_from_data(const Trial& t, std::string* why) {
   double next = 0;
   for (int a = 0; a < 3; ++a)
     if (a != best) next = std::max(next, med[a]);
-  if (med[best] < 1.3 * next || med[best] > 2.5 || 5 * positive[best] < 4 * valid[best]) return std::nullopt;
+  if (med[best] < 1.3 * next || med[best] > 2.5 || 5 * positive[best] < 4 * valid) return std::nullopt;
   if (why) {
     char b[160];
     std::snprintf(b, sizeof b, "the markers' spread (median %.2f m along %s against %.2f m across)", med[best],

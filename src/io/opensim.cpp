@@ -88,15 +88,11 @@ MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
   if (name_cells.size() < 2 || trim(name_cells[0]) != "Frame#") {
     throw InputError(where(path, 3) + ": expected 'Frame#<tab>Time<tab>names...'");
   }
-  // A label used twice: the later one is renamed NAME#k (as the C3D reader does), never silently
-  // shadowed by the first (a biceps marker taken for the heel).
-  for (std::size_t i = 0; i < names.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (names[j] == names[i]) {
-        if (warnings) warnings->push_back("marker label '" + names[i] + "' repeated; the later one is named " + names[i] + "#" + std::to_string(i + 1));
-        names[i] += "#" + std::to_string(i + 1);
-        break;
-      }
+  {
+    std::vector<std::string> unique;  // a label used twice: the later one is NAME#k (unique_label)
+    for (std::size_t i = 0; i < names.size(); ++i) unique.push_back(unique_label(unique, names[i], i, warnings));
+    names = std::move(unique);
+  }
   if (static_cast<double>(names.size()) != nmark_decl) {
     throw InputError(where(path, 3) + ": NumMarkers says " + fmt(nmark_decl) + " but " +
                      std::to_string(names.size()) + " marker names follow");

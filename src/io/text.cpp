@@ -70,7 +70,7 @@ std::string read_file_text(const std::string& path) {
   return std::string(b.begin(), b.end());
 }
 
-void write_file_text(const std::string& path, const std::string& text) {
+void write_file_text(const std::string& path, std::string_view text) {
   // Through a temporary file in the same folder, renamed at the end: a failed or interrupted run
   // leaves the old file (or none), never half a file.
   namespace fs = std::filesystem;

@@ -1,5 +1,7 @@
 #include "kin2grf/io/trial.hpp"
 
+#include <algorithm>
+
 namespace kin2grf {
 
 const char* to_string(Axis a) {
@@ -16,6 +18,14 @@ const char* to_string(Side s) {
     case Side::Left: return "left";
     default: return "general";
   }
+}
+
+std::string unique_label(const std::vector<std::string>& taken, const std::string& name, std::size_t index,
+                         std::vector<std::string>* warnings) {
+  if (std::find(taken.begin(), taken.end(), name) == taken.end()) return name;
+  const std::string renamed = name + "#" + std::to_string(index + 1);
+  if (warnings) warnings->push_back("marker label '" + name + "' repeated; the later one is named " + renamed);
+  return renamed;
 }
 
 int MarkerTrajectories::find(const std::string& name) const {

@@ -110,11 +110,18 @@ Eigen::MatrixX3d functional_joint_centre(const std::vector<Eigen::MatrixX3d>& pr
   Eigen::Matrix<double, 6, 6> AtA = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> Atb = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> prior = Eigen::Matrix<double, 6, 1>::Zero();
-  std::vector<Eigen::Index> frames;
-  for (Eigen::Index i = 0; i < n; ++i) {
+  // Both clusters' frames, once per frame seen (the fit and the positions below use them).
+  struct Seen {
+    Eigen::Index i;
     Eigen::Matrix3d R1, R2;
     Eigen::Vector3d o1, o2;
-    if (!cluster_frame(prox, i, R1, o1) || !cluster_frame(dist, i, R2, o2)) continue;
+  };
+  std::vector<Seen> frames;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Seen f{i, {}, {}, {}, {}};
+    if (!cluster_frame(prox, i, f.R1, f.o1) || !cluster_frame(dist, i, f.R2, f.o2)) continue;
+    const auto &R1 = f.R1, &R2 = f.R2;
+    const auto &o1 = f.o1, &o2 = f.o2;
     Eigen::Matrix<double, 3, 6> A;
     A << R1, -R2;
     const Eigen::Vector3d b = o2 - o1;
@@ -123,7 +130,7 @@ Eigen::MatrixX3d functional_joint_centre(const std::vector<Eigen::MatrixX3d>& pr
     const Eigen::Vector3d mid = 0.5 * (o1 + o2);
     prior.head<3>() += R1.transpose() * (mid - o1);
     prior.tail<3>() += R2.transpose() * (mid - o2);
-    frames.push_back(i);
+    frames.push_back(f);
   }
   if (frames.size() < 20) {
     message = "the two segments' clusters are seen together in " + std::to_string(frames.size()) +
@@ -143,14 +150,10 @@ Eigen::MatrixX3d functional_joint_centre(const std::vector<Eigen::MatrixX3d>& pr
   }
   Eigen::MatrixX3d P = Eigen::MatrixX3d::Constant(n, 3, kNaN);
   double sq = 0;
-  for (const Eigen::Index i : frames) {
-    Eigen::Matrix3d R1, R2;
-    Eigen::Vector3d o1, o2;
-    cluster_frame(prox, i, R1, o1);
-    cluster_frame(dist, i, R2, o2);
-    const Eigen::Vector3d p1 = R1 * x.head<3>() + o1, p2 = R2 * x.tail<3>() + o2;
+  for (const Seen& f : frames) {
+    const Eigen::Vector3d p1 = f.R1 * x.head<3>() + f.o1, p2 = f.R2 * x.tail<3>() + f.o2;
     sq += (p1 - p2).squaredNorm();
-    P.row(i) = (0.5 * (p1 + p2)).transpose();
+    P.row(f.i) = (0.5 * (p1 + p2)).transpose();
   }
   char b[200];
   std::snprintf(b, sizeof b, "functional joint centre (SCoRE) from %zu frames, the two segments' points %.1f mm apart (RMS)%s",
@@ -289,26 +292,33 @@ const MarkerSet* recognise_marker_set(const MarkerTrajectories& m, std::string* 
   return best;
 }
 
-int remove_marker_outliers(MarkerTrajectories& m, const std::vector<std::string>& only, std::vector<std::string>& messages) {
+std::optional<MarkerTrajectories> without_marker_outliers(const MarkerTrajectories& m, const std::vector<std::string>& only,
+                                                          std::vector<std::string>& messages) {
   const Eigen::Index n = m.frames();
   const double limit = kMaxMarkerSpeedMps / std::max(m.rate_hz, 1e-9) + 0.02;
-  int removed = 0;
+  std::optional<MarkerTrajectories> out;  // copied only when there is something to remove
   for (std::size_t k = 0; k < m.positions_m.size(); ++k) {
     if (!only.empty() && std::find(only.begin(), only.end(), m.names[k]) == only.end()) continue;
-    auto& P = m.positions_m[k];
+    const auto& P = m.positions_m[k];
+    // Usable samples: finite and inside any capture volume.
+    std::vector<bool> ok(static_cast<std::size_t>(n));
     std::vector<Eigen::Index> where;
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (P.row(i).allFinite() && P.row(i).cwiseAbs().maxCoeff() > kMaxLabCoordinateM) P.row(i).setConstant(kNaN), where.push_back(i);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      ok[static_cast<std::size_t>(i)] = P.row(i).allFinite() && P.row(i).cwiseAbs().maxCoeff() <= kMaxLabCoordinateM;
+      if (P.row(i).allFinite() && !ok[static_cast<std::size_t>(i)]) where.push_back(i);
+    }
     for (Eigen::Index i = 1; i + 1 < n; ++i) {
-      if (!P.row(i - 1).allFinite() || !P.row(i).allFinite() || !P.row(i + 1).allFinite()) continue;
+      if (!ok[static_cast<std::size_t>(i - 1)] || !ok[static_cast<std::size_t>(i)] || !ok[static_cast<std::size_t>(i + 1)]) continue;
       if ((P.row(i) - P.row(i - 1)).norm() > limit && (P.row(i + 1) - P.row(i)).norm() > limit &&
           (P.row(i + 1) - P.row(i - 1)).norm() < limit) {
-        P.row(i).setConstant(kNaN);
+        ok[static_cast<std::size_t>(i)] = false;
         where.push_back(i);
       }
     }
     if (where.empty()) continue;
-    removed += static_cast<int>(where.size());
+    if (!out) out = m;
+    for (const Eigen::Index i : where) out->positions_m[k].row(i).setConstant(kNaN);
+    std::sort(where.begin(), where.end());
     std::string frames;
     for (std::size_t w = 0; w < where.size() && w < 5; ++w) frames += (w ? ", " : "") + std::to_string(m.first_frame + where[w]);
     if (where.size() > 5) frames += ", ...";
@@ -316,7 +326,7 @@ int remove_marker_outliers(MarkerTrajectories& m, const std::vector<std::string>
                        ": outside the lab or a one-frame jump faster than " + std::to_string(static_cast<int>(kMaxMarkerSpeedMps)) +
                        " m/s) treated as gaps");
   }
-  return removed;
+  return out;
 }
 
 Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m, const MarkerTrajectories* st,

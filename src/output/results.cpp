@@ -49,6 +49,24 @@ std::string format_results_csv(const EstimateResult& r) {
   return os.str();
 }
 
+namespace {
+
+/// The runs of frames in contact: (first, last) frame indices, inclusive.
+std::vector<std::pair<Eigen::Index, Eigen::Index>> contact_runs(const std::vector<bool>& c) {
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> out;
+  const auto n = static_cast<Eigen::Index>(c.size());
+  for (Eigen::Index i = 0; i < n;) {
+    if (!c[static_cast<std::size_t>(i)]) { ++i; continue; }
+    Eigen::Index k = i;
+    while (k < n && c[static_cast<std::size_t>(k)]) ++k;
+    out.emplace_back(i, k - 1);
+    i = k;
+  }
+  return out;
+}
+
+}  // namespace
+
 nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings) {
   using nlohmann::json;
   json j;
@@ -69,14 +87,7 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
   json contacts = json::object();
   for (int s = 0; s < 2; ++s) {
     json iv = json::array();
-    const auto& c = r.feet[s].contact;
-    for (Eigen::Index i = 0; i < n;) {
-      if (!c[static_cast<std::size_t>(i)]) { ++i; continue; }
-      Eigen::Index k = i;
-      while (k < n && c[static_cast<std::size_t>(k)]) ++k;
-      iv.push_back({{"start_s", r.time_s[i]}, {"end_s", r.time_s[k - 1]}});
-      i = k;
-    }
+    for (const auto& [first, last] : contact_runs(r.feet[s].contact)) iv.push_back({{"start_s", r.time_s[first]}, {"end_s", r.time_s[last]}});
     contacts[s ? "left" : "right"] = iv;
   }
   j["contact_intervals"] = contacts;
@@ -112,10 +123,8 @@ std::string format_results_text(const EstimateResult& r) {
   const double bw = r.mass_kg * r.model.gravity_mps2;
   for (int s = 0; s < 2; ++s) {
     const auto& f = r.feet[static_cast<std::size_t>(s)];
-    int stances = 0;
-    for (Eigen::Index i = 0; i < n; ++i) stances += f.contact[static_cast<std::size_t>(i)] && (i == 0 || !f.contact[static_cast<std::size_t>(i - 1)]);
-    std::snprintf(b, sizeof b, "%-5s foot: %d contact interval(s), peak vertical %.0f N (%.2f body weights)\n", s ? "left" : "right",
-                  stances, f.force_N.col(1).maxCoeff(), f.force_N.col(1).maxCoeff() / bw);
+    std::snprintf(b, sizeof b, "%-5s foot: %zu contact interval(s), peak vertical %.0f N (%.2f body weights)\n", s ? "left" : "right",
+                  contact_runs(f.contact).size(), f.force_N.col(1).maxCoeff(), f.force_N.col(1).maxCoeff() / bw);
     os << b;
   }
   return os.str();

@@ -129,7 +129,7 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
     out.samples_per_trial.push_back(per[k].theta_rad.size());
   }
   // Leave one LAB out: a trial's held-out fit uses no trial of its lab (same lab, same set-up).
-  auto lab = [&](std::size_t k) { return trials[k].lab.empty() ? trials[k].name : trials[k].lab; };
+  auto lab = [&](std::size_t k) { return trials[k].lab_or_name(); };
   auto pooled = [&](std::size_t skip) {
     CopSamples all;
     for (std::size_t k = 0; k < n; ++k) {

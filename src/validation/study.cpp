@@ -112,7 +112,7 @@ StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& tr
     row.value = s.value;
     std::vector<StudyTrialResult> per_trial;
     for (const auto& t : trials) {
-      StudyTrialResult tr{t.name, t.activity, t.lab.empty() ? t.name : t.lab, {}, std::numeric_limits<double>::quiet_NaN(), false};
+      StudyTrialResult tr{t.name, t.activity, t.lab_or_name(), {}, std::numeric_limits<double>::quiet_NaN(), false};
       EstimateOptions o = t.options;
       s.apply(o);
       try {
@@ -151,7 +151,6 @@ CrossValidation cross_validate(const StudyResult& s) {
   }
   if (labs.size() < 2) throw InputError("cross-validation: the trials come from one lab; give each trial its lab (trial list: activity|lab|name|TRIAL)");
   if (activities.size() > 1) activities.push_back("all");
-  // The setting with the lowest criterion over the trials `use` accepts.
   // The criterion of setting r over the trials `use` accepts; NaN when a trial failed (a setting
   // that breaks a trial is never chosen) or none has a stance.
   auto criterion = [&](std::size_t r, const std::function<bool(const StudyTrialResult&)>& use) {

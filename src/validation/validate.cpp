@@ -47,30 +47,15 @@ double mean_finite(const Eigen::VectorXd& v) {
   return k ? s / k : kNaN;
 }
 
-/// Per foot and frame: a sole point (A, B or C) within kPlantedGapM of the ground and moving
-/// slower than kPlantedSpeedMps relative to it (or the belt): the foot stands on the floor.
-constexpr double kPlantedGapM = 0.02, kPlantedSpeedMps = 0.3;
-
-std::array<std::vector<bool>, 2> planted_feet(const EstimateResult& e) {
-  const Eigen::Index n = e.time_s.size();
-  std::array<std::vector<bool>, 2> out;
-  for (int side = 0; side < 2; ++side) {
-    auto& o = out[static_cast<std::size_t>(side)];
-    o.assign(static_cast<std::size_t>(n), false);
-    const auto& S = e.feet[static_cast<std::size_t>(side)].sole_m;
-    if (S.rows() != n || n < 3) continue;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const Eigen::Index a = std::max<Eigen::Index>(0, i - 1), b = std::min<Eigen::Index>(n - 1, i + 1);
-      const double dt = e.time_s[b] - e.time_s[a];
-      if (!(dt > 0)) continue;
-      for (int k = 0; k < 3; ++k) {
-        const double gap = S(i, 2 * k + 1) - e.ground_level_m;
-        const double vx = (S(b, 2 * k) - S(a, 2 * k)) / dt - e.frame.belt_velocity_mps;
-        if (gap < kPlantedGapM && std::abs(vx) < kPlantedSpeedMps) o[static_cast<std::size_t>(i)] = true;
-      }
-    }
-  }
-  return out;
+/// Sole point s (A, B, C) of foot f at frame i stands still on the floor: within
+/// ground_contact_height_m of it and slower than still_speed_mps relative to it (or the belt).
+bool sole_point_planted(const EstimateResult& e, int f, int s, Eigen::Index i, const ValidationOptions& o) {
+  const auto& sm = e.feet[static_cast<std::size_t>(f)].sole_m;
+  const Eigen::Index n = sm.rows();
+  if (n < 2 || sm(i, 2 * s + 1) - e.ground_level_m > o.ground_contact_height_m) return false;
+  const Eigen::Index i0 = std::max<Eigen::Index>(i - 1, 0), i1 = std::min<Eigen::Index>(i + 1, n - 1);
+  const double vx = (sm(i1, 2 * s) - sm(i0, 2 * s)) * e.landmarks.rate_hz / static_cast<double>(i1 - i0);
+  return std::abs(vx - e.frame.belt_velocity_mps) <= o.still_speed_mps;
 }
 
 }  // namespace
@@ -251,12 +236,7 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
               const double margin = outside ? o.edge_margin_m : 0.0;
               const bool x_in = x >= mp.x_min - margin && x <= mp.x_max + margin;
               // The other foot counts only when standing still: a swinging foot's toes skim the plate.
-              if (!outside) {
-                const Eigen::Index i0 = std::max<Eigen::Index>(i - 1, 0), i1 = std::min<Eigen::Index>(i + 1, n - 1);
-                const auto& sm = e.feet[static_cast<std::size_t>(f)].sole_m;
-                const double vx = (sm(i1, 2 * s) - sm(i0, 2 * s)) * rate / static_cast<double>(i1 - i0);
-                if (std::abs(vx - e.frame.belt_velocity_mps) > o.still_speed_mps) continue;
-              }
+              if (!outside && !sole_point_planted(e, f, s, i, o)) continue;
               const bool h = outside ? !(x_in && lat_in) : (x_in && lat_in);
               hit = hit || h;
             }
@@ -375,17 +355,17 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
     for (Eigen::Index i = 0; i < n; ++i)
       if (v.plates[static_cast<std::size_t>(pi)].force_N(i, 1) > o.threshold_N) mask[static_cast<std::size_t>(i)] |= 1u << pi;
   // A foot on the floor off the plates, from the kinematics alone (not the estimate's contact
-  // state): a sole point within kPlantedGapM of the ground and slower than kPlantedSpeedMps
-  // (relative to the belt) while no kept stance of that foot covers the frame. The plates then
-  // miss part of the body's load, whatever the other frames of its run say: the frame is left
-  // out of an accepted run (it does not split runs, so it can only remove frames).
-  const auto planted = planted_feet(e);
+  // state): a sole point planted (sole_point_planted) while no kept stance of that foot covers the
+  // frame. The plates then miss part of the body's load, whatever the other frames of its run
+  // say: the frame is left out of an accepted run (it does not split runs, so it can only remove
+  // frames).
   std::vector<bool> off_plate(static_cast<std::size_t>(n), false);
   for (Eigen::Index i = 0; i < n; ++i) {
     const unsigned mk = mask[static_cast<std::size_t>(i)];
     if (mk == 0) ok[static_cast<std::size_t>(i)] = false;
     for (int side = 0; side < 2; ++side) {
-      if (!planted[static_cast<std::size_t>(side)][static_cast<std::size_t>(i)]) continue;
+      if (!sole_point_planted(e, side, 0, i, o) && !sole_point_planted(e, side, 1, i, o) && !sole_point_planted(e, side, 2, i, o))
+        continue;
       bool on_plate = false;
       for (const Candidate& c : cands) on_plate = on_plate || (c.kept && c.foot == side && i >= c.run.first && i <= c.run.last);
       if (!on_plate) off_plate[static_cast<std::size_t>(i)] = true;

@@ -18,7 +18,7 @@ std::vector<std::string> split(std::string_view s, std::string_view delims, bool
 std::vector<std::uint8_t> read_file_bytes(const std::string& path);
 std::string read_file_text(const std::string& path);
 /// Write through a temporary file renamed at the end (no half file on failure).
-void write_file_text(const std::string& path, const std::string& text);
+void write_file_text(const std::string& path, std::string_view text);
 /// InputError when `output` is one of `inputs` (the same file by any name): an output never
 /// overwrites a run's input.
 void ensure_not_an_input(const std::string& output, const std::vector<std::string>& inputs);

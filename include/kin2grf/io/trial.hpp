@@ -21,6 +21,11 @@ enum class Axis { X = 0, Y = 1, Z = 2 };
 enum class Side { Right, Left, General };
 
 const char* to_string(Axis a);
+
+/// A label read from a file, made unique: `name`, or NAME#k (k = index + 1) with a warning when
+/// `taken` already holds it (a label used twice is never silently shadowed by the first).
+std::string unique_label(const std::vector<std::string>& taken, const std::string& name, std::size_t index,
+                         std::vector<std::string>* warnings);
 const char* to_string(Side s);
 
 /// Marker trajectories of one trial, N frames x 3 per marker, metres, lab frame.

@@ -137,10 +137,12 @@ struct SagittalFrame {
 ///  - a coordinate beyond kMaxLabCoordinateM (no capture volume is 10 km; 1e300 would overflow);
 ///  - a one-frame spike: a sample farther than kMaxMarkerSpeedMps x dt + 2 cm from both neighbours
 ///    while the neighbours are within that of each other (a marker does not leave and come back in
-///    two frames faster than a thrown ball). Returns the number of samples removed.
-/// `only`: the markers to clean (a set's motion_markers()); empty: all.
+///    two frames faster than a thrown ball).
+/// `only`: the markers to check (a set's motion_markers()); empty: all. Returns the cleaned copy,
+/// or nothing (and no copy) when every sample is usable.
 inline constexpr double kMaxLabCoordinateM = 1e4, kMaxMarkerSpeedMps = 30.0;
-int remove_marker_outliers(MarkerTrajectories& markers, const std::vector<std::string>& only, std::vector<std::string>& messages);
+std::optional<MarkerTrajectories> without_marker_outliers(const MarkerTrajectories& markers, const std::vector<std::string>& only,
+                                                          std::vector<std::string>& messages);
 
 Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& motion,
                               const MarkerTrajectories* static_trial, const LandmarkOptions& options,

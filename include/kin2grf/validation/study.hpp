@@ -32,6 +32,8 @@ namespace kin2grf {
 struct StudyTrial {
   std::string name, activity;
   std::string lab;  ///< the recording's lab (or data source): the unit of leave-one-lab-out
+  /// The lab, or the trial's own name when none is given (each trial then its own lab).
+  [[nodiscard]] const std::string& lab_or_name() const { return lab.empty() ? name : lab; }
   const Trial* trial = nullptr;
   const Trial* static_trial = nullptr;
   const ForcePlateRecording* plates = nullptr;
