@@ -9,7 +9,10 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/opensim.hpp"
@@ -220,4 +223,80 @@ TEST(CliExport, ExternalLoadsMatchTheMotColumnsAndTimes) {
   const double mid = mot.data(mot.data.rows() / 2, vy) + mot.data(mot.data.rows() / 2, vy1);
   EXPECT_GT(mid, 0.5 * 70 * 9.81);
   EXPECT_NEAR(mot.data.col(mot.column("ground_force_vz")).cwiseAbs().maxCoeff(), 0.0, 1e-9) << "no mediolateral force";
+}
+
+namespace {
+/// A CSV's lines with the timing columns (seconds, frames_per_s) blanked.
+std::vector<std::string> batch_lines_without_timing(const std::string& csv) {
+  std::vector<std::string> out;
+  std::istringstream in(csv);
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells;
+    std::string cellv;
+    std::istringstream ls(line);
+    while (std::getline(ls, cellv, ',')) cells.push_back(cellv);
+    if (cells.size() > 8) cells[7] = cells[8] = "";
+    std::string joined;
+    for (const auto& c : cells) joined += c + ",";
+    out.push_back(joined);
+  }
+  return out;
+}
+}  // namespace
+
+// batch (issue 12): every trial of a list, past a failing one (its error in its row, exit 1),
+// validated where it has plates, outputs per trial, the same table whatever --jobs.
+TEST(CliBatch, RunsEveryTrialPastAFailureAndTheTableDoesNotDependOnJobs) {
+  const auto dir = kin2grf::test::temp_dir("cli_batch");
+  const std::string c3d = (example_dir() / "example_walk.c3d").string();
+  {
+    std::ofstream list(dir / "list.txt");
+    list << "# a comment\n"
+         << "walking|own|with-plates|" << c3d << "\n"
+         << "squat|own|missing|" << (dir / "no-such-trial.trc").string() << " --mass 70\n"
+         << "squat|own|markers-only|" << example_trc() << " --mass 70 --paper\n";
+  }
+  const std::string list = (dir / "list.txt").string();
+  const CliRun r2 = run("batch " + list + " --jobs 2 --csv " + (dir / "b2.csv").string() + " --json " +
+                        (dir / "b2.json").string() + " --out-dir " + (dir / "out").string());
+  EXPECT_EQ(r2.status, 1) << r2.out;  // one trial failed
+  EXPECT_NE(r2.out.find("3 trials, 1 failed"), std::string::npos) << r2.out;
+  const CliRun r1 = run("batch " + list + " --jobs 1 --csv " + (dir / "b1.csv").string());
+  EXPECT_EQ(r1.status, 1) << r1.out;
+
+  const std::string csv2 = kin2grf::read_file_text((dir / "b2.csv").string());
+  const auto lines = batch_lines_without_timing(csv2);
+  ASSERT_EQ(lines.size(), 4u) << csv2;
+  EXPECT_EQ(lines, batch_lines_without_timing(kin2grf::read_file_text((dir / "b1.csv").string())));
+  // Rows in the list's order; the failure names its file.
+  EXPECT_EQ(lines[1].rfind("walking,own,with-plates,", 0), 0u) << lines[1];
+  EXPECT_NE(lines[2].find(",0,0,"), std::string::npos) << lines[2];
+  EXPECT_NE(lines[2].find("no-such-trial.trc"), std::string::npos) << lines[2];
+
+  const auto j = nlohmann::json::parse(kin2grf::read_file_text((dir / "b2.json").string()));
+  ASSERT_EQ(j["trials"].size(), 3u);
+  EXPECT_TRUE(j["trials"][0]["ok"].get<bool>());
+  EXPECT_TRUE(j["trials"][0]["validated"].get<bool>());
+  EXPECT_GT(j["trials"][0]["stances"].get<int>(), 0);
+  EXPECT_TRUE(j["trials"][0]["vertical_rrmse_pct"].is_number());
+  EXPECT_FALSE(j["trials"][1]["ok"].get<bool>());
+  EXPECT_TRUE(j["trials"][2]["ok"].get<bool>());
+  EXPECT_FALSE(j["trials"][2]["validated"].get<bool>());  // a TRC has no plates
+  EXPECT_TRUE(j["trials"][2]["vertical_rrmse_pct"].is_null());
+  for (const char* f : {"with-plates.csv", "with-plates_grf.mot", "with-plates.json", "markers-only.csv"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / f)) << f;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "missing.csv"));
+}
+
+TEST(CliBatch, ABadLineNamesTheListAndTheLine) {
+  const auto dir = kin2grf::test::temp_dir("cli_batch_bad");
+  {
+    std::ofstream list(dir / "list.txt");
+    list << "squat|own|ok|" << example_trc() << " --mass 70\n"
+         << "squat|own|bad|" << example_trc() << " --no-such-option 3\n";
+  }
+  const CliRun r = run("batch " + (dir / "list.txt").string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("list.txt:2"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--no-such-option"), std::string::npos) << r.out;
 }

@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <thread>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/c3d.hpp"
@@ -25,29 +27,18 @@
 #include "kin2grf/validation/cop_fit.hpp"
 #include "kin2grf/validation/study.hpp"
 #include "kin2grf/validation/validate.hpp"
+#include "kin2grf/workflow/batch.hpp"
+#include "kin2grf/workflow/settings.hpp"
+#include "kin2grf/workflow/trial_list.hpp"
 
 namespace {
 
 constexpr long kProgressFrames = 20000;  ///< inputs at least this long report progress
 
-kin2grf::LoadOptions load_options(const std::string& zero) {
-  kin2grf::LoadOptions lo;
-  if (zero == "zero") lo.c3d.zero_offset = kin2grf::ZeroOffset::ZeroParameter;
-  if (zero == "unloaded") lo.c3d.zero_offset = kin2grf::ZeroOffset::Unloaded;
-  return lo;
-}
-
-std::optional<kin2grf::Axis> parse_axis(const std::string& text) {
-  if (text.empty()) return std::nullopt;
-  const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(text[0])));
-  if (c < 'X' || c > 'Z' || text.size() != 1) throw kin2grf::InputError("--up-axis must be X, Y or Z");
-  return static_cast<kin2grf::Axis>(c - 'X');
-}
-
 int run_info(const std::string& file, bool json, double threshold, const std::string& zero, const std::string& up_axis) {
   if (!(std::isfinite(threshold) && threshold > 0)) throw kin2grf::InputError("--load-threshold must be a force above 0 N");
-  kin2grf::Trial t = kin2grf::load_trial(file, load_options(zero));
-  if (const auto up = parse_axis(up_axis)) {  // the user's word over the data's
+  kin2grf::Trial t = kin2grf::load_trial(file, kin2grf::load_options(zero));
+  if (const auto up = kin2grf::parse_axis(up_axis)) {  // the user's word over the data's
     t.markers.up_axis = *up;
     if (t.plates) t.plates->up_axis = *up;
   }
@@ -57,75 +48,15 @@ int run_info(const std::string& file, bool json, double threshold, const std::st
   return 0;
 }
 
-const char* torso_length_name(kin2grf::TorsoLength t) { return t == kin2grf::TorsoLength::Fixed ? "fixed" : "measured"; }
-
-struct EstimateArgs {
+/// estimate's arguments: the settings (the library's names) and where the outputs go.
+struct EstimateArgs : kin2grf::Settings {
   std::string opensim_dir;
   std::vector<std::string> opensim_bodies;
-  std::string trial, static_trial, markers, out_mot, out_csv, out_json, foot_model = "cop", norm = "torque-scaled",
-      anthropometry = kin2grf::EstimateOptions{}.anthropometry, up_axis, cop_function, running_cop = "builtin",
-      torso_length = torso_length_name(kin2grf::EstimateOptions{}.torso_length);
-  // Numerical defaults come from the library's option structs (one source for CLI and API).
-  std::optional<double> mass;
-  bool force_mass = false;
-  double r = kin2grf::SolverOptions{}.r_N_per_m, kin_cutoff = kin2grf::EstimateOptions{}.kinematic_cutoff_hz,
-         post_cutoff = kin2grf::EstimateOptions{}.post_cutoff_hz, ground_shift = 0,
-         speed_gate = kin2grf::SolverOptions{}.speed_gate_mps, split_distance = kin2grf::SolverOptions{}.min_split_distance_m,
-         speed_gate_ratio = kin2grf::SolverOptions{}.speed_gate_ratio, speed_gate_floor = kin2grf::SolverOptions{}.speed_gate_floor_mps;
-  bool paper = false, r_given = false, anthropometry_given = false;
-  std::optional<double> ground_level;
-  std::vector<double> grm_reference;
-  int max_gap = 10;
+  std::string out_mot, out_csv, out_json;
 };
 
 void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
-  c->add_option("TRIAL", a.trial, "Motion trial (C3D or TRC)")->required();
-  c->add_option("--static", a.static_trial, "Static calibration trial (for virtual knee/ankle landmarks)");
-  c->add_option("--markers", a.markers, "Marker-set preset name or mapping file (JSON); default: recognised");
-  c->add_option("--mass", a.mass, "Body mass, kg (default: the C3D's PROCESSING:Bodymass or SUBJECT(S):WEIGHT); 20-300");
-  c->add_flag("--force-mass", a.force_mass, "Accept a body mass outside 20-300 kg");
-  c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
-      ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
-  c->add_option_function<double>(
-       "--r", [&a](double v) { a.r = v, a.r_given = true; },
-       "Activation parameter r, N/m (Eq. 8); default 1000 (from `kin2grf study r`), 10000 with --paper");
-  c->add_option("--kinematic-cutoff", a.kin_cutoff, "Kinematics low-pass cut-off, Hz")->capture_default_str();
-  c->add_option("--post-cutoff", a.post_cutoff, "Multiplier post-filter cut-off, Hz")->capture_default_str();
-  c->add_option("--ground-level", a.ground_level, "Floor height in the lab's up axis, m (default: estimated)");
-  c->add_option("--grm-reference", a.grm_reference,
-                 "GRM reference point in the sagittal frame: along progression and up from the lab origin, m (default 0 0)")
-      ->expected(2);
-  c->add_option("--ground-shift", a.ground_shift, "Shift the ground by this much, m (robustness study)")->capture_default_str();
-  c->add_option_function<double>(
-       "--speed-gate", [&a](double v) { a.speed_gate = v, a.speed_gate_ratio = 0; },
-       "A fixed speed gate: contact allowed only below this sole speed, m/s (0 = off, the paper); replaces --speed-gate-ratio")
-      ->check(CLI::Range(0.0, 20.0));
-  c->add_option("--speed-gate-ratio", a.speed_gate_ratio,
-                "The speed gate as this multiple of the progression speed (hip or belt), at least --speed-gate-floor; "
-                "0 = the fixed --speed-gate")
-      ->check(CLI::Range(0.0, 20.0))->capture_default_str();
-  c->add_option("--speed-gate-floor", a.speed_gate_floor, "Lowest speed gate with --speed-gate-ratio, m/s")
-      ->check(CLI::Range(0.0, 20.0))->capture_default_str();
-  c->add_option("--split-distance", a.split_distance,
-                "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)")
-      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
-  c->add_option("--torso-length", a.torso_length,
-                "measured (the hip-shoulder distance of each frame, filtered) or fixed (its median, the paper's rigid HAT)")
-      ->check(CLI::IsMember({"measured", "fixed"}))->capture_default_str();
-  c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
-      ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
-  c->add_option_function<std::string>(
-       "--anthropometry", [&a](const std::string& v) { a.anthropometry = v, a.anthropometry_given = true; },
-       "winter or de-leva; default de-leva, winter with --paper")
-      ->check(CLI::IsMember({"winter", "de-leva"}));
-  c->add_option("--cop-function", a.cop_function,
-                "Foot model 2's COP function from this JSON (see kin2grf fit-cop); used on every frame unless --running-cop FILE");
-  c->add_option("--running-cop", a.running_cop,
-                "COP function near flight phases (running): builtin (kin2grf's running fit), off, or a JSON file")
-      ->capture_default_str();
-  c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
-  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length");
-  c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
+  kin2grf::add_settings_options(c, a);
   if (!outputs) return;
   c->add_option("-o,--output", a.out_mot, "OpenSim GRF .mot output");
   c->add_option("--csv", a.out_csv, "Per-frame CSV output (sagittal frame)");
@@ -137,126 +68,28 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
       ->expected(2);
 }
 
-kin2grf::EstimateOptions to_options(const EstimateArgs& a) {
-  kin2grf::EstimateOptions o;
-  o.mass_kg = a.mass;  // any given value, checked by the library (a negative one is refused, not ignored)
-  o.allow_unusual_mass = a.force_mass;
-  o.anthropometry = (a.paper && !a.anthropometry_given) ? "winter" : a.anthropometry;
-  o.kinematic_cutoff_hz = a.kin_cutoff;
-  o.post_cutoff_hz = a.post_cutoff;
-  o.ground_level_m = a.ground_level;
-  o.contact.foot_model = a.foot_model == "cop" ? kin2grf::FootModel::Cop : kin2grf::FootModel::ThreePoint;
-  o.contact.ground_shift_m = a.ground_shift;
-  if (a.grm_reference.size() == 2) o.grm_reference_m = Eigen::Vector2d(a.grm_reference[0], a.grm_reference[1]);
-  if (a.paper) o.contact.cop = kin2grf::CopFunction::paper();
-  if (!a.cop_function.empty()) o.contact.cop = kin2grf::read_cop_function(a.cop_function);
-  // The running function: kin2grf's own unless the paper's configuration, a user's function for
-  // every frame, or "off" is asked for; a file replaces it.
-  if (a.running_cop == "off" || (a.running_cop == "builtin" && (a.paper || !a.cop_function.empty()))) o.contact.running_cop.reset();
-  else if (a.running_cop != "builtin") o.contact.running_cop = kin2grf::read_cop_function(a.running_cop);
-  o.solver.r_N_per_m = (a.paper && !a.r_given) ? 1e4 : a.r;
-  o.solver.norm = (a.paper || a.norm == "paper") ? kin2grf::MultiplierNorm::Paper : kin2grf::MultiplierNorm::TorqueScaled;
-  o.solver.speed_gate_mps = a.paper ? 0.0 : a.speed_gate;
-  o.solver.speed_gate_ratio = a.paper ? 0.0 : a.speed_gate_ratio;
-  o.solver.speed_gate_floor_mps = a.speed_gate_floor;
-  o.solver.min_split_distance_m = a.paper ? 0.0 : a.split_distance;
-  o.torso_length = (a.paper || a.torso_length == "fixed") ? kin2grf::TorsoLength::Fixed : kin2grf::TorsoLength::Measured;
-  o.landmarks.max_gap_frames = a.max_gap;
-  o.landmarks.up_axis = parse_axis(a.up_axis);
-  return o;
+/// Long inputs report the contact solve's progress on stderr, on one line when it is a terminal.
+std::function<void(long, long)> progress_printer(const kin2grf::Trial& trial) {
+  if (trial.markers.frames() < kProgressFrames) return {};
+  const bool tty = isatty(fileno(stderr)) != 0;
+  return [tty, last = -1](long done, long all) mutable {
+    const int pct = static_cast<int>(100 * done / std::max(1L, all));
+    if (pct / 10 == last / 10 && pct != 100 && !tty) return;
+    if (pct == last) return;
+    last = pct;
+    std::fprintf(stderr, tty ? "\rkin2grf: contact solve %3d %% (%ld of %ld frames)" : "kin2grf: contact solve %3d %% (%ld of %ld frames)\n",
+                 pct, done, all);
+    if (tty && pct == 100) std::fputc('\n', stderr);
+  };
 }
 
-/// The settings a run used, from the resolved options (what --paper and the defaults made of them).
-nlohmann::json settings_json(const EstimateArgs& a, const kin2grf::EstimateOptions& o) {
-  const auto& c = o.contact.cop;
-  return {{"trial", a.trial},
-          {"static", a.static_trial},
-          {"paper_configuration", a.paper},
-          {"foot_model", a.foot_model},
-          {"cop_function", {{"source", !a.cop_function.empty() ? a.cop_function : a.paper ? "paper event angles" : "built-in fit"},
-                            {"delta_rad", {c.delta_hs, c.delta_ho, c.delta_mo, c.delta_to}},
-                            {"s", {c.s_hs, c.s_ho, c.s_mo, c.s_to}}}},
-          {"running_cop_function", o.contact.running_cop ? nlohmann::json{{"source", a.running_cop == "builtin" ? "built-in running fit" : a.running_cop},
-                                                                         {"delta_rad", {o.contact.running_cop->delta_hs, o.contact.running_cop->delta_ho, o.contact.running_cop->delta_mo, o.contact.running_cop->delta_to}},
-                                                                         {"s", {o.contact.running_cop->s_hs, o.contact.running_cop->s_ho, o.contact.running_cop->s_mo, o.contact.running_cop->s_to}}}
-                                                       : nlohmann::json(nullptr)},
-          {"r_N_per_m", o.solver.r_N_per_m},
-          {"norm", o.solver.norm == kin2grf::MultiplierNorm::Paper ? "paper" : "torque-scaled"},
-          {"speed_gate_mps", o.solver.speed_gate_mps},
-          {"speed_gate_ratio", o.solver.speed_gate_ratio},
-          {"speed_gate_floor_mps", o.solver.speed_gate_floor_mps},
-          {"min_split_distance_m", o.solver.min_split_distance_m},
-          {"torso_length", torso_length_name(o.torso_length)},
-          {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
-          {"post_cutoff_hz", o.post_cutoff_hz},
-          {"anthropometry", o.anthropometry},
-          {"ground_level_m", o.ground_level_m ? nlohmann::json(*o.ground_level_m) : nlohmann::json("auto")},
-          {"ground_shift_m", o.contact.ground_shift_m},
-          {"grm_reference_m", {o.grm_reference_m.x(), o.grm_reference_m.y()}},
-          {"max_gap_frames", o.landmarks.max_gap_frames}};
-}
-
-/// The marker set: --markers (preset name or mapping file), else recognised from the names.
-const kin2grf::MarkerSet& resolve_marker_set(const EstimateArgs& a, const kin2grf::Trial& trial, kin2grf::MarkerSet& custom) {
-  if (!a.markers.empty()) {
-    if (const auto* set = kin2grf::find_marker_set(a.markers)) return *set;
-    custom = kin2grf::load_marker_set(a.markers);
-    return custom;
-  }
-  std::string why;
-  const auto* set = kin2grf::recognise_marker_set(trial.markers, &why);
-  if (!set) {
-    std::string names;
-    for (const auto& s : kin2grf::builtin_marker_sets()) names += " " + s.name;
-    throw kin2grf::InputError(a.trial + ": marker set not recognised (presets:" + names +
-                              "). Give --markers FILE.json with a rule for each landmark: shoulder, hip, knee_r, "
-                              "ankle_r, heel_r, mt_r, hallux_r and the same _l (see docs/MARKERSETS.md)");
-  }
-  std::cerr << "kin2grf: marker set recognised: " << set->name << " (" << why << ")\n";
-  return *set;
-}
-
-kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, kin2grf::EstimateOptions options, const kin2grf::Trial& trial) {
-  std::optional<kin2grf::Trial> st;
-  if (!a.static_trial.empty()) st = kin2grf::load_trial(a.static_trial);
-  kin2grf::MarkerSet custom;
-  const kin2grf::MarkerSet& set = resolve_marker_set(a, trial, custom);
-  if (trial.markers.frames() >= kProgressFrames) {
-    // Long inputs: progress on stderr, on one line when stderr is a terminal.
-    const bool tty = isatty(fileno(stderr)) != 0;
-    options.progress = [tty, last = -1](long done, long all) mutable {
-      const int pct = static_cast<int>(100 * done / std::max(1L, all));
-      if (pct / 10 == last / 10 && pct != 100 && !tty) return;
-      if (pct == last) return;
-      last = pct;
-      std::fprintf(stderr, tty ? "\rkin2grf: contact solve %3d %% (%ld of %ld frames)" : "kin2grf: contact solve %3d %% (%ld of %ld frames)\n",
-                   pct, done, all);
-      if (tty && pct == 100) std::fputc('\n', stderr);
-    };
-  }
-  std::optional<kin2grf::EstimateResult> res;
-  try {
-    res = kin2grf::estimate(trial, st ? &*st : nullptr, set, options);
-  } catch (const kin2grf::InputError&) {
-    // The readers' warnings travel in the result; when there is none, say them before the error.
-    for (const auto& w : trial.warnings) std::cerr << "kin2grf: input: " << w << "\n";
-    if (st)
-      for (const auto& w : st->warnings) std::cerr << "kin2grf: static trial: " << w << "\n";
-    throw;
-  }
-  auto& r = *res;
+kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, const kin2grf::Trial& trial) {
+  auto r = kin2grf::estimate_trial(a, trial, progress_printer(trial));
   for (const auto& m : r.messages) std::cerr << "kin2grf: " << m << "\n";
   std::cerr << "kin2grf: " << r.time_s.size() << " frames, mass " << r.mass_kg << " kg, "
             << static_cast<long>(static_cast<double>(r.time_s.size()) / std::max(1e-9, r.seconds_kinematics + r.seconds_dynamics))
             << " frames/s\n";
-  return std::move(*res);
-}
-
-/// The files a run reads: no output may be one of them.
-std::vector<std::string> inputs_of(const EstimateArgs& a) {
-  std::vector<std::string> in = {a.trial, a.static_trial, a.markers, a.cop_function};
-  if (a.running_cop != "builtin" && a.running_cop != "off") in.push_back(a.running_cop);
-  return in;
+  return r;
 }
 
 void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
@@ -274,14 +107,14 @@ std::vector<std::string> opensim_outputs(const EstimateArgs& a) {
 }
 
 int run_estimate(const EstimateArgs& a) {
-  check_outputs({a.out_mot, a.out_csv, a.out_json}, inputs_of(a));
-  check_outputs(opensim_outputs(a), inputs_of(a));
+  check_outputs({a.out_mot, a.out_csv, a.out_json}, kin2grf::input_files(a));
+  check_outputs(opensim_outputs(a), kin2grf::input_files(a));
   const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
-  const auto options = to_options(a);
-  const auto r = run_estimate_core(a, options, trial);
+  const auto options = kin2grf::to_options(a);
+  const auto r = run_estimate_core(a, trial);
   if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r);
   if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::format_results_csv(r));
-  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(kin2grf::results_summary(r, settings_json(a, options))));
+  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(kin2grf::results_summary(r, kin2grf::settings_json(a, options))));
   std::cout << kin2grf::format_results_text(r);
   for (const auto& [file, what] : {std::pair{a.out_mot, "OpenSim GRF"}, {a.out_csv, "per-frame CSV"}, {a.out_json, "JSON summary"}})
     if (!file.empty()) std::cout << "wrote " << file << " (" << what << ")\n";
@@ -305,23 +138,23 @@ struct ValidateArgs {
 
 int run_validate(const ValidateArgs& a) {
   {
-    auto in = inputs_of(a.est);
+    auto in = kin2grf::input_files(a.est);
     in.push_back(a.plates);
     check_outputs({a.out_json, a.report}, in);
   }
   if (!(std::isfinite(a.options.threshold_N) && a.options.threshold_N > 0))
     throw kin2grf::InputError("--threshold " + std::to_string(a.options.threshold_N) + ": must be a force above 0 N");
-  const kin2grf::Trial trial = kin2grf::load_trial(a.est.trial, load_options(a.zero_offset));
+  const kin2grf::Trial trial = kin2grf::load_trial(a.est.trial, kin2grf::load_options(a.zero_offset));
   std::optional<kin2grf::Trial> plates_file;
-  if (!a.plates.empty()) plates_file = kin2grf::load_trial(a.plates, load_options(a.zero_offset));
+  if (!a.plates.empty()) plates_file = kin2grf::load_trial(a.plates, kin2grf::load_options(a.zero_offset));
   const kin2grf::Trial& source = plates_file ? *plates_file : trial;
   if (!source.plates || source.plates->plates.empty())
     throw kin2grf::InputError(source.path + ": no force plates to validate against" +
                               (plates_file ? std::string() : std::string("; give --plates GRF.mot")));
-  const auto options = to_options(a.est);
-  const auto r = run_estimate_core(a.est, options, trial);
+  const auto options = kin2grf::to_options(a.est);
+  const auto r = run_estimate_core(a.est, trial);
   const auto v = kin2grf::validate(r, *source.plates, a.options);
-  nlohmann::json settings = settings_json(a.est, options);
+  nlohmann::json settings = kin2grf::settings_json(a.est, options);
   settings["plates"] = source.path;
   settings["threshold_N"] = a.options.threshold_N;
   settings["zero_offset"] = a.zero_offset;
@@ -330,49 +163,6 @@ int run_validate(const ValidateArgs& a) {
   if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(j));
   if (!a.report.empty()) kin2grf::write_file_text(a.report, kin2grf::validation_report_html(a.est.trial, r, v, j));
   return 0;
-}
-
-/// `study`: one line of a trial list is "activity|lab|name|TRIAL [estimate options] [--plates FILE]"
-/// (the older "activity|name|TRIAL" is read with each trial its own lab).
-struct StudyInput {
-  std::string activity, lab, name;
-  EstimateArgs args;
-  std::string plates;
-};
-
-std::vector<StudyInput> read_trial_list(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw kin2grf::InputError(path + ": cannot open the trial list");
-  std::vector<StudyInput> out;
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (line.empty() || line[0] == '#') continue;
-    std::vector<std::string> fields;
-    std::size_t start = 0;
-    for (std::size_t bar; fields.size() < 3 && (bar = line.find('|', start)) != std::string::npos; start = bar + 1)
-      fields.push_back(line.substr(start, bar - start));
-    if (fields.size() < 2)
-      throw kin2grf::InputError(path + ":" + std::to_string(number) + ": expected activity|lab|name|TRIAL [options]");
-    StudyInput si;
-    si.activity = fields[0];
-    si.lab = fields[1];  // the old 3-field form: the name is the lab
-    si.name = fields.back();
-    for (const auto& f : fields)
-      if (f.empty()) throw kin2grf::InputError(path + ":" + std::to_string(number) + ": an empty field in activity|lab|name");
-    CLI::App parser{"trial"};
-    add_estimate_options(&parser, si.args, false);
-    parser.add_option("--plates", si.plates);
-    try {
-      parser.parse(line.substr(start), false);
-    } catch (const CLI::ParseError& e) {
-      throw kin2grf::InputError(path + ":" + std::to_string(number) + ": " + e.what());
-    }
-    out.push_back(std::move(si));
-  }
-  if (out.empty()) throw kin2grf::InputError(path + ": no trials in the list");
-  return out;
 }
 
 struct StudyArgs {
@@ -389,31 +179,31 @@ struct LoadedTrials {
   std::vector<kin2grf::StudyTrial> study;
 };
 
-void load_study_trials(const std::vector<StudyInput>& inputs, LoadedTrials& L) {
+void load_study_trials(const std::vector<kin2grf::TrialListEntry>& inputs, LoadedTrials& L) {
   L.trials.reserve(inputs.size()), L.statics.reserve(inputs.size()), L.plates.reserve(inputs.size()), L.sets.reserve(inputs.size());
   for (const auto& in : inputs) {
-    L.trials.push_back(kin2grf::load_trial(in.args.trial, load_options("unloaded")));
+    L.trials.push_back(kin2grf::load_trial(in.settings.trial, kin2grf::load_options("unloaded")));
     kin2grf::StudyTrial x;
     x.name = in.name;
     x.activity = in.activity;
     x.lab = in.lab;
     x.trial = &L.trials.back();
-    if (!in.args.static_trial.empty()) {
-      L.statics.push_back(kin2grf::load_trial(in.args.static_trial));
+    if (!in.settings.static_trial.empty()) {
+      L.statics.push_back(kin2grf::load_trial(in.settings.static_trial));
       x.static_trial = &L.statics.back();
     }
     const kin2grf::Trial* source = x.trial;
     if (!in.plates.empty()) {
-      L.plates.push_back(kin2grf::load_trial(in.plates, load_options("unloaded")));
+      L.plates.push_back(kin2grf::load_trial(in.plates, kin2grf::load_options("unloaded")));
       source = &L.plates.back();
     }
     if (!source->plates || source->plates->plates.empty())
       throw kin2grf::InputError(source->path + ": no force plates; give --plates");
     x.plates = &*source->plates;
     kin2grf::MarkerSet custom;
-    L.sets.push_back(resolve_marker_set(in.args, *x.trial, custom));
+    L.sets.push_back(kin2grf::resolve_marker_set(in.settings, *x.trial, custom));
     x.marker_set = &L.sets.back();
-    x.options = to_options(in.args);
+    x.options = kin2grf::to_options(in.settings);
     L.study.push_back(x);
   }
 }
@@ -424,15 +214,15 @@ int run_study(const StudyArgs& a) {
     in.push_back(a.trial_list);
     check_outputs({a.out_json, a.report}, in);
   }
-  std::vector<StudyInput> inputs;
-  if (!a.trial_list.empty()) inputs = read_trial_list(a.trial_list);
+  std::vector<kin2grf::TrialListEntry> inputs;
+  if (!a.trial_list.empty()) inputs = kin2grf::read_trial_list(a.trial_list);
   for (const auto& t : a.trials) {
-    StudyInput si;
+    kin2grf::TrialListEntry si;
     si.activity = "trials";
     si.name = std::filesystem::path(t).filename().string();
     si.lab = si.name;
-    si.args = a.est;
-    si.args.trial = t;
+    si.settings = a.est;
+    si.settings.trial = t;
     si.plates = a.plates;
     inputs.push_back(si);
   }
@@ -463,8 +253,8 @@ struct FitCopArgs {
 /// fit-cop: the COP function of foot model 2 fitted to the plate COPs of a trial list's stances.
 int run_fit_cop(const FitCopArgs& a) {
   check_outputs({a.out}, {a.trial_list});
-  std::vector<StudyInput> inputs;
-  for (auto& in : read_trial_list(a.trial_list))
+  std::vector<kin2grf::TrialListEntry> inputs;
+  for (auto& in : kin2grf::read_trial_list(a.trial_list))
     if (a.activity.empty() || in.activity == a.activity) inputs.push_back(in);
   if (inputs.empty()) throw kin2grf::InputError(a.trial_list + ": no trial of activity '" + a.activity + "'");
   LoadedTrials L;
@@ -508,12 +298,82 @@ int run_fit_cop(const FitCopArgs& a) {
   return 0;
 }
 
-/// The bundled example: a synthetic squat on two force plates whose signals are the model's own
-/// ground reactions (written by kin2grf's own C3D, TRC and MOT writers).
+struct BatchArgs {
+  std::string trial_list, out_csv, out_json, out_dir;
+  int jobs = 0;  ///< 0: every core
+};
+
+/// batch: every trial of a list, on all cores, past failures, into one summary table.
+int run_batch(const BatchArgs& a) {
+  check_outputs({a.out_csv, a.out_json}, {a.trial_list});
+  const auto entries = kin2grf::read_trial_list(a.trial_list);
+  kin2grf::BatchOptions o;
+  o.jobs = a.jobs > 0 ? a.jobs : static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  o.out_dir = a.out_dir;
+  const bool tty = isatty(fileno(stderr)) != 0;
+  const auto start = std::chrono::steady_clock::now();
+  o.progress = [&](std::size_t done, std::size_t all, const kin2grf::BatchRow& row) {
+    // A bar on a terminal; one line a trial in a log.
+    const int width = 30;
+    const int filled = static_cast<int>(width * done / std::max<std::size_t>(1, all));
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const std::string what = row.ok ? row.name : row.name + " FAILED";
+    if (tty)
+      std::fprintf(stderr, "\r[%s%s] %zu/%zu  %.0f s  %-40.40s", std::string(static_cast<std::size_t>(filled), '#').c_str(),
+                   std::string(static_cast<std::size_t>(width - filled), '.').c_str(), done, all, elapsed, what.c_str());
+    else
+      std::fprintf(stderr, "kin2grf: batch %zu/%zu (%.0f s): %s\n", done, all, elapsed, what.c_str());
+    if (tty && done == all) std::fputc('\n', stderr);
+  };
+  std::cerr << "kin2grf: batch of " << entries.size() << " trials on " << o.jobs << " threads\n";
+  const auto rows = kin2grf::run_batch(entries, o);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The summary: one line a trial.
+  std::printf("%-28s %-8s %7s %6s %7s %7s %7s %7s  %s\n", "trial", "status", "frames", "s", "vert %", "ant %", "COP %",
+              "GRM %", "");
+  int failed = 0;
+  for (const auto& r : rows) {
+    auto pct = [](double v) {
+      char buf[32] = "-";
+      if (std::isfinite(v)) std::snprintf(buf, sizeof buf, "%.1f", v);
+      return std::string(buf);
+    };
+    if (!r.ok) ++failed;
+    std::printf("%-28.28s %-8s %7ld %6.1f %7s %7s %7s %7s  %s\n", r.name.c_str(), r.ok ? "ok" : "FAILED", r.frames, r.seconds,
+                pct(r.vertical).c_str(), pct(r.anterior).c_str(), pct(r.cop).c_str(), pct(r.total_grm).c_str(),
+                r.ok ? "" : r.error.substr(0, r.error.find('\n')).c_str());
+  }
+  std::printf("%zu trials, %d failed, %.1f s on %d threads\n", rows.size(), failed, wall, o.jobs);
+  if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::batch_csv(rows));
+  if (!a.out_json.empty()) {
+    auto j = kin2grf::batch_json(rows);
+    j["trial_list"] = a.trial_list, j["jobs"] = o.jobs, j["wall_seconds"] = wall;
+    kin2grf::write_file_text(a.out_json, kin2grf::json_text(j));
+  }
+  return failed == 0 ? 0 : 1;
+}
+
+/// The bundled examples: a synthetic level walk over two force plates and a squat on two plates,
+/// of the project's own making (kin2grf's own C3D, TRC and MOT writers). The walk's plates share
+/// the model's kinematic totals between the feet by a rule that is not the method's; the squat's
+/// carry the method's own estimate.
 int run_make_example(const std::string& dir, double seconds) {
   if (!(std::isfinite(seconds) && seconds >= 1.0 && seconds <= 600.0))
     throw kin2grf::InputError("--seconds " + std::to_string(seconds) + ": must be between 1 and 600");
   std::filesystem::create_directories(dir);
+  {
+    kin2grf::SyntheticWalkOptions wo;
+    wo.duration_s = std::max(seconds, 2.5 * wo.stride_time_s);
+    const kin2grf::Trial walk = kin2grf::make_example_walk(wo);
+    const std::string base = (std::filesystem::path(dir) / "example_walk").string();
+    kin2grf::write_c3d(base + ".c3d", walk);
+    kin2grf::write_trc(base + ".trc", walk.markers);
+    const auto& p = walk.plates->plates;
+    auto t = kin2grf::grf_table(walk.plates->time_s, p[0], p[1]);
+    t.name = "kin2grf_example_walk_plates";
+    kin2grf::write_sto(base + "_grf.mot", t);
+    std::cout << "wrote " << base << ".c3d, .trc and _grf.mot (a walk over plates FP1 and FP2)\n";
+  }
   kin2grf::SyntheticOptions so;
   so.duration_s = seconds;
   kin2grf::Trial t = kin2grf::make_synthetic_trial(so);
@@ -525,7 +385,7 @@ int run_make_example(const std::string& dir, double seconds) {
   kin2grf::write_c3d(base + ".c3d", t);
   kin2grf::write_trc(base + ".trc", t.markers);
   kin2grf::write_grf_mot(base + "_grf.mot", r);
-  std::cout << "wrote " << base << ".c3d, .trc and _grf.mot\n";
+  std::cout << "wrote " << base << ".c3d, .trc and _grf.mot (a squat on two plates)\n";
   return 0;
 }
 
@@ -600,6 +460,14 @@ int main(int argc, char** argv) {
                     "Also report each trial's COP error with a fit on the other labs' trials (leave one lab out)");
   fit_cop->add_option("-o,--output", fit_args.out, "Write the fitted function and its provenance (JSON)");
 
+  BatchArgs batch_args;
+  auto* batch = app.add_subcommand("batch", "Estimate (and validate, where plates exist) every trial of a trial list, on all cores");
+  batch->add_option("LIST", batch_args.trial_list, "File of lines 'activity|lab|name|TRIAL [options] [--plates F]'")->required();
+  batch->add_option("-j,--jobs", batch_args.jobs, "Worker threads (default: every core)")->check(CLI::Range(0, 1024));
+  batch->add_option("--csv", batch_args.out_csv, "Summary table, one line per trial (CSV)");
+  batch->add_option("--json", batch_args.out_json, "Summary table as JSON, with each trial's messages");
+  batch->add_option("--out-dir", batch_args.out_dir, "Write NAME.csv, NAME_grf.mot and NAME.json per trial into this folder");
+
   std::string example_dir = "example";
   double example_seconds = 3.0;
   auto* make_example = app.add_subcommand("make-example", "Write the synthetic example trial (C3D with plates, TRC, GRF .mot)");
@@ -618,6 +486,7 @@ int main(int argc, char** argv) {
     else if (*validate) rc = run_validate(val);
     else if (*study) rc = run_study(study_args);
     else if (*fit_cop) rc = run_fit_cop(fit_args);
+    else if (*batch) rc = run_batch(batch_args);
     else if (*make_example) rc = run_make_example(example_dir, example_seconds);
     // Standard output closed or full: the output is lost, so the run failed.
     std::cout.flush();

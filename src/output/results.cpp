@@ -16,35 +16,67 @@ void write_grf_mot(const std::string& path, const EstimateResult& r) {
   write_sto(path, t);
 }
 
-std::string format_results_csv(const EstimateResult& r) {
-  std::ostringstream os;
-  os << "frame,time_s";
+ResultsTable results_table(const EstimateResult& r) {
+  ResultsTable t;
+  auto& c = t.columns;
+  c = {"frame", "time_s"};
   for (const char* s : {"r", "l"})
-    os << ",grf_anterior_" << s << "_N,grf_vertical_" << s << "_N,cop_x_" << s << "_m,contact_" << s << ",gap_" << s
-       << "_m,foot_inclination_" << s << "_rad,grf_vertical_unfiltered_" << s << "_N";
-  os << ",grm_Nm";
-  for (int j = 0; j < kJointCount; ++j) os << ",torque_" << joint_name(j) << "_Nm";
-  for (int j = 0; j < kJointCount; ++j) os << ",force_" << joint_name(j) << "_x_N,force_" << joint_name(j) << "_y_N";
-  os << ",residual_x_N,residual_y_N,residual_moment_Nm,iterations\n";
-  char buf[64];
-  auto num = [&](double v) {
-    if (!std::isfinite(v)) return std::string("");
-    std::snprintf(buf, sizeof buf, "%.6g", v);
-    return std::string(buf);
-  };
-  for (Eigen::Index i = 0; i < r.time_s.size(); ++i) {
-    os << r.first_frame_number + i << "," << num(r.time_s[i]);
+    for (const char* name : {"grf_anterior_%s_N", "grf_vertical_%s_N", "cop_x_%s_m", "contact_%s", "gap_%s_m",
+                             "foot_inclination_%s_rad", "grf_vertical_unfiltered_%s_N"}) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, name, s);
+      c.emplace_back(buf);
+    }
+  c.emplace_back("grm_Nm");
+  for (int j = 0; j < kJointCount; ++j) c.push_back(std::string("torque_") + joint_name(j) + "_Nm");
+  for (int j = 0; j < kJointCount; ++j) {
+    c.push_back(std::string("force_") + joint_name(j) + "_x_N");
+    c.push_back(std::string("force_") + joint_name(j) + "_y_N");
+  }
+  for (const char* name : {"residual_x_N", "residual_y_N", "residual_moment_Nm", "iterations"}) c.emplace_back(name);
+  const Eigen::Index n = r.time_s.size();
+  auto& v = t.values;
+  v.resize(n, static_cast<Eigen::Index>(c.size()));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Eigen::Index k = 0;
+    v(i, k++) = static_cast<double>(r.first_frame_number + i);
+    v(i, k++) = r.time_s[i];
     for (int s = 0; s < 2; ++s) {
       const auto& f = r.feet[s];
-      os << "," << num(f.force_N(i, 0)) << "," << num(f.force_N(i, 1)) << "," << num(f.cop_x_m[i]) << ","
-         << (f.contact[static_cast<std::size_t>(i)] ? 1 : 0) << "," << num(f.gap_m[i]) << "," << num(f.inclination_rad[i]) << ","
-         << num(f.raw_force_N(i, 1));
+      v(i, k++) = f.force_N(i, 0), v(i, k++) = f.force_N(i, 1), v(i, k++) = f.cop_x_m[i];
+      v(i, k++) = f.contact[static_cast<std::size_t>(i)] ? 1.0 : 0.0;
+      v(i, k++) = f.gap_m[i], v(i, k++) = f.inclination_rad[i], v(i, k++) = f.raw_force_N(i, 1);
     }
-    os << "," << num(r.grm_Nm[i]);
-    for (int j = 0; j < kJointCount; ++j) os << "," << num(r.joint_torque_Nm(i, j));
-    for (int j = 0; j < 2 * kJointCount; ++j) os << "," << num(r.joint_force_N(i, j));
-    os << "," << num(r.residual(i, 0)) << "," << num(r.residual(i, 1)) << "," << num(r.residual(i, 2)) << ","
-       << r.iterations[static_cast<std::size_t>(i)] << "\n";
+    v(i, k++) = r.grm_Nm[i];
+    for (int j = 0; j < kJointCount; ++j) v(i, k++) = r.joint_torque_Nm(i, j);
+    for (int j = 0; j < 2 * kJointCount; ++j) v(i, k++) = r.joint_force_N(i, j);
+    for (int j = 0; j < 3; ++j) v(i, k++) = r.residual(i, j);
+    v(i, k++) = r.iterations[static_cast<std::size_t>(i)];
+  }
+  return t;
+}
+
+std::string format_results_csv(const EstimateResult& r) {
+  const ResultsTable t = results_table(r);
+  std::ostringstream os;
+  for (std::size_t k = 0; k < t.columns.size(); ++k) os << (k ? "," : "") << t.columns[k];
+  os << "\n";
+  // Counts (frame, contact, iterations) as integers; the rest to 6 significant digits; NaN empty.
+  std::vector<bool> integer(t.columns.size());
+  for (std::size_t k = 0; k < t.columns.size(); ++k)
+    integer[k] = t.columns[k] == "frame" || t.columns[k].rfind("contact_", 0) == 0 || t.columns[k] == "iterations";
+  char buf[64];
+  for (Eigen::Index i = 0; i < t.values.rows(); ++i) {
+    for (Eigen::Index k = 0; k < t.values.cols(); ++k) {
+      const double x = t.values(i, k);
+      if (k) os << ',';
+      if (integer[static_cast<std::size_t>(k)]) os << static_cast<long long>(x);
+      else if (std::isfinite(x)) {
+        std::snprintf(buf, sizeof buf, "%.6g", x);
+        os << buf;
+      }
+    }
+    os << "\n";
   }
   return os.str();
 }

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "kin2grf/pipeline.hpp"
 
@@ -12,6 +13,15 @@ namespace kin2grf {
 /// OpenSim ExternalLoads-ready: ground_force_v/p, ground_torque_ (right), 1_-prefixed (left),
 /// lab frame of the input, metres, force on the body.
 void write_grf_mot(const std::string& path, const EstimateResult& r);
+/// The per-frame results as one table (sagittal frame; units in the column names): what the CSV
+/// writes and the Python module returns. NaN where a value does not exist (COP without contact).
+struct ResultsTable {
+  std::vector<std::string> columns;
+  Eigen::MatrixXd values;  ///< frames x columns
+};
+ResultsTable results_table(const EstimateResult& r);
+/// results_table as CSV: counts (frame, contact, iterations) as integers, the rest to 6
+/// significant digits, NaN as an empty cell.
 std::string format_results_csv(const EstimateResult& r);
 nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings);
 /// A few lines for a person: frames, mass, progression, each foot's contact intervals and peak

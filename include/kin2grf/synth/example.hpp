@@ -4,6 +4,9 @@
 // Z up, floor at 0).
 #pragma once
 
+#include <array>
+#include <vector>
+
 #include "kin2grf/io/trial.hpp"
 
 namespace kin2grf {
@@ -24,11 +27,48 @@ struct SyntheticOptions {
 Trial make_synthetic_trial(const SyntheticOptions& options);
 
 struct EstimateResult;
+struct ForcePlate;
 
 /// Two force plates (FP1 under the right foot, FP2 under the left; C3D TYPE-2 geometry, lab
 /// frame) whose signals are an estimate's own per-foot forces at the marker rate: the bundled
 /// example's plates, and exact "measurements" for the validation tests. Frames within
 /// `unloaded_ends` of either end are zeroed so that stances start and end inside the trial.
 ForcePlateRecording example_plates(const EstimateResult& estimate, const Trial& trial, int unloaded_ends = 0);
+
+/// A level walk (src/synth/walk.cpp says how it is made).
+struct SyntheticWalkOptions {
+  double duration_s = 4.4;
+  double rate_hz = 100.0;
+  double mass_kg = 70.0;
+  double speed_mps = 1.2;
+  double stride_time_s = 1.1;
+  double hip_height_m = 0.86;       ///< mean hip-joint height
+  double hip_oscillation_m = 0.02;  ///< amplitude of its rise at each mid-stance
+  double speed_oscillation_mps = 0.15;  ///< amplitude of the hips' forward speed, slowest at mid-stance
+  double clearance_m = 0.08;        ///< heel lift at mid-swing
+  double heel_strike_angle_rad = 0.25;  ///< foot inclination at heel strike (toes up)
+  double toe_off_angle_rad = 0.7;       ///< at toe-off (heel up)
+};
+
+struct SyntheticWalk {
+  Trial trial;  ///< markers (kin2grf-example set), body mass; no plates
+  /// Per foot (0 right, 1 left), per frame: in stance by construction, the stance's phase (0
+  /// heel strike, 1 toe-off) and the nominal COP along x (m; NaN in swing).
+  std::array<std::vector<bool>, 2> stance;
+  std::array<Eigen::VectorXd, 2> stance_phase, nominal_cop_x_m;
+  std::array<Eigen::MatrixX2d, 2> sole_x_m;  ///< x of the heel's ground point and the hallux in stance
+};
+
+SyntheticWalk make_synthetic_walk(const SyntheticWalkOptions& options);
+
+/// The walk's ground reactions per foot, lab frame, one row per trial frame (zero in swing): the
+/// estimate's kinematic totals shared between the feet by the synthetic rule (walk.cpp), not by
+/// the method. `estimate` is estimate() on `walk.trial`.
+std::array<ForcePlate, 2> synthetic_walk_feet(const SyntheticWalk& walk, const EstimateResult& estimate);
+
+/// The bundled example: the walk with two force plates in series along the walkway, the right
+/// foot's middle stance on FP1 and the left foot's next on FP2 (each plate records the foot whose
+/// COP is over it).
+Trial make_example_walk(const SyntheticWalkOptions& options = {});
 
 }  // namespace kin2grf

@@ -1,0 +1,59 @@
+// kin2grf batches: every trial of a trial list, estimated (and validated where it has plates),
+// on all cores, past failing trials, into one summary table.
+//
+// Each trial is independent: a worker thread takes the next trial of the list, loads it, runs
+// estimate_trial() and, when the trial (or its --plates file) has force plates, validate(). A
+// trial's error ends that trial only; its message goes into its row. Rows come back in the
+// list's order whatever the order they finish in, so a batch's table does not depend on --jobs.
+#pragma once
+
+#include <functional>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "kin2grf/validation/validate.hpp"
+#include "kin2grf/workflow/trial_list.hpp"
+
+namespace kin2grf {
+
+struct BatchRow {
+  std::string activity, lab, name, trial;
+  bool ok = false;
+  std::string error;           ///< why the trial failed (ok == false)
+  long frames = 0;             ///< frames processed
+  double duration_s = 0;       ///< of the processed window
+  double seconds = 0;          ///< wall time of the trial (load, estimate, validate, outputs)
+  double mass_kg = 0;
+  std::string marker_set;
+  bool validated = false;      ///< it had plates and was compared with them
+  /// Means over the validated stances (per foot) of the rRMSE, %; NaN when not validated.
+  int stances = 0;
+  double vertical = std::numeric_limits<double>::quiet_NaN(), anterior = vertical, cop = vertical, moment = vertical;
+  double total_vertical = vertical, total_grm = vertical;  ///< whole-body comparison, %
+  std::vector<std::string> messages;  ///< the estimate's notes and the readers' warnings
+  std::vector<std::string> outputs;   ///< files written (BatchOptions::out_dir)
+};
+
+struct BatchOptions {
+  int jobs = 1;                  ///< worker threads (>= 1)
+  std::string out_dir;           ///< when set: NAME.csv, NAME_grf.mot and NAME.json per trial
+  ValidationOptions validation;
+  /// Called after each trial with (trials done, trials in all, that trial's row), from the
+  /// thread that ran it, one call at a time. The core prints nothing itself.
+  std::function<void(std::size_t, std::size_t, const BatchRow&)> progress;
+};
+
+/// One trial: never throws for the trial's own faults (they are the row's error).
+BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& options = {});
+/// Every trial, rows in the list's order.
+std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, const BatchOptions& options = {});
+
+/// The summary table: CSV (one header line, one line per trial; empty cells for NaN) and JSON
+/// (an array of objects with the same fields, null for NaN).
+std::string batch_csv(const std::vector<BatchRow>& rows);
+nlohmann::json batch_json(const std::vector<BatchRow>& rows);
+nlohmann::json batch_row_json(const BatchRow& row);
+
+}  // namespace kin2grf

@@ -1,0 +1,72 @@
+// kin2grf settings: what a user chooses for one trial, by the names of the command line, and the
+// one translation of them into the library's option structs. The CLI, the trial list of
+// `study`/`batch`/`fit-cop` and the Python module all go through here, so that a setting has
+// one name, one default and one meaning everywhere.
+#pragma once
+
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/pipeline.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace kin2grf {
+
+/// One trial's settings as the user gives them (flag names without the dashes; strings where the
+/// command line takes a word). Numerical defaults come from EstimateOptions/SolverOptions.
+struct Settings {
+  std::string trial, static_trial, markers;
+  std::optional<double> mass;
+  bool force_mass = false;
+  std::string foot_model = "cop", norm = "torque-scaled", anthropometry = EstimateOptions{}.anthropometry, up_axis,
+              cop_function, running_cop = "builtin", torso_length = "measured";
+  double r = SolverOptions{}.r_N_per_m, kinematic_cutoff = EstimateOptions{}.kinematic_cutoff_hz,
+         post_cutoff = EstimateOptions{}.post_cutoff_hz, ground_shift = 0, speed_gate = SolverOptions{}.speed_gate_mps,
+         split_distance = SolverOptions{}.min_split_distance_m, speed_gate_ratio = SolverOptions{}.speed_gate_ratio,
+         speed_gate_floor = SolverOptions{}.speed_gate_floor_mps;
+  bool paper = false, r_given = false, anthropometry_given = false;
+  std::optional<double> ground_level;
+  std::vector<double> grm_reference;
+  int max_gap = 10;
+};
+
+/// Registers TRIAL and every setting as options of `app` (the command line's and the trial
+/// list's parser; the Python module's keyword arguments are these names with '_' for '-').
+void add_settings_options(CLI::App* app, Settings& s);
+
+/// Parses `--name value ...` words (a trial-list line, Python keyword arguments) into `s`, after
+/// TRIAL. InputError naming `where` and the option on a bad one.
+void parse_settings(const std::vector<std::string>& words, Settings& s, const std::string& where);
+
+/// The resolved options: what --paper and the defaults make of the settings (reads COP function
+/// files). Ranges are checked by estimate() (check_options).
+EstimateOptions to_options(const Settings& s);
+
+/// The settings a run used, from the resolved options: recorded in every JSON output.
+nlohmann::json settings_json(const Settings& s, const EstimateOptions& o);
+
+/// C3D plate offsets by name: "none", "zero" (FORCE_PLATFORM:ZERO) or "unloaded".
+LoadOptions load_options(const std::string& zero_offset);
+/// "X", "Y", "Z" (either case) or "" (none); InputError otherwise.
+std::optional<Axis> parse_axis(const std::string& text);
+
+/// The marker set: `s.markers` (a preset name or a mapping file), else recognised from the
+/// trial's markers (`why` says how). `custom` holds a mapping file's set.
+const MarkerSet& resolve_marker_set(const Settings& s, const Trial& trial, MarkerSet& custom, std::string* why = nullptr);
+
+/// The files a run with these settings reads (no output may be one of them).
+std::vector<std::string> input_files(const Settings& s);
+
+/// Loads the static trial, resolves the marker set and runs estimate() on `trial`; the marker
+/// set's recognition goes into the result's messages.
+EstimateResult estimate_trial(const Settings& s, const Trial& trial,
+                              std::function<void(long, long)> progress = {});
+
+}  // namespace kin2grf

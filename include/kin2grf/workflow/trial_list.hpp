@@ -1,0 +1,26 @@
+// kin2grf trial lists: the file `study`, `fit-cop` and `batch` read. One trial a line:
+//   activity|lab|name|TRIAL [settings as on the command line] [--plates FILE]
+// '#' starts a comment line; the older "activity|name|TRIAL" is read with each trial its own lab.
+// Paths are as written (relative to the working directory).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "kin2grf/workflow/settings.hpp"
+
+namespace kin2grf {
+
+struct TrialListEntry {
+  std::string activity, lab, name;
+  Settings settings;
+  std::string plates;  ///< measured forces from this file instead of the trial's plates
+  int line = 0;        ///< line number in the list (1-based)
+};
+
+/// One line (not a comment); `where` names it in errors ("list.txt:12").
+TrialListEntry parse_trial_list_line(const std::string& line, const std::string& where);
+/// Every trial of the file; InputError naming the file and line on a bad one, or when empty.
+std::vector<TrialListEntry> read_trial_list(const std::string& path);
+
+}  // namespace kin2grf

@@ -1,0 +1,256 @@
+// A synthetic level walk of the project's own making: the bundled example's gait and the tests'.
+//
+// Kinematics (x forward, y up, m; both legs share the sagittal plane, laterally 0.1 m apart):
+// - Hips move forward at the walking speed v; their height is highest at each mid-stance
+//   (h0 + A cos(4 pi (t/T - 0.3))), as the body vaults over the stance leg.
+// - Each foot is a rigid body whose stance follows the three rockers: heel rocker about the heel's
+//   ground point from phi_hs (toes up) to flat over 8 % of the cycle, flat to 35 %, then the
+//   forefoot rocker about the MT ground point to -phi_to at toe-off (60 %: 10 % double supports).
+//   The swing carries the foot from its toe-off pose to the next heel strike one stride ahead,
+//   by a minimum-jerk path with a heel lift of `clearance_m`.
+// - Knees from the two-link inverse kinematics of hip and ankle (knee forward); the torso leans
+//   forward by 0.05 rad over the hips.
+// Ground reactions ("measured"): the model's own totals from these kinematics (sum m (a + g) and
+// the moment, as estimate() computes them) are shared between the feet in contact by a rule
+// that is not the method's: the trailing foot hands its share to the leading one by a cosine over
+// each double support, each foot's COP starts at a nominal point (the heel during the heel
+// rocker, moving to the MT head over the flat foot, the MT head in the forefoot rocker), and one
+// common shift of the COPs makes the moment exact. So the plates agree with the kinematics
+// exactly, and the method's per-foot split and COP are tested against an independent rule.
+#include <cmath>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/force_plate.hpp"
+#include "kin2grf/markers/landmarks.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/synth/example.hpp"
+
+namespace kin2grf {
+
+namespace {
+
+constexpr double kStanceEnd = 0.6, kHeelRockerEnd = 0.08, kFlatEnd = 0.35;
+// Foot points relative to the heel's ground point with the foot flat (x forward, y up), m.
+const Eigen::Vector2d kAnkle(0.05, 0.08), kHeelMarker(0.0, 0.035), kMtMarker(0.18, 0.025), kHallux(0.24, 0.02),
+    kMtGround(0.18, 0.0);
+
+double smoothstep(double u) {
+  u = std::clamp(u, 0.0, 1.0);
+  return u * u * u * (10 - 15 * u + 6 * u * u);  // minimum jerk
+}
+Eigen::Vector2d rotated(const Eigen::Vector2d& p, double a) {
+  return {std::cos(a) * p.x() - std::sin(a) * p.y(), std::sin(a) * p.x() + std::cos(a) * p.y()};
+}
+
+/// One foot's pose at phase p of its own cycle (0 = heel strike) of stride k.
+struct FootPose {
+  Eigen::Vector2d heel_ground;  ///< the heel's ground point (where the foot's frame is)
+  double phi = 0;               ///< inclination, + toes up
+  bool stance = false;
+  double stance_phase = 0;      ///< p / kStanceEnd in stance
+  [[nodiscard]] Eigen::Vector2d point(const Eigen::Vector2d& local) const { return heel_ground + rotated(local, phi); }
+};
+
+FootPose stance_pose(double heel_x, double p, const SyntheticWalkOptions& o) {
+  FootPose f;
+  f.stance = true;
+  f.stance_phase = p / kStanceEnd;
+  if (p < kHeelRockerEnd) {
+    f.phi = o.heel_strike_angle_rad * (1 - smoothstep(p / kHeelRockerEnd));
+    f.heel_ground = {heel_x, 0.0};
+  } else if (p < kFlatEnd) {
+    f.heel_ground = {heel_x, 0.0};
+  } else {
+    f.phi = -o.toe_off_angle_rad * smoothstep((p - kFlatEnd) / (kStanceEnd - kFlatEnd));
+    const Eigen::Vector2d pivot(heel_x + kMtGround.x(), 0.0);
+    f.heel_ground = pivot + rotated(-kMtGround, f.phi);
+  }
+  return f;
+}
+
+FootPose foot_pose(double cycles, double first_heel_x, const SyntheticWalkOptions& o) {
+  const double stride = o.speed_mps * o.stride_time_s;
+  const double k = std::floor(cycles), p = cycles - k;
+  const double heel_x = first_heel_x + k * stride;
+  if (p < kStanceEnd) return stance_pose(heel_x, p, o);
+  const FootPose off = stance_pose(heel_x, kStanceEnd - 1e-12, o), on = stance_pose(heel_x + stride, 0.0, o);
+  const double u = (p - kStanceEnd) / (1 - kStanceEnd), s = smoothstep(u);
+  FootPose f;
+  f.phi = off.phi + (on.phi - off.phi) * s;
+  f.heel_ground = off.heel_ground + (on.heel_ground - off.heel_ground) * s;
+  f.heel_ground.y() += o.clearance_m * std::pow(std::sin(M_PI * u), 2);
+  return f;
+}
+
+}  // namespace
+
+SyntheticWalk make_synthetic_walk(const SyntheticWalkOptions& o) {
+  if (!(o.speed_mps > 0.2 && o.speed_mps < 2.5 && o.stride_time_s > 0.6 && o.stride_time_s < 2.5 && o.duration_s >= 2 * o.stride_time_s &&
+        o.duration_s <= 600 && o.rate_hz >= 50 && o.rate_hz <= 1000))
+    throw InputError("synthetic walk: speed 0.2-2.5 m/s, stride time 0.6-2.5 s, at least two strides, 50-1000 Hz");
+  SyntheticWalk w;
+  Trial& t = w.trial;
+  t.path = "synthetic walk";
+  t.format = "C3D";
+  t.body_mass_kg = o.mass_kg;
+  auto& m = t.markers;
+  m.rate_hz = o.rate_hz;
+  const int n = static_cast<int>(std::lround(o.duration_s * o.rate_hz));
+  m.time_s = Eigen::VectorXd::LinSpaced(n, 0.0, (n - 1) / o.rate_hz);
+  m.up_axis = Axis::Z;
+  const char* names[] = {"SHO", "HJC", "KJC", "AJC", "HEE", "MT1", "HLX"};
+  for (const char* side : {"R", "L"})
+    for (const char* nm : names) m.names.push_back(std::string(side) + nm);
+  m.descriptions.assign(m.names.size(), "");
+  m.positions_m.assign(m.names.size(), Eigen::MatrixX3d(n, 3));
+  const double Lsh = 0.43, Lth = 0.44, Lt = 0.55, T = o.stride_time_s, v = o.speed_mps;
+  // The right foot's first heel strike puts its ankle under the hip at mid-stance.
+  const double first_heel_x = 0.3 * v * T - kAnkle.x();
+  for (auto& f : w.nominal_cop_x_m) f = Eigen::VectorXd::Constant(n, std::nan(""));
+  for (auto& c : w.stance) c.assign(static_cast<std::size_t>(n), false);
+  for (auto& s : w.stance_phase) s = Eigen::VectorXd::Zero(n);
+  for (auto& s : w.sole_x_m) s = Eigen::MatrixX2d::Constant(n, 2, std::nan(""));
+  for (int i = 0; i < n; ++i) {
+    const double time = m.time_s[i];
+    // Slowest and highest at each mid-stance (t/T = 0.3 and 0.8): braking, then propulsion.
+    const double wave = 4 * M_PI * (time / T - 0.3);
+    const Eigen::Vector2d hip(v * time - o.speed_oscillation_mps * T / (4 * M_PI) * std::sin(wave),
+                              o.hip_height_m + o.hip_oscillation_m * std::cos(wave));
+    const Eigen::Vector2d sho = hip + Lt * Eigen::Vector2d(std::cos(M_PI / 2 - 0.05), std::sin(M_PI / 2 - 0.05));
+    for (int side = 0; side < 2; ++side) {
+      // The left foot is half a cycle ahead in its cycle: its current stance began half a stride back.
+      const double cycles = time / T + (side ? 0.5 : 0.0);
+      const FootPose f = foot_pose(cycles, first_heel_x - (side ? 0.5 * v * T : 0.0), o);
+      const Eigen::Vector2d ankle = f.point(kAnkle);
+      const Eigen::Vector2d d = ankle - hip;
+      const double dist = d.norm();
+      if (dist > Lth + Lsh - 1e-3) throw InputError("synthetic walk: the leg cannot reach the foot (a longer stride than the legs allow)");
+      const double alpha = std::acos(std::clamp((Lth * Lth + dist * dist - Lsh * Lsh) / (2 * Lth * dist), -1.0, 1.0));
+      const Eigen::Vector2d knee = hip + Lth * rotated(d / dist, alpha);  // knee forward
+      const Eigen::Vector2d pts[] = {sho, hip, knee, ankle, f.point(kHeelMarker), f.point(kMtMarker), f.point(kHallux)};
+      const double y = side == 0 ? -0.1 : 0.1;  // right foot at -Y (Y points left)
+      for (int k = 0; k < 7; ++k) m.positions_m[static_cast<std::size_t>(7 * side + k)].row(i) << pts[k].x(), y, pts[k].y();
+      if (f.stance) {
+        w.stance[side][static_cast<std::size_t>(i)] = true;
+        w.stance_phase[side][i] = f.stance_phase;
+        // Nominal COP: heel, then heel -> MT head over the flat foot, then the MT head.
+        const double p = f.stance_phase * kStanceEnd;
+        const double heel = f.point(Eigen::Vector2d::Zero()).x(), mt = f.point(kMtGround).x();
+        w.sole_x_m[side](i, 0) = heel;
+        w.sole_x_m[side](i, 1) = f.point(kHallux).x();
+        w.nominal_cop_x_m[side][i] =
+            p < kHeelRockerEnd ? heel : p < kFlatEnd ? heel + (mt - heel) * (p - kHeelRockerEnd) / (kFlatEnd - kHeelRockerEnd) : mt;
+      }
+    }
+  }
+  return w;
+}
+
+std::array<ForcePlate, 2> synthetic_walk_feet(const SyntheticWalk& w, const EstimateResult& r) {
+  const Eigen::Index n = r.time_s.size();
+  std::array<ForcePlate, 2> feet;
+  for (int side = 0; side < 2; ++side) {
+    auto& p = feet[static_cast<std::size_t>(side)];
+    p.name = side ? "left" : "right";
+    p.force_N = Eigen::MatrixX3d::Zero(w.trial.markers.frames(), 3);
+    p.cop_m = Eigen::MatrixX3d::Constant(w.trial.markers.frames(), 3, std::nan(""));
+    p.free_moment_Nm = Eigen::MatrixX3d::Zero(w.trial.markers.frames(), 3);
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Index k = r.first_index + i;
+    const auto ks = static_cast<std::size_t>(k);
+    // Shares: one foot in contact takes all; in double support the foot further into its stance
+    // (the trailing one) hands over by a cosine of its remaining stance.
+    std::array<double, 2> share = {0, 0};
+    const bool both = w.stance[0][ks] && w.stance[1][ks];
+    for (int side = 0; side < 2; ++side) {
+      if (!w.stance[side][ks]) continue;
+      if (!both) share[side] = 1;
+      else {
+        const double ds = 1.0 / 6.0;  // a double support is the last (and first) sixth of a stance
+        const double ph = w.stance_phase[side][k];
+        share[side] = ph > 0.5 ? 0.5 * (1 + std::cos(M_PI * (ph - (1 - ds)) / ds)) : 0.5 * (1 - std::cos(M_PI * ph / ds));
+      }
+    }
+    const double sum = share[0] + share[1];
+    if (sum <= 0) continue;  // a flight: no synthetic walk has one
+    const Eigen::Vector3d total = r.kinematic_total.row(i).transpose();  // (Fx, Fy, M about the origin)
+    double moment_nominal = 0;
+    for (int side = 0; side < 2; ++side)
+      if (share[side] > 0) moment_nominal += w.nominal_cop_x_m[side][k] * total.y() * share[side] / sum;
+    // One shift of both COPs makes sum x_i Fy_i - y_g Fx = M (floor at y_g = 0), as far as each
+    // COP stays under its foot (heel to hallux): a designed gait's angular momentum is not a real
+    // walker's, and a COP off the foot is no plate's.
+    const double shift = (total.z() + r.ground_level_m * total.x() - moment_nominal) / total.y();
+    for (int side = 0; side < 2; ++side) {
+      if (share[side] <= 0) continue;
+      auto& p = feet[static_cast<std::size_t>(side)];
+      const double f = share[side] / sum;
+      p.force_N.row(k) << f * total.x(), 0.0, f * total.y();
+      const double x = std::clamp(w.nominal_cop_x_m[side][k] + shift, w.sole_x_m[side](k, 0), w.sole_x_m[side](k, 1));
+      p.cop_m.row(k) << x, side ? 0.1 : -0.1, r.ground_level_m;
+    }
+  }
+  return feet;
+}
+
+Trial make_example_walk(const SyntheticWalkOptions& o) {
+  SyntheticWalk w = make_synthetic_walk(o);
+  const auto* set = find_marker_set("kin2grf-example");
+  const EstimateResult r = estimate(w.trial, nullptr, *set, EstimateOptions{});
+  const auto feet = synthetic_walk_feet(w, r);
+  // Two plates in series along the walkway, 0.6 m long and 0.5 m wide, each under one stance of
+  // the middle stride: the right foot's on FP1, the left foot's next on FP2.
+  const double v = o.speed_mps, T = o.stride_time_s;
+  const int stride = std::max(1, static_cast<int>(std::floor(o.duration_s / T / 2)) - 0);
+  const double right_heel = 0.3 * v * T - kAnkle.x() + stride * v * T, left_heel = right_heel + 0.5 * v * T;
+  ForcePlateRecording rec;
+  rec.rate_hz = w.trial.markers.rate_hz;
+  rec.time_s = w.trial.markers.time_s;
+  const Eigen::Index n = w.trial.markers.frames();
+  for (int k = 0; k < 2; ++k) {
+    ForcePlate p;
+    p.name = k ? "FP2" : "FP1";
+    p.type = 2;
+    p.has_geometry = true;
+    const double x0 = (k ? left_heel : right_heel) - 0.18;
+    p.corners_m = {Eigen::Vector3d(x0 + 0.6, 0.25, 0), Eigen::Vector3d(x0, 0.25, 0), Eigen::Vector3d(x0, -0.25, 0),
+                   Eigen::Vector3d(x0 + 0.6, -0.25, 0)};
+    Eigen::Matrix<double, 3, 4> C;
+    for (int c = 0; c < 4; ++c) C.col(c) = p.corners_m[static_cast<std::size_t>(c)];
+    p.lab_R_plate = plate_axes(C);
+    p.centre_m = C.rowwise().mean();
+    p.origin_m = Eigen::Vector3d(0, 0, -0.04);
+    p.force_N = Eigen::MatrixX3d::Zero(n, 3);
+    p.cop_m = Eigen::MatrixX3d::Constant(n, 3, std::nan(""));
+    p.free_moment_Nm = Eigen::MatrixX3d::Zero(n, 3);
+    p.moment_centre_Nm = Eigen::MatrixX3d::Zero(n, 3);
+    // The plate records the stance whose foot stands on it (FP1 the right foot, FP2 the left).
+    {
+      const int side = k;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const Eigen::Vector3d cop = feet[static_cast<std::size_t>(side)].cop_m.row(i).transpose();
+        const double heel = w.sole_x_m[side](i, 0);
+        if (!cop.allFinite() || !(heel > x0 && heel < x0 + 0.6)) continue;
+        const Eigen::Vector3d F = feet[static_cast<std::size_t>(side)].force_N.row(i).transpose();
+        p.force_N.row(i) += F.transpose();
+        p.moment_centre_Nm.row(i) += (cop - p.centre_m).cross(F).transpose();
+      }
+    }
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Vector3d F = p.force_N.row(i).transpose(), M = p.moment_centre_Nm.row(i).transpose();
+      if (F.z() > 1e-6) {
+        // The COP on the surface from the force and the moment about the centre.
+        p.cop_m.row(i) << p.centre_m.x() - M.y() / F.z(), p.centre_m.y() + M.x() / F.z(), 0.0;
+      } else {
+        p.cop_m.row(i) = p.centre_m.transpose();
+      }
+    }
+    rec.plates.push_back(p);
+  }
+  w.trial.plates = rec;
+  w.trial.path = "synthetic walk";
+  return w.trial;
+}
+
+}  // namespace kin2grf

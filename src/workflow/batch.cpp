@@ -1,0 +1,166 @@
+#include "kin2grf/workflow/batch.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/text.hpp"
+#include "kin2grf/output/results.hpp"
+
+namespace kin2grf {
+
+namespace {
+
+/// A file name from a trial's name: letters, digits, '-', '_' and '.' kept, others '_'.
+std::string file_stem(const std::string& name) {
+  std::string s;
+  for (char c : name) s += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.') ? c : '_';
+  return s.empty() || s[0] == '.' ? "trial" + s : s;
+}
+
+void fill_validation(BatchRow& row, const ValidationResult& v) {
+  row.validated = true;
+  const MeanMetrics m = mean_rrmse(v.stances);
+  row.stances = m.n;
+  if (m.n > 0) row.vertical = m.vertical, row.anterior = m.anterior, row.cop = m.cop, row.moment = m.moment;
+  if (v.total) {
+    if (v.total->metrics.vertical) row.total_vertical = v.total->metrics.vertical->rrmse_percent;
+    if (v.total->metrics.moment) row.total_grm = v.total->metrics.moment->rrmse_percent;
+  }
+  for (const auto& e : v.excluded) row.messages.push_back("validation: excluded " + e);
+}
+
+}  // namespace
+
+BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& options) {
+  BatchRow row;
+  row.activity = entry.activity, row.lab = entry.lab, row.name = entry.name, row.trial = entry.settings.trial;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    const Trial trial = load_trial(entry.settings.trial, load_options("unloaded"));
+    std::optional<Trial> plates_file;
+    if (!entry.plates.empty()) plates_file = load_trial(entry.plates, load_options("unloaded"));
+    const EstimateResult r = estimate_trial(entry.settings, trial);
+    row.frames = static_cast<long>(r.time_s.size());
+    row.duration_s = r.time_s.size() > 1 ? r.time_s[r.time_s.size() - 1] - r.time_s[0] : 0.0;
+    row.mass_kg = r.mass_kg;
+    row.marker_set = r.marker_set;
+    row.messages = r.messages;
+    const Trial& source = plates_file ? *plates_file : trial;
+    std::optional<ValidationResult> v;
+    if (source.plates && !source.plates->plates.empty()) {
+      v = validate(r, *source.plates, options.validation);
+      fill_validation(row, *v);
+    }
+    if (!options.out_dir.empty()) {
+      const auto base = std::filesystem::path(options.out_dir) / file_stem(entry.name);
+      const Settings& s = entry.settings;
+      const std::vector<std::string> inputs = [&] {
+        auto in = input_files(s);
+        in.push_back(entry.plates);
+        return in;
+      }();
+      const std::string csv = base.string() + ".csv", mot = base.string() + "_grf.mot", json = base.string() + ".json";
+      for (const auto& o : {csv, mot, json}) ensure_not_an_input(o, inputs);
+      write_file_text(csv, format_results_csv(r));
+      write_grf_mot(mot, r);
+      auto settings = settings_json(s, to_options(s));
+      write_file_text(json, json_text(v ? validation_json(entry.name, r, *v, settings) : results_summary(r, settings)));
+      row.outputs = {csv, mot, json};
+    }
+    row.ok = true;
+  } catch (const std::bad_alloc&) {
+    row.error = "out of memory";
+  } catch (const InputError& e) {
+    row.error = e.what();
+  } catch (const std::exception& e) {
+    row.error = std::string("internal error: ") + e.what();
+  }
+  row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return row;
+}
+
+std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, const BatchOptions& options) {
+  if (options.jobs < 1) throw InputError("jobs " + std::to_string(options.jobs) + ": must be at least 1");
+  if (!options.out_dir.empty()) {
+    // One trial's outputs must not replace another's.
+    std::set<std::string> stems;
+    for (const auto& e : entries)
+      if (!stems.insert(file_stem(e.name)).second)
+        throw InputError("two trials of the batch are named '" + e.name + "': their outputs would share a name");
+    std::filesystem::create_directories(options.out_dir);
+  }
+  std::vector<BatchRow> rows(entries.size());
+  std::atomic<std::size_t> next{0};
+  std::size_t done = 0;
+  std::mutex progress_mutex;
+  auto work = [&] {
+    for (std::size_t k; (k = next++) < entries.size();) {
+      rows[k] = run_batch_entry(entries[k], options);
+      std::lock_guard lock(progress_mutex);
+      ++done;
+      if (options.progress) options.progress(done, entries.size(), rows[k]);
+    }
+  };
+  const auto n = std::min<std::size_t>(static_cast<std::size_t>(options.jobs), std::max<std::size_t>(1, entries.size()));
+  std::vector<std::thread> threads;
+  for (std::size_t t = 1; t < n; ++t) threads.emplace_back(work);
+  work();
+  for (auto& t : threads) t.join();
+  return rows;
+}
+
+namespace {
+std::string cell(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+std::string quoted(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : c == '\n' ? std::string(" ") : std::string(1, c);
+  return q + "\"";
+}
+nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+}  // namespace
+
+std::string batch_csv(const std::vector<BatchRow>& rows) {
+  std::ostringstream os;
+  os << "activity,lab,name,trial,ok,frames,duration_s,seconds,frames_per_s,mass_kg,marker_set,stances,"
+        "vertical_rrmse_pct,anterior_rrmse_pct,cop_rrmse_pct,moment_rrmse_pct,total_vertical_rrmse_pct,total_grm_rrmse_pct,error\n";
+  for (const auto& r : rows)
+    os << quoted(r.activity) << ',' << quoted(r.lab) << ',' << quoted(r.name) << ',' << quoted(r.trial) << ','
+       << (r.ok ? 1 : 0) << ',' << r.frames << ',' << cell(r.duration_s) << ',' << cell(r.seconds) << ','
+       << cell(r.seconds > 0 ? static_cast<double>(r.frames) / r.seconds : NAN) << ',' << cell(r.mass_kg) << ','
+       << quoted(r.marker_set) << ',' << r.stances << ',' << cell(r.vertical) << ',' << cell(r.anterior) << ','
+       << cell(r.cop) << ',' << cell(r.moment) << ',' << cell(r.total_vertical) << ',' << cell(r.total_grm) << ','
+       << quoted(r.error) << '\n';
+  return os.str();
+}
+
+nlohmann::json batch_row_json(const BatchRow& r) {
+  return {{"activity", r.activity}, {"lab", r.lab}, {"name", r.name}, {"trial", r.trial}, {"ok", r.ok},
+          {"error", r.ok ? nlohmann::json(nullptr) : nlohmann::json(r.error)}, {"frames", r.frames},
+          {"duration_s", r.duration_s}, {"seconds", r.seconds}, {"mass_kg", r.mass_kg}, {"marker_set", r.marker_set},
+          {"validated", r.validated}, {"stances", r.stances}, {"vertical_rrmse_pct", number(r.vertical)},
+          {"anterior_rrmse_pct", number(r.anterior)}, {"cop_rrmse_pct", number(r.cop)}, {"moment_rrmse_pct", number(r.moment)},
+          {"total_vertical_rrmse_pct", number(r.total_vertical)}, {"total_grm_rrmse_pct", number(r.total_grm)},
+          {"messages", r.messages}, {"outputs", r.outputs}};
+}
+
+nlohmann::json batch_json(const std::vector<BatchRow>& rows) {
+  nlohmann::json j = {{"kin2grf_version", KIN2GRF_VERSION}, {"trials", nlohmann::json::array()}};
+  for (const auto& r : rows) j["trials"].push_back(batch_row_json(r));
+  return j;
+}
+
+}  // namespace kin2grf

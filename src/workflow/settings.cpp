@@ -1,0 +1,202 @@
+// The command line's names for the settings, shared by the CLI, trial lists and Python.
+#include "kin2grf/workflow/settings.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <cctype>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/cop_function.hpp"
+#include "kin2grf/io/trial.hpp"
+
+namespace kin2grf {
+
+namespace {
+const char* torso_length_name(TorsoLength t) { return t == TorsoLength::Fixed ? "fixed" : "measured"; }
+}  // namespace
+
+void add_settings_options(CLI::App* c, Settings& a) {
+  c->add_option("TRIAL", a.trial, "Motion trial (C3D or TRC)")->required();
+  c->add_option("--static", a.static_trial, "Static calibration trial (for virtual knee/ankle landmarks)");
+  c->add_option("--markers", a.markers, "Marker-set preset name or mapping file (JSON); default: recognised");
+  c->add_option("--mass", a.mass, "Body mass, kg (default: the C3D's PROCESSING:Bodymass or SUBJECT(S):WEIGHT); 20-300");
+  c->add_flag("--force-mass", a.force_mass, "Accept a body mass outside 20-300 kg");
+  c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
+      ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
+  c->add_option_function<double>(
+       "--r", [&a](double v) { a.r = v, a.r_given = true; },
+       "Activation parameter r, N/m (Eq. 8); default 1000 (from `kin2grf study r`), 10000 with --paper");
+  c->add_option("--kinematic-cutoff", a.kinematic_cutoff, "Kinematics low-pass cut-off, Hz")->capture_default_str();
+  c->add_option("--post-cutoff", a.post_cutoff, "Multiplier post-filter cut-off, Hz")->capture_default_str();
+  c->add_option("--ground-level", a.ground_level, "Floor height in the lab's up axis, m (default: estimated)");
+  c->add_option("--grm-reference", a.grm_reference,
+                 "GRM reference point in the sagittal frame: along progression and up from the lab origin, m (default 0 0)")
+      ->expected(2);
+  c->add_option("--ground-shift", a.ground_shift, "Shift the ground by this much, m (robustness study)")->capture_default_str();
+  c->add_option_function<double>(
+       "--speed-gate", [&a](double v) { a.speed_gate = v, a.speed_gate_ratio = 0; },
+       "A fixed speed gate: contact allowed only below this sole speed, m/s (0 = off, the paper); replaces --speed-gate-ratio")
+      ->check(CLI::Range(0.0, 20.0));
+  c->add_option("--speed-gate-ratio", a.speed_gate_ratio,
+                "The speed gate as this multiple of the progression speed (hip or belt), at least --speed-gate-floor; "
+                "0 = the fixed --speed-gate")
+      ->check(CLI::Range(0.0, 20.0))->capture_default_str();
+  c->add_option("--speed-gate-floor", a.speed_gate_floor, "Lowest speed gate with --speed-gate-ratio, m/s")
+      ->check(CLI::Range(0.0, 20.0))->capture_default_str();
+  c->add_option("--split-distance", a.split_distance,
+                "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  c->add_option("--torso-length", a.torso_length,
+                "measured (the hip-shoulder distance of each frame, filtered) or fixed (its median, the paper's rigid HAT)")
+      ->check(CLI::IsMember({"measured", "fixed"}))->capture_default_str();
+  c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
+      ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
+  c->add_option_function<std::string>(
+       "--anthropometry", [&a](const std::string& v) { a.anthropometry = v, a.anthropometry_given = true; },
+       "winter or de-leva; default de-leva, winter with --paper")
+      ->check(CLI::IsMember({"winter", "de-leva"}));
+  c->add_option("--cop-function", a.cop_function,
+                "Foot model 2's COP function from this JSON (see kin2grf fit-cop); used on every frame unless --running-cop FILE");
+  c->add_option("--running-cop", a.running_cop,
+                "COP function near flight phases (running): builtin (kin2grf's running fit), off, or a JSON file")
+      ->capture_default_str();
+  c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
+  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length");
+  c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
+}
+
+void parse_settings(const std::vector<std::string>& words, Settings& s, const std::string& where) {
+  CLI::App parser{"settings"};
+  add_settings_options(&parser, s);
+  std::vector<std::string> args(words.rbegin(), words.rend());  // CLI11 parses a reversed vector
+  try {
+    parser.parse(args);
+  } catch (const CLI::ParseError& e) {
+    throw InputError(where + ": " + e.what());
+  }
+}
+
+LoadOptions load_options(const std::string& zero) {
+  LoadOptions lo;
+  if (zero == "zero") lo.c3d.zero_offset = ZeroOffset::ZeroParameter;
+  else if (zero == "unloaded") lo.c3d.zero_offset = ZeroOffset::Unloaded;
+  else if (zero != "none") throw InputError("zero offset '" + zero + "': must be none, zero or unloaded");
+  return lo;
+}
+
+std::optional<Axis> parse_axis(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(text[0])));
+  if (c < 'X' || c > 'Z' || text.size() != 1) throw InputError("up axis '" + text + "': must be X, Y or Z");
+  return static_cast<Axis>(c - 'X');
+}
+
+EstimateOptions to_options(const Settings& a) {
+  EstimateOptions o;
+  o.mass_kg = a.mass;  // any given value, checked by the library (a negative one is refused, not ignored)
+  o.allow_unusual_mass = a.force_mass;
+  o.anthropometry = (a.paper && !a.anthropometry_given) ? "winter" : a.anthropometry;
+  o.kinematic_cutoff_hz = a.kinematic_cutoff;
+  o.post_cutoff_hz = a.post_cutoff;
+  o.ground_level_m = a.ground_level;
+  o.contact.foot_model = a.foot_model == "cop" ? FootModel::Cop : FootModel::ThreePoint;
+  o.contact.ground_shift_m = a.ground_shift;
+  if (a.grm_reference.size() == 2) o.grm_reference_m = Eigen::Vector2d(a.grm_reference[0], a.grm_reference[1]);
+  if (a.paper) o.contact.cop = CopFunction::paper();
+  if (!a.cop_function.empty()) o.contact.cop = read_cop_function(a.cop_function);
+  // The running function: kin2grf's own unless the paper's configuration, a user's function for
+  // every frame, or "off" is asked for; a file replaces it.
+  if (a.running_cop == "off" || (a.running_cop == "builtin" && (a.paper || !a.cop_function.empty()))) o.contact.running_cop.reset();
+  else if (a.running_cop != "builtin") o.contact.running_cop = read_cop_function(a.running_cop);
+  o.solver.r_N_per_m = (a.paper && !a.r_given) ? 1e4 : a.r;
+  o.solver.norm = (a.paper || a.norm == "paper") ? MultiplierNorm::Paper : MultiplierNorm::TorqueScaled;
+  o.solver.speed_gate_mps = a.paper ? 0.0 : a.speed_gate;
+  o.solver.speed_gate_ratio = a.paper ? 0.0 : a.speed_gate_ratio;
+  o.solver.speed_gate_floor_mps = a.speed_gate_floor;
+  o.solver.min_split_distance_m = a.paper ? 0.0 : a.split_distance;
+  o.torso_length = (a.paper || a.torso_length == "fixed") ? TorsoLength::Fixed : TorsoLength::Measured;
+  o.landmarks.max_gap_frames = a.max_gap;
+  o.landmarks.up_axis = parse_axis(a.up_axis);
+  return o;
+}
+
+namespace {
+nlohmann::json cop_json(const CopFunction& c, const std::string& source) {
+  return {{"source", source}, {"delta_rad", {c.delta_hs, c.delta_ho, c.delta_mo, c.delta_to}}, {"s", {c.s_hs, c.s_ho, c.s_mo, c.s_to}}};
+}
+}  // namespace
+
+nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
+  return {{"trial", a.trial},
+          {"static", a.static_trial},
+          {"paper_configuration", a.paper},
+          {"foot_model", a.foot_model},
+          {"cop_function", cop_json(o.contact.cop, !a.cop_function.empty() ? a.cop_function : a.paper ? "paper event angles" : "built-in fit")},
+          {"running_cop_function", o.contact.running_cop
+                                       ? cop_json(*o.contact.running_cop, a.running_cop == "builtin" ? "built-in running fit" : a.running_cop)
+                                       : nlohmann::json(nullptr)},
+          {"r_N_per_m", o.solver.r_N_per_m},
+          {"norm", o.solver.norm == MultiplierNorm::Paper ? "paper" : "torque-scaled"},
+          {"speed_gate_mps", o.solver.speed_gate_mps},
+          {"speed_gate_ratio", o.solver.speed_gate_ratio},
+          {"speed_gate_floor_mps", o.solver.speed_gate_floor_mps},
+          {"min_split_distance_m", o.solver.min_split_distance_m},
+          {"torso_length", torso_length_name(o.torso_length)},
+          {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
+          {"post_cutoff_hz", o.post_cutoff_hz},
+          {"anthropometry", o.anthropometry},
+          {"ground_level_m", o.ground_level_m ? nlohmann::json(*o.ground_level_m) : nlohmann::json("auto")},
+          {"ground_shift_m", o.contact.ground_shift_m},
+          {"grm_reference_m", {o.grm_reference_m.x(), o.grm_reference_m.y()}},
+          {"max_gap_frames", o.landmarks.max_gap_frames}};
+}
+
+const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, MarkerSet& custom, std::string* why) {
+  if (!a.markers.empty()) {
+    if (const auto* set = find_marker_set(a.markers)) return *set;
+    custom = load_marker_set(a.markers);
+    return custom;
+  }
+  std::string reason;
+  const auto* set = recognise_marker_set(trial.markers, &reason);
+  if (!set) {
+    std::string names;
+    for (const auto& s : builtin_marker_sets()) names += " " + s.name;
+    throw InputError(a.trial + ": marker set not recognised (presets:" + names +
+                     "). Give a mapping file (markers setting) with a rule for each landmark: shoulder, hip, knee_r, "
+                     "ankle_r, heel_r, mt_r, hallux_r and the same _l (see docs/MARKERSETS.md)");
+  }
+  if (why) *why = set->name + " (" + reason + ")";
+  return *set;
+}
+
+std::vector<std::string> input_files(const Settings& a) {
+  std::vector<std::string> in = {a.trial, a.static_trial, a.markers, a.cop_function};
+  if (a.running_cop != "builtin" && a.running_cop != "off") in.push_back(a.running_cop);
+  return in;
+}
+
+EstimateResult estimate_trial(const Settings& s, const Trial& trial, std::function<void(long, long)> progress) {
+  std::optional<Trial> st;
+  if (!s.static_trial.empty()) st = load_trial(s.static_trial);
+  MarkerSet custom;
+  std::string why;
+  const MarkerSet& set = resolve_marker_set(s, trial, custom, &why);
+  auto options = to_options(s);
+  options.progress = std::move(progress);
+  try {
+    auto r = estimate(trial, st ? &*st : nullptr, set, options);
+    if (!why.empty()) r.messages.insert(r.messages.begin(), "marker set recognised: " + why);
+    return r;
+  } catch (const InputError& e) {
+    // The readers' warnings travel in the result; when there is none, they go with the error.
+    std::string warnings;
+    for (const auto& w : trial.warnings) warnings += "\n  input: " + w;
+    if (st)
+      for (const auto& w : st->warnings) warnings += "\n  static trial: " + w;
+    if (warnings.empty()) throw;
+    throw InputError(std::string(e.what()) + warnings);
+  }
+}
+
+}  // namespace kin2grf

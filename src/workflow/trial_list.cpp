@@ -1,0 +1,50 @@
+#include "kin2grf/workflow/trial_list.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <fstream>
+
+#include "kin2grf/error.hpp"
+
+namespace kin2grf {
+
+TrialListEntry parse_trial_list_line(const std::string& line, const std::string& where) {
+  std::vector<std::string> fields;
+  std::size_t start = 0;
+  for (std::size_t bar; fields.size() < 3 && (bar = line.find('|', start)) != std::string::npos; start = bar + 1)
+    fields.push_back(line.substr(start, bar - start));
+  if (fields.size() < 2) throw InputError(where + ": expected activity|lab|name|TRIAL [options]");
+  TrialListEntry e;
+  e.activity = fields[0];
+  e.lab = fields[1];  // the old 3-field form: the name is the lab
+  e.name = fields.back();
+  for (const auto& f : fields)
+    if (f.empty()) throw InputError(where + ": an empty field in activity|lab|name");
+  CLI::App parser{"trial"};
+  add_settings_options(&parser, e.settings);
+  parser.add_option("--plates", e.plates);
+  try {
+    parser.parse(line.substr(start), false);
+  } catch (const CLI::ParseError& err) {
+    throw InputError(where + ": " + err.what());
+  }
+  return e;
+}
+
+std::vector<TrialListEntry> read_trial_list(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the trial list");
+  std::vector<TrialListEntry> out;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    out.push_back(parse_trial_list_line(line, path + ":" + std::to_string(number)));
+    out.back().line = number;
+  }
+  if (out.empty()) throw InputError(path + ": no trials in the list");
+  return out;
+}
+
+}  // namespace kin2grf
