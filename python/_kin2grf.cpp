@@ -1,0 +1,133 @@
+// kin2grf's Python binding (pybind11): the library's settings, estimate, validate and batch,
+// with numpy arrays and plain dicts. The Python package (python/kin2grf/__init__.py) turns
+// keyword arguments into the command line's settings and adds pandas and Dask on top.
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <CLI/CLI.hpp>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/text.hpp"
+#include "kin2grf/output/results.hpp"
+#include "kin2grf/validation/validate.hpp"
+#include "kin2grf/workflow/batch.hpp"
+#include "kin2grf/workflow/settings.hpp"
+#include "kin2grf/workflow/trial_list.hpp"
+
+namespace py = pybind11;
+
+namespace {
+
+/// JSON -> Python objects through the json module (one copy, no hand-written walker).
+py::object to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(kin2grf::json_text(j)); }
+
+kin2grf::Settings settings_from(const std::string& trial, const std::vector<std::string>& words) {
+  kin2grf::Settings s;
+  // The trial first (a path starting with '-' would read as an option: "./" keeps it a path).
+  std::vector<std::string> all = {!trial.empty() && trial[0] == '-' ? "./" + trial : trial};
+  all.insert(all.end(), words.begin(), words.end());
+  kin2grf::parse_settings(all, s, "settings");
+  return s;
+}
+
+py::dict estimate_dict(const kin2grf::Settings& s, const kin2grf::EstimateResult& r) {
+  const auto table = kin2grf::results_table(r);
+  py::dict d;
+  d["columns"] = table.columns;
+  d["values"] = table.values;
+  d["summary"] = to_python(kin2grf::results_summary(r, kin2grf::settings_json(s, kin2grf::to_options(s))));
+  d["messages"] = r.messages;
+  return d;
+}
+
+py::dict estimate(const std::string& trial, const std::vector<std::string>& words) {
+  const auto s = settings_from(trial, words);
+  kin2grf::EstimateResult r;
+  {
+    py::gil_scoped_release nogil;
+    const auto t = kin2grf::load_trial(s.trial);
+    r = kin2grf::estimate_trial(s, t);
+  }
+  return estimate_dict(s, r);
+}
+
+py::dict validate(const std::string& trial, const std::vector<std::string>& words, const std::string& plates,
+                  double threshold_N, const std::string& zero_offset) {
+  const auto s = settings_from(trial, words);
+  kin2grf::ValidationOptions vo;
+  if (!(std::isfinite(threshold_N) && threshold_N > 0))
+    throw kin2grf::InputError("threshold " + std::to_string(threshold_N) + ": must be a force above 0 N");
+  vo.threshold_N = threshold_N;
+  std::optional<kin2grf::EstimateResult> r;
+  std::optional<kin2grf::ValidationResult> v;
+  {
+    py::gil_scoped_release nogil;
+    const auto t = kin2grf::load_trial(s.trial, kin2grf::load_options(zero_offset));
+    std::optional<kin2grf::Trial> pf;
+    if (!plates.empty()) pf = kin2grf::load_trial(plates, kin2grf::load_options(zero_offset));
+    const kin2grf::Trial& source = pf ? *pf : t;
+    if (!source.plates || source.plates->plates.empty())
+      throw kin2grf::InputError(source.path + ": no force plates to validate against" + (pf ? "" : "; give plates=FILE"));
+    r = kin2grf::estimate_trial(s, t);
+    v = kin2grf::validate(*r, *source.plates, vo);
+  }
+  auto settings = kin2grf::settings_json(s, kin2grf::to_options(s));
+  settings["plates"] = plates;
+  settings["threshold_N"] = threshold_N;
+  settings["zero_offset"] = zero_offset;
+  py::dict d;
+  d["validation"] = to_python(kin2grf::validation_json(s.trial, *r, *v, settings));
+  d["estimate"] = estimate_dict(s, *r);
+  return d;
+}
+
+py::list batch_lines(const std::vector<std::string>& lines, int jobs, const std::string& out_dir) {
+  std::vector<kin2grf::TrialListEntry> entries;
+  for (std::size_t k = 0; k < lines.size(); ++k)
+    entries.push_back(kin2grf::parse_trial_list_line(lines[k], "trial " + std::to_string(k + 1)));
+  kin2grf::BatchOptions o;
+  o.jobs = jobs;
+  o.out_dir = out_dir;
+  std::vector<kin2grf::BatchRow> rows;
+  {
+    py::gil_scoped_release nogil;
+    rows = kin2grf::run_batch(entries, o);
+  }
+  py::list out;
+  for (const auto& r : rows) out.append(to_python(kin2grf::batch_row_json(r)));
+  return out;
+}
+
+/// The settings' names, defaults and help, from the command line's own parser.
+py::list settings_help() {
+  kin2grf::Settings s;
+  CLI::App app{"settings"};
+  kin2grf::add_settings_options(&app, s);
+  py::list out;
+  for (const auto* opt : app.get_options()) {
+    if (opt->get_lnames().empty() || opt->get_lnames().front() == "help") continue;
+    py::dict d;
+    d["name"] = opt->get_lnames().front();
+    d["flag"] = opt->get_items_expected_max() == 0;  // a flag takes no value
+    d["default"] = opt->get_default_str();
+    d["help"] = opt->get_description();
+    out.append(d);
+  }
+  return out;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_kin2grf, m) {
+  m.doc() = "kin2grf's C++ core (use the kin2grf package)";
+  m.attr("__version__") = KIN2GRF_VERSION;
+  // Bad input raises kin2grf.InputError (a ValueError) with the library's own message.
+  py::register_exception<kin2grf::InputError>(m, "InputError", PyExc_ValueError);
+  m.def("estimate", &estimate, py::arg("trial"), py::arg("words"));
+  m.def("validate", &validate, py::arg("trial"), py::arg("words"), py::arg("plates"), py::arg("threshold_N"),
+        py::arg("zero_offset"));
+  m.def("batch_lines", &batch_lines, py::arg("lines"), py::arg("jobs"), py::arg("out_dir"));
+  m.def("settings_help", &settings_help);
+}

@@ -1,0 +1,141 @@
+"""kin2grf: ground reaction forces, centre of pressure and joint torques from motion-capture
+markers alone (no force plates), as the command line computes them.
+
+    import kin2grf
+    r = kin2grf.estimate("walk.c3d", static="static.c3d", r=1000)
+    r.table          # per-frame results (pandas DataFrame when pandas is present, else a dict)
+    r.summary        # the --json summary as a dict
+    v = kin2grf.validate("walk.c3d")            # against the trial's plates
+    rows = kin2grf.batch("trials.txt", jobs=2)  # or client=dask.distributed.Client(...)
+
+Keyword arguments are the command line's settings with '_' for '-' (``speed_gate_ratio=1``,
+``paper=True``, ``grm_reference=(0, 0)``); their defaults are the command line's
+(``kin2grf.settings()`` lists them). Bad input raises ``kin2grf.InputError`` (a ValueError) with
+the command line's message.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Iterable
+
+import numpy as np
+
+from . import _kin2grf
+from ._kin2grf import InputError
+
+__version__ = _kin2grf.__version__
+__all__ = ["estimate", "validate", "batch", "settings", "read_trial_list", "Estimate", "InputError", "__version__"]
+
+
+def settings() -> list[dict]:
+    """The settings estimate() and validate() take: name, whether it is a flag, default, help."""
+    return [dict(d, name=d["name"].replace("-", "_")) for d in _kin2grf.settings_help()]
+
+
+_NAMES = None
+
+
+def _words(kwargs: dict) -> list[str]:
+    """Keyword arguments -> the command line's words, refusing unknown names as Python does."""
+    global _NAMES
+    if _NAMES is None:
+        _NAMES = {d["name"]: d["flag"] for d in settings()}
+    words: list[str] = []
+    for key, value in kwargs.items():
+        if key not in _NAMES:
+            raise TypeError(f"unexpected keyword argument '{key}' (kin2grf.settings() lists the settings)")
+        flag = "--" + key.replace("_", "-")
+        if value is None or value is False:
+            continue
+        if _NAMES[key]:
+            if value is not True:
+                raise TypeError(f"'{key}' is a flag: give True or False")
+            words.append(flag)
+        elif isinstance(value, (list, tuple, np.ndarray)):
+            words += [flag, *(_text(v) for v in value)]
+        else:
+            words += [flag, _text(value)]
+    return words
+
+
+def _text(v: Any) -> str:
+    if isinstance(v, (float, np.floating)):
+        return repr(float(v))  # shortest text that reads back to the same double
+    return os.fspath(v) if isinstance(v, os.PathLike) else str(v)
+
+
+def _table(columns: list[str], values: np.ndarray):
+    try:
+        import pandas as pd
+    except ImportError:
+        return {c: values[:, k] for k, c in enumerate(columns)}
+    return pd.DataFrame(values, columns=columns)
+
+
+class Estimate:
+    """One trial's estimate.
+
+    columns, values: the per-frame table of ``kin2grf estimate --csv`` (same columns; full
+    precision; NaN where the CSV has an empty cell). table: that as a pandas DataFrame (a dict
+    of arrays without pandas). summary: the ``--json`` document. messages: what the method noted.
+    """
+
+    def __init__(self, d: dict):
+        self.columns: list[str] = list(d["columns"])
+        self.values: np.ndarray = np.asarray(d["values"])
+        self.summary: dict = d["summary"]
+        self.messages: list[str] = list(d["messages"])
+
+    @property
+    def table(self):
+        return _table(self.columns, self.values)
+
+    def __getitem__(self, column: str) -> np.ndarray:
+        return self.values[:, self.columns.index(column)]
+
+    def __repr__(self) -> str:
+        return f"<kin2grf.Estimate {self.values.shape[0]} frames, mass {self.summary.get('mass_kg')} kg>"
+
+
+def estimate(trial: str | os.PathLike, **settings) -> Estimate:
+    """Estimate GRF, COP, GRM and joint torques of `trial` (C3D or TRC), as `kin2grf estimate`."""
+    return Estimate(_kin2grf.estimate(os.fspath(trial), _words(settings)))
+
+
+def validate(trial: str | os.PathLike, plates: str | os.PathLike | None = None, threshold: float = 20.0,
+             zero_offset: str = "unloaded", **settings) -> dict:
+    """Estimate, then compare with the trial's plates (or `plates`, a GRF .mot or C3D), as
+    `kin2grf validate`. Returns the ``--json`` document, with the estimate under "estimate"."""
+    d = _kin2grf.validate(os.fspath(trial), _words(settings), os.fspath(plates) if plates else "", float(threshold), zero_offset)
+    out = d["validation"]
+    out["estimate"] = Estimate(d["estimate"])
+    return out
+
+
+def read_trial_list(path: str | os.PathLike) -> list[str]:
+    """The trial lines of a trial-list file ('activity|lab|name|TRIAL [settings] [--plates F]')."""
+    with open(path, encoding="utf-8") as f:
+        return [line.rstrip("\n") for line in f if line.strip() and not line.startswith("#")]
+
+
+def _batch_one(line: str, out_dir: str) -> dict:
+    return _kin2grf.batch_lines([line], 1, out_dir)[0]
+
+
+def batch(trials: str | os.PathLike | Iterable[str], jobs: int | None = None, client=None, out_dir: str = ""):
+    """Run every trial (a trial-list file or its lines), as `kin2grf batch`: estimated, validated
+    where it has plates, past failures (a row's "error"). Locally on `jobs` threads (default:
+    every core), or on a dask.distributed `client`'s workers, one task per trial. Rows in the
+    list's order: a pandas DataFrame when pandas is present, else a list of dicts."""
+    lines = read_trial_list(trials) if isinstance(trials, (str, os.PathLike)) else list(trials)
+    if client is None:
+        rows = _kin2grf.batch_lines(lines, int(jobs or os.cpu_count() or 1), out_dir)
+    else:
+        futures = client.map(_batch_one, lines, out_dir=out_dir, pure=False)
+        rows = client.gather(futures)
+    try:
+        import pandas as pd
+    except ImportError:
+        return rows
+    return pd.DataFrame(rows)

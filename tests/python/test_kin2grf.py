@@ -1,0 +1,136 @@
+"""The Python module (issue 12): the same numbers as the command line, the same errors, and
+batches that give the same rows locally and on a Dask cluster."""
+
+import csv
+import math
+import os
+import subprocess
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import kin2grf
+
+CLI = os.environ.get("KIN2GRF_CLI", "kin2grf")
+DATA = Path(os.environ.get("KIN2GRF_DATA_DIR", Path(__file__).resolve().parents[2] / ".." / "shared" / "data"))
+
+
+@pytest.fixture(scope="module")
+def example(tmp_path_factory):
+    d = tmp_path_factory.mktemp("example")
+    subprocess.run([CLI, "make-example", "--out-dir", str(d)], check=True, capture_output=True)
+    return d
+
+
+def cli_csv(trial, *args, tmp):
+    out = Path(tmp) / "cli.csv"
+    subprocess.run([CLI, "estimate", str(trial), *args, "--csv", str(out)], check=True, capture_output=True)
+    with open(out, newline="") as f:
+        return list(csv.reader(f))
+
+
+def formatted(column, x):
+    """A value as the CLI's CSV writes it: counts as integers, the rest %.6g, NaN empty."""
+    if column == "frame" or column.startswith("contact_") or column == "iterations":
+        return str(int(x))
+    return "" if not math.isfinite(x) else "%.6g" % x
+
+
+def assert_same_as_cli(r, rows):
+    assert r.columns == rows[0]
+    assert r.values.shape == (len(rows) - 1, len(rows[0]))
+    for i, row in enumerate(rows[1:]):
+        for k, cell in enumerate(row):
+            assert formatted(r.columns[k], r.values[i, k]) == cell, (i, r.columns[k])
+    # And numerically: the CSV is the module's values to 6 significant digits.
+    csv_values = np.array([[float(c) if c else np.nan for c in row] for row in rows[1:]])
+    np.testing.assert_allclose(r.values, csv_values, rtol=1e-5, atol=1e-9, equal_nan=True)
+
+
+def test_estimate_equals_the_cli_csv_on_the_example(example, tmp_path):
+    trial = example / "example_walk.c3d"
+    assert_same_as_cli(kin2grf.estimate(trial), cli_csv(trial, tmp=tmp_path))
+    # Settings by keyword, the same as the flags.
+    r = kin2grf.estimate(trial, paper=True, r=2000.0, grm_reference=(1.0, 0.0), post_cutoff=10)
+    assert_same_as_cli(r, cli_csv(trial, "--paper", "--r", "2000", "--grm-reference", "1", "0", "--post-cutoff", "10", tmp=tmp_path))
+    assert r.summary["settings"]["r_N_per_m"] == 2000.0
+    assert r.summary["settings"]["paper_configuration"] is True
+
+
+def test_estimate_equals_the_cli_csv_on_a_shared_trial(tmp_path):
+    trial = DATA / "opensim_c3d_overground_walk" / "walking2.c3d"
+    if not trial.exists():
+        pytest.skip(f"shared recordings not found at {DATA} (set KIN2GRF_DATA_DIR)")
+    assert_same_as_cli(kin2grf.estimate(trial, mass=64.9), cli_csv(trial, "--mass", "64.9", tmp=tmp_path))
+
+
+def test_table_and_columns(example):
+    r = kin2grf.estimate(example / "example_walk.c3d")
+    assert r["grf_vertical_r_N"].shape == (r.values.shape[0],)
+    t = r.table
+    try:
+        import pandas  # noqa: F401
+        assert list(t.columns) == r.columns
+    except ImportError:
+        assert set(t) == set(r.columns)
+    assert r.summary["mass_kg"] == 70.0
+
+
+def test_validate_compares_the_example_plates(example):
+    v = kin2grf.validate(example / "example_walk.c3d")
+    assert v["mean_rrmse_percent"]["all"]["stances"] == 2
+    assert isinstance(v["estimate"], kin2grf.Estimate)
+    with pytest.raises(kin2grf.InputError, match="no force plates"):
+        kin2grf.validate(example / "example_walk.trc", mass=70)
+
+
+def test_errors_carry_the_cli_messages(example, tmp_path):
+    with pytest.raises(kin2grf.InputError, match="no-such.c3d"):
+        kin2grf.estimate(tmp_path / "no-such.c3d")
+    with pytest.raises(ValueError, match="activation parameter r"):
+        kin2grf.estimate(example / "example_walk.c3d", r=-1)
+    with pytest.raises(kin2grf.InputError, match="foot-model"):
+        kin2grf.estimate(example / "example_walk.c3d", foot_model="no-such-model")
+    with pytest.raises(TypeError, match="no_such_setting"):
+        kin2grf.estimate(example / "example_walk.c3d", no_such_setting=1)
+    names = {s["name"] for s in kin2grf.settings()}
+    assert {"static", "markers", "mass", "r", "speed_gate_ratio", "paper", "grm_reference"} <= names
+
+
+def batch_lines(example, tmp):
+    return [
+        f"walking|own|walk|{example / 'example_walk.c3d'}",
+        f"walking|own|missing|{Path(tmp) / 'no-such.trc'} --mass 70",
+        f"squat|own|squat|{example / 'example_squat.trc'} --mass 70",
+    ]
+
+
+def without_timing(rows):
+    """Rows without the wall time, NaN as None (NaN is not equal to itself)."""
+    def plain(v):
+        return None if isinstance(v, float) and math.isnan(v) else v
+    return [{k: plain(v) for k, v in r.items() if k != "seconds"} for r in rows]
+
+
+def test_batch_locally_and_on_a_dask_cluster(example, tmp_path):
+    pd = pytest.importorskip("pandas")
+    lines = batch_lines(example, tmp_path)
+    local = kin2grf.batch(lines, jobs=2)
+    assert list(local["name"]) == ["walk", "missing", "squat"]
+    assert list(local["ok"]) == [True, False, True]
+    assert "no-such.trc" in local["error"][1]
+    assert local["stances"][0] == 2
+    # The file form of the list gives the same rows.
+    listing = tmp_path / "list.txt"
+    listing.write_text("# a comment\n" + "\n".join(lines) + "\n")
+    one = kin2grf.batch(listing, jobs=1)
+    assert without_timing(one.to_dict("records")) == without_timing(local.to_dict("records"))
+
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  silence_logs=40) as cluster, distributed.Client(cluster) as client:
+        remote = kin2grf.batch(lines, client=client)
+    assert isinstance(remote, pd.DataFrame)
+    assert without_timing(remote.to_dict("records")) == without_timing(local.to_dict("records"))
