@@ -7,21 +7,28 @@
 
 namespace kin2grf {
 
-Trial make_synthetic_trial(const SyntheticOptions& o) {
+Trial example_trial_frame(const std::string& path, double duration_s, double rate_hz, double mass_kg) {
   Trial t;
-  t.path = "synthetic";
+  t.path = path;
   t.format = "C3D";
-  t.body_mass_kg = o.mass_kg;
+  t.body_mass_kg = mass_kg;
   auto& m = t.markers;
-  m.rate_hz = o.rate_hz;
-  const int n = static_cast<int>(std::lround(o.duration_s * o.rate_hz));
-  m.time_s = Eigen::VectorXd::LinSpaced(n, 0.0, (n - 1) / o.rate_hz);
+  m.rate_hz = rate_hz;
+  const int n = static_cast<int>(std::lround(duration_s * rate_hz));
+  m.time_s = Eigen::VectorXd::LinSpaced(n, 0.0, (n - 1) / rate_hz);
   m.up_axis = Axis::Z;
   const char* names[] = {"SHO", "HJC", "KJC", "AJC", "HEE", "MT1", "HLX"};
   for (const char* side : {"R", "L"})
     for (const char* nm : names) m.names.push_back(std::string(side) + nm);
   m.descriptions.assign(m.names.size(), "");
   m.positions_m.assign(m.names.size(), Eigen::MatrixX3d(n, 3));
+  return t;
+}
+
+Trial make_synthetic_trial(const SyntheticOptions& o) {
+  Trial t = example_trial_frame("synthetic", o.duration_s, o.rate_hz, o.mass_kg);
+  auto& m = t.markers;
+  const auto n = static_cast<int>(m.frames());
   const double Lsh = 0.43, Lth = 0.44, Lt = 0.55;
   for (int i = 0; i < n; ++i) {
     const double time = m.time_s[i];

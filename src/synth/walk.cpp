@@ -89,20 +89,9 @@ SyntheticWalk make_synthetic_walk(const SyntheticWalkOptions& o) {
         o.duration_s <= 600 && o.rate_hz >= 50 && o.rate_hz <= 1000))
     throw InputError("synthetic walk: speed 0.2-2.5 m/s, stride time 0.6-2.5 s, at least two strides, 50-1000 Hz");
   SyntheticWalk w;
-  Trial& t = w.trial;
-  t.path = "synthetic walk";
-  t.format = "C3D";
-  t.body_mass_kg = o.mass_kg;
-  auto& m = t.markers;
-  m.rate_hz = o.rate_hz;
-  const int n = static_cast<int>(std::lround(o.duration_s * o.rate_hz));
-  m.time_s = Eigen::VectorXd::LinSpaced(n, 0.0, (n - 1) / o.rate_hz);
-  m.up_axis = Axis::Z;
-  const char* names[] = {"SHO", "HJC", "KJC", "AJC", "HEE", "MT1", "HLX"};
-  for (const char* side : {"R", "L"})
-    for (const char* nm : names) m.names.push_back(std::string(side) + nm);
-  m.descriptions.assign(m.names.size(), "");
-  m.positions_m.assign(m.names.size(), Eigen::MatrixX3d(n, 3));
+  w.trial = example_trial_frame("synthetic walk", o.duration_s, o.rate_hz, o.mass_kg);
+  auto& m = w.trial.markers;
+  const auto n = static_cast<int>(m.frames());
   const double Lsh = 0.43, Lth = 0.44, Lt = 0.55, T = o.stride_time_s, v = o.speed_mps;
   // The right foot's first heel strike puts its ankle under the hip at mid-stance.
   const double first_heel_x = 0.3 * v * T - kAnkle.x();

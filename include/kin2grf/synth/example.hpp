@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "kin2grf/io/trial.hpp"
@@ -22,6 +23,10 @@ struct SyntheticOptions {
   /// the right foot; the left foot clears the floor by L (1 - cos a)).
   double left_leg_raised_rad = 0.0;
 };
+
+/// A trial with the kin2grf-example markers (R/L SHO, HJC, KJC, AJC, HEE, MT1, HLX), Z up, their
+/// positions to be filled (uninitialised).
+Trial example_trial_frame(const std::string& path, double duration_s, double rate_hz, double mass_kg);
 
 /// Markers only (plates are added by the caller from the model's own estimate).
 Trial make_synthetic_trial(const SyntheticOptions& options);
