@@ -115,7 +115,20 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     if (flat[s] < 3) r.messages.push_back(std::string(s ? "left" : "right") + " foot: only " + std::to_string(flat[s]) +
                                           " foot-flat frames for the contact calibration");
 
-  ModelMotion motion = compute_motion(r.model, lm, o.kinematic_cutoff_hz, o.torso_length);
+  // The kinematic cut-off: the user's (6 Hz), lowered where the markers' own noise needs it
+  // (Winter's residual analysis on the landmarks, noise_limited_cutoff).
+  r.kinematic_cutoff_hz = o.kinematic_cutoff_hz;
+  if (o.cutoff_from_noise) {
+    const double fc = noise_limited_cutoff(lm, o.kinematic_cutoff_hz);
+    if (fc < o.kinematic_cutoff_hz) {
+      r.kinematic_cutoff_hz = fc;
+      char b[200];
+      std::snprintf(b, sizeof b, "kinematic cut-off lowered from %.1f to %.2f Hz: the markers' noise (residual analysis)",
+                    o.kinematic_cutoff_hz, fc);
+      r.messages.emplace_back(b);
+    }
+  }
+  ModelMotion motion = compute_motion(r.model, lm, r.kinematic_cutoff_hz, o.torso_length);
   ContactModelOptions co = o.contact;
   co.ground_level_m = r.ground_level_m;
   std::vector<bool> running;

@@ -25,6 +25,9 @@ struct EstimateOptions {
   std::string anthropometry = "de-leva";  ///< kin2grf's default; the paper cites Winter (--paper)
   double kinematic_cutoff_hz = 6.0;        ///< paper: 6 Hz
   double post_cutoff_hz = 12.0;            ///< paper: 12 Hz
+  /// Lower the kinematic cut-off to what the markers' noise allows (noise_limited_cutoff; kin2grf)
+  /// or keep it fixed (the paper).
+  bool cutoff_from_noise = true;
   /// The torso's hip-shoulder length: measured per frame (kin2grf) or fixed (the paper).
   TorsoLength torso_length = TorsoLength::Measured;
   std::optional<double> ground_level_m;    ///< else estimate_ground_level
@@ -58,6 +61,7 @@ struct EstimateResult {
   /// belt's speed.
   double progression_speed_mps = 0.0;
   double speed_gate_mps = 0.0;     ///< the contact speed gate used (0: none)
+  double kinematic_cutoff_hz = 0.0;  ///< the kinematic cut-off used (EstimateOptions::cutoff_from_noise)
   Model model;
   Eigen::VectorXd time_s;
   Eigen::Index first_index = 0;    ///< first processed frame's index in the trial

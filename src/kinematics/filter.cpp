@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 #include <stdexcept>
 
 namespace kin2grf {
@@ -94,6 +96,49 @@ Eigen::MatrixXd second_difference(const Eigen::MatrixXd& x, double dt) {
   d.row(0) = d.row(1);
   d.row(n - 1) = d.row(n - 2);
   return d;
+}
+
+}  // namespace kin2grf
+
+namespace kin2grf {
+
+double residual_analysis_cutoff(const Eigen::MatrixXd& x, double rate_hz, double upper_hz) {
+  // At most a minute of frames: the noise of a recording does not change along it.
+  const Eigen::Index n = std::min<Eigen::Index>(x.rows(), static_cast<Eigen::Index>(60 * rate_hz));
+  const double nyq = 0.5 * rate_hz;
+  const double f_lo = 0.5 * nyq, f_hi = 0.8 * nyq;  // where the residual is mostly noise
+  if (n < 20 || x.cols() == 0 || !(upper_hz > 0.5 && upper_hz < f_lo)) return upper_hz;
+  std::vector<double> choice;  // per column; +inf: above upper_hz
+  for (Eigen::Index c = 0; c < x.cols(); ++c) {
+    const Eigen::VectorXd col = x.col(c).head(n);
+    auto residual = [&](double f) { return std::sqrt((col - butterworth_filtfilt(col, rate_hz, f)).squaredNorm() / static_cast<double>(n)); };
+    // The noise line R = a + b f, least squares on 8 points of the noise region.
+    constexpr int m = 8;
+    double sf = 0, sr = 0, sff = 0, sfr = 0;
+    for (int k = 0; k < m; ++k) {
+      const double f = f_lo + (f_hi - f_lo) * k / (m - 1), r = residual(f);
+      sf += f, sr += r, sff += f * f, sfr += f * r;
+    }
+    const double b = (m * sfr - sf * sr) / (m * sff - sf * sf), a = (sr - b * sf) / m;
+    // R falls as f rises: the lowest f with R(f) <= a, by bisection, only when it is below
+    // upper_hz (most clean recordings stop at this one test).
+    if (!(a > 0) || residual(upper_hz) > a) {
+      choice.push_back(std::numeric_limits<double>::infinity());
+      continue;
+    }
+    double lo = 0.5, hi = upper_hz;
+    if (residual(lo) <= a) {
+      choice.push_back(lo);
+      continue;
+    }
+    for (int it = 0; it < 16; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (residual(mid) > a ? lo : hi) = mid;
+    }
+    choice.push_back(hi);
+  }
+  std::nth_element(choice.begin(), choice.begin() + static_cast<long>(choice.size() / 2), choice.end());
+  return std::min(upper_hz, choice[choice.size() / 2]);
 }
 
 }  // namespace kin2grf

@@ -161,4 +161,10 @@ ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, doub
   return reconstruct_motion(model, x, xd, xdd, lm.rate_hz, lm.time_s);
 }
 
+double noise_limited_cutoff(const SagittalLandmarks& lm, double upper_hz) {
+  Eigen::MatrixXd xy(lm.frames(), 2 * kLandmarkCount);
+  for (int k = 0; k < kLandmarkCount; ++k) xy.middleCols(2 * k, 2) = lm.p[static_cast<std::size_t>(k)];
+  return residual_analysis_cutoff(xy, lm.rate_hz, upper_hz);
+}
+
 }  // namespace kin2grf

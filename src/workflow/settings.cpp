@@ -27,6 +27,9 @@ void add_settings_options(CLI::App* c, Settings& a) {
        "--r", [&a](double v) { a.r = v, a.r_given = true; },
        "Activation parameter r, N/m (Eq. 8); default 1000 (from `kin2grf study r`), 10000 with --paper");
   c->add_option("--kinematic-cutoff", a.kinematic_cutoff, "Kinematics low-pass cut-off, Hz")->capture_default_str();
+  c->add_option("--kinematic-cutoff-rule", a.kinematic_cutoff_rule,
+                "noise: --kinematic-cutoff lowered where the markers' noise needs it (residual analysis); fixed: as given (--paper)")
+      ->check(CLI::IsMember({"noise", "fixed"}))->capture_default_str();
   c->add_option("--post-cutoff", a.post_cutoff, "Multiplier post-filter cut-off, Hz")->capture_default_str();
   c->add_option("--ground-level", a.ground_level, "Floor height in the lab's up axis, m (default: estimated)");
   c->add_option("--grm-reference", a.grm_reference,
@@ -98,6 +101,7 @@ EstimateOptions to_options(const Settings& a) {
   o.anthropometry = (a.paper && !a.anthropometry_given) ? "winter" : a.anthropometry;
   o.kinematic_cutoff_hz = a.kinematic_cutoff;
   o.post_cutoff_hz = a.post_cutoff;
+  o.cutoff_from_noise = !a.paper && a.kinematic_cutoff_rule == "noise";
   o.ground_level_m = a.ground_level;
   o.contact.foot_model = a.foot_model == "cop" ? FootModel::Cop : FootModel::ThreePoint;
   o.contact.ground_shift_m = a.ground_shift;
@@ -143,6 +147,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"min_split_distance_m", o.solver.min_split_distance_m},
           {"torso_length", torso_length_name(o.torso_length)},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
+          {"kinematic_cutoff_rule", o.cutoff_from_noise ? "noise" : "fixed"},
           {"post_cutoff_hz", o.post_cutoff_hz},
           {"anthropometry", o.anthropometry},
           {"ground_level_m", o.ground_level_m ? nlohmann::json(*o.ground_level_m) : nlohmann::json("auto")},

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
 
 namespace kin2grf {
 
@@ -26,4 +27,12 @@ Eigen::MatrixXd central_difference(const Eigen::MatrixXd& x, double dt_s);
 /// Second derivative (x[i+1] - 2 x[i] + x[i-1]) / dt^2 (ends copied from their neighbours).
 Eigen::MatrixXd second_difference(const Eigen::MatrixXd& x, double dt_s);
 
+/// Winter's residual analysis (Winter 2009, Biomechanics and Motor Control of Human Movement,
+/// Sect. 3.4.4.3), bounded above: per column, the residual RMS R(f) of (x - filtered at f) falls
+/// as f rises and, at high frequencies (50-80 % of Nyquist), is mostly noise, a straight line
+/// a + b f; the column's cut-off is the lowest f with R(f) <= a, where the signal left in the
+/// residual equals the noise let through. Returns min(upper_hz, the median over the columns).
+/// Clean (lab-smoothed) markers give cut-offs far above 6 Hz; 2 mm of white noise at 60-100 Hz,
+/// 3-4 Hz.
+double residual_analysis_cutoff(const Eigen::MatrixXd& x, double rate_hz, double upper_hz);
 }  // namespace kin2grf

@@ -34,6 +34,12 @@ struct SagittalLandmarks {
   [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
 };
 
+/// The kinematic cut-off the landmarks' noise allows: residual_analysis_cutoff over the x and y of
+/// every landmark, at most `upper_hz` (the paper's 6 Hz). Double differentiation multiplies noise
+/// by (2 pi f)^2: where the markers are noisy, a lower cut-off keeps the accelerations, and with
+/// them the forces, from carrying it.
+double noise_limited_cutoff(const SagittalLandmarks& lm, double upper_hz);
+
 /// Medians over the frames of the landmark distances (fixed-length model) and of the heel's
 /// place in the foot frame.
 BodyGeometry measure_geometry(const SagittalLandmarks& lm);

@@ -26,7 +26,8 @@ struct Settings {
   std::optional<double> mass;
   bool force_mass = false;
   std::string foot_model = "cop", norm = "torque-scaled", anthropometry = EstimateOptions{}.anthropometry, up_axis,
-              cop_function, running_cop = "builtin", torso_length = "measured";
+              cop_function, running_cop = "builtin", torso_length = "measured",
+              kinematic_cutoff_rule = "noise";
   double r = SolverOptions{}.r_N_per_m, kinematic_cutoff = EstimateOptions{}.kinematic_cutoff_hz,
          post_cutoff = EstimateOptions{}.post_cutoff_hz, ground_shift = 0, speed_gate = SolverOptions{}.speed_gate_mps,
          split_distance = SolverOptions{}.min_split_distance_m, speed_gate_ratio = SolverOptions{}.speed_gate_ratio,
