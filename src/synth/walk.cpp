@@ -1,13 +1,14 @@
 // A synthetic level walk of the project's own making: the bundled example's gait and the tests'.
 //
 // Kinematics (x forward, y up, m; both legs share the sagittal plane, laterally 0.1 m apart):
-// - Hips move forward at the walking speed v; their height is highest at each mid-stance
+// - Hips move forward at the walking speed v, slowest and highest at each mid-stance
 //   (h0 + A cos(4 pi (t/T - 0.3))), as the body vaults over the stance leg.
 // - Each foot is a rigid body whose stance follows the three rockers: heel rocker about the heel's
 //   ground point from phi_hs (toes up) to flat over 8 % of the cycle, flat to 35 %, then the
-//   forefoot rocker about the MT ground point to -phi_to at toe-off (60 %: 10 % double supports).
-//   The swing carries the foot from its toe-off pose to the next heel strike one stride ahead,
-//   by a minimum-jerk path with a heel lift of `clearance_m`.
+//   forefoot rocker about the MT ground point to -phi_to at toe-off (60 %: 10 % double supports),
+//   speeding up so that the foot leaves the ground rotating. The swing carries the foot from its
+//   toe-off pose and velocity to rest at the next heel strike one stride ahead (minimum jerk plus
+//   a quintic term for the initial velocity), with a heel lift of `clearance_m`.
 // - Knees from the two-link inverse kinematics of hip and ankle (knee forward); the torso leans
 //   forward by 0.05 rad over the hips.
 // Ground reactions ("measured"): the model's own totals from these kinematics (sum m (a + g) and
@@ -61,7 +62,10 @@ FootPose stance_pose(double heel_x, double p, const SyntheticWalkOptions& o) {
   } else if (p < kFlatEnd) {
     f.heel_ground = {heel_x, 0.0};
   } else {
-    f.phi = -o.toe_off_angle_rad * smoothstep((p - kFlatEnd) / (kStanceEnd - kFlatEnd));
+    // Heel rise speeding up to toe-off: the foot leaves the ground rotating (about 5 rad/s), as
+    // a push-off does, not at rest.
+    const double u = (p - kFlatEnd) / (kStanceEnd - kFlatEnd);
+    f.phi = -o.toe_off_angle_rad * u * u;
     const Eigen::Vector2d pivot(heel_x + kMtGround.x(), 0.0);
     f.heel_ground = pivot + rotated(-kMtGround, f.phi);
   }
@@ -73,11 +77,16 @@ FootPose foot_pose(double cycles, double first_heel_x, const SyntheticWalkOption
   const double k = std::floor(cycles), p = cycles - k;
   const double heel_x = first_heel_x + k * stride;
   if (p < kStanceEnd) return stance_pose(heel_x, p, o);
-  const FootPose off = stance_pose(heel_x, kStanceEnd - 1e-12, o), on = stance_pose(heel_x + stride, 0.0, o);
+  const double h = 1e-6;
+  const FootPose off = stance_pose(heel_x, kStanceEnd - 1e-12, o), before = stance_pose(heel_x, kStanceEnd - h, o),
+                 on = stance_pose(heel_x + stride, 0.0, o);
   const double u = (p - kStanceEnd) / (1 - kStanceEnd), s = smoothstep(u);
+  // The swing starts with the foot's toe-off velocity (the quintic Hermite term of the initial
+  // velocity: zero at both ends, slope 1 at the start) and ends at rest.
+  const double carry = (1 - kStanceEnd) / h * (u - 6 * std::pow(u, 3) + 8 * std::pow(u, 4) - 3 * std::pow(u, 5));
   FootPose f;
-  f.phi = off.phi + (on.phi - off.phi) * s;
-  f.heel_ground = off.heel_ground + (on.heel_ground - off.heel_ground) * s;
+  f.phi = off.phi + (on.phi - off.phi) * s + (off.phi - before.phi) * carry;
+  f.heel_ground = off.heel_ground + (on.heel_ground - off.heel_ground) * s + (off.heel_ground - before.heel_ground) * carry;
   f.heel_ground.y() += o.clearance_m * std::pow(std::sin(M_PI * u), 2);
   return f;
 }
