@@ -4,6 +4,10 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <stdexcept>
+
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCore>
 
 namespace kin2grf {
 
@@ -18,7 +22,7 @@ constexpr int kRigidRows = 40, kDefRows = 40, kRheoRows = 48;
 }  // namespace
 
 ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
-    : model_(model), options_(options) {
+    : model_(model), options_(options), Phi_(kBilateralCount, coord::kCount) {
   mass_ = model.mass_diagonal();
   gravity_ = model.gravity_force();
   weight_bilateral_ = Eigen::VectorXd::Ones(kBilateralCount);
@@ -28,12 +32,84 @@ ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
     weight_bilateral_.tail(4).setZero();
   }
   // The sparsity pattern does not depend on q: take it from a generic configuration (no
-  // coordinate zero, so no structural entry vanishes) and order the columns once.
+  // coordinate zero, so no structural entry vanishes).
   Eigen::VectorXd generic(coord::kCount);
   for (int i = 0; i < coord::kCount; ++i) generic[i] = 0.37 + 0.113 * i;
-  B_ = bilateral_jacobian(generic).transpose().sparseView();
-  B_.makeCompressed();
-  qr_.analyzePattern(B_);
+  const Eigen::MatrixXd Phi = bilateral_jacobian(generic);
+  phi_column_start_.assign(coord::kCount + 1, 0);
+  for (int c = 0; c < coord::kCount; ++c) {
+    phi_column_start_[static_cast<std::size_t>(c)] = static_cast<int>(phi_entries_.size());
+    for (int r = 0; r < kBilateralCount; ++r)
+      if (Phi(r, c) != 0.0) phi_entries_.push_back({r, c});
+  }
+  phi_column_start_[coord::kCount] = static_cast<int>(phi_entries_.size());
+  // N's pattern, an AMD order of it, and the factor's fill (symbolic elimination).
+  const Eigen::MatrixXd Npattern = (Phi.cwiseAbs() * Phi.cwiseAbs().transpose()).unaryExpr([](double v) { return v != 0.0 ? 1.0 : 0.0; });
+  Eigen::SparseMatrix<double> Nsparse = Npattern.sparseView();
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
+  Eigen::AMDOrdering<int>()(Nsparse, perm);  // perm: new place -> old row (Eigen's P^-1)
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse = perm.inverse();
+  for (int r = 0; r < kBilateralCount; ++r) order_[static_cast<std::size_t>(r)] = inverse.indices()[r];
+  Eigen::Matrix<bool, kBilateralCount, kBilateralCount> fill;
+  fill.setConstant(false);
+  for (int a = 0; a < kBilateralCount; ++a)
+    for (int b = 0; b < kBilateralCount; ++b)
+      if (Npattern(a, b) != 0.0) fill(order_[static_cast<std::size_t>(a)], order_[static_cast<std::size_t>(b)]) = true;
+  for (int k = 0; k < kBilateralCount; ++k)
+    for (int i = k + 1; i < kBilateralCount; ++i)
+      if (fill(i, k))
+        for (int j = k + 1; j <= i; ++j)
+          if (fill(j, k)) fill(i, j) = fill(j, i) = true;
+  factor_row_start_.assign(kBilateralCount + 1, 0);
+  for (int i = 0; i < kBilateralCount; ++i) {
+    factor_row_start_[static_cast<std::size_t>(i)] = static_cast<int>(factor_row_.size());
+    for (int k = 0; k < i; ++k)
+      if (fill(i, k)) factor_row_.push_back(k);
+  }
+  factor_row_start_[kBilateralCount] = static_cast<int>(factor_row_.size());
+  L_.setZero();
+  D_.setZero();
+}
+
+bool ContactSolver::factorise_normal_equations() {
+  // N = Phi Phi^T on its pattern, permuted, lower triangle: sum over each coordinate's entries.
+  for (int i = 0; i < kBilateralCount; ++i) {
+    L_(i, i) = 0.0;
+    for (int p = factor_row_start_[static_cast<std::size_t>(i)]; p < factor_row_start_[static_cast<std::size_t>(i) + 1]; ++p)
+      L_(i, factor_row_[static_cast<std::size_t>(p)]) = 0.0;
+  }
+  for (int c = 0; c < coord::kCount; ++c) {
+    const int b0 = phi_column_start_[static_cast<std::size_t>(c)], b1 = phi_column_start_[static_cast<std::size_t>(c) + 1];
+    for (int a = b0; a < b1; ++a)
+      for (int b = b0; b <= a; ++b) {
+        const int ra = phi_entries_[static_cast<std::size_t>(a)][0], rb = phi_entries_[static_cast<std::size_t>(b)][0];
+        const int i = order_[static_cast<std::size_t>(ra)], j = order_[static_cast<std::size_t>(rb)];
+        L_(std::max(i, j), std::min(i, j)) += Phi_(ra, c) * Phi_(rb, c);
+      }
+  }
+  // L D L^T, row by row (up-looking): L(i, k) = (N(i, k) - sum_m L(i, m) L(k, m) D(m)) / D(k).
+  double largest = 0.0;
+  for (int i = 0; i < kBilateralCount; ++i) {
+    const int p0 = factor_row_start_[static_cast<std::size_t>(i)], p1 = factor_row_start_[static_cast<std::size_t>(i) + 1];
+    for (int p = p0; p < p1; ++p) {
+      const int k = factor_row_[static_cast<std::size_t>(p)];
+      double v = L_(i, k);
+      for (int q = factor_row_start_[static_cast<std::size_t>(k)]; q < factor_row_start_[static_cast<std::size_t>(k) + 1]; ++q) {
+        const int m = factor_row_[static_cast<std::size_t>(q)];
+        v -= L_(i, m) * L_(k, m) * D_[m];
+      }
+      L_(i, k) = v / D_[k];
+    }
+    double d = L_(i, i);
+    for (int p = p0; p < p1; ++p) {
+      const int k = factor_row_[static_cast<std::size_t>(p)];
+      d -= L_(i, k) * L_(i, k) * D_[k];
+    }
+    largest = std::max(largest, d);
+    if (!(d > 1e-10 * largest)) return false;  // a vanishing pivot: degenerate geometry
+    D_[i] = d;
+  }
+  return true;
 }
 
 Eigen::MatrixXd ContactSolver::bilateral_jacobian(const Eigen::VectorXd& q) const {
@@ -76,48 +152,67 @@ void ContactSolver::fill_bilateral_jacobian(const Eigen::VectorXd& q, Eigen::Mat
 }
 
 FrameSolution ContactSolver::solve(const Eigen::VectorXd& q, const Eigen::VectorXd& qdd, const FrameContacts& fc) {
-  fill_bilateral_jacobian(q, Phi_);  // reused buffer: no allocation per frame
-  if (options_.dense_factorisation) return solve_dense(Phi_.transpose(), qdd, fc);
-  // B = Phi^T: B(i, j) = Phi(j, i) on the fixed sparsity pattern.
-  for (int c = 0; c < B_.outerSize(); ++c)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(B_, c); it; ++it) it.valueRef() = Phi_(it.col(), it.row());
-  qr_.factorize(B_);
-  if (qr_.info() != Eigen::Success || qr_.rank() < kBilateralCount) return solve_dense(Phi_.transpose(), qdd, fc);
-  // Columns: b, then (normal, tangent) per contact point. One application of Q^T serves both
-  // parts: B^+ X = P R^-1 (Q^T X)_top (B P = Q R, full column rank) and U^T X = (Q^T X)_bottom.
-  const Eigen::MatrixXd X = contact_columns(qdd, fc);
-  const Eigen::MatrixXd QtX = qr_.matrixQ().transpose() * X;
-  const Eigen::MatrixXd Rinv_QtX = qr_.matrixR()
-                                       .topLeftCorner(kBilateralCount, kBilateralCount)
-                                       .template triangularView<Eigen::Upper>()
-                                       .solve(QtX.topRows(kBilateralCount));
-  const Eigen::MatrixXd BpX = qr_.colsPermutation() * Rinv_QtX;  // B^+ [b C]
-  const Eigen::MatrixXd UtX = QtX.bottomRows(coord::kCount - kBilateralCount);  // U^T [b C]
-  return solve_reduced(BpX, UtX, fc);
+  fill_bilateral_jacobian(q, Phi_);
+  if (options_.dense_factorisation || !factorise_normal_equations()) return solve_dense(Phi_.transpose(), qdd, fc);
+  // Columns: b, then (normal, tangent) per contact point.
+  contact_columns(qdd, fc, X_);
+  const Eigen::Index m = X_.cols();
+  // B^+ X = N^-1 (Phi X): Phi X on Phi's entries, in the factor's order; then L, D, L^T.
+  Z_.setZero(kBilateralCount, m);
+  for (const auto& [r, c] : phi_entries_) Z_.row(order_[static_cast<std::size_t>(r)]) += Phi_(r, c) * X_.row(c);
+  for (int i = 0; i < kBilateralCount; ++i)
+    for (int p = factor_row_start_[static_cast<std::size_t>(i)]; p < factor_row_start_[static_cast<std::size_t>(i) + 1]; ++p)
+      Z_.row(i) -= L_(i, factor_row_[static_cast<std::size_t>(p)]) * Z_.row(factor_row_[static_cast<std::size_t>(p)]);
+  for (int i = 0; i < kBilateralCount; ++i) Z_.row(i) /= D_[i];
+  for (int i = kBilateralCount - 1; i >= 0; --i)
+    for (int p = factor_row_start_[static_cast<std::size_t>(i)]; p < factor_row_start_[static_cast<std::size_t>(i) + 1]; ++p)
+      Z_.row(factor_row_[static_cast<std::size_t>(p)]) -= L_(i, factor_row_[static_cast<std::size_t>(p)]) * Z_.row(i);
+  BpX_.resize(kBilateralCount, m);
+  for (int r = 0; r < kBilateralCount; ++r) BpX_.row(r) = Z_.row(order_[static_cast<std::size_t>(r)]);
+  // U: the whole body's rigid motions (x, y, rotation about the origin), orthonormalised.
+  U_.setZero();
+  for (int k = 0; k < coord::kComs / 2 + kSegmentCount + 2; ++k) {
+    // points, COMs and D*: every (x, y) pair of q
+    const int c = k < coord::kComs / 2 ? 2 * k : k < coord::kComs / 2 + kSegmentCount ? coord::com_x(k - coord::kComs / 2)
+                                                                                        : coord::dstar_x(k - coord::kComs / 2 - kSegmentCount);
+    U_(c, 0) = 1.0;
+    U_(c + 1, 1) = 1.0;
+    U_(c, 2) = -q[c + 1];
+    U_(c + 1, 2) = q[c];
+  }
+  for (int s = 0; s < kSegmentCount; ++s) U_(coord::theta(s), 2) = 1.0;
+  for (int a = 0; a < 3; ++a) {  // Gram-Schmidt, twice for round-off
+    for (int pass = 0; pass < 2; ++pass)
+      for (int b = 0; b < a; ++b) U_.col(a) -= U_.col(b).dot(U_.col(a)) * U_.col(b);
+    U_.col(a).normalize();
+  }
+  UtX_.leftCols(m).noalias() = U_.transpose() * X_;
+  return solve_reduced(BpX_, UtX_.leftCols(m), fc);
 }
 
 FrameSolution ContactSolver::solve_dense(const Eigen::MatrixXd& Bd, const Eigen::VectorXd& qdd, const FrameContacts& fc) {
   // Rank-revealing dense fallback (a degenerate geometry the sparse factorisation flags).
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Bd);
-  const Eigen::MatrixXd X = contact_columns(qdd, fc);
+  Columns X;
+  contact_columns(qdd, fc, X);
   const Eigen::MatrixXd QtX = qr.householderQ().transpose() * X;
   const Eigen::MatrixXd BpX = Bd.completeOrthogonalDecomposition().solve(X);
   return solve_reduced(BpX, QtX.bottomRows(coord::kCount - qr.rank()), fc);
 }
 
-Eigen::MatrixXd ContactSolver::contact_columns(const Eigen::VectorXd& qdd, const FrameContacts& fc) const {
-  const Eigen::VectorXd b = mass_.cwiseProduct(qdd) - gravity_;
+void ContactSolver::contact_columns(const Eigen::VectorXd& qdd, const FrameContacts& fc, Columns& X) const {
   const int np = static_cast<int>(fc.points.size());
-  Eigen::MatrixXd X(coord::kCount, 1 + 2 * np);
-  X.col(0) = b;
+  if (np > kMaxContactPoints) throw std::logic_error("more contact points than kMaxContactPoints");
+  X.resize(coord::kCount, 1 + 2 * np);
+  X.col(0) = mass_.cwiseProduct(qdd) - gravity_;
   for (int j = 0; j < np; ++j) {
     X.col(1 + 2 * j) = fc.points[static_cast<std::size_t>(j)].jac_normal;
     X.col(2 + 2 * j) = fc.points[static_cast<std::size_t>(j)].jac_tangent;
   }
-  return X;
 }
 
-FrameSolution ContactSolver::solve_reduced(const Eigen::MatrixXd& BpX, const Eigen::MatrixXd& UtX, const FrameContacts& fc) {
+FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixXd>& BpX, const Eigen::Ref<const Eigen::MatrixXd>& UtX,
+                                           const FrameContacts& fc) {
   const int np = static_cast<int>(fc.points.size());
   const int k = 2 * np;
   const Eigen::VectorXd& wB = weight_bilateral_;

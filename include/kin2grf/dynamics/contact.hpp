@@ -62,8 +62,11 @@ struct ContactPoint {
   Eigen::VectorXd jac_normal, jac_tangent;             ///< d(y)/dq and d(x)/dq, 63 each
 };
 
+/// Contact points of one frame at most: three per foot (model 1).
+inline constexpr int kMaxContactPoints = 6;
+
 struct FrameContacts {
-  std::vector<ContactPoint> points;  ///< model 2: [D*_R, D*_L]; model 1: [A_R,B_R,C_R,A_L,B_L,C_L]
+  std::vector<ContactPoint> points;  ///< model 2: [D*_R, D*_L]; model 1: [A_R,B_R,C_R,A_L,B_L,C_L] (at most kMaxContactPoints)
   std::array<double, 2> foot_inclination_rad{};  ///< theta_A per side
   std::array<double, 2> cop_fraction{};          ///< model 2: s = F(theta_A)
   std::array<std::array<Eigen::Vector2d, 3>, 2> sole{};  ///< sole points A, B, C per side (sole_points)

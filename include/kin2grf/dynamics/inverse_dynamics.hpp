@@ -8,14 +8,19 @@
 //   lambda_A = argmin ||lambda||_W  over  argmin || Phi_q,A^T lambda - (M qdd - f) ||      (Eq. 7)
 // i.e. the minimum-norm least-squares solution (the pseudo-inverse for W = I, the paper).
 // How it is computed: Phi_q,A^T = [B C], B the 60 bilateral columns (full column rank), C the
-// contact columns. With B P = Q R (sparse Householder QR with a fill-reducing column order fixed
-// once per solver, factorised once per frame: B has about 160 non-zeros of 3780) and U the 3 columns of Q
-// orthogonal to range(B) (the global x, y, rotation directions), the least-squares residual
-// only lives in U: lambda_C solves the 3-equation problem U^T C lambda_C ~ U^T b, its remaining
-// freedom is fixed by minimising ||W_C lambda_C||^2 + ||W_B B^+ (b - C lambda_C)||^2 (an SVD of
-// at most 3 x 12 and a small least squares), and lambda_B = B^+ (b - C lambda_C). This is the
-// exact pseudo-inverse solution of the full 63-column problem, without refactoring it for
-// each active set. Rank decisions in the 3 x k problem use a relative tolerance of 1e-8.
+// contact columns. B^+ X = N^-1 Phi_q X with N = Phi_q Phi_q^T (60 x 60, about 330 non-zeros),
+// factorised per frame as L D L^T on a fill pattern and an AMD order found once per solver
+// (Phi_q's sparsity does not depend on q), in buffers of fixed size. U, the orthonormal basis of
+// the complement of range(B) = null(Phi_q), is known in closed form: the whole body's rigid
+// motions (translation along x and y, rotation about the origin: every point (x, y) moves by
+// (-y, x), every absolute angle by 1, the relative angles not at all), orthonormalised. The
+// least-squares residual only lives in U: lambda_C solves the 3-equation problem
+// U^T C lambda_C ~ U^T b, its remaining freedom is fixed by minimising
+// ||W_C lambda_C||^2 + ||W_B B^+ (b - C lambda_C)||^2 (an SVD of at most 3 x 12 and a small least
+// squares), and lambda_B = B^+ (b - C lambda_C). This is the exact pseudo-inverse solution of the
+// full 63-column problem, without refactoring it for each active set. Rank decisions in the
+// 3 x k problem use a relative tolerance of 1e-8; a pivot of D below 1e-10 of the largest (a
+// degenerate geometry) falls back to a dense rank-revealing factorisation.
 // Activation (Alart-Curnier mixed criterion, Eqs. 8-9): contact j is active when
 //   lambda_n,j - r g_n,j > 0.
 // Semi-smooth Newton / active-set iterations (Fig. 5): start with every contact active, solve,
@@ -25,9 +30,6 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <Eigen/OrderingMethods>
-#include <Eigen/Sparse>
-#include <Eigen/SparseQR>
 #include <array>
 #include <vector>
 
@@ -78,8 +80,8 @@ struct SolverOptions {
   /// feet 0.37-0.57 m apart (the 7 development trials) and is not affected; the drop jump's
   /// side-by-side landing (0-9 cm) goes from 58 to 17 % vertical (`kin2grf study split-distance`).
   double min_split_distance_m = 0.15;
-  /// Dense rank-revealing factorisation instead of the sparse one (the fallback when the sparse
-  /// factorisation reports a rank below 60; selectable to cross-check them).
+  /// Dense rank-revealing factorisation instead of the structured one (the fallback when a pivot
+  /// of the normal equations vanishes; selectable to cross-check them).
   bool dense_factorisation = false;
 };
 
@@ -108,16 +110,28 @@ class ContactSolver {
   [[nodiscard]] Eigen::MatrixXd bilateral_jacobian(const Eigen::VectorXd& q) const;
 
  private:
+  static constexpr int kMaxColumns = 1 + 2 * kMaxContactPoints;  ///< b and (n, t) per contact point
+  using Columns = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, coord::kCount, kMaxColumns>;
   void fill_bilateral_jacobian(const Eigen::VectorXd& q, Eigen::MatrixXd& Phi) const;
-  Eigen::MatrixXd contact_columns(const Eigen::VectorXd& qdd, const FrameContacts& contacts) const;
-  FrameSolution solve_reduced(const Eigen::MatrixXd& BpX, const Eigen::MatrixXd& UtX, const FrameContacts& contacts);
+  void contact_columns(const Eigen::VectorXd& qdd, const FrameContacts& contacts, Columns& X) const;
+  bool factorise_normal_equations();
+  FrameSolution solve_reduced(const Eigen::Ref<const Eigen::MatrixXd>& BpX, const Eigen::Ref<const Eigen::MatrixXd>& UtX,
+                              const FrameContacts& contacts);
   FrameSolution solve_dense(const Eigen::MatrixXd& B, const Eigen::VectorXd& qdd, const FrameContacts& contacts);
   const Model& model_;
   SolverOptions options_;
   Eigen::VectorXd mass_, gravity_, weight_bilateral_;
-  Eigen::MatrixXd Phi_;            ///< the frame's bilateral Jacobian (60 x 63), reused
-  Eigen::SparseMatrix<double> B_;  ///< Phi_q^T with the structural pattern of every frame
-  Eigen::SparseQR<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> qr_;
+  Eigen::MatrixXd Phi_;  ///< the frame's bilateral Jacobian (60 x 63), reused
+  // The structure of N = Phi Phi^T and of its factor, found once (constructor).
+  std::array<int, kBilateralCount> order_{};            ///< constraint row -> its place in the factor
+  std::vector<std::array<int, 2>> phi_entries_;         ///< (row, coordinate) of Phi's structural non-zeros
+  std::vector<int> phi_column_start_;                   ///< per coordinate: its entries in phi_entries_
+  std::vector<int> factor_row_start_, factor_row_;      ///< per factor row i: the k < i with L(i, k) != 0
+  Eigen::Matrix<double, kBilateralCount, kBilateralCount> L_;  ///< N (lower, permuted), then L in place
+  Eigen::Matrix<double, kBilateralCount, 1> D_;
+  Columns X_, Z_, BpX_;                                 ///< per-frame buffers (no heap)
+  Eigen::Matrix<double, coord::kCount, 3> U_;
+  Eigen::Matrix<double, 3, kMaxColumns> UtX_;
 };
 
 }  // namespace kin2grf
