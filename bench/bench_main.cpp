@@ -2,6 +2,8 @@
 // Figures are reported in the README with the command that produced them.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -12,6 +14,30 @@
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
+
+// Every heap allocation of the process is counted (the per-frame solve must make none): malloc,
+// calloc and realloc are interposed and passed to glibc's own (operator new and Eigen allocate
+// through malloc).
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* malloc(std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_malloc(n);
+}
+void* calloc(std::size_t n, std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_realloc(p, n);
+}
+}
 
 namespace {
 
@@ -79,15 +105,19 @@ void BM_ContactSolvePerFrame(benchmark::State& state) {
   const auto contacts = kin2grf::prepare_contacts(r.model, co, motion);
   kin2grf::ContactSolver solver(r.model, w.options.solver);
   const Eigen::Index n = motion.frames();
-  long frames = 0;
+  long frames = 0, allocations = 0;
   for (auto _ : state) {
+    const long before = g_allocations.load();
     for (Eigen::Index i = 0; i < n; ++i) {
       auto s = solver.solve(motion.q.row(i).transpose(), motion.qdd.row(i).transpose(), contacts[static_cast<std::size_t>(i)]);
       benchmark::DoNotOptimize(s);
     }
+    allocations += g_allocations.load() - before;
     frames += n;
   }
   state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
+  // Heap allocations per frame inside the solve (malloc, calloc, realloc: operator new and Eigen too).
+  state.counters["allocations_per_frame"] = static_cast<double>(allocations) / static_cast<double>(std::max(1L, frames));
 }
 BENCHMARK(BM_ContactSolvePerFrame)->Arg(0)->Arg(1)->ArgNames({"real"})->Unit(benchmark::kMillisecond);
 

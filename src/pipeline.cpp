@@ -178,7 +178,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   const int np = static_cast<int>(contacts.front().points.size());
   Eigen::MatrixXd lam(n, 2 * np);
   Eigen::MatrixXd torque(n, kJointCount);
-  std::vector<std::vector<bool>> act(static_cast<std::size_t>(n));
+  std::vector<std::array<bool, kMaxContactPoints>> act(static_cast<std::size_t>(n));
   r.iterations.resize(static_cast<std::size_t>(n));
   const Eigen::Index step = std::max<Eigen::Index>(1, n / 100);
   for (Eigen::Index i = 0; i < n; ++i) {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <set>
+#include <cstdint>
 #include <stdexcept>
 
 #include <Eigen/OrderingMethods>
@@ -118,7 +118,7 @@ Eigen::MatrixXd ContactSolver::bilateral_jacobian(const Eigen::VectorXd& q) cons
   return Phi;
 }
 
-void ContactSolver::fill_bilateral_jacobian(const Eigen::VectorXd& q, Eigen::MatrixXd& Phi) const {
+void ContactSolver::fill_bilateral_jacobian(const FrameVector& q, Eigen::MatrixXd& Phi) const {
   Phi.setZero(kBilateralCount, coord::kCount);
   int row = 0;
   auto pt = [&](int k) { return Eigen::Vector2d(q[coord::point_x(k)], q[coord::point_x(k) + 1]); };
@@ -151,7 +151,7 @@ void ContactSolver::fill_bilateral_jacobian(const Eigen::VectorXd& q, Eigen::Mat
   }
 }
 
-FrameSolution ContactSolver::solve(const Eigen::VectorXd& q, const Eigen::VectorXd& qdd, const FrameContacts& fc) {
+FrameSolution ContactSolver::solve(const FrameVector& q, const FrameVector& qdd, const FrameContacts& fc) {
   fill_bilateral_jacobian(q, Phi_);
   if (options_.dense_factorisation || !factorise_normal_equations()) return solve_dense(Phi_.transpose(), qdd, fc);
   // Columns: b, then (normal, tangent) per contact point.
@@ -190,7 +190,7 @@ FrameSolution ContactSolver::solve(const Eigen::VectorXd& q, const Eigen::Vector
   return solve_reduced(BpX_, UtX_.leftCols(m), fc);
 }
 
-FrameSolution ContactSolver::solve_dense(const Eigen::MatrixXd& Bd, const Eigen::VectorXd& qdd, const FrameContacts& fc) {
+FrameSolution ContactSolver::solve_dense(const Eigen::MatrixXd& Bd, const FrameVector& qdd, const FrameContacts& fc) {
   // Rank-revealing dense fallback (a degenerate geometry the sparse factorisation flags).
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Bd);
   Columns X;
@@ -200,7 +200,7 @@ FrameSolution ContactSolver::solve_dense(const Eigen::MatrixXd& Bd, const Eigen:
   return solve_reduced(BpX, QtX.bottomRows(coord::kCount - qr.rank()), fc);
 }
 
-void ContactSolver::contact_columns(const Eigen::VectorXd& qdd, const FrameContacts& fc, Columns& X) const {
+void ContactSolver::contact_columns(const FrameVector& qdd, const FrameContacts& fc, Columns& X) const {
   const int np = static_cast<int>(fc.points.size());
   if (np > kMaxContactPoints) throw std::logic_error("more contact points than kMaxContactPoints");
   X.resize(coord::kCount, 1 + 2 * np);
@@ -213,41 +213,49 @@ void ContactSolver::contact_columns(const Eigen::VectorXd& qdd, const FrameConta
 
 FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixXd>& BpX, const Eigen::Ref<const Eigen::MatrixXd>& UtX,
                                            const FrameContacts& fc) {
+  // Fixed capacities: at most 6 contact points (12 multipliers), so nothing here touches the
+  // heap. Active sets are bit masks (a point j is bit j).
+  constexpr int kMaxK = 2 * kMaxContactPoints;
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxK, kMaxK>;
+  using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxK, 1>;
+  using Tall = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxK + kBilateralCount, kMaxK>;
+  using TallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxK + kBilateralCount, 1>;
+  // 3 equations, or more in the dense fallback of a degenerate frame (63 - rank of B).
+  using Fit = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, coord::kCount, kMaxK>;
   const int np = static_cast<int>(fc.points.size());
   const int k = 2 * np;
   const Eigen::VectorXd& wB = weight_bilateral_;
+  const int neq = static_cast<int>(UtX.rows());
 
   FrameSolution sol;
-  sol.contact_lambda = Eigen::VectorXd::Zero(k);
-  sol.contact_active.assign(static_cast<std::size_t>(np), true);
+  sol.contact_lambda = SmallVector::Zero(k);
   // The speed gate removes a contact from the candidates before the iterations.
-  std::vector<bool> allowed(static_cast<std::size_t>(np), true);
-  if (options_.speed_gate_mps > 0) {
-    for (int j = 0; j < np; ++j) {
-      const auto& p = fc.points[static_cast<std::size_t>(j)];
-      if (std::abs(p.velocity.x() - options_.belt_velocity_mps) > options_.speed_gate_mps) allowed[static_cast<std::size_t>(j)] = false;
-    }
-  }
-  std::vector<bool> active = allowed;
-  std::set<std::vector<bool>> seen;
-  Eigen::VectorXd lamC = Eigen::VectorXd::Zero(k);
-  for (int it = 0; it < options_.max_iterations; ++it) {
-    seen.insert(active);
-    sol.iterations = it + 1;
-    std::vector<int> cols;
+  unsigned allowed = (1U << np) - 1U;
+  if (options_.speed_gate_mps > 0)
     for (int j = 0; j < np; ++j)
-      if (active[static_cast<std::size_t>(j)]) { cols.push_back(2 * j); cols.push_back(2 * j + 1); }
-    const int ka = static_cast<int>(cols.size());
+      if (std::abs(fc.points[static_cast<std::size_t>(j)].velocity.x() - options_.belt_velocity_mps) > options_.speed_gate_mps)
+        allowed &= ~(1U << j);
+  unsigned active = allowed;
+  std::uint64_t seen = 0;  // the active sets tried (2^6 of them at most)
+  SmallVector lamC = SmallVector::Zero(k);
+  const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, coord::kCount, 1> b3 = UtX.col(0);
+  const Eigen::Matrix<double, kBilateralCount, 1> w = wB.cwiseProduct(BpX.col(0));
+  for (int it = 0; it < options_.max_iterations; ++it) {
+    seen |= std::uint64_t{1} << active;
+    sol.iterations = it + 1;
+    std::array<int, kMaxK> cols{};
+    int ka = 0;
+    for (int j = 0; j < np; ++j)
+      if (active >> j & 1U) cols[static_cast<std::size_t>(ka++)] = 2 * j, cols[static_cast<std::size_t>(ka++)] = 2 * j + 1;
     lamC.setZero();
     if (ka > 0) {
-      Eigen::MatrixXd A3(UtX.rows(), ka), W(kBilateralCount, ka);
+      Fit A3(neq, ka);
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kBilateralCount, kMaxK> W(kBilateralCount, ka);
       for (int c = 0; c < ka; ++c) {
         A3.col(c) = UtX.col(1 + cols[static_cast<std::size_t>(c)]);
         W.col(c) = wB.cwiseProduct(BpX.col(1 + cols[static_cast<std::size_t>(c)]));
       }
-      const Eigen::VectorXd b3 = UtX.col(0);
-      const Eigen::VectorXd w = wB.cwiseProduct(BpX.col(0));
-      Eigen::JacobiSVD<Eigen::MatrixXd> svd(A3, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      const Eigen::JacobiSVD<Fit> svd(A3, Eigen::ComputeFullU | Eigen::ComputeFullV);
       const auto& sv = svd.singularValues();
       // Singular values below 1e-8 of the largest count as zero: two contacts whose columns
       // differ only by round-off (feet at the same place) must not create a force couple.
@@ -257,26 +265,26 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
         if (sv[i] > tol) ++rank;
       // Fit the first r singular directions exactly; the remaining freedom by the minimum norm.
       auto fit = [&](int r) {
-        Eigen::VectorXd lam0 = Eigen::VectorXd::Zero(ka);
+        SmallVector lam0 = SmallVector::Zero(ka);
         for (int i = 0; i < r; ++i) lam0 += svd.matrixV().col(i) * (svd.matrixU().col(i).dot(b3) / sv[i]);
         if (r == ka) return lam0;
-        const Eigen::MatrixXd N = svd.matrixV().rightCols(ka - r);
-        Eigen::MatrixXd S(ka + kBilateralCount, ka - r);
+        const Small N = svd.matrixV().rightCols(ka - r);
+        Tall S(ka + kBilateralCount, ka - r);
         S << N, W * N;
-        Eigen::VectorXd rhs(ka + kBilateralCount);
+        TallVector rhs(ka + kBilateralCount);
         rhs << -lam0, w - W * lam0;
-        const Eigen::VectorXd z = S.completeOrthogonalDecomposition().solve(rhs);
-        return Eigen::VectorXd(lam0 + N * z);
+        const SmallVector z = Eigen::CompleteOrthogonalDecomposition<Tall>(S).solve(rhs);
+        return SmallVector(lam0 + N * z);
       };
       // Feet side by side: with all 3 global directions fitted, the weakest is the moment that
       // only a couple between the feet can make (its singular value shrinks with their distance
       // along x and height); fade it out of the fit. Feet exactly together already leave it out.
       double keep = 1.0;
-      if (options_.min_split_distance_m > 0 && rank == UtX.rows()) {
+      if (options_.min_split_distance_m > 0 && rank == neq) {
         std::array<bool, 2> side_on{false, false};
         double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
         for (int j = 0; j < np; ++j) {
-          if (!active[static_cast<std::size_t>(j)]) continue;
+          if (!(active >> j & 1U)) continue;
           const auto& p = fc.points[static_cast<std::size_t>(j)];
           side_on[static_cast<std::size_t>(p.side)] = true;
           xmin = std::min(xmin, p.position.x()), xmax = std::max(xmax, p.position.x());
@@ -286,18 +294,18 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
           keep = u * u * (3.0 - 2.0 * u);  // smoothstep: 0 below half the distance, 1 above it
         }
       }
-      Eigen::VectorXd lam = fit(rank);
+      SmallVector lam = fit(rank);
       if (keep < 1.0) lam = keep * lam + (1.0 - keep) * fit(rank - 1);
       for (int c = 0; c < ka; ++c) lamC[cols[static_cast<std::size_t>(c)]] = lam[c];
     }
     // Re-classify (Eqs. 8-9).
-    std::vector<bool> next(static_cast<std::size_t>(np));
+    unsigned next = 0;
     for (int j = 0; j < np; ++j) {
       const double crit = lamC[2 * j] - options_.r_N_per_m * fc.points[static_cast<std::size_t>(j)].gap_m;
-      next[static_cast<std::size_t>(j)] = allowed[static_cast<std::size_t>(j)] && crit > 0;
+      if ((allowed >> j & 1U) && crit > 0) next |= 1U << j;
     }
     if (next == active) break;
-    if (seen.count(next)) {
+    if (seen >> next & 1U) {
       sol.cycled = true;
       break;
     }
@@ -305,9 +313,9 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
     if (it + 1 == options_.max_iterations) sol.capped = true;
   }
   sol.contact_lambda = lamC;
-  sol.contact_active = active;
+  for (int j = 0; j < np; ++j) sol.contact_active[static_cast<std::size_t>(j)] = (active >> j & 1U) != 0;
   // Bilateral multipliers: lambda_B = B^+ (b - C lambda_C); the rheonomic ones are the torques.
-  Eigen::VectorXd lamB = BpX.col(0);
+  Eigen::Matrix<double, kBilateralCount, 1> lamB = BpX.col(0);
   for (int c = 0; c < k; ++c)
     if (lamC[c] != 0.0) lamB -= BpX.col(1 + c) * lamC[c];
   sol.joint_torque_Nm = lamB.segment<kJointCount>(kRheoRows);
@@ -316,7 +324,7 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
     bool any = false;
     for (int j = 0; j < np; ++j) {
       const auto& p = fc.points[static_cast<std::size_t>(j)];
-      if (p.side != side || !active[static_cast<std::size_t>(j)]) continue;
+      if (p.side != side || !(active >> j & 1U)) continue;
       any = true;
       fy += lamC[2 * j];
       fx += lamC[2 * j + 1];

@@ -93,8 +93,9 @@ struct FrameSolution {
   std::array<Eigen::Vector2d, 2> force_N{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};  ///< per foot (x, y)
   std::array<bool, 2> active{false, false};
   Eigen::Matrix<double, kJointCount, 1> joint_torque_Nm = Eigen::Matrix<double, kJointCount, 1>::Zero();
-  Eigen::VectorXd contact_lambda;           ///< per contact point (n, t) pairs
-  std::vector<bool> contact_active;
+  /// Per contact point (n, t) pairs (fixed capacity: a frame's solve allocates nothing).
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 2 * kMaxContactPoints, 1> contact_lambda;
+  std::array<bool, kMaxContactPoints> contact_active{};  ///< per contact point; false beyond them
   int iterations = 0;
   bool cycled = false;
   bool capped = false;
@@ -105,19 +106,21 @@ class ContactSolver {
  public:
   ContactSolver(const Model& model, const SolverOptions& options);
   /// q, qdd: the frame's 63 coordinates (D* filled) and accelerations.
-  FrameSolution solve(const Eigen::VectorXd& q, const Eigen::VectorXd& qdd, const FrameContacts& contacts);
+  /// A row of ModelMotion's q and qdd is taken as it is (strided), without a copy.
+  using FrameVector = Eigen::Ref<const Eigen::VectorXd, 0, Eigen::InnerStride<>>;
+  FrameSolution solve(const FrameVector& q, const FrameVector& qdd, const FrameContacts& contacts);
   /// The bilateral constraint Jacobian Phi_q (60 x 63) at q (exposed for tests).
   [[nodiscard]] Eigen::MatrixXd bilateral_jacobian(const Eigen::VectorXd& q) const;
 
  private:
   static constexpr int kMaxColumns = 1 + 2 * kMaxContactPoints;  ///< b and (n, t) per contact point
   using Columns = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, coord::kCount, kMaxColumns>;
-  void fill_bilateral_jacobian(const Eigen::VectorXd& q, Eigen::MatrixXd& Phi) const;
-  void contact_columns(const Eigen::VectorXd& qdd, const FrameContacts& contacts, Columns& X) const;
+  void fill_bilateral_jacobian(const FrameVector& q, Eigen::MatrixXd& Phi) const;
+  void contact_columns(const FrameVector& qdd, const FrameContacts& contacts, Columns& X) const;
   bool factorise_normal_equations();
   FrameSolution solve_reduced(const Eigen::Ref<const Eigen::MatrixXd>& BpX, const Eigen::Ref<const Eigen::MatrixXd>& UtX,
                               const FrameContacts& contacts);
-  FrameSolution solve_dense(const Eigen::MatrixXd& B, const Eigen::VectorXd& qdd, const FrameContacts& contacts);
+  FrameSolution solve_dense(const Eigen::MatrixXd& B, const FrameVector& qdd, const FrameContacts& contacts);
   const Model& model_;
   SolverOptions options_;
   Eigen::VectorXd mass_, gravity_, weight_bilateral_;
