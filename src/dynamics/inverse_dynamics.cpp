@@ -60,50 +60,75 @@ ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
       if (fill(i, k))
         for (int j = k + 1; j <= i; ++j)
           if (fill(j, k)) fill(i, j) = fill(j, i) = true;
+  // The factor's entries, row by row (k ascending): entry e is L(factor_i_[e], factor_k_[e]).
+  std::array<std::array<int, kBilateralCount>, kBilateralCount> entry{};
+  for (auto& row : entry) row.fill(-1);
   factor_row_start_.assign(kBilateralCount + 1, 0);
   for (int i = 0; i < kBilateralCount; ++i) {
-    factor_row_start_[static_cast<std::size_t>(i)] = static_cast<int>(factor_row_.size());
+    factor_row_start_[static_cast<std::size_t>(i)] = static_cast<int>(factor_k_.size());
     for (int k = 0; k < i; ++k)
-      if (fill(i, k)) factor_row_.push_back(k);
+      if (fill(i, k)) {
+        entry[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)] = static_cast<int>(factor_k_.size());
+        factor_k_.push_back(k);
+      }
   }
-  factor_row_start_[kBilateralCount] = static_cast<int>(factor_row_.size());
-  L_.setZero();
-  D_.setZero();
-}
-
-bool ContactSolver::factorise_normal_equations() {
-  // N = Phi Phi^T on its pattern, permuted, lower triangle: sum over each coordinate's entries.
-  for (int i = 0; i < kBilateralCount; ++i) {
-    L_(i, i) = 0.0;
-    for (int p = factor_row_start_[static_cast<std::size_t>(i)]; p < factor_row_start_[static_cast<std::size_t>(i) + 1]; ++p)
-      L_(i, factor_row_[static_cast<std::size_t>(p)]) = 0.0;
-  }
+  factor_row_start_[kBilateralCount] = static_cast<int>(factor_k_.size());
+  // The elimination as a schedule: for entry (i, k), the pairs (L(i, m), L(k, m)) with both
+  // structurally non-zero, m < k; so the numeric factorisation multiplies no structural zero.
+  update_start_.assign(factor_k_.size() + 1, 0);
+  for (int i = 0; i < kBilateralCount; ++i)
+    for (int e = factor_row_start_[static_cast<std::size_t>(i)]; e < factor_row_start_[static_cast<std::size_t>(i) + 1]; ++e) {
+      update_start_[static_cast<std::size_t>(e)] = static_cast<int>(updates_.size());
+      const int k = factor_k_[static_cast<std::size_t>(e)];
+      for (int f = factor_row_start_[static_cast<std::size_t>(k)]; f < factor_row_start_[static_cast<std::size_t>(k) + 1]; ++f) {
+        const int m = factor_k_[static_cast<std::size_t>(f)];
+        const int g = entry[static_cast<std::size_t>(i)][static_cast<std::size_t>(m)];
+        if (g >= 0) updates_.push_back({g, f, m});
+      }
+    }
+  update_start_[factor_k_.size()] = static_cast<int>(updates_.size());
+  // N = Phi Phi^T assembled from the products of Phi's entries that share a coordinate: each
+  // product goes to a diagonal place (target < 0: -1 - row) or a factor entry.
   for (int c = 0; c < coord::kCount; ++c) {
     const int b0 = phi_column_start_[static_cast<std::size_t>(c)], b1 = phi_column_start_[static_cast<std::size_t>(c) + 1];
     for (int a = b0; a < b1; ++a)
       for (int b = b0; b <= a; ++b) {
-        const int ra = phi_entries_[static_cast<std::size_t>(a)][0], rb = phi_entries_[static_cast<std::size_t>(b)][0];
-        const int i = order_[static_cast<std::size_t>(ra)], j = order_[static_cast<std::size_t>(rb)];
-        L_(std::max(i, j), std::min(i, j)) += Phi_(ra, c) * Phi_(rb, c);
+        const int ia = order_[static_cast<std::size_t>(phi_entries_[static_cast<std::size_t>(a)][0])];
+        const int ib = order_[static_cast<std::size_t>(phi_entries_[static_cast<std::size_t>(b)][0])];
+        const int target = ia == ib ? -1 - ia : entry[static_cast<std::size_t>(std::max(ia, ib))][static_cast<std::size_t>(std::min(ia, ib))];
+        products_.push_back({a, b, target});
       }
   }
-  // L D L^T, row by row (up-looking): L(i, k) = (N(i, k) - sum_m L(i, m) L(k, m) D(m)) / D(k).
+  Lv_.assign(factor_k_.size(), 0.0);
+  D_.setZero();
+  phi_values_.assign(phi_entries_.size(), 0.0);
+}
+
+bool ContactSolver::factorise_normal_equations() {
+  for (std::size_t e = 0; e < phi_entries_.size(); ++e) phi_values_[e] = Phi_(phi_entries_[e][0], phi_entries_[e][1]);
+  std::fill(Lv_.begin(), Lv_.end(), 0.0);
+  D_.setZero();
+  for (const auto& [a, b, target] : products_) {
+    const double v = phi_values_[static_cast<std::size_t>(a)] * phi_values_[static_cast<std::size_t>(b)];
+    if (target < 0) D_[-1 - target] += v;
+    else Lv_[static_cast<std::size_t>(target)] += v;
+  }
+  // L D L^T, row by row (up-looking): L(i, k) = (N(i, k) - sum_m L(i, m) L(k, m) D(m)) / D(k),
+  // D(i) = N(i, i) - sum_k L(i, k)^2 D(k).
   double largest = 0.0;
   for (int i = 0; i < kBilateralCount; ++i) {
-    const int p0 = factor_row_start_[static_cast<std::size_t>(i)], p1 = factor_row_start_[static_cast<std::size_t>(i) + 1];
-    for (int p = p0; p < p1; ++p) {
-      const int k = factor_row_[static_cast<std::size_t>(p)];
-      double v = L_(i, k);
-      for (int q = factor_row_start_[static_cast<std::size_t>(k)]; q < factor_row_start_[static_cast<std::size_t>(k) + 1]; ++q) {
-        const int m = factor_row_[static_cast<std::size_t>(q)];
-        v -= L_(i, m) * L_(k, m) * D_[m];
+    const int e0 = factor_row_start_[static_cast<std::size_t>(i)], e1 = factor_row_start_[static_cast<std::size_t>(i) + 1];
+    double d = D_[i];
+    for (int e = e0; e < e1; ++e) {
+      double v = Lv_[static_cast<std::size_t>(e)];
+      for (int u = update_start_[static_cast<std::size_t>(e)]; u < update_start_[static_cast<std::size_t>(e) + 1]; ++u) {
+        const auto& [g, f, m] = updates_[static_cast<std::size_t>(u)];
+        v -= Lv_[static_cast<std::size_t>(g)] * Lv_[static_cast<std::size_t>(f)] * D_[m];
       }
-      L_(i, k) = v / D_[k];
-    }
-    double d = L_(i, i);
-    for (int p = p0; p < p1; ++p) {
-      const int k = factor_row_[static_cast<std::size_t>(p)];
-      d -= L_(i, k) * L_(i, k) * D_[k];
+      const int k = factor_k_[static_cast<std::size_t>(e)];
+      v /= D_[k];
+      Lv_[static_cast<std::size_t>(e)] = v;
+      d -= v * v * D_[k];
     }
     largest = std::max(largest, d);
     if (!(d > 1e-10 * largest)) return false;  // a vanishing pivot: degenerate geometry
@@ -157,18 +182,20 @@ FrameSolution ContactSolver::solve(const FrameVector& q, const FrameVector& qdd,
   // Columns: b, then (normal, tangent) per contact point.
   contact_columns(qdd, fc, X_);
   const Eigen::Index m = X_.cols();
-  // B^+ X = N^-1 (Phi X): Phi X on Phi's entries, in the factor's order; then L, D, L^T.
-  Z_.setZero(kBilateralCount, m);
-  for (const auto& [r, c] : phi_entries_) Z_.row(order_[static_cast<std::size_t>(r)]) += Phi_(r, c) * X_.row(c);
+  // B^+ X = N^-1 (Phi X), worked on Zt = (Phi X)^T in the factor's order (a row of Phi X is a
+  // contiguous column of Zt): Phi X on Phi's entries, then L, D, L^T.
+  Zt_.setZero(m, kBilateralCount);
+  for (std::size_t e = 0; e < phi_entries_.size(); ++e)
+    Zt_.col(order_[static_cast<std::size_t>(phi_entries_[e][0])]) += phi_values_[e] * X_.row(phi_entries_[e][1]).transpose();
   for (int i = 0; i < kBilateralCount; ++i)
-    for (int p = factor_row_start_[static_cast<std::size_t>(i)]; p < factor_row_start_[static_cast<std::size_t>(i) + 1]; ++p)
-      Z_.row(i) -= L_(i, factor_row_[static_cast<std::size_t>(p)]) * Z_.row(factor_row_[static_cast<std::size_t>(p)]);
-  for (int i = 0; i < kBilateralCount; ++i) Z_.row(i) /= D_[i];
+    for (int e = factor_row_start_[static_cast<std::size_t>(i)]; e < factor_row_start_[static_cast<std::size_t>(i) + 1]; ++e)
+      Zt_.col(i) -= Lv_[static_cast<std::size_t>(e)] * Zt_.col(factor_k_[static_cast<std::size_t>(e)]);
+  for (int i = 0; i < kBilateralCount; ++i) Zt_.col(i) /= D_[i];
   for (int i = kBilateralCount - 1; i >= 0; --i)
-    for (int p = factor_row_start_[static_cast<std::size_t>(i)]; p < factor_row_start_[static_cast<std::size_t>(i) + 1]; ++p)
-      Z_.row(factor_row_[static_cast<std::size_t>(p)]) -= L_(i, factor_row_[static_cast<std::size_t>(p)]) * Z_.row(i);
+    for (int e = factor_row_start_[static_cast<std::size_t>(i)]; e < factor_row_start_[static_cast<std::size_t>(i) + 1]; ++e)
+      Zt_.col(factor_k_[static_cast<std::size_t>(e)]) -= Lv_[static_cast<std::size_t>(e)] * Zt_.col(i);
   BpX_.resize(kBilateralCount, m);
-  for (int r = 0; r < kBilateralCount; ++r) BpX_.row(r) = Z_.row(order_[static_cast<std::size_t>(r)]);
+  for (int r = 0; r < kBilateralCount; ++r) BpX_.row(r) = Zt_.col(order_[static_cast<std::size_t>(r)]).transpose();
   // U: the whole body's rigid motions (x, y, rotation about the origin), orthonormalised.
   U_.setZero();
   for (int k = 0; k < coord::kComs / 2 + kSegmentCount + 2; ++k) {
