@@ -15,10 +15,12 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines = split(text, "\n", true);
+/// The lines of a text, views into it (no copy), without their '\r'.
+std::vector<std::string_view> lines_of(const std::string& text) {
+  std::vector<std::string_view> lines;
+  split_views(text, '\n', lines);
   for (auto& l : lines)
-    if (!l.empty() && l.back() == '\r') l.pop_back();
+    if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
   return lines;
 }
 
@@ -101,15 +103,18 @@ MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
   std::vector<std::vector<double>> rows;
   std::vector<int> frames;
   std::size_t short_rows = 0;
+  rows.reserve(lines.size());
+  std::vector<std::string_view> cells;
   for (std::size_t li = 5; li < lines.size(); ++li) {
-    if (trim(lines[li]).empty()) continue;
-    auto cells = split(lines[li], "\t", true);
+    if (lines[li].find_first_not_of(" \t\r\n\v\f") == std::string_view::npos) continue;
+    split_views(lines[li], '\t', cells);
+    std::vector<std::string> ws;  // some writers separate by spaces
     if (cells.size() < nm * 3 + 2) {
-      // Some writers separate by spaces.
-      auto ws = split(lines[li], " \t", false);
-      if (ws.size() == nm * 3 + 2) cells = ws;
+      ws = split(lines[li], " \t", false);
+      if (ws.size() == nm * 3 + 2) cells.assign(ws.begin(), ws.end());
     }
-    while (cells.size() > nm * 3 + 2 && trim(cells.back()).empty()) cells.pop_back();
+    auto blank = [](std::string_view c) { return c.find_first_not_of(" \t\r\n\v\f") == std::string_view::npos; };
+    while (cells.size() > nm * 3 + 2 && blank(cells.back())) cells.pop_back();
     if (cells.size() > nm * 3 + 2) {
       throw InputError(where(path, li) + ": " + std::to_string(cells.size()) + " columns, but " +
                        std::to_string(nm) + " markers make " + std::to_string(nm * 3 + 2));
@@ -118,16 +123,15 @@ MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
     std::vector<double> r(nm * 3 + 1, kNaN);
     double fr = kNaN;
     if (!parse_double(cells[0], fr) || !std::isfinite(fr) || std::abs(fr) > 1e9)
-      throw InputError(where(path, li) + ": Frame# '" + cells[0] + "' is not a frame number");
+      throw InputError(where(path, li) + ": Frame# '" + std::string(cells[0]) + "' is not a frame number");
     if (cells.size() < 2 || !parse_double(cells[1], r[0]) || !std::isfinite(r[0]))
       throw InputError(where(path, li) + ": Time is missing or not a number");
     for (std::size_t c = 2; c < cells.size(); ++c) {
-      const std::string cell = trim(cells[c]);
-      if (cell.empty()) continue;
+      if (blank(cells[c])) continue;
       double v;
-      if (!parse_double(cell, v)) {
+      if (!parse_double(cells[c], v)) {
         throw InputError(where(path, li) + ": marker " + names[(c - 2) / 3] + " " +
-                         "XYZ"[(c - 2) % 3] + " = '" + cell + "' is not a number");
+                         "XYZ"[(c - 2) % 3] + " = '" + trim(cells[c]) + "' is not a number");
       }
       r[c - 1] = v;
     }

@@ -67,7 +67,7 @@ std::vector<std::uint8_t> read_file_bytes(const std::string& path) {
 
 std::string read_file_text(const std::string& path) {
   const auto b = read_file_bytes(path);
-  return std::string(b.begin(), b.end());
+  return std::string(reinterpret_cast<const char*>(b.data()), b.size());
 }
 
 void write_file_text(const std::string& path, std::string_view text) {
@@ -112,18 +112,39 @@ std::string json_text(const nlohmann::json& j) {
 }
 
 bool parse_double(std::string_view s, double& out) {
-  std::string t = trim(s);
-  if (t.empty()) return false;
-  const std::string l = to_lower(t);
-  if (l == "nan" || l == "-nan" || l == "-1.#ind" || l == "1.#qnan") {
-    out = std::numeric_limits<double>::quiet_NaN();
-    return true;
-  }
+  // Called for every cell of a text file: views only, no allocation.
+  const auto b0 = s.find_first_not_of(" \t\r\n\v\f");
+  if (b0 == std::string_view::npos) return false;
+  const auto e0 = s.find_last_not_of(" \t\r\n\v\f");
+  const std::string_view t = s.substr(b0, e0 - b0 + 1);
   const char* b = t.data();
   const char* e = t.data() + t.size();
   if (*b == '+') ++b;
   auto r = std::from_chars(b, e, out);
-  return r.ec == std::errc() && r.ptr == e;
+  if (r.ec == std::errc() && r.ptr == e) return true;
+  // Missing-value spellings of other tools (NaN, -nan, MATLAB's and MSVC's): NaN.
+  auto same = [&](std::string_view word) {
+    if (t.size() != word.size()) return false;
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (std::tolower(static_cast<unsigned char>(t[i])) != word[i]) return false;
+    return true;
+  };
+  if (same("nan") || same("-nan") || same("-1.#ind") || same("1.#qnan")) {
+    out = std::numeric_limits<double>::quiet_NaN();
+    return true;
+  }
+  return false;
+}
+
+void split_views(std::string_view s, char delim, std::vector<std::string_view>& out) {
+  out.clear();
+  std::size_t start = 0;
+  while (true) {
+    const auto pos = s.find(delim, start);
+    out.push_back(s.substr(start, pos == std::string_view::npos ? std::string_view::npos : pos - start));
+    if (pos == std::string_view::npos) break;
+    start = pos + 1;
+  }
 }
 
 std::string extension(const std::string& path) {

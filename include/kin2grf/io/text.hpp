@@ -14,6 +14,8 @@ std::string rtrim(std::string_view s);
 std::string to_lower(std::string s);
 /// Split on any run of the given delimiters; `keep_empty` keeps empty fields (tab-separated).
 std::vector<std::string> split(std::string_view s, std::string_view delims, bool keep_empty);
+/// The fields of `s` between `delim`s (empty ones kept), as views into `s`; `out` is reused.
+void split_views(std::string_view s, char delim, std::vector<std::string_view>& out);
 /// Whole file as bytes; InputError naming the file when it cannot be opened.
 std::vector<std::uint8_t> read_file_bytes(const std::string& path);
 std::string read_file_text(const std::string& path);
