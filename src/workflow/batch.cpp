@@ -1,6 +1,7 @@
 #include "kin2grf/workflow/batch.hpp"
 
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -82,6 +83,8 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
     row.error = e.what();
   } catch (const std::exception& e) {
     row.error = std::string("internal error: ") + e.what();
+  } catch (...) {  // nothing may leave a worker thread
+    row.error = "internal error";
   }
   row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return row;
