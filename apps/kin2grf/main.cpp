@@ -112,7 +112,8 @@ int run_estimate(const EstimateArgs& a) {
   const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
   const auto options = kin2grf::to_options(a);
   const auto r = run_estimate_core(a, trial);
-  if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r);
+  const std::string settings_line = kin2grf::settings_json(a, options).dump();
+  if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r, settings_line);
   if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::format_results_csv(r));
   if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(kin2grf::results_summary(r, kin2grf::settings_json(a, options))));
   std::cout << kin2grf::format_results_text(r);
@@ -121,6 +122,7 @@ int run_estimate(const EstimateArgs& a) {
   if (!a.opensim_dir.empty()) {
     kin2grf::OpenSimExportOptions eo;
     if (a.opensim_bodies.size() == 2) eo.right_body = a.opensim_bodies[0], eo.left_body = a.opensim_bodies[1];
+    eo.settings = settings_line;
     const auto f = kin2grf::write_opensim_export(a.opensim_dir, std::filesystem::path(a.trial).stem().string(), trial, r, eo);
     std::cout << "wrote " << f.grf_mot << ", " << f.markers_trc << " and " << f.external_loads_xml
               << " (OpenSim: Y up, X forward; sagittal model: no mediolateral force or free moment)\n";

@@ -81,6 +81,8 @@ OpenSimExportFiles write_opensim_export(const std::string& dir, const std::strin
   Table t = grf_table(trial.markers.time_s, feet[0], feet[1]);
   t.name = stem + "_grf";
   t.header["DataType"] = "double";
+  t.header["kin2grf_version"] = KIN2GRF_VERSION;
+  if (!o.settings.empty()) t.header["kin2grf_settings"] = o.settings;
   OpenSimExportFiles out;
   out.grf_mot = (fs::path(dir) / (stem + "_grf.mot")).string();
   write_file_text(out.grf_mot, format_sto(t));

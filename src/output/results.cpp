@@ -8,11 +8,13 @@
 
 namespace kin2grf {
 
-void write_grf_mot(const std::string& path, const EstimateResult& r) {
+void write_grf_mot(const std::string& path, const EstimateResult& r, const std::string& settings) {
   const auto plates = as_lab_plates(r);
   Table t = grf_table(r.time_s, plates[0], plates[1]);
   t.name = "kin2grf_estimated_grf";
   t.header["DataType"] = "double";
+  t.header["kin2grf_version"] = KIN2GRF_VERSION;
+  if (!settings.empty()) t.header["kin2grf_settings"] = settings;
   write_sto(path, t);
 }
 
@@ -102,6 +104,7 @@ std::vector<std::pair<Eigen::Index, Eigen::Index>> contact_runs(const std::vecto
 nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings) {
   using nlohmann::json;
   json j;
+  j["kin2grf_version"] = KIN2GRF_VERSION;
   j["settings"] = settings;
   j["marker_set"] = r.marker_set;
   j["mass_kg"] = r.mass_kg;

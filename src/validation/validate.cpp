@@ -532,6 +532,7 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
   const double bw = v.mass_kg * e.model.gravity_mps2;
   nlohmann::json j;
   j["trial"] = trial;
+  j["kin2grf_version"] = KIN2GRF_VERSION;
   j["mass_kg"] = v.mass_kg;
   j["settings"] = settings;
   j["per_foot"] = nlohmann::json::array();

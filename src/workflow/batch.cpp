@@ -71,8 +71,8 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
       const std::string csv = base.string() + ".csv", mot = base.string() + "_grf.mot", json = base.string() + ".json";
       for (const auto& o : {csv, mot, json}) ensure_not_an_input(o, inputs);
       write_file_text(csv, format_results_csv(r));
-      write_grf_mot(mot, r);
       auto settings = settings_json(s, to_options(s));
+      write_grf_mot(mot, r, settings.dump());
       write_file_text(json, json_text(v ? validation_json(entry.name, r, *v, settings) : results_summary(r, settings)));
       row.outputs = {csv, mot, json};
     }

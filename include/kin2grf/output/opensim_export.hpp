@@ -29,6 +29,7 @@ namespace kin2grf {
 struct OpenSimExportOptions {
   std::string right_body = "calcn_r";
   std::string left_body = "calcn_l";
+  std::string settings;  ///< the run's settings (compact JSON), recorded in the .mot header
 };
 
 struct OpenSimExportFiles {

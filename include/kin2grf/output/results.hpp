@@ -12,7 +12,9 @@ namespace kin2grf {
 
 /// OpenSim ExternalLoads-ready: ground_force_v/p, ground_torque_ (right), 1_-prefixed (left),
 /// lab frame of the input, metres, force on the body.
-void write_grf_mot(const std::string& path, const EstimateResult& r);
+/// `settings`: the run's settings as one line (compact JSON), written to the header with the
+/// version (kin2grf_version=, kin2grf_settings=).
+void write_grf_mot(const std::string& path, const EstimateResult& r, const std::string& settings = "");
 /// The per-frame results as one table (sagittal frame; units in the column names): what the CSV
 /// writes and the Python module returns. NaN where a value does not exist (COP without contact).
 struct ResultsTable {
