@@ -63,20 +63,25 @@ void check_options(const EstimateOptions& o) {
             "body mass (kg)", *o.mass_kg, "between 20 and 300 (or allowed as unusual)");
 }
 
-EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o) {
-  using clock = std::chrono::steady_clock;
-  const auto t0 = clock::now();
-  check_options(o);
-  EstimateResult r;
-  r.marker_set = set.name;
-  if (o.mass_kg) r.mass_kg = *o.mass_kg;
-  else if (trial.body_mass_kg) r.mass_kg = *trial.body_mass_kg;
-  else throw InputError(trial.path + ": no body mass: the file stores none (PROCESSING:Bodymass, SUBJECT(S):WEIGHT); give the mass");
-  if (!o.mass_kg && !o.allow_unusual_mass && !(r.mass_kg >= kMassRangeKg[0] && r.mass_kg <= kMassRangeKg[1])) {
+namespace {
+
+/// The body mass: the user's, else the file's (checked against kMassRangeKg unless allowed).
+double resolve_mass(const Trial& trial, const EstimateOptions& o) {
+  if (o.mass_kg) return *o.mass_kg;  // checked by check_options
+  if (!trial.body_mass_kg)
+    throw InputError(trial.path + ": no body mass: the file stores none (PROCESSING:Bodymass, SUBJECT(S):WEIGHT); give the mass");
+  const double m = *trial.body_mass_kg;
+  if (!o.allow_unusual_mass && !(m >= kMassRangeKg[0] && m <= kMassRangeKg[1])) {
     char b[200];
-    std::snprintf(b, sizeof b, ": the file's body mass %g kg is outside 20-300 kg; give the mass (or allow an unusual one)", r.mass_kg);
+    std::snprintf(b, sizeof b, ": the file's body mass %g kg is outside 20-300 kg; give the mass (or allow an unusual one)", m);
     throw InputError(trial.path + b);
   }
+  return m;
+}
+
+/// markers -> landmarks -> the sagittal frame and window (r.frame, r.landmarks, r.time_s...).
+void sagittal_stage(const Trial& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o,
+                    EstimateResult& r) {
   if (trial.markers.frames() == 0) throw InputError(trial.path + ": the trial has no marker frames");
   std::vector<std::string> cleaning;
   const std::optional<MarkerTrajectories> cleaned = without_marker_outliers(trial.markers, set.motion_markers(), cleaning);
@@ -102,7 +107,12 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     throw InputError(trial.path + ": cut-off frequencies must be below half the marker rate (" + std::to_string(lm.rate_hz) + " Hz)");
   r.time_s = lm.time_s;
 
-  // Model: fixed segment lengths (medians over the window), anthropometry, contact calibration.
+}
+
+/// The model: fixed segment lengths (medians over the window), anthropometry, ground level and
+/// the contact calibration.
+void model_stage(const EstimateOptions& o, EstimateResult& r) {
+  const SagittalLandmarks& lm = r.landmarks;
   const BodyGeometry geom = measure_geometry(lm);
   r.model = build_model(geom, r.mass_kg, anthropometric_table(o.anthropometry));
   std::string gmsg;
@@ -114,7 +124,11 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   for (int s = 0; s < 2; ++s)
     if (flat[s] < 3) r.messages.push_back(std::string(s ? "left" : "right") + " foot: only " + std::to_string(flat[s]) +
                                           " foot-flat frames for the contact calibration");
+}
 
+/// Model coordinates and their derivatives, filtered at the kinematic cut-off.
+ModelMotion kinematics_stage(const EstimateOptions& o, EstimateResult& r) {
+  const SagittalLandmarks& lm = r.landmarks;
   // The kinematic cut-off: the user's (6 Hz), lowered where the markers' own noise needs it
   // (Winter's residual analysis on the landmarks, noise_limited_cutoff).
   r.kinematic_cutoff_hz = o.kinematic_cutoff_hz;
@@ -128,7 +142,13 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
       r.messages.emplace_back(b);
     }
   }
-  ModelMotion motion = compute_motion(r.model, lm, r.kinematic_cutoff_hz, o.torso_length);
+  return compute_motion(r.model, lm, r.kinematic_cutoff_hz, o.torso_length);
+}
+
+/// The contact points of every frame (D* filled into the motion), the belt velocity and the
+/// speed gate; `so` becomes the trial's solver options.
+std::vector<FrameContacts> contact_stage(const EstimateOptions& o, EstimateResult& r, ModelMotion& motion, SolverOptions& so) {
+  const SagittalLandmarks& lm = r.landmarks;
   ContactModelOptions co = o.contact;
   co.ground_level_m = r.ground_level_m;
   std::vector<bool> running;
@@ -143,7 +163,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     }
   }
   const auto contacts = prepare_contacts(r.model, co, motion, running);
-  SolverOptions so = o.solver;
+  so = o.solver;
   if (r.frame.treadmill) {
     // Belt velocity (always measured, whatever the gate): the median horizontal velocity of the
     // lowest sole point over foot-flat-like frames.
@@ -171,14 +191,28 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     r.messages.push_back(b);
   }
   r.frame.belt_velocity_mps = so.belt_velocity_mps;
-  const auto t1 = clock::now();
+  return contacts;
+}
 
+/// The per-frame solve's raw results (before the post-filter).
+struct RawSolve {
+  Eigen::MatrixXd lambda, torque;  ///< N x 2 np contact multipliers (n, t); N x 8 joint torques
+  std::vector<std::array<bool, kMaxContactPoints>> active;
+};
+
+/// Eqs. 5-10 on every frame (least squares, activation, semi-smooth iterations).
+RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResult& r, const ModelMotion& motion,
+                     const std::vector<FrameContacts>& contacts, const SolverOptions& so) {
   const Eigen::Index n = motion.frames();
   ContactSolver solver(r.model, so);
   const int np = static_cast<int>(contacts.front().points.size());
-  Eigen::MatrixXd lam(n, 2 * np);
-  Eigen::MatrixXd torque(n, kJointCount);
-  std::vector<std::array<bool, kMaxContactPoints>> act(static_cast<std::size_t>(n));
+  RawSolve raw;
+  raw.lambda.resize(n, 2 * np);
+  raw.torque.resize(n, kJointCount);
+  raw.active.resize(static_cast<std::size_t>(n));
+  Eigen::MatrixXd& lam = raw.lambda;
+  Eigen::MatrixXd& torque = raw.torque;
+  auto& act = raw.active;
   r.iterations.resize(static_cast<std::size_t>(n));
   const Eigen::Index step = std::max<Eigen::Index>(1, n / 100);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -197,13 +231,19 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
     if (!lam.row(i).allFinite() || !torque.row(i).allFinite())
       throw InputError(trial.path + ": the contact solve gave a non-finite force at frame " +
                        std::to_string(r.first_frame_number + static_cast<int>(i)) + " (check the markers there)");
-  const auto t2 = clock::now();
-  r.seconds_kinematics = std::chrono::duration<double>(t1 - t0).count();
-  r.seconds_dynamics = std::chrono::duration<double>(t2 - t1).count();
+  return raw;
+}
 
+/// The post-filter (Sect. 2.6) and each foot's force, COP, contact state, gap and sole.
+void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, const std::vector<FrameContacts>& contacts,
+                const RawSolve& raw) {
+  const Eigen::Index n = raw.lambda.rows();
+  const int np = static_cast<int>(contacts.front().points.size());
+  const Eigen::MatrixXd& lam = raw.lambda;
+  const auto& act = raw.active;
   // Final filtering (Sect. 2.6): all multipliers at post_cutoff, then inactive ones back to zero.
-  Eigen::MatrixXd lamf = o.post_cutoff_hz > 0 ? butterworth_filtfilt(lam, motion.rate_hz, o.post_cutoff_hz) : lam;
-  r.joint_torque_Nm = o.post_cutoff_hz > 0 ? butterworth_filtfilt(torque, motion.rate_hz, o.post_cutoff_hz) : torque;
+  Eigen::MatrixXd lamf = o.post_cutoff_hz > 0 ? butterworth_filtfilt(lam, rate_hz, o.post_cutoff_hz) : lam;
+  r.joint_torque_Nm = o.post_cutoff_hz > 0 ? butterworth_filtfilt(raw.torque, rate_hz, o.post_cutoff_hz) : raw.torque;
   for (Eigen::Index i = 0; i < n; ++i)
     for (int j = 0; j < np; ++j)
       if (!act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;
@@ -251,6 +291,11 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
       r.messages.push_back(b);
     }
   }
+}
+
+/// Whole-body totals from the kinematics alone, the GRM, the dynamic residual and joint forces.
+void totals_stage(const EstimateOptions& o, EstimateResult& r, const ModelMotion& motion) {
+  const Eigen::Index n = motion.frames();
   // GRM about the reference point, residual and joint forces.
   r.grm_Nm = Eigen::VectorXd::Zero(n);
   r.residual = Eigen::MatrixX3d::Zero(n, 3);
@@ -287,6 +332,29 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
       r.joint_force_N(i, 2 * j + 1) = F.y();
     }
   }
+}
+
+}  // namespace
+
+EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  check_options(o);
+  EstimateResult r;
+  r.marker_set = set.name;
+  r.mass_kg = resolve_mass(trial, o);
+  sagittal_stage(trial, static_trial, set, o, r);
+  model_stage(o, r);
+  ModelMotion motion = kinematics_stage(o, r);
+  SolverOptions so;
+  const auto contacts = contact_stage(o, r, motion, so);
+  const auto t1 = clock::now();
+  const RawSolve raw = solve_stage(trial, o, r, motion, contacts, so);
+  const auto t2 = clock::now();
+  r.seconds_kinematics = std::chrono::duration<double>(t1 - t0).count();
+  r.seconds_dynamics = std::chrono::duration<double>(t2 - t1).count();
+  feet_stage(o, r, motion.rate_hz, contacts, raw);
+  totals_stage(o, r, motion);
   return r;
 }
 
