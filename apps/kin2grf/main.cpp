@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -330,22 +331,9 @@ int run_batch(const BatchArgs& a) {
   std::cerr << "kin2grf: batch of " << entries.size() << " trials on " << o.jobs << " threads\n";
   const auto rows = kin2grf::run_batch(entries, o);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The summary: one line a trial.
-  std::printf("%-28s %-8s %7s %6s %7s %7s %7s %7s  %s\n", "trial", "status", "frames", "s", "vert %", "ant %", "COP %",
-              "GRM %", "");
-  int failed = 0;
-  for (const auto& r : rows) {
-    auto pct = [](double v) {
-      char buf[32] = "-";
-      if (std::isfinite(v)) std::snprintf(buf, sizeof buf, "%.1f", v);
-      return std::string(buf);
-    };
-    if (!r.ok) ++failed;
-    std::printf("%-28.28s %-8s %7ld %6.1f %7s %7s %7s %7s  %s\n", r.name.c_str(), r.ok ? "ok" : "FAILED", r.frames, r.seconds,
-                pct(r.vertical).c_str(), pct(r.anterior).c_str(), pct(r.cop).c_str(), pct(r.total_grm).c_str(),
-                r.ok ? "" : r.error.substr(0, r.error.find('\n')).c_str());
-  }
-  std::printf("%zu trials, %d failed, %.1f s on %d threads\n", rows.size(), failed, wall, o.jobs);
+  std::cout << kin2grf::format_batch_table(rows);
+  const auto failed = std::count_if(rows.begin(), rows.end(), [](const kin2grf::BatchRow& r) { return !r.ok; });
+  std::printf("%zu trials, %ld failed, %.1f s on %d threads\n", rows.size(), static_cast<long>(failed), wall, o.jobs);
   if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::batch_csv(rows));
   if (!a.out_json.empty()) {
     auto j = kin2grf::batch_json(rows);
@@ -355,39 +343,9 @@ int run_batch(const BatchArgs& a) {
   return failed == 0 ? 0 : 1;
 }
 
-/// The bundled examples: a synthetic level walk over two force plates and a squat on two plates,
-/// of the project's own making (kin2grf's own C3D, TRC and MOT writers). The walk's plates share
-/// the model's kinematic totals between the feet by a rule that is not the method's; the squat's
-/// carry the method's own estimate.
+/// The bundled examples (write_examples): a walk over two plates and a squat.
 int run_make_example(const std::string& dir, double seconds) {
-  if (!(std::isfinite(seconds) && seconds >= 1.0 && seconds <= 600.0))
-    throw kin2grf::InputError("--seconds " + std::to_string(seconds) + ": must be between 1 and 600");
-  std::filesystem::create_directories(dir);
-  {
-    kin2grf::SyntheticWalkOptions wo;
-    wo.duration_s = std::max(seconds, 2.5 * wo.stride_time_s);
-    const kin2grf::Trial walk = kin2grf::make_example_walk(wo);
-    const std::string base = (std::filesystem::path(dir) / "example_walk").string();
-    kin2grf::write_c3d(base + ".c3d", walk);
-    kin2grf::write_trc(base + ".trc", walk.markers);
-    const auto& p = walk.plates->plates;
-    auto t = kin2grf::grf_table(walk.plates->time_s, p[0], p[1]);
-    t.name = "kin2grf_example_walk_plates";
-    kin2grf::write_sto(base + "_grf.mot", t);
-    std::cout << "wrote " << base << ".c3d, .trc and _grf.mot (a walk over plates FP1 and FP2)\n";
-  }
-  kin2grf::SyntheticOptions so;
-  so.duration_s = seconds;
-  kin2grf::Trial t = kin2grf::make_synthetic_trial(so);
-  const auto* set = kin2grf::find_marker_set("kin2grf-example");
-  kin2grf::EstimateOptions eo;
-  const auto r = kin2grf::estimate(t, nullptr, *set, eo);
-  t.plates = kin2grf::example_plates(r, t, 0);
-  const std::string base = (std::filesystem::path(dir) / "example_squat").string();
-  kin2grf::write_c3d(base + ".c3d", t);
-  kin2grf::write_trc(base + ".trc", t.markers);
-  kin2grf::write_grf_mot(base + "_grf.mot", r);
-  std::cout << "wrote " << base << ".c3d, .trc and _grf.mot (a squat on two plates)\n";
+  for (const auto& line : kin2grf::write_examples(dir, seconds)) std::cout << "wrote " << line << "\n";
   return 0;
 }
 

@@ -19,9 +19,14 @@
 // common shift of the COPs makes the moment exact. So the plates agree with the kinematics
 // exactly, and the method's per-foot split and COP are tested against an independent rule.
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/c3d.hpp"
 #include "kin2grf/io/force_plate.hpp"
+#include "kin2grf/io/opensim.hpp"
+#include "kin2grf/output/results.hpp"
 #include "kin2grf/markers/landmarks.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
@@ -249,6 +254,41 @@ Trial make_example_walk(const SyntheticWalkOptions& o) {
   w.trial.plates = rec;
   w.trial.path = "synthetic walk";
   return w.trial;
+}
+
+std::vector<std::string> write_examples(const std::string& dir, double seconds) {
+  if (!(std::isfinite(seconds) && seconds >= 1.0 && seconds <= 600.0))
+  {
+    char b[128];
+    std::snprintf(b, sizeof b, "example duration (--seconds) %g s: must be between 1 and 600", seconds);
+    throw InputError(b);
+  }
+  std::filesystem::create_directories(dir);
+  std::vector<std::string> written;
+  {
+    SyntheticWalkOptions wo;
+    wo.duration_s = std::max(seconds, 2.5 * wo.stride_time_s);
+    const Trial walk = make_example_walk(wo);
+    const std::string base = (std::filesystem::path(dir) / "example_walk").string();
+    write_c3d(base + ".c3d", walk);
+    write_trc(base + ".trc", walk.markers);
+    const auto& p = walk.plates->plates;
+    auto t = grf_table(walk.plates->time_s, p[0], p[1]);
+    t.name = "kin2grf_example_walk_plates";
+    write_sto(base + "_grf.mot", t);
+    written.push_back(base + ".c3d, .trc and _grf.mot (a walk over plates FP1 and FP2)");
+  }
+  SyntheticOptions so;
+  so.duration_s = seconds;
+  Trial t = make_synthetic_trial(so);
+  const EstimateResult r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+  t.plates = example_plates(r, t, 0);
+  const std::string base = (std::filesystem::path(dir) / "example_squat").string();
+  write_c3d(base + ".c3d", t);
+  write_trc(base + ".trc", t.markers);
+  write_grf_mot(base + "_grf.mot", r);
+  written.push_back(base + ".c3d, .trc and _grf.mot (a squat on two plates)");
+  return written;
 }
 
 }  // namespace kin2grf

@@ -150,6 +150,26 @@ std::string batch_csv(const std::vector<BatchRow>& rows) {
   return os.str();
 }
 
+std::string format_batch_table(const std::vector<BatchRow>& rows) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "%-28s %-8s %7s %6s %7s %7s %7s %7s\n", "trial", "status", "frames", "s", "vert %", "ant %",
+                "COP %", "GRM %");
+  out += line;
+  auto pct = [](double v) {
+    char buf[32] = "-";
+    if (std::isfinite(v)) std::snprintf(buf, sizeof buf, "%.1f", v);
+    return std::string(buf);
+  };
+  for (const auto& r : rows) {
+    std::snprintf(line, sizeof line, "%-28.28s %-8s %7ld %6.1f %7s %7s %7s %7s  %s\n", r.name.c_str(), r.ok ? "ok" : "FAILED",
+                  r.frames, r.seconds, pct(r.vertical).c_str(), pct(r.anterior).c_str(), pct(r.cop).c_str(),
+                  pct(r.total_grm).c_str(), r.ok ? "" : r.error.substr(0, r.error.find('\n')).substr(0, 200).c_str());
+    out += line;
+  }
+  return out;
+}
+
 nlohmann::json batch_row_json(const BatchRow& r) {
   return {{"activity", r.activity}, {"lab", r.lab}, {"name", r.name}, {"trial", r.trial}, {"ok", r.ok},
           {"error", r.ok ? nlohmann::json(nullptr) : nlohmann::json(r.error)}, {"frames", r.frames},

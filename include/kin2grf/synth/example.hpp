@@ -76,4 +76,10 @@ std::array<ForcePlate, 2> synthetic_walk_feet(const SyntheticWalk& walk, const E
 /// COP is over it).
 Trial make_example_walk(const SyntheticWalkOptions& options = {});
 
+/// The bundled examples in `dir` (`kin2grf make-example`): example_walk.c3d/.trc/_grf.mot (the
+/// walk, at least 2.5 strides long) and example_squat.c3d/.trc/_grf.mot (a squat on two plates
+/// whose signals are the method's own estimate), `seconds` long (1-600). Returns what was written,
+/// a line per example.
+std::vector<std::string> write_examples(const std::string& dir, double seconds);
+
 }  // namespace kin2grf

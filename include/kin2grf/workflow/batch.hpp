@@ -53,6 +53,8 @@ std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, cons
 /// The summary table: CSV (one header line, one line per trial; empty cells for NaN) and JSON
 /// (an array of objects with the same fields, null for NaN).
 std::string batch_csv(const std::vector<BatchRow>& rows);
+/// For a person: one line a trial (status, frames, seconds, mean rRMSE %, the error's first line).
+std::string format_batch_table(const std::vector<BatchRow>& rows);
 nlohmann::json batch_json(const std::vector<BatchRow>& rows);
 nlohmann::json batch_row_json(const BatchRow& row);
 
