@@ -270,9 +270,9 @@ TEST(Estimate, PrescribedSingleSupportRecoversTheExactContactForce) {
   EXPECT_DOUBLE_EQ(s.force_N[1].y(), 0.0);
 }
 
-// The sparse factorisation of the bilateral block and a dense rank-revealing one give the same
+// The structured factorisation (normal equations, compiled L D L^T) and a dense rank-revealing one give the same
 // multipliers on every frame of a squat (double support) and a single-support trial.
-TEST(Solver, SparseAndDenseFactorisationsAgree) {
+TEST(Solver, StructuredAndDenseFactorisationsAgree) {
   for (double raised : {0.0, 0.6}) {
     SyntheticOptions so;
     so.left_leg_raised_rad = raised;
@@ -282,12 +282,12 @@ TEST(Solver, SparseAndDenseFactorisationsAgree) {
     ContactModelOptions co;
     co.ground_level_m = r.ground_level_m;
     const auto contacts = prepare_contacts(r.model, co, mm);
-    SolverOptions sparse_opt, dense_opt;
+    SolverOptions structured_opt, dense_opt;
     dense_opt.dense_factorisation = true;
-    ContactSolver sparse(r.model, sparse_opt), dense(r.model, dense_opt);
+    ContactSolver structured(r.model, structured_opt), dense(r.model, dense_opt);
     for (Eigen::Index i = 0; i < mm.frames(); i += 11) {
       const Eigen::VectorXd q = mm.q.row(i).transpose(), qdd = mm.qdd.row(i).transpose();
-      const auto a = sparse.solve(q, qdd, contacts[static_cast<std::size_t>(i)]);
+      const auto a = structured.solve(q, qdd, contacts[static_cast<std::size_t>(i)]);
       const auto b = dense.solve(q, qdd, contacts[static_cast<std::size_t>(i)]);
       ASSERT_EQ(a.contact_active, b.contact_active) << "frame " << i;
       EXPECT_LT((a.contact_lambda - b.contact_lambda).cwiseAbs().maxCoeff(), 1e-6) << "frame " << i;

@@ -218,7 +218,7 @@ FrameSolution ContactSolver::solve(const FrameVector& q, const FrameVector& qdd,
 }
 
 FrameSolution ContactSolver::solve_dense(const Eigen::MatrixXd& Bd, const FrameVector& qdd, const FrameContacts& fc) {
-  // Rank-revealing dense fallback (a degenerate geometry the sparse factorisation flags).
+  // Rank-revealing dense fallback (a degenerate geometry the structured factorisation flags with a vanishing pivot).
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Bd);
   Columns X;
   contact_columns(qdd, fc, X);
