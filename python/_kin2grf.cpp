@@ -32,12 +32,12 @@ kin2grf::Settings settings_from(const std::string& trial, const std::vector<std:
   return s;
 }
 
-py::dict estimate_dict(const kin2grf::Settings& s, const kin2grf::EstimateResult& r) {
+py::dict estimate_dict(const kin2grf::Settings& s, const kin2grf::EstimateOptions& o, const kin2grf::EstimateResult& r) {
   const auto table = kin2grf::results_table(r);
   py::dict d;
   d["columns"] = table.columns;
   d["values"] = table.values;
-  d["summary"] = to_python(kin2grf::results_summary(r, kin2grf::settings_json(s, kin2grf::to_options(s))));
+  d["summary"] = to_python(kin2grf::results_summary(r, kin2grf::settings_json(s, o)));
   d["messages"] = r.messages;
   return d;
 }
@@ -45,12 +45,14 @@ py::dict estimate_dict(const kin2grf::Settings& s, const kin2grf::EstimateResult
 py::dict estimate(const std::string& trial, const std::vector<std::string>& words) {
   const auto s = settings_from(trial, words);
   kin2grf::EstimateResult r;
+  kin2grf::EstimateOptions o;
   {
     py::gil_scoped_release nogil;
     const auto t = kin2grf::load_trial(s.trial);
-    r = kin2grf::estimate_trial(s, t);
+    o = kin2grf::to_options(s);
+    r = kin2grf::estimate_trial(s, o, t);
   }
-  return estimate_dict(s, r);
+  return estimate_dict(s, o, r);
 }
 
 py::dict validate(const std::string& trial, const std::vector<std::string>& words, const std::string& plates,
@@ -62,6 +64,7 @@ py::dict validate(const std::string& trial, const std::vector<std::string>& word
   vo.threshold_N = threshold_N;
   std::optional<kin2grf::EstimateResult> r;
   std::optional<kin2grf::ValidationResult> v;
+  kin2grf::EstimateOptions o;
   {
     py::gil_scoped_release nogil;
     const auto t = kin2grf::load_trial(s.trial, kin2grf::load_options(zero_offset));
@@ -70,16 +73,17 @@ py::dict validate(const std::string& trial, const std::vector<std::string>& word
     const kin2grf::Trial& source = pf ? *pf : t;
     if (!source.plates || source.plates->plates.empty())
       throw kin2grf::InputError(source.path + ": no force plates to validate against" + (pf ? "" : "; give plates=FILE"));
-    r = kin2grf::estimate_trial(s, t);
+    o = kin2grf::to_options(s);
+    r = kin2grf::estimate_trial(s, o, t);
     v = kin2grf::validate(*r, *source.plates, vo);
   }
-  auto settings = kin2grf::settings_json(s, kin2grf::to_options(s));
+  auto settings = kin2grf::settings_json(s, o);
   settings["plates"] = plates;
   settings["threshold_N"] = threshold_N;
   settings["zero_offset"] = zero_offset;
   py::dict d;
   d["validation"] = to_python(kin2grf::validation_json(s.trial, *r, *v, settings));
-  d["estimate"] = estimate_dict(s, *r);
+  d["estimate"] = estimate_dict(s, o, *r);
   return d;
 }
 

@@ -106,7 +106,6 @@ void sagittal_stage(const Trial& trial, const Trial* static_trial, const MarkerS
   if (2.0 * o.kinematic_cutoff_hz >= lm.rate_hz || 2.0 * o.post_cutoff_hz >= lm.rate_hz)
     throw InputError(trial.path + ": cut-off frequencies must be below half the marker rate (" + std::to_string(lm.rate_hz) + " Hz)");
   r.time_s = lm.time_s;
-
 }
 
 /// The model: fixed segment lengths (medians over the window), anthropometry, ground level and

@@ -84,8 +84,9 @@ std::function<void(long, long)> progress_printer(const kin2grf::Trial& trial) {
   };
 }
 
-kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, const kin2grf::Trial& trial) {
-  auto r = kin2grf::estimate_trial(a, trial, progress_printer(trial));
+kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, kin2grf::EstimateOptions options, const kin2grf::Trial& trial) {
+  options.progress = progress_printer(trial);
+  auto r = kin2grf::estimate_trial(a, std::move(options), trial);
   for (const auto& m : r.messages) std::cerr << "kin2grf: " << m << "\n";
   std::cerr << "kin2grf: " << r.time_s.size() << " frames, mass " << r.mass_kg << " kg, "
             << static_cast<long>(static_cast<double>(r.time_s.size()) / std::max(1e-9, r.seconds_kinematics + r.seconds_dynamics))
@@ -112,7 +113,7 @@ int run_estimate(const EstimateArgs& a) {
   check_outputs(opensim_outputs(a), kin2grf::input_files(a));
   const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
   const auto options = kin2grf::to_options(a);
-  const auto r = run_estimate_core(a, trial);
+  const auto r = run_estimate_core(a, options, trial);
   const std::string settings_line = kin2grf::settings_json(a, options).dump();
   if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r, settings_line);
   if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::format_results_csv(r));
@@ -155,7 +156,7 @@ int run_validate(const ValidateArgs& a) {
     throw kin2grf::InputError(source.path + ": no force plates to validate against" +
                               (plates_file ? std::string() : std::string("; give --plates GRF.mot")));
   const auto options = kin2grf::to_options(a.est);
-  const auto r = run_estimate_core(a.est, trial);
+  const auto r = run_estimate_core(a.est, options, trial);
   const auto v = kin2grf::validate(r, *source.plates, a.options);
   nlohmann::json settings = kin2grf::settings_json(a.est, options);
   settings["plates"] = source.path;

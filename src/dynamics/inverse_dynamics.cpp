@@ -19,6 +19,14 @@ namespace {
 
 constexpr int kRigidRows = 40, kDefRows = 40, kRheoRows = 48;
 
+/// The (x, y) pairs of q: the landmark points, the segments' COMs and D*. k-th pair's x column.
+constexpr int kXyPairs = coord::kComs / 2 + kSegmentCount + 2;
+constexpr int xy_coordinate(int k) {
+  return k < coord::kComs / 2 ? coord::point_x(k)
+         : k < coord::kComs / 2 + kSegmentCount ? coord::com_x(k - coord::kComs / 2)
+                                               : coord::dstar_x(k - coord::kComs / 2 - kSegmentCount);
+}
+
 }  // namespace
 
 ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
@@ -36,13 +44,13 @@ ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
   Eigen::VectorXd generic(coord::kCount);
   for (int i = 0; i < coord::kCount; ++i) generic[i] = 0.37 + 0.113 * i;
   const Eigen::MatrixXd Phi = bilateral_jacobian(generic);
-  phi_column_start_.assign(coord::kCount + 1, 0);
+  std::vector<int> phi_column_start(coord::kCount + 1, 0);  // per coordinate: its entries in phi_entries_
   for (int c = 0; c < coord::kCount; ++c) {
-    phi_column_start_[static_cast<std::size_t>(c)] = static_cast<int>(phi_entries_.size());
+    phi_column_start[static_cast<std::size_t>(c)] = static_cast<int>(phi_entries_.size());
     for (int r = 0; r < kBilateralCount; ++r)
       if (Phi(r, c) != 0.0) phi_entries_.push_back({r, c});
   }
-  phi_column_start_[coord::kCount] = static_cast<int>(phi_entries_.size());
+  phi_column_start[coord::kCount] = static_cast<int>(phi_entries_.size());
   // N's pattern, an AMD order of it, and the factor's fill (symbolic elimination).
   const Eigen::MatrixXd Npattern = (Phi.cwiseAbs() * Phi.cwiseAbs().transpose()).unaryExpr([](double v) { return v != 0.0 ? 1.0 : 0.0; });
   Eigen::SparseMatrix<double> Nsparse = Npattern.sparseView();
@@ -60,7 +68,7 @@ ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
       if (fill(i, k))
         for (int j = k + 1; j <= i; ++j)
           if (fill(j, k)) fill(i, j) = fill(j, i) = true;
-  // The factor's entries, row by row (k ascending): entry e is L(factor_i_[e], factor_k_[e]).
+  // The factor's entries, row by row (k ascending): entry e of row i is L(i, factor_k_[e]).
   std::array<std::array<int, kBilateralCount>, kBilateralCount> entry{};
   for (auto& row : entry) row.fill(-1);
   factor_row_start_.assign(kBilateralCount + 1, 0);
@@ -90,7 +98,7 @@ ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
   // N = Phi Phi^T assembled from the products of Phi's entries that share a coordinate: each
   // product goes to a diagonal place (target < 0: -1 - row) or a factor entry.
   for (int c = 0; c < coord::kCount; ++c) {
-    const int b0 = phi_column_start_[static_cast<std::size_t>(c)], b1 = phi_column_start_[static_cast<std::size_t>(c) + 1];
+    const int b0 = phi_column_start[static_cast<std::size_t>(c)], b1 = phi_column_start[static_cast<std::size_t>(c) + 1];
     for (int a = b0; a < b1; ++a)
       for (int b = b0; b <= a; ++b) {
         const int ia = order_[static_cast<std::size_t>(phi_entries_[static_cast<std::size_t>(a)][0])];
@@ -102,6 +110,11 @@ ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
   Lv_.assign(factor_k_.size(), 0.0);
   D_.setZero();
   phi_values_.assign(phi_entries_.size(), 0.0);
+  // U's translation columns (the body moved along x, along y) do not depend on q: once here.
+  U_.setZero();
+  for (int k = 0; k < kXyPairs; ++k) U_(xy_coordinate(k), 0) = U_(xy_coordinate(k) + 1, 1) = 1.0;
+  U_.col(0).normalize();
+  U_.col(1).normalize();
 }
 
 bool ContactSolver::factorise_normal_equations() {
@@ -196,23 +209,20 @@ FrameSolution ContactSolver::solve(const FrameVector& q, const FrameVector& qdd,
       Zt_.col(factor_k_[static_cast<std::size_t>(e)]) -= Lv_[static_cast<std::size_t>(e)] * Zt_.col(i);
   BpX_.resize(kBilateralCount, m);
   for (int r = 0; r < kBilateralCount; ++r) BpX_.row(r) = Zt_.col(order_[static_cast<std::size_t>(r)]).transpose();
-  // U: the whole body's rigid motions (x, y, rotation about the origin), orthonormalised.
-  U_.setZero();
-  for (int k = 0; k < coord::kComs / 2 + kSegmentCount + 2; ++k) {
-    // points, COMs and D*: every (x, y) pair of q
-    const int c = k < coord::kComs / 2 ? 2 * k : k < coord::kComs / 2 + kSegmentCount ? coord::com_x(k - coord::kComs / 2)
-                                                                                        : coord::dstar_x(k - coord::kComs / 2 - kSegmentCount);
-    U_(c, 0) = 1.0;
-    U_(c + 1, 1) = 1.0;
-    U_(c, 2) = -q[c + 1];
-    U_(c + 1, 2) = q[c];
+  // U's rotation column, the body turned about the origin: every (x, y) of q moves by (-y, x),
+  // every absolute angle by 1, the relative angles not at all; orthonormal to the translations
+  // (Gram-Schmidt, twice for round-off).
+  auto rotation = U_.col(2);
+  rotation.setZero();
+  for (int k = 0; k < kXyPairs; ++k) {
+    const int c = xy_coordinate(k);
+    rotation[c] = -q[c + 1];
+    rotation[c + 1] = q[c];
   }
-  for (int s = 0; s < kSegmentCount; ++s) U_(coord::theta(s), 2) = 1.0;
-  for (int a = 0; a < 3; ++a) {  // Gram-Schmidt, twice for round-off
-    for (int pass = 0; pass < 2; ++pass)
-      for (int b = 0; b < a; ++b) U_.col(a) -= U_.col(b).dot(U_.col(a)) * U_.col(b);
-    U_.col(a).normalize();
-  }
+  for (int s = 0; s < kSegmentCount; ++s) rotation[coord::theta(s)] = 1.0;
+  for (int pass = 0; pass < 2; ++pass)
+    for (int b = 0; b < 2; ++b) rotation -= U_.col(b).dot(rotation) * U_.col(b);
+  rotation.normalize();
   UtX_.leftCols(m).noalias() = U_.transpose() * X_;
   return solve_reduced(BpX_, UtX_.leftCols(m), fc);
 }

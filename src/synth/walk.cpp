@@ -77,6 +77,9 @@ FootPose stance_pose(double heel_x, double p, const SyntheticWalkOptions& o) {
   return f;
 }
 
+/// The right foot's first heel strike (x, m): its ankle is under the hip at mid-stance.
+double right_first_heel_x(const SyntheticWalkOptions& o) { return 0.3 * o.speed_mps * o.stride_time_s - kAnkle.x(); }
+
 FootPose foot_pose(double cycles, double first_heel_x, const SyntheticWalkOptions& o) {
   const double stride = o.speed_mps * o.stride_time_s;
   const double k = std::floor(cycles), p = cycles - k;
@@ -107,8 +110,7 @@ SyntheticWalk make_synthetic_walk(const SyntheticWalkOptions& o) {
   auto& m = w.trial.markers;
   const auto n = static_cast<int>(m.frames());
   const double Lsh = 0.43, Lth = 0.44, Lt = 0.55, T = o.stride_time_s, v = o.speed_mps;
-  // The right foot's first heel strike puts its ankle under the hip at mid-stance.
-  const double first_heel_x = 0.3 * v * T - kAnkle.x();
+  const double first_heel_x = right_first_heel_x(o);
   for (auto& f : w.nominal_cop_x_m) f = Eigen::VectorXd::Constant(n, std::nan(""));
   for (auto& c : w.stance) c.assign(static_cast<std::size_t>(n), false);
   for (auto& s : w.stance_phase) s = Eigen::VectorXd::Zero(n);
@@ -205,8 +207,8 @@ Trial make_example_walk(const SyntheticWalkOptions& o) {
   // Two plates in series along the walkway, 0.6 m long and 0.5 m wide, each under one stance of
   // the middle stride: the right foot's on FP1, the left foot's next on FP2.
   const double v = o.speed_mps, T = o.stride_time_s;
-  const int stride = std::max(1, static_cast<int>(std::floor(o.duration_s / T / 2)) - 0);
-  const double right_heel = 0.3 * v * T - kAnkle.x() + stride * v * T, left_heel = right_heel + 0.5 * v * T;
+  const int stride = std::max(1, static_cast<int>(std::floor(o.duration_s / T / 2)));
+  const double right_heel = right_first_heel_x(o) + stride * v * T, left_heel = right_heel + 0.5 * v * T;
   ForcePlateRecording rec;
   rec.rate_hz = w.trial.markers.rate_hz;
   rec.time_s = w.trial.markers.time_s;
@@ -252,7 +254,6 @@ Trial make_example_walk(const SyntheticWalkOptions& o) {
     rec.plates.push_back(p);
   }
   w.trial.plates = rec;
-  w.trial.path = "synthetic walk";
   return w.trial;
 }
 

@@ -48,7 +48,8 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
     const Trial trial = load_trial(entry.settings.trial, load_options("unloaded"));
     std::optional<Trial> plates_file;
     if (!entry.plates.empty()) plates_file = load_trial(entry.plates, load_options("unloaded"));
-    const EstimateResult r = estimate_trial(entry.settings, trial);
+    const EstimateOptions estimate_options = to_options(entry.settings);
+    const EstimateResult r = estimate_trial(entry.settings, estimate_options, trial);
     row.frames = static_cast<long>(r.time_s.size());
     row.duration_s = r.time_s.size() > 1 ? r.time_s[r.time_s.size() - 1] - r.time_s[0] : 0.0;
     row.mass_kg = r.mass_kg;
@@ -71,7 +72,7 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
       const std::string csv = base.string() + ".csv", mot = base.string() + "_grf.mot", json = base.string() + ".json";
       for (const auto& o : {csv, mot, json}) ensure_not_an_input(o, inputs);
       write_file_text(csv, format_results_csv(r));
-      auto settings = settings_json(s, to_options(s));
+      auto settings = settings_json(s, estimate_options);
       write_grf_mot(mot, r, settings.dump());
       write_file_text(json, json_text(v ? validation_json(entry.name, r, *v, settings) : results_summary(r, settings)));
       row.outputs = {csv, mot, json};

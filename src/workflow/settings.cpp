@@ -181,14 +181,12 @@ std::vector<std::string> input_files(const Settings& a) {
   return in;
 }
 
-EstimateResult estimate_trial(const Settings& s, const Trial& trial, std::function<void(long, long)> progress) {
+EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial) {
   std::optional<Trial> st;
   if (!s.static_trial.empty()) st = load_trial(s.static_trial);
   MarkerSet custom;
   std::string why;
   const MarkerSet& set = resolve_marker_set(s, trial, custom, &why);
-  auto options = to_options(s);
-  options.progress = std::move(progress);
   try {
     auto r = estimate(trial, st ? &*st : nullptr, set, options);
     if (!why.empty()) r.messages.insert(r.messages.begin(), "marker set recognised: " + why);

@@ -128,7 +128,6 @@ class ContactSolver {
   // The structure of N = Phi Phi^T and of its factor, found once (constructor).
   std::array<int, kBilateralCount> order_{};            ///< constraint row -> its place in the factor
   std::vector<std::array<int, 2>> phi_entries_;         ///< (row, coordinate) of Phi's structural non-zeros
-  std::vector<int> phi_column_start_;                   ///< per coordinate: its entries in phi_entries_
   std::vector<int> factor_row_start_, factor_k_;        ///< factor row i: entries [start_i, start_i+1), columns k
   std::vector<int> update_start_;                       ///< per entry: its updates in updates_
   std::vector<std::array<int, 3>> updates_;             ///< (entry L(i, m), entry L(k, m), m)
@@ -137,7 +136,7 @@ class ContactSolver {
   Eigen::Matrix<double, kBilateralCount, 1> D_;
   Columns X_, BpX_;                                     ///< per-frame buffers (no heap)
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxColumns, kBilateralCount> Zt_;
-  Eigen::Matrix<double, coord::kCount, 3> U_;
+  Eigen::Matrix<double, coord::kCount, 3> U_;           ///< translations (once per trial), rotation (per frame)
   Eigen::Matrix<double, 3, kMaxColumns> UtX_;
 };
 

@@ -65,9 +65,9 @@ const MarkerSet& resolve_marker_set(const Settings& s, const Trial& trial, Marke
 /// The files a run with these settings reads (no output may be one of them).
 std::vector<std::string> input_files(const Settings& s);
 
-/// Loads the static trial, resolves the marker set and runs estimate() on `trial`; the marker
-/// set's recognition goes into the result's messages.
-EstimateResult estimate_trial(const Settings& s, const Trial& trial,
-                              std::function<void(long, long)> progress = {});
+/// Loads the static trial, resolves the marker set and runs estimate() on `trial` with `options`
+/// (to_options(s), resolved once by the caller, who also records them); the marker set's
+/// recognition goes into the result's messages.
+EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial);
 
 }  // namespace kin2grf
