@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(cmake make g++ clang libclang-rt-14-dev libeigen3-dev libcli11-dev nlohmann-json3-dev
           libgtest-dev libgmock-dev libbenchmark-dev
-          libjs-chart.js chromium python3
+          libjs-chart.js chromium python3 time
           pybind11-dev python3-dev python3-numpy python3-pandas python3-pytest python3-distributed)
 missing=()
 for p in "${packages[@]}"; do
