@@ -1,6 +1,7 @@
 #include "kin2grf/io/opensim.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -26,9 +27,9 @@ std::vector<std::string_view> lines_of(const std::string& text) {
 
 std::string fmt(double v) {
   if (!std::isfinite(v)) return "NaN";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.8g", v);
-  return buf;
+  char buf[64];  // printf's %.8g (to_chars is specified to match it), without the format parsing
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 8);
+  return std::string(buf, r.ptr);
 }
 
 std::string where(const std::string& path, std::size_t line) {
@@ -113,7 +114,11 @@ MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
       ws = split(lines[li], " \t", false);
       if (ws.size() == nm * 3 + 2) cells.assign(ws.begin(), ws.end());
     }
-    auto blank = [](std::string_view c) { return c.find_first_not_of(" \t\r\n\v\f") == std::string_view::npos; };
+    auto blank = [](std::string_view c) {
+      for (const char ch : c)
+        if (ch != ' ' && ch != '\t' && ch != '\r' && ch != '\n' && ch != '\v' && ch != '\f') return false;
+      return true;
+    };
     while (cells.size() > nm * 3 + 2 && blank(cells.back())) cells.pop_back();
     if (cells.size() > nm * 3 + 2) {
       throw InputError(where(path, li) + ": " + std::to_string(cells.size()) + " columns, but " +

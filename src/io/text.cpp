@@ -44,7 +44,10 @@ std::vector<std::string> split(std::string_view s, std::string_view delims, bool
   return out;
 }
 
-std::vector<std::uint8_t> read_file_bytes(const std::string& path) {
+namespace {
+
+/// The size of a regular file that kin2grf will read, or an InputError naming why not.
+std::size_t checked_input_size(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const auto st = fs::status(path, ec);
@@ -57,18 +60,27 @@ std::vector<std::uint8_t> read_file_bytes(const std::string& path) {
   if (size > kMaxInputBytes)
     throw InputError(path + ": " + std::to_string(size >> 20) + " MiB, more than the " + std::to_string(kMaxInputBytes >> 20) +
                      " MiB kin2grf reads");
+  return static_cast<std::size_t>(size);
+}
+
+/// A whole regular file into a byte buffer (a vector or a string), read once, no second copy.
+template <class Buffer>
+Buffer read_whole_file(const std::string& path) {
+  const auto size = checked_input_size(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open file (" + std::strerror(errno) + ")");
-  std::vector<std::uint8_t> data(static_cast<std::size_t>(size));
+  Buffer data(size, typename Buffer::value_type{});
   in.read(reinterpret_cast<char*>(data.data()), static_cast<std::streamsize>(size));
-  if (in.gcount() != static_cast<std::streamsize>(size)) throw InputError(path + ": read " + std::to_string(in.gcount()) + " of " + std::to_string(size) + " bytes");
+  if (in.gcount() != static_cast<std::streamsize>(size))
+    throw InputError(path + ": read " + std::to_string(in.gcount()) + " of " + std::to_string(size) + " bytes");
   return data;
 }
 
-std::string read_file_text(const std::string& path) {
-  const auto b = read_file_bytes(path);
-  return std::string(reinterpret_cast<const char*>(b.data()), b.size());
-}
+}  // namespace
+
+std::vector<std::uint8_t> read_file_bytes(const std::string& path) { return read_whole_file<std::vector<std::uint8_t>>(path); }
+
+std::string read_file_text(const std::string& path) { return read_whole_file<std::string>(path); }
 
 void write_file_text(const std::string& path, std::string_view text) {
   // Through a temporary file in the same folder, renamed at the end: a failed or interrupted run
@@ -112,11 +124,14 @@ std::string json_text(const nlohmann::json& j) {
 }
 
 bool parse_double(std::string_view s, double& out) {
-  // Called for every cell of a text file: views only, no allocation.
-  const auto b0 = s.find_first_not_of(" \t\r\n\v\f");
-  if (b0 == std::string_view::npos) return false;
-  const auto e0 = s.find_last_not_of(" \t\r\n\v\f");
-  const std::string_view t = s.substr(b0, e0 - b0 + 1);
+  // Called for every cell of a text file: views only, no allocation, and the blanks skipped by
+  // hand (find_first_not_of over a set of six was a third of reading a TRC).
+  auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; };
+  std::size_t b0 = 0, e0 = s.size();
+  while (b0 < e0 && space(s[b0])) ++b0;
+  while (e0 > b0 && space(s[e0 - 1])) --e0;
+  if (b0 == e0) return false;
+  const std::string_view t = s.substr(b0, e0 - b0);
   const char* b = t.data();
   const char* e = t.data() + t.size();
   if (*b == '+') ++b;

@@ -1,5 +1,6 @@
 #include "kin2grf/output/results.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -74,8 +75,8 @@ std::string format_results_csv(const EstimateResult& r) {
       if (k) os << ',';
       if (integer[static_cast<std::size_t>(k)]) os << static_cast<long long>(x);
       else if (std::isfinite(x)) {
-        std::snprintf(buf, sizeof buf, "%.6g", x);
-        os << buf;
+        const auto end = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::general, 6).ptr;  // = %.6g
+        os.write(buf, end - buf);
       }
     }
     os << "\n";
