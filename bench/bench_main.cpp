@@ -100,10 +100,8 @@ void BM_ContactSolvePerFrame(benchmark::State& state) {
   }
   const auto r = kin2grf::estimate(w.trial, nullptr, *w.set, w.options);
   kin2grf::ModelMotion motion = kin2grf::compute_motion(r.model, r.landmarks, w.options.kinematic_cutoff_hz, w.options.torso_length);
-  kin2grf::ContactModelOptions co = w.options.contact;
-  co.ground_level_m = r.ground_level_m;
-  const auto contacts = kin2grf::prepare_contacts(r.model, co, motion);
-  kin2grf::ContactSolver solver(r.model, w.options.solver);
+  const auto contacts = kin2grf::prepare_contacts(r.model, r.calibration.contact, w.options.contact, motion);
+  kin2grf::ContactSolver solver(r.model, r.calibration, w.options.solver);
   const Eigen::Index n = motion.frames();
   long frames = 0, allocations = 0;
   for (auto _ : state) {

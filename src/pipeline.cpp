@@ -108,25 +108,24 @@ void sagittal_stage(const Trial& trial, const Trial* static_trial, const MarkerS
   r.time_s = lm.time_s;
 }
 
-/// The model: fixed segment lengths (medians over the window), anthropometry, ground level and
-/// the contact calibration.
-void model_stage(const EstimateOptions& o, EstimateResult& r) {
+/// The model (fixed segment lengths, the medians over the window, and anthropometry) and the
+/// trial's floor and soles (ground level, contact calibration).
+std::pair<Model, ContactCalibration> model_stage(const EstimateOptions& o, EstimateResult& r) {
   const SagittalLandmarks& lm = r.landmarks;
-  const BodyGeometry geom = measure_geometry(lm);
-  r.model = build_model(geom, r.mass_kg, anthropometric_table(o.anthropometry));
   std::string gmsg;
-  r.ground_level_m = o.ground_level_m ? *o.ground_level_m : estimate_ground_level(lm, gmsg);
+  const double ground = o.ground_level_m ? *o.ground_level_m : estimate_ground_level(lm, gmsg);
   if (!gmsg.empty()) r.messages.push_back(gmsg);
-  std::string cmsg;
-  const auto flat = calibrate_contact(r.model, lm, r.ground_level_m, &cmsg);
-  if (!cmsg.empty()) r.messages.push_back(cmsg);
+  ContactCalibration soles = calibrate_contact(lm, ground);
+  if (!soles.message.empty()) r.messages.push_back(soles.message);
   for (int s = 0; s < 2; ++s)
-    if (flat[s] < 3) r.messages.push_back(std::string(s ? "left" : "right") + " foot: only " + std::to_string(flat[s]) +
-                                          " foot-flat frames for the contact calibration");
+    if (soles.flat_frames[static_cast<std::size_t>(s)] < 3)
+      r.messages.push_back(std::string(s ? "left" : "right") + " foot: only " + std::to_string(soles.flat_frames[static_cast<std::size_t>(s)]) +
+                           " foot-flat frames for the contact calibration");
+  return {build_model(measure_geometry(lm), r.mass_kg, anthropometric_table(o.anthropometry)), std::move(soles)};
 }
 
 /// Model coordinates and their derivatives, filtered at the kinematic cut-off.
-ModelMotion kinematics_stage(const EstimateOptions& o, EstimateResult& r) {
+ModelMotion kinematics_stage(const EstimateOptions& o, const Model& model, EstimateResult& r) {
   const SagittalLandmarks& lm = r.landmarks;
   // The kinematic cut-off: the user's (6 Hz), lowered where the markers' own noise needs it
   // (Winter's residual analysis on the landmarks, noise_limited_cutoff).
@@ -141,18 +140,20 @@ ModelMotion kinematics_stage(const EstimateOptions& o, EstimateResult& r) {
       r.messages.emplace_back(b);
     }
   }
-  return compute_motion(r.model, lm, r.kinematic_cutoff_hz, o.torso_length);
+  return compute_motion(model, lm, r.kinematic_cutoff_hz, o.torso_length);
 }
 
-/// The contact points of every frame (D* filled into the motion), the belt velocity and the
-/// speed gate; `so` becomes the trial's solver options.
-std::vector<FrameContacts> contact_stage(const EstimateOptions& o, EstimateResult& r, ModelMotion& motion, SolverOptions& so) {
+/// The contact points of every frame (D* filled into the motion), and from them the rest of the
+/// trial's calibration: the belt velocity (always, on a treadmill), the progression speed and the
+/// speed gate.
+std::pair<std::vector<FrameContacts>, TrialCalibration> contact_stage(const EstimateOptions& o, const Model& model,
+                                                                      ContactCalibration soles, EstimateResult& r,
+                                                                      ModelMotion& motion) {
   const SagittalLandmarks& lm = r.landmarks;
-  ContactModelOptions co = o.contact;
-  co.ground_level_m = r.ground_level_m;
+  const ContactModelOptions& co = o.contact;
   std::vector<bool> running;
   if (co.foot_model == FootModel::Cop && co.running_cop) {
-    running = flight_frames(r.model, motion);
+    running = flight_frames(model, motion);
     const auto nrun = std::count(running.begin(), running.end(), true);
     if (nrun > 0) {
       char b[160];
@@ -161,36 +162,30 @@ std::vector<FrameContacts> contact_stage(const EstimateOptions& o, EstimateResul
       r.messages.push_back(b);
     }
   }
-  const auto contacts = prepare_contacts(r.model, co, motion, running);
-  so = o.solver;
+  auto contacts = prepare_contacts(model, soles, co, motion, running);
+  TrialCalibration cal;
+  cal.contact = std::move(soles);
   if (r.frame.treadmill) {
-    // Belt velocity (always measured, whatever the gate): the median horizontal velocity of the
-    // lowest sole point over foot-flat-like frames.
-    std::vector<double> v;
-    for (const auto& fc : contacts)
-      for (const auto& p : fc.points)
-        if (p.gap_m < 0.01) v.push_back(p.velocity.x());
-    if (!v.empty()) {
-      so.belt_velocity_mps = median(v);
+    // Measured on every treadmill trial, whatever the solver's settings: validation's still-foot
+    // rule takes it too.
+    if (const auto belt = measure_belt_velocity(contacts)) {
+      cal.belt_velocity_mps = *belt;
       char b[128];
-      std::snprintf(b, sizeof b, std::abs(so.belt_velocity_mps) < 0.05 ? "no progression (stationary trial): ground velocity %.2f m/s"
-                                                                       : "treadmill: belt velocity %.3f m/s",
-                    so.belt_velocity_mps);
+      std::snprintf(b, sizeof b, std::abs(*belt) < 0.05 ? "no progression (stationary trial): ground velocity %.2f m/s"
+                                                        : "treadmill: belt velocity %.3f m/s",
+                    *belt);
       r.messages.push_back(b);
     }
   }
-  r.progression_speed_mps = r.frame.treadmill ? std::abs(so.belt_velocity_mps) : progression_speed(lm);
-  so.speed_gate_mps = speed_gate_for(so, r.progression_speed_mps);
-  so.speed_gate_ratio = 0.0;
-  r.speed_gate_mps = so.speed_gate_mps;
+  cal.progression_speed_mps = r.frame.treadmill ? std::abs(cal.belt_velocity_mps) : progression_speed(lm);
+  cal.speed_gate_mps = speed_gate_for(o.solver, cal.progression_speed_mps);
   if (o.solver.speed_gate_ratio > 0) {
     char b[160];
-    std::snprintf(b, sizeof b, "contact speed gate %.2f m/s (%.2f x the progression speed %.2f m/s, at least %.2f)", so.speed_gate_mps,
-                  o.solver.speed_gate_ratio, r.progression_speed_mps, o.solver.speed_gate_floor_mps);
+    std::snprintf(b, sizeof b, "contact speed gate %.2f m/s (%.2f x the progression speed %.2f m/s, at least %.2f)", cal.speed_gate_mps,
+                  o.solver.speed_gate_ratio, cal.progression_speed_mps, o.solver.speed_gate_floor_mps);
     r.messages.push_back(b);
   }
-  r.frame.belt_velocity_mps = so.belt_velocity_mps;
-  return contacts;
+  return {std::move(contacts), std::move(cal)};
 }
 
 /// The per-frame solve's raw results (before the post-filter).
@@ -201,9 +196,9 @@ struct RawSolve {
 
 /// Eqs. 5-10 on every frame (least squares, activation, semi-smooth iterations).
 RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResult& r, const ModelMotion& motion,
-                     const std::vector<FrameContacts>& contacts, const SolverOptions& so) {
+                     const std::vector<FrameContacts>& contacts) {
   const Eigen::Index n = motion.frames();
-  ContactSolver solver(r.model, so);
+  ContactSolver solver(r.model, r.calibration, o.solver);
   const int np = static_cast<int>(contacts.front().points.size());
   RawSolve raw;
   raw.lambda.resize(n, 2 * np);
@@ -286,7 +281,7 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, con
     if (!any) {
       char b[200];
       std::snprintf(b, sizeof b, "no stance: neither foot touches the ground (%.3f m) in the processed window; the GRF is zero "
-                                 "throughout (check --ground-level)", r.ground_level_m);
+                                 "throughout (check --ground-level)", r.ground_level_m());
       r.messages.push_back(b);
     }
   }
@@ -315,7 +310,7 @@ void totals_stage(const EstimateOptions& o, EstimateResult& r, const ModelMotion
     for (int side = 0; side < 2; ++side) {
       const auto& f = r.feet[side];
       if (!f.contact[static_cast<std::size_t>(i)]) continue;
-      const double x = f.cop_x_m[i], y = r.ground_level_m;
+      const double x = f.cop_x_m[i], y = r.ground_level_m();
       const double fx = f.force_N(i, 0), fy = f.force_N(i, 1);
       r.grm_Nm[i] += (x - o.grm_reference_m.x()) * fy - (y - o.grm_reference_m.y()) * fx;
       ext += Eigen::Vector3d(fx, fy, x * fy - y * fx);
@@ -343,12 +338,13 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   r.marker_set = set.name;
   r.mass_kg = resolve_mass(trial, o);
   sagittal_stage(trial, static_trial, set, o, r);
-  model_stage(o, r);
-  ModelMotion motion = kinematics_stage(o, r);
-  SolverOptions so;
-  const auto contacts = contact_stage(o, r, motion, so);
+  auto [model, soles] = model_stage(o, r);
+  r.model = std::move(model);
+  ModelMotion motion = kinematics_stage(o, r.model, r);
+  auto [contacts, calibration] = contact_stage(o, r.model, std::move(soles), r, motion);
+  r.calibration = std::move(calibration);
   const auto t1 = clock::now();
-  const RawSolve raw = solve_stage(trial, o, r, motion, contacts, so);
+  const RawSolve raw = solve_stage(trial, o, r, motion, contacts);
   const auto t2 = clock::now();
   r.seconds_kinematics = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_dynamics = std::chrono::duration<double>(t2 - t1).count();
@@ -375,7 +371,7 @@ std::array<ForcePlate, 2> as_lab_plates(const EstimateResult& r) {
       const Eigen::Vector3d F = f.force_N(i, 0) * r.frame.forward_at(k) + f.force_N(i, 1) * r.frame.up;
       p.force_N.row(i) = F.transpose();
       if (std::isfinite(f.cop_x_m[i])) {
-        p.cop_m.row(i) = r.frame.to_lab(f.cop_x_m[i], r.ground_level_m, r.foot_lateral_m[side][i], k).transpose();
+        p.cop_m.row(i) = r.frame.to_lab(f.cop_x_m[i], r.ground_level_m(), r.foot_lateral_m[side][i], k).transpose();
       } else {
         p.cop_m.row(i).setConstant(nan);
       }

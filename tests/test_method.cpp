@@ -74,9 +74,8 @@ TEST(Kinematics, ReconstructionSatisfiesTheBilateralConstraints) {
   // Rebuild the motion and check Phi(q) ~ 0 via Phi_q qd = 0 and finite differences of q.
   const SagittalLandmarks lm = synthetic_landmarks(t);
   ModelMotion mm = compute_motion(r.model, lm, 6.0);
-  ContactModelOptions co;
-  (void)prepare_contacts(r.model, co, mm);
-  ContactSolver solver(r.model, {});
+  (void)prepare_contacts(r.model, r.calibration.contact, ContactModelOptions{}, mm);
+  ContactSolver solver(r.model, r.calibration, {});
   for (Eigen::Index i = 5; i < mm.frames(); i += 37) {
     const Eigen::MatrixXd Phi = solver.bilateral_jacobian(mm.q.row(i).transpose());
     // Velocity level: Phi_q qd = 0 except the rheonomic rows (their time derivative is phi_dot).
@@ -233,8 +232,7 @@ TEST(Estimate, PrescribedSingleSupportRecoversTheExactContactForce) {
 
   // One frame, forward dynamics: [M -A^T; A 0] [qdd; mu] = [f; c].
   ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
-  ContactModelOptions co;
-  auto contacts = prepare_contacts(r.model, co, mm);
+  auto contacts = prepare_contacts(r.model, r.calibration.contact, ContactModelOptions{}, mm);
   const Eigen::Index i = 120;
   const FrameContacts& fc = contacts[static_cast<std::size_t>(i)];
   ASSERT_EQ(fc.points.size(), 2u);
@@ -242,7 +240,7 @@ TEST(Estimate, PrescribedSingleSupportRecoversTheExactContactForce) {
   const Eigen::VectorXd q = mm.q.row(i).transpose();
   SolverOptions sopt;
   sopt.r_N_per_m = 1e5;
-  ContactSolver solver(r.model, sopt);
+  ContactSolver solver(r.model, r.calibration, sopt);  // no speed gate (eo's)
   const Eigen::MatrixXd Phi = solver.bilateral_jacobian(q);
   Eigen::MatrixXd A(kBilateralCount + 2, coord::kCount);
   A << Phi, fc.points[0].jac_normal.transpose(), fc.points[0].jac_tangent.transpose();
@@ -279,12 +277,10 @@ TEST(Solver, StructuredAndDenseFactorisationsAgree) {
     const Trial t = make_synthetic_trial(so);
     const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), {});
     ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
-    ContactModelOptions co;
-    co.ground_level_m = r.ground_level_m;
-    const auto contacts = prepare_contacts(r.model, co, mm);
+    const auto contacts = prepare_contacts(r.model, r.calibration.contact, ContactModelOptions{}, mm);
     SolverOptions structured_opt, dense_opt;
     dense_opt.dense_factorisation = true;
-    ContactSolver structured(r.model, structured_opt), dense(r.model, dense_opt);
+    ContactSolver structured(r.model, r.calibration, structured_opt), dense(r.model, r.calibration, dense_opt);
     for (Eigen::Index i = 0; i < mm.frames(); i += 11) {
       const Eigen::VectorXd q = mm.q.row(i).transpose(), qdd = mm.qdd.row(i).transpose();
       const auto a = structured.solve(q, qdd, contacts[static_cast<std::size_t>(i)]);
@@ -417,7 +413,7 @@ TEST(Solver, SlowWalkSwingFootCarriesNothing) {
   EstimateOptions eo;
   const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
   ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
-  auto contacts = prepare_contacts(r.model, ContactModelOptions{}, mm);
+  auto contacts = prepare_contacts(r.model, r.calibration.contact, ContactModelOptions{}, mm);
   const Eigen::Index i = 120;
   FrameContacts fc = contacts[static_cast<std::size_t>(i)];
   ASSERT_EQ(fc.points.size(), 2u);
@@ -428,18 +424,16 @@ TEST(Solver, SlowWalkSwingFootCarriesNothing) {
   Eigen::VectorXd qdd = mm.qdd.row(i).transpose();
   qdd[coord::theta(kTorso)] += 20.0;  // rad/s^2: about 30 N m that no single contact point balances
 
-  SolverOptions fixed;
-  fixed.speed_gate_ratio = 0.0;
+  TrialCalibration fixed = r.calibration;  // the old fixed gate
   fixed.speed_gate_mps = 1.5;
-  const FrameSolution before = ContactSolver(r.model, fixed).solve(q, qdd, fc);
+  const FrameSolution before = ContactSolver(r.model, fixed, SolverOptions{}).solve(q, qdd, fc);
   ASSERT_TRUE(before.active[1]) << "the failure this test guards: the fixed gate lets the swing foot in";
   ASSERT_GT(before.force_N[1].y(), 20.0);
 
-  SolverOptions rule;  // the defaults: the progression speed, at least 0.75 m/s
-  rule.speed_gate_mps = speed_gate_for(rule, 0.4);
-  rule.speed_gate_ratio = 0.0;
+  TrialCalibration rule = r.calibration;  // the defaults: the progression speed, at least 0.75 m/s
+  rule.speed_gate_mps = speed_gate_for(SolverOptions{}, 0.4);
   EXPECT_NEAR(rule.speed_gate_mps, 0.75, 1e-12);
-  const FrameSolution after = ContactSolver(r.model, rule).solve(q, qdd, fc);
+  const FrameSolution after = ContactSolver(r.model, rule, SolverOptions{}).solve(q, qdd, fc);
   EXPECT_FALSE(after.active[1]);
   EXPECT_EQ(after.force_N[1].y(), 0.0);
   EXPECT_EQ(after.force_N[1].x(), 0.0);

@@ -54,15 +54,13 @@ struct FootResult {
 struct EstimateResult {
   std::string marker_set;
   double mass_kg = 0.0;
-  double ground_level_m = 0.0;
   SagittalFrame frame;
-  /// The subject's progression speed (m/s): overground the median over the window of the hip's
-  /// horizontal speed over +-0.25 s (a step's average, not its oscillation); on a treadmill the
-  /// belt's speed.
-  double progression_speed_mps = 0.0;
-  double speed_gate_mps = 0.0;     ///< the contact speed gate used (0: none)
   double kinematic_cutoff_hz = 0.0;  ///< the kinematic cut-off used (EstimateOptions::cutoff_from_noise)
   Model model;
+  /// The floor, the soles, the belt velocity, the progression speed and the speed gate the trial
+  /// was solved with (measured once, model_stage and contact_stage).
+  TrialCalibration calibration;
+  [[nodiscard]] double ground_level_m() const { return calibration.contact.ground_level_m; }
   Eigen::VectorXd time_s;
   Eigen::Index first_index = 0;    ///< first processed frame's index in the trial
   int first_frame_number = 1;      ///< its frame number in the file

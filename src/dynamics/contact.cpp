@@ -55,14 +55,14 @@ double CopFunction::fraction(double th) const {
   return s_to;
 }
 
-std::array<Eigen::Vector2d, 3> sole_points(const Model& model, const ModelMotion& m, Eigen::Index i, int side) {
+std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, const ModelMotion& m, Eigen::Index i, int side) {
   const int foot = segment(side, 2), toes = segment(side, 3);
   const int ankle = landmark(side, 1), mt = landmark(side, 3);
   const Eigen::Vector2d rA(m.q(i, coord::point_x(ankle)), m.q(i, coord::point_x(ankle) + 1));
   const Eigen::Vector2d rM(m.q(i, coord::point_x(mt)), m.q(i, coord::point_x(mt) + 1));
   const Eigen::Matrix2d Rf = rot(m.q(i, coord::theta(foot)));
   const Eigen::Matrix2d Rt = rot(m.q(i, coord::theta(toes)));
-  const auto& fg = model.feet[side];
+  const auto& fg = soles.feet[static_cast<std::size_t>(side)];
   return {rA + Rf * fg.heel_local, rA + Rf * fg.mt_local, rM + Rt * fg.hallux_local};
 }
 
@@ -92,18 +92,18 @@ std::vector<bool> flight_frames(const Model& model, const ModelMotion& m, double
   return out;
 }
 
-std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactModelOptions& o, ModelMotion& m,
-                                            const std::vector<bool>& running) {
+std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCalibration& soles, const ContactModelOptions& o,
+                                            ModelMotion& m, const std::vector<bool>& running) {
   const Eigen::Index n = m.frames();
   std::vector<FrameContacts> out(static_cast<std::size_t>(n));
-  const double ground = o.ground_level_m + o.ground_shift_m;
+  const double ground = soles.ground_level_m + o.ground_shift_m;
   for (Eigen::Index i = 0; i < n; ++i) {
     FrameContacts& fc = out[static_cast<std::size_t>(i)];
     for (int side = 0; side < 2; ++side) {
       const int foot = segment(side, 2), toes = segment(side, 3);
-      const auto sp = sole_points(model, m, i, side);
+      const auto sp = sole_points(soles, m, i, side);
       fc.sole[static_cast<std::size_t>(side)] = sp;
-      fc.foot_inclination_rad[side] = -(m.q(i, coord::theta(foot)) - model.feet[side].flat_angle_rad);
+      fc.foot_inclination_rad[side] = -(m.q(i, coord::theta(foot)) - soles.feet[static_cast<std::size_t>(side)].flat_angle_rad);
       if (o.foot_model == FootModel::ThreePoint) {
         for (int k = 0; k < 3; ++k) {
           const MaterialPoint mp = material_point(model, m, i, k < 2 ? foot : toes, sp[k]);
@@ -152,6 +152,15 @@ std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactMod
   return out;
 }
 
+std::optional<double> measure_belt_velocity(const std::vector<FrameContacts>& contacts) {
+  std::vector<double> v;
+  for (const auto& fc : contacts)
+    for (const auto& p : fc.points)
+      if (p.gap_m < 0.01) v.push_back(p.velocity.x());
+  if (v.empty()) return std::nullopt;
+  return median(std::move(v));
+}
+
 }  // namespace kin2grf
 
 namespace kin2grf {
@@ -179,8 +188,9 @@ Eigen::Matrix2d rot2(double a) {
 }
 }  // namespace
 
-std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, double ground_level, std::string* message) {
-  std::array<int, 2> counts{};
+ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_level) {
+  ContactCalibration cal;
+  cal.ground_level_m = ground_level;
   std::array<double, 2> heel_height{};
   // Heel landmarks stand 20-90 mm above the floor in foot-flat stance. When both feet's flat
   // frames stand higher than kMaxHeelHeight, neither foot stands on this floor in the window:
@@ -197,17 +207,16 @@ std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, 
     }
     if (std::min(h[0], h[1]) - ground_level > kMaxHeelHeight) {
       for (int side = 0; side < 2; ++side) sole[static_cast<std::size_t>(side)] = h[static_cast<std::size_t>(side)] - kNominalHeelHeight;
-      if (message)
-        *message = "neither foot stands on the floor in the processed window (heel landmarks " +
-                   std::to_string(static_cast<int>(1000 * (std::min(h[0], h[1]) - ground_level))) +
-                   " mm above it at their lowest): soles placed " + std::to_string(static_cast<int>(1000 * kNominalHeelHeight)) +
-                   " mm below the heel landmarks";
+      cal.message = "neither foot stands on the floor in the processed window (heel landmarks " +
+              std::to_string(static_cast<int>(1000 * (std::min(h[0], h[1]) - ground_level))) +
+              " mm above it at their lowest): soles placed " + std::to_string(static_cast<int>(1000 * kNominalHeelHeight)) +
+              " mm below the heel landmarks";
     }
   }
   for (int side = 0; side < 2; ++side) {
     const double ground = sole[static_cast<std::size_t>(side)];
     const auto f = flat_frames(lm, side);
-    counts[side] = static_cast<int>(f.size());
+    cal.flat_frames[static_cast<std::size_t>(side)] = static_cast<int>(f.size());
     const auto& A = lm.p[landmark(side, 1)];
     const auto& E = lm.p[landmark(side, 2)];
     const auto& M = lm.p[landmark(side, 3)];
@@ -228,7 +237,7 @@ std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, 
     std::vector<double> hh;
     for (auto i : f) hh.push_back(E(i, 1) - ground_level);
     heel_height[static_cast<std::size_t>(side)] = median_or_zero(hh);
-    auto& fg = model.feet[side];
+    auto& fg = cal.feet[static_cast<std::size_t>(side)];
     fg.flat_angle_rad = median_or_zero(ang);
     fg.heel_local = Eigen::Vector2d(median_or_zero(ax), median_or_zero(ay));
     fg.mt_local = Eigen::Vector2d(median_or_zero(bx), median_or_zero(by));
@@ -240,14 +249,13 @@ std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, 
   for (int side = 0; side < 2 && sole[0] == ground_level; ++side) {
     const int other = 1 - side;
     if (heel_height[static_cast<std::size_t>(side)] > heel_height[static_cast<std::size_t>(other)] + 0.03) {
-      model.feet[side] = model.feet[other];
-      if (message)
-        *message = std::string(side ? "left" : "right") + " foot never stands on the floor (heel landmark " +
-                   std::to_string(static_cast<int>(1000 * heel_height[static_cast<std::size_t>(side)])) +
-                   " mm above it at its lowest): its sole geometry is taken from the " + (side ? "right" : "left") + " foot";
+      cal.feet[static_cast<std::size_t>(side)] = cal.feet[static_cast<std::size_t>(other)];
+      cal.message = std::string(side ? "left" : "right") + " foot never stands on the floor (heel landmark " +
+              std::to_string(static_cast<int>(1000 * heel_height[static_cast<std::size_t>(side)])) +
+              " mm above it at its lowest): its sole geometry is taken from the " + (side ? "right" : "left") + " foot";
     }
   }
-  return counts;
+  return cal;
 }
 
 double estimate_ground_level(const SagittalLandmarks& lm, std::string& message) {

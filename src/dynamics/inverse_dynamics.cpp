@@ -30,8 +30,9 @@ constexpr int xy_coordinate(int k) {
 
 }  // namespace
 
-ContactSolver::ContactSolver(const Model& model, const SolverOptions& options)
-    : model_(model), options_(options), Phi_(Eigen::MatrixXd::Zero(kBilateralCount, coord::kCount)) {
+ContactSolver::ContactSolver(const Model& model, const TrialCalibration& calibration, const SolverOptions& options)
+    : model_(model), options_(options), belt_velocity_mps_(calibration.belt_velocity_mps),
+      speed_gate_mps_(calibration.speed_gate_mps), Phi_(Eigen::MatrixXd::Zero(kBilateralCount, coord::kCount)) {
   mass_ = model.mass_diagonal();
   gravity_ = model.gravity_force();
   weight_bilateral_ = Eigen::VectorXd::Ones(kBilateralCount);
@@ -272,9 +273,9 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
   sol.contact_lambda = SmallVector::Zero(k);
   // The speed gate removes a contact from the candidates before the iterations.
   unsigned allowed = (1U << np) - 1U;
-  if (options_.speed_gate_mps > 0)
+  if (speed_gate_mps_ > 0)
     for (int j = 0; j < np; ++j)
-      if (std::abs(fc.points[static_cast<std::size_t>(j)].velocity.x() - options_.belt_velocity_mps) > options_.speed_gate_mps)
+      if (std::abs(fc.points[static_cast<std::size_t>(j)].velocity.x() - belt_velocity_mps_) > speed_gate_mps_)
         allowed &= ~(1U << j);
   unsigned active = allowed;
   std::uint64_t seen = 0;  // the active sets tried (2^6 of them at most)

@@ -57,10 +57,6 @@ Model build_model(const BodyGeometry& g, double mass, const AnthropometricTable&
     Body& foot = m.bodies[segment(side, 2)];
     foot.points[1] = landmark(side, 2);
     foot.points_local[1] = g.heel_local[side];
-    // Default sole points (replaced by the contact calibration).
-    m.feet[side].heel_local = g.heel_local[side];
-    m.feet[side].mt_local = Eigen::Vector2d(g.foot[side], 0);
-    m.feet[side].hallux_local = Eigen::Vector2d(g.toes[side], 0);
   }
   return m;
 }

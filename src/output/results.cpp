@@ -109,15 +109,15 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
   j["settings"] = settings;
   j["marker_set"] = r.marker_set;
   j["mass_kg"] = r.mass_kg;
-  j["ground_level_m"] = r.ground_level_m;
+  j["ground_level_m"] = r.ground_level_m();
   j["progression"] = {{"forward", {r.frame.forward.x(), r.frame.forward.y(), r.frame.forward.z()}},
                       {"up", {r.frame.up.x(), r.frame.up.y(), r.frame.up.z()}},
                       {"treadmill", r.frame.treadmill},
                       {"turning", r.frame.turning()},
-                      {"belt_velocity_mps", r.frame.belt_velocity_mps},
-                      {"speed_mps", r.progression_speed_mps},
+                      {"belt_velocity_mps", r.calibration.belt_velocity_mps},
+                      {"speed_mps", r.calibration.progression_speed_mps},
                       {"how", r.frame.how}};
-  j["contact_speed_gate_mps"] = r.speed_gate_mps;
+  j["contact_speed_gate_mps"] = r.calibration.speed_gate_mps;
   j["kinematic_cutoff_hz"] = r.kinematic_cutoff_hz;  // the one used (lowered for noisy markers)
   const auto n = r.time_s.size();
   j["frames"] = {{"first", r.first_frame_number}, {"last", r.first_frame_number + n - 1}, {"count", n}};
@@ -155,7 +155,7 @@ std::string format_results_text(const EstimateResult& r) {
                 r.first_frame_number + static_cast<int>(n) - 1, r.time_s[0], r.time_s[n - 1], r.mass_kg, r.marker_set.c_str());
   os << b;
   std::snprintf(b, sizeof b, "progression: %s, speed %.2f m/s, contact speed gate %.2f m/s\n", r.frame.how.c_str(),
-                r.progression_speed_mps, r.speed_gate_mps);
+                r.calibration.progression_speed_mps, r.calibration.speed_gate_mps);
   os << b;
   const double bw = r.mass_kg * r.model.gravity_mps2;
   for (int s = 0; s < 2; ++s) {

@@ -186,14 +186,14 @@ std::array<ForcePlate, 2> synthetic_walk_feet(const SyntheticWalk& w, const Esti
     // One shift of both COPs makes sum x_i Fy_i - y_g Fx = M (floor at y_g = 0), as far as each
     // COP stays under its foot (heel to hallux): a designed gait's angular momentum is not a real
     // walker's, and a COP off the foot is no plate's.
-    const double shift = (total.z() + r.ground_level_m * total.x() - moment_nominal) / total.y();
+    const double shift = (total.z() + r.ground_level_m() * total.x() - moment_nominal) / total.y();
     for (int side = 0; side < 2; ++side) {
       if (share[side] <= 0) continue;
       auto& p = feet[static_cast<std::size_t>(side)];
       const double f = share[side] / sum;
       p.force_N.row(k) << f * total.x(), 0.0, f * total.y();
       const double x = std::clamp(w.nominal_cop_x_m[side][k] + shift, w.sole_x_m[side](k, 0), w.sole_x_m[side](k, 1));
-      p.cop_m.row(k) << x, side ? 0.1 : -0.1, r.ground_level_m;
+      p.cop_m.row(k) << x, side ? 0.1 : -0.1, r.ground_level_m();
     }
   }
   return feet;

@@ -52,10 +52,10 @@ double mean_finite(const Eigen::VectorXd& v) {
 bool sole_point_planted(const EstimateResult& e, int f, int s, Eigen::Index i, const ValidationOptions& o) {
   const auto& sm = e.feet[static_cast<std::size_t>(f)].sole_m;
   const Eigen::Index n = sm.rows();
-  if (n < 2 || sm(i, 2 * s + 1) - e.ground_level_m > o.ground_contact_height_m) return false;
+  if (n < 2 || sm(i, 2 * s + 1) - e.ground_level_m() > o.ground_contact_height_m) return false;
   const Eigen::Index i0 = std::max<Eigen::Index>(i - 1, 0), i1 = std::min<Eigen::Index>(i + 1, n - 1);
   const double vx = (sm(i1, 2 * s) - sm(i0, 2 * s)) * e.landmarks.rate_hz / static_cast<double>(i1 - i0);
-  return std::abs(vx - e.frame.belt_velocity_mps) <= o.still_speed_mps;
+  return std::abs(vx - e.calibration.belt_velocity_mps) <= o.still_speed_mps;
 }
 
 }  // namespace
@@ -166,7 +166,7 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
   v.plates = resample_plates(rec, e.frame, e.time_s, rec.cop_threshold_N, e.first_index);
   const double rate = e.landmarks.rate_hz;
   const Eigen::Index search = static_cast<Eigen::Index>(std::lround(0.2 * rate));
-  const double ground = e.ground_level_m;
+  const double ground = e.ground_level_m();
   for (int f = 0; f < 2; ++f) {
     v.measured_force_N[static_cast<std::size_t>(f)] = Eigen::MatrixX2d::Constant(n, 2, kNaN);
     v.measured_cop_x_m[static_cast<std::size_t>(f)] = Eigen::VectorXd::Constant(n, kNaN);

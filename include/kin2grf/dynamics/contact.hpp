@@ -1,6 +1,6 @@
 // kin2grf dynamics: the foot-ground contact models of the paper (Sect. 2.3).
 //
-// Sole points (model.hpp, FootContactGeometry): A under the heel and B under the MT head, both
+// Sole points (FootContactGeometry, below): A under the heel and B under the MT head, both
 // on the foot; C under the hallux, on the toes. Foot inclination (paper's theta_A):
 //   theta_A = -(theta_foot - theta_foot,flat),
 // positive when the heel is raised (plantar flexion against the ground), negative at heel strike
@@ -19,12 +19,47 @@
 #include <Eigen/Dense>
 #include <array>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/model/model.hpp"
 
 namespace kin2grf {
+
+/// The sole points of a foot used by the contact models: under the heel (A) and the MT head
+/// (B) in the foot frame, under the hallux (C) in the toes frame, at ground level in the
+/// foot-flat reference pose (Sect. 2.3).
+struct FootContactGeometry {
+  Eigen::Vector2d heel_local = Eigen::Vector2d::Zero();    ///< A, foot frame
+  Eigen::Vector2d mt_local = Eigen::Vector2d::Zero();      ///< B, foot frame
+  Eigen::Vector2d hallux_local = Eigen::Vector2d::Zero();  ///< C, toes frame
+  double flat_angle_rad = 0.0;  ///< theta_foot (ankle->MT direction) in the foot-flat pose
+};
+
+/// The floor and the soles of one trial (Sect. 2.3), measured once from its foot-flat frames
+/// (calibrate_contact) and const afterwards.
+struct ContactCalibration {
+  double ground_level_m = 0.0;                ///< the floor's height in the sagittal frame
+  std::array<FootContactGeometry, 2> feet{};  ///< sole points A, B, C per side
+  std::array<int, 2> flat_frames{};           ///< the foot-flat frames they were measured on
+  std::string message;                        ///< what calibrate_contact chose when not the usual
+};
+
+/// What one trial fixes before its frames are solved. Options hold the user's choices; this
+/// holds the trial's measured values, each built once and const afterwards (the Model/Data split:
+/// Model the subject, TrialCalibration the trial, ModelMotion and the solver's workspace the frames).
+struct TrialCalibration {
+  ContactCalibration contact;
+  /// Ground velocity along x (m/s): a treadmill's belt, measured on every treadmill trial whatever
+  /// the solver's settings (validation's still-foot rule needs it too); 0 overground.
+  double belt_velocity_mps = 0.0;
+  /// The subject's progression speed (m/s): overground the median over the window of the hip's
+  /// horizontal speed over +-0.25 s (a step's average, not its oscillation); on a treadmill the
+  /// belt's speed.
+  double progression_speed_mps = 0.0;
+  double speed_gate_mps = 0.0;  ///< the trial's contact speed gate (speed_gate_for); 0: none
+};
 
 enum class FootModel { Cop, ThreePoint };
 
@@ -78,16 +113,16 @@ struct ContactModelOptions {
   /// Model 2's function on running frames (prepare_contacts' `running`); none: `cop` everywhere
   /// (the paper, or a user's own function).
   std::optional<CopFunction> running_cop = CopFunction::running();
-  double ground_level_m = 0.0;  ///< the floor's height in the sagittal frame
-  double ground_shift_m = 0.0;  ///< added to the ground (the paper's robustness study)
+  double ground_shift_m = 0.0;  ///< added to the measured ground (the paper's robustness study)
 };
 
 /// World positions of the sole points A, B, C of a foot at frame i.
-std::array<Eigen::Vector2d, 3> sole_points(const Model& model, const ModelMotion& motion, Eigen::Index i, int side);
+std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, const ModelMotion& motion, Eigen::Index i, int side);
 
 /// Fill the D* columns of q/qd/qdd (model 2) and return each frame's contact points. `running`
 /// (empty, or one flag per frame): frames that take options.running_cop.
-std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactModelOptions& options, ModelMotion& motion,
+std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCalibration& soles, const ContactModelOptions& options,
+                                            ModelMotion& motion,
                                             const std::vector<bool>& running = {});
 
 /// Running frames: those within `window_s` of a flight frame, where the whole body's vertical
@@ -109,9 +144,11 @@ namespace kin2grf {
 /// higher than the other's never touches the floor: it takes the other foot's geometry. When
 /// both feet's heel landmarks stay more than 150 mm above the floor, neither foot stands on it:
 /// the soles go 40 mm below the heel landmarks (no stance is invented). `message` says which.
-/// Returns the number of flat frames per foot.
-std::array<int, 2> calibrate_contact(Model& model, const SagittalLandmarks& lm, double ground_level_m,
-                                     std::string* message = nullptr);
+ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_level_m);
+
+/// The belt velocity of a treadmill trial (m/s): the median horizontal velocity of the contact
+/// points within 10 mm of the floor; none when no point comes that close.
+std::optional<double> measure_belt_velocity(const std::vector<FrameContacts>& contacts);
 
 /// Automatic ground level: 0 (the lab floor, where capture systems put it) when the feet's
 /// flat-stance landmarks stand 0-150 mm above it; otherwise the lowest of them (a raised or

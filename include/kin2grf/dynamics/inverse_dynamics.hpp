@@ -68,7 +68,6 @@ struct SolverOptions {
   /// landing foot in 60-90 ms early (docs/METHOD-NOTES.md).
   double speed_gate_ratio = 1.0;
   double speed_gate_floor_mps = 0.75;
-  double belt_velocity_mps = 0.0;  ///< ground velocity along x (treadmill belt), m/s
   /// Feet side by side: when both feet are in contact and all their active points lie within
   /// this distance along progression (m), the sagittal moment equation cannot tell how the load
   /// is split between them (F_R x_R + F_L x_L = M with x_R ~ x_L), and fitting it anyway hands one
@@ -101,10 +100,12 @@ struct FrameSolution {
   bool capped = false;
 };
 
-/// Per-frame solver; owns its workspace so that a trial's frames reuse the same buffers.
+/// Per-frame solver over (Model, TrialCalibration); owns its workspace (the Data) so that a
+/// trial's frames reuse the same buffers. From the calibration it takes the trial's speed gate
+/// and the belt velocity the gate is measured against.
 class ContactSolver {
  public:
-  ContactSolver(const Model& model, const SolverOptions& options);
+  ContactSolver(const Model& model, const TrialCalibration& calibration, const SolverOptions& options);
   /// q, qdd: the frame's 63 coordinates (D* filled) and accelerations.
   /// A row of ModelMotion's q and qdd is taken as it is (strided), without a copy.
   using FrameVector = Eigen::Ref<const Eigen::VectorXd, 0, Eigen::InnerStride<>>;
@@ -123,6 +124,7 @@ class ContactSolver {
   FrameSolution solve_dense(const Eigen::MatrixXd& B, const FrameVector& qdd, const FrameContacts& contacts);
   const Model& model_;
   SolverOptions options_;
+  double belt_velocity_mps_ = 0.0, speed_gate_mps_ = 0.0;  ///< the trial's (TrialCalibration)
   Eigen::VectorXd mass_, gravity_, weight_bilateral_;
   Eigen::MatrixXd Phi_;  ///< the frame's bilateral Jacobian (60 x 63), reused
   // The structure of N = Phi Phi^T and of its factor, found once (constructor).

@@ -108,8 +108,7 @@ struct SagittalFrame {
   Eigen::Vector3d forward = Eigen::Vector3d::UnitX();
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d lateral = Eigen::Vector3d::UnitY();  ///< forward x up (to the right)
-  bool treadmill = false;           ///< the pelvis does not progress
-  double belt_velocity_mps = 0.0;   ///< ground velocity along x on a treadmill (sagittal)
+  bool treadmill = false;           ///< the pelvis does not progress (belt velocity: TrialCalibration)
   std::string how;                  ///< how progression was found
   Eigen::MatrixX3d heading;         ///< N x 3 per trial frame (turning only), lab unit vectors
   Eigen::VectorXd x_offset_m;       ///< N (turning only)

@@ -70,21 +70,12 @@ struct Body {
   double length_m = 0.0;
 };
 
-/// The sole points of a foot used by the contact models: under the heel (A) and the MT head
-/// (B) in the foot frame, under the hallux (C) in the toes frame, at ground level in the
-/// foot-flat reference pose (Sect. 2.3).
-struct FootContactGeometry {
-  Eigen::Vector2d heel_local = Eigen::Vector2d::Zero();    ///< A, foot frame
-  Eigen::Vector2d mt_local = Eigen::Vector2d::Zero();      ///< B, foot frame
-  Eigen::Vector2d hallux_local = Eigen::Vector2d::Zero();  ///< C, toes frame
-  double flat_angle_rad = 0.0;  ///< theta_foot (ankle->MT direction) in the foot-flat pose
-};
-
+/// The 9 bodies: what the dynamics needs of the subject (Model/Data split, as in Pinocchio and
+/// RBDL: per-frame values live in ModelMotion and the solver's workspace, never here).
 struct Model {
   double body_mass_kg = 0.0;
   double gravity_mps2 = 9.81;
   std::array<Body, kSegmentCount> bodies{};
-  std::array<FootContactGeometry, 2> feet{};
   std::string anthropometry = "winter";
 
   /// Diagonal of the constant mass matrix (63).
@@ -100,7 +91,9 @@ struct BodyGeometry {
   std::array<Eigen::Vector2d, 2> heel_local{Eigen::Vector2d(-0.06, -0.04), Eigen::Vector2d(-0.06, -0.04)};
 };
 
-/// Masses and inertias from the table; geometry as given; contact geometry default (set later).
+/// Masses and inertias from the table; geometry as given. Built once per trial and const
+/// afterwards: what else the trial fixes (the floor, the soles, the belt) is its TrialCalibration
+/// (dynamics/contact.hpp).
 Model build_model(const BodyGeometry& geometry, double body_mass_kg, const AnthropometricTable& table);
 
 }  // namespace kin2grf
