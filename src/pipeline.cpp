@@ -320,7 +320,7 @@ void totals_stage(const EstimateOptions& o, EstimateResult& r, const ModelMotion
     for (int j = 0; j < kJointCount; ++j) {
       const int side = j / 4, depth = j % 4;
       Eigen::Vector2d F = Eigen::Vector2d::Zero();
-      for (int k = depth; k < 4; ++k) F += seg_force[static_cast<std::size_t>(segment(side, k))];
+      for (int k = depth; k < 4; ++k) F += seg_force[static_cast<std::size_t>(segment(side, static_cast<LegSegment>(k)))];
       if (depth <= 2 && r.feet[side].contact[static_cast<std::size_t>(i)]) F -= r.feet[side].force_N.row(i).transpose();
       r.joint_force_N(i, 2 * j) = F.x();
       r.joint_force_N(i, 2 * j + 1) = F.y();

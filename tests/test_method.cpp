@@ -28,8 +28,8 @@ SagittalLandmarks synthetic_landmarks(const Trial& t) {
   for (int side = 0; side < 2; ++side)
     for (int k = 2; k < 7; ++k) {
       const auto& P = t.markers.positions_m[static_cast<std::size_t>(7 * side + k)];
-      lm.p[landmark(side, k - 2)].col(0) = P.col(0);
-      lm.p[landmark(side, k - 2)].col(1) = P.col(2);
+      lm.p[landmark(side, static_cast<LegLandmark>(k - 2))].col(0) = P.col(0);
+      lm.p[landmark(side, static_cast<LegLandmark>(k - 2))].col(1) = P.col(2);
     }
   for (int k : {0, 1}) {  // shoulder, hip
     lm.p[k].col(0) = t.markers.positions_m[static_cast<std::size_t>(k)].col(0);
@@ -80,7 +80,7 @@ TEST(Kinematics, ReconstructionSatisfiesTheBilateralConstraints) {
     const Eigen::MatrixXd Phi = solver.bilateral_jacobian(mm.q.row(i).transpose());
     // Velocity level: Phi_q qd = 0 except the rheonomic rows (their time derivative is phi_dot).
     Eigen::VectorXd v = Phi * mm.qd.row(i).transpose();
-    v.segment(48, 8) -= mm.qd.row(i).segment(coord::kPhi, 8).transpose();
+    v.segment(row::kDriving, kJointCount) -= mm.qd.row(i).segment(coord::kPhi, 8).transpose();
     EXPECT_LT(v.cwiseAbs().maxCoeff(), 1e-9) << "frame " << i;
   }
 }
@@ -584,7 +584,7 @@ TEST(Landmarks, FunctionalKneeCentreOfAHingeIsOnItsAxis) {
     j["landmarks"][id] = std::string(id) == "knee_r" ? rule : nlohmann::json{{"marker", "TH1"}};
   const MarkerSet set = parse_marker_set(j, "test");
   const Landmarks3D lm = compute_landmarks(set, m, nullptr, {}, "synthetic");
-  const auto& K = lm.p[landmark(0, 0)];
+  const auto& K = lm.p[landmark(kRight, kKnee)];
   for (int i = 0; i < n; i += 10) {
     EXPECT_NEAR(K(i, 0), knee(i, 0), 1e-3) << i;
     EXPECT_NEAR(K(i, 2), knee(i, 2), 1e-3) << i;

@@ -56,8 +56,8 @@ double CopFunction::fraction(double th) const {
 }
 
 std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, const ModelMotion& m, Eigen::Index i, int side) {
-  const int foot = segment(side, 2), toes = segment(side, 3);
-  const int ankle = landmark(side, 1), mt = landmark(side, 3);
+  const int foot = segment(side, kFoot), toes = segment(side, kToes);
+  const int ankle = landmark(side, kAnkle), mt = landmark(side, kMt);
   const Eigen::Vector2d rA(m.q(i, coord::point_x(ankle)), m.q(i, coord::point_x(ankle) + 1));
   const Eigen::Vector2d rM(m.q(i, coord::point_x(mt)), m.q(i, coord::point_x(mt) + 1));
   const Eigen::Matrix2d Rf = rot(m.q(i, coord::theta(foot)));
@@ -100,7 +100,7 @@ std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCal
   for (Eigen::Index i = 0; i < n; ++i) {
     FrameContacts& fc = out[static_cast<std::size_t>(i)];
     for (int side = 0; side < 2; ++side) {
-      const int foot = segment(side, 2), toes = segment(side, 3);
+      const int foot = segment(side, kFoot), toes = segment(side, kToes);
       const auto sp = sole_points(soles, m, i, side);
       fc.sole[static_cast<std::size_t>(side)] = sp;
       fc.foot_inclination_rad[side] = -(m.q(i, coord::theta(foot)) - soles.feet[static_cast<std::size_t>(side)].flat_angle_rad);
@@ -170,8 +170,8 @@ double percentile(std::vector<double> v, double p) {
   return v[static_cast<std::size_t>(p * static_cast<double>(v.size() - 1))];
 }
 std::vector<Eigen::Index> flat_frames(const SagittalLandmarks& lm, int side) {
-  const auto& E = lm.p[landmark(side, 2)];
-  const auto& M = lm.p[landmark(side, 3)];
+  const auto& E = lm.p[landmark(side, kHeel)];
+  const auto& M = lm.p[landmark(side, kMt)];
   std::vector<double> he(E.col(1).data(), E.col(1).data() + E.rows()), hm(M.col(1).data(), M.col(1).data() + M.rows());
   const double te = percentile(he, 0.10) + 0.015, tm = percentile(hm, 0.10) + 0.015;
   std::vector<Eigen::Index> f;
@@ -202,7 +202,7 @@ ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_
     std::array<double, 2> h{};
     for (int side = 0; side < 2; ++side) {
       std::vector<double> hh;
-      for (auto i : flat_frames(lm, side)) hh.push_back(lm.p[landmark(side, 2)](i, 1));
+      for (auto i : flat_frames(lm, side)) hh.push_back(lm.p[landmark(side, kHeel)](i, 1));
       h[static_cast<std::size_t>(side)] = median_or_zero(hh);
     }
     if (std::min(h[0], h[1]) - ground_level > kMaxHeelHeight) {
@@ -217,10 +217,10 @@ ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_
     const double ground = sole[static_cast<std::size_t>(side)];
     const auto f = flat_frames(lm, side);
     cal.flat_frames[static_cast<std::size_t>(side)] = static_cast<int>(f.size());
-    const auto& A = lm.p[landmark(side, 1)];
-    const auto& E = lm.p[landmark(side, 2)];
-    const auto& M = lm.p[landmark(side, 3)];
-    const auto& T = lm.p[landmark(side, 4)];
+    const auto& A = lm.p[landmark(side, kAnkle)];
+    const auto& E = lm.p[landmark(side, kHeel)];
+    const auto& M = lm.p[landmark(side, kMt)];
+    const auto& T = lm.p[landmark(side, kHallux)];
     std::vector<double> ang, ax, ay, bx, by, cx, cy;
     for (auto i : f) {
       const Eigen::Vector2d a = A.row(i).transpose(), e = E.row(i).transpose(), m = M.row(i).transpose(), t = T.row(i).transpose();
@@ -264,8 +264,8 @@ double estimate_ground_level(const SagittalLandmarks& lm, std::string& message) 
     const auto f = flat_frames(lm, side);
     std::vector<double> he, hm;
     for (auto i : f) {
-      he.push_back(lm.p[landmark(side, 2)](i, 1));
-      hm.push_back(lm.p[landmark(side, 3)](i, 1));
+      he.push_back(lm.p[landmark(side, kHeel)](i, 1));
+      hm.push_back(lm.p[landmark(side, kMt)](i, 1));
     }
     lowest = std::min({lowest, median_or_zero(he), median_or_zero(hm)});
   }

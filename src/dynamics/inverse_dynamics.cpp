@@ -18,8 +18,6 @@ double speed_gate_for(const SolverOptions& o, double v) {
 }
 namespace {
 
-constexpr int kRigidRows = 40, kDefRows = 40, kRheoRows = 48;
-
 /// The (x, y) pairs of q: the landmark points, the segments' COMs and D*. k-th pair's x column.
 constexpr int kXyPairs = coord::kComs / 2 + kSegmentCount + 2;
 constexpr int xy_coordinate(int k) {
@@ -37,9 +35,9 @@ ContactSolver::ContactSolver(const Model& model, const TrialCalibration& calibra
   gravity_ = model.gravity_force();
   weight_bilateral_ = Eigen::VectorXd::Ones(kBilateralCount);
   if (options_.norm == MultiplierNorm::TorqueScaled) {
-    weight_bilateral_.head(kRigidRows).setZero();
-    weight_bilateral_.segment(kDefRows, 16).setConstant(1.0 / options_.torque_length_m);
-    weight_bilateral_.tail(4).setZero();
+    weight_bilateral_.segment(row::kRigid, row::kRigidCount).setZero();
+    weight_bilateral_.segment(row::kAngle, 2 * kJointCount).setConstant(1.0 / options_.torque_length_m);
+    weight_bilateral_.segment(row::kDStar, row::kCount - row::kDStar).setZero();
   }
   // The sparsity pattern does not depend on q: take it from a generic configuration (no
   // coordinate zero, so no structural entry vanishes).
@@ -190,7 +188,7 @@ void ContactSolver::fill_bilateral_jacobian(const FrameVector& q, Eigen::MatrixX
   for (int j = 0; j < kJointCount; ++j, ++row) Phi(row, coord::phi(j)) = 1.0;
   for (int side = 0; side < 2; ++side) {
     const int c = coord::dstar_x(side);
-    attach(c, Eigen::Vector2d(q[c], q[c + 1]), landmark(side, 1), segment(side, 2));
+    attach(c, Eigen::Vector2d(q[c], q[c + 1]), landmark(side, kAnkle), segment(side, kFoot));
   }
 }
 
@@ -360,7 +358,7 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
   Eigen::Matrix<double, kBilateralCount, 1> lamB = BpX.col(0);
   for (int c = 0; c < k; ++c)
     if (lamC[c] != 0.0) lamB -= BpX.col(1 + c) * lamC[c];
-  sol.joint_torque_Nm = lamB.segment<kJointCount>(kRheoRows);
+  sol.joint_torque_Nm = lamB.segment<kJointCount>(row::kDriving);
   for (int side = 0; side < 2; ++side) {
     double fx = 0, fy = 0;
     bool any = false;

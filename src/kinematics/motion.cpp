@@ -34,15 +34,15 @@ BodyGeometry measure_geometry(const SagittalLandmarks& lm) {
   BodyGeometry g;
   g.torso = dist(kHip, kShoulder);
   for (int s = 0; s < 2; ++s) {
-    g.thigh[s] = dist(kHip, landmark(s, 0));
-    g.shank[s] = dist(landmark(s, 0), landmark(s, 1));
-    g.foot[s] = dist(landmark(s, 1), landmark(s, 3));
-    g.toes[s] = dist(landmark(s, 3), landmark(s, 4));
+    g.thigh[s] = dist(kHip, landmark(s, kKnee));
+    g.shank[s] = dist(landmark(s, kKnee), landmark(s, kAnkle));
+    g.foot[s] = dist(landmark(s, kAnkle), landmark(s, kMt));
+    g.toes[s] = dist(landmark(s, kMt), landmark(s, kHallux));
     std::vector<double> hx, hy;
     for (Eigen::Index i = 0; i < n; ++i) {
-      const Eigen::Vector2d A = lm.p[landmark(s, 1)].row(i).transpose();
-      const Eigen::Vector2d M = lm.p[landmark(s, 3)].row(i).transpose();
-      const Eigen::Vector2d E = lm.p[landmark(s, 2)].row(i).transpose();
+      const Eigen::Vector2d A = lm.p[landmark(s, kAnkle)].row(i).transpose();
+      const Eigen::Vector2d M = lm.p[landmark(s, kMt)].row(i).transpose();
+      const Eigen::Vector2d E = lm.p[landmark(s, kHeel)].row(i).transpose();
       const Eigen::Vector2d local = rot(-angle_of(M - A)) * (E - A);
       hx.push_back(local.x());
       hy.push_back(local.y());
@@ -60,10 +60,10 @@ Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm) {
     auto P = [&](int k) { return Eigen::Vector2d(lm.p[k].row(i).transpose()); };
     theta(i, kTorso) = angle_of(P(kShoulder) - P(kHip));
     for (int s = 0; s < 2; ++s) {
-      theta(i, segment(s, 0)) = angle_of(P(landmark(s, 0)) - P(kHip));
-      theta(i, segment(s, 1)) = angle_of(P(landmark(s, 1)) - P(landmark(s, 0)));
-      theta(i, segment(s, 2)) = angle_of(P(landmark(s, 3)) - P(landmark(s, 1)));
-      theta(i, segment(s, 3)) = angle_of(P(landmark(s, 4)) - P(landmark(s, 3)));
+      theta(i, segment(s, kThigh)) = angle_of(P(landmark(s, kKnee)) - P(kHip));
+      theta(i, segment(s, kShank)) = angle_of(P(landmark(s, kAnkle)) - P(landmark(s, kKnee)));
+      theta(i, segment(s, kFoot)) = angle_of(P(landmark(s, kMt)) - P(landmark(s, kAnkle)));
+      theta(i, segment(s, kToes)) = angle_of(P(landmark(s, kHallux)) - P(landmark(s, kMt)));
     }
     x(i, 0) = lm.p[kHip](i, 0);
     x(i, 1) = lm.p[kHip](i, 1);

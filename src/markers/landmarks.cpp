@@ -445,7 +445,7 @@ void follow_heading(SagittalFrame& f, const Landmarks3D& lm, double rate_hz) {
   const Eigen::MatrixXd feet = hold([&](Eigen::Index i, Eigen::RowVector2d& v) {
     v.setZero();
     for (int side = 0; side < 2; ++side) {
-      const Eigen::RowVector3d d = lm.p[landmark(side, 3)].row(i) - lm.p[landmark(side, 2)].row(i);
+      const Eigen::RowVector3d d = lm.p[landmark(side, kMt)].row(i) - lm.p[landmark(side, kHeel)].row(i);
       const Eigen::RowVector2d dh(d.dot(e1.transpose()), d.dot(e2.transpose()));
       if (dh.allFinite()) v += dh;  // not normalised: a foot pitched steeply (swing) weighs little
     }
@@ -512,7 +512,7 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
     Eigen::Vector3d s = Eigen::Vector3d::Zero();
     for (int side = 0; side < 2; ++side)
       for (Eigen::Index i = 0; i < hip.rows(); ++i) {
-        const Eigen::Vector3d d = (lm.p[landmark(side, 3)].row(i) - lm.p[landmark(side, 2)].row(i)).transpose();
+        const Eigen::Vector3d d = (lm.p[landmark(side, kMt)].row(i) - lm.p[landmark(side, kHeel)].row(i)).transpose();
         if (d.allFinite()) s += horizontal(d);
       }
     if (s.norm() == 0) throw InputError("cannot find the direction of progression (no pelvis travel, no feet)");
@@ -615,12 +615,12 @@ SagittalWindow sagittal_landmarks(const Landmarks3D& lm3, const MarkerSet& set, 
     w.foot_lateral_m[side].resize(best_len);
     for (Eigen::Index i = 0; i < best_len; ++i)
       w.foot_lateral_m[side][i] =
-          0.5 * (p[landmark(side, 2)].row(best_a + i) + p[landmark(side, 3)].row(best_a + i)).dot(fr.lateral_at(best_a + i).transpose());
+          0.5 * (p[landmark(side, kHeel)].row(best_a + i) + p[landmark(side, kMt)].row(best_a + i)).dot(fr.lateral_at(best_a + i).transpose());
     // Virtual hallux: toes straight along the foot, held at the MT head's foot-flat height.
-    const LandmarkRule& r = set.rules[static_cast<std::size_t>(landmark(side, 4))];
+    const LandmarkRule& r = set.rules[static_cast<std::size_t>(landmark(side, kHallux))];
     if (r.kind != "virtual_hallux") continue;
-    const auto& A = s.p[landmark(side, 1)];
-    const auto& M = s.p[landmark(side, 3)];
+    const auto& A = s.p[landmark(side, kAnkle)];
+    const auto& M = s.p[landmark(side, kMt)];
     std::vector<double> hm;
     for (Eigen::Index i = 0; i < best_len; ++i) hm.push_back(M(i, 1));
     std::sort(hm.begin(), hm.end());
@@ -629,7 +629,7 @@ SagittalWindow sagittal_landmarks(const Landmarks3D& lm3, const MarkerSet& set, 
     for (Eigen::Index i = 0; i < best_len; ++i)
       if (M(i, 1) < flat_h + 0.01) flat_ang.push_back(std::atan2(M(i, 1) - A(i, 1), M(i, 0) - A(i, 0)));
     const double th_flat = median(flat_ang);
-    auto& T = s.p[landmark(side, 4)];
+    auto& T = s.p[landmark(side, kHallux)];
     for (Eigen::Index i = 0; i < best_len; ++i) {
       const double L = r.value * (M.row(i) - A.row(i)).norm();
       const double th_f = std::atan2(M(i, 1) - A(i, 1), M(i, 0) - A(i, 0));

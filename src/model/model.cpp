@@ -50,12 +50,12 @@ Model build_model(const BodyGeometry& g, double mass, const AnthropometricTable&
   };
   set(kTorso, kHip, kShoulder, g.torso, t.hat);
   for (int side = 0; side < 2; ++side) {
-    set(segment(side, 0), kHip, landmark(side, 0), g.thigh[side], t.thigh);
-    set(segment(side, 1), landmark(side, 0), landmark(side, 1), g.shank[side], t.shank);
-    set(segment(side, 2), landmark(side, 1), landmark(side, 3), g.foot[side], t.foot);
-    set(segment(side, 3), landmark(side, 3), landmark(side, 4), g.toes[side], t.toes);
-    Body& foot = m.bodies[segment(side, 2)];
-    foot.points[1] = landmark(side, 2);
+    set(segment(side, kThigh), kHip, landmark(side, kKnee), g.thigh[side], t.thigh);
+    set(segment(side, kShank), landmark(side, kKnee), landmark(side, kAnkle), g.shank[side], t.shank);
+    set(segment(side, kFoot), landmark(side, kAnkle), landmark(side, kMt), g.foot[side], t.foot);
+    set(segment(side, kToes), landmark(side, kMt), landmark(side, kHallux), g.toes[side], t.toes);
+    Body& foot = m.bodies[segment(side, kFoot)];
+    foot.points[1] = landmark(side, kHeel);
     foot.points_local[1] = g.heel_local[side];
   }
   return m;

@@ -37,7 +37,7 @@ namespace {
 
 constexpr double kStanceEnd = 0.6, kHeelRockerEnd = 0.08, kFlatEnd = 0.35;
 // Foot points relative to the heel's ground point with the foot flat (x forward, y up), m.
-const Eigen::Vector2d kAnkle(0.05, 0.08), kHeelMarker(0.0, 0.035), kMtMarker(0.18, 0.025), kHallux(0.24, 0.02),
+const Eigen::Vector2d kAnkleMarker(0.05, 0.08), kHeelMarker(0.0, 0.035), kMtMarker(0.18, 0.025), kHalluxMarker(0.24, 0.02),
     kMtGround(0.18, 0.0);
 
 double smoothstep(double u) {
@@ -78,7 +78,7 @@ FootPose stance_pose(double heel_x, double p, const SyntheticWalkOptions& o) {
 }
 
 /// The right foot's first heel strike (x, m): its ankle is under the hip at mid-stance.
-double right_first_heel_x(const SyntheticWalkOptions& o) { return 0.3 * o.speed_mps * o.stride_time_s - kAnkle.x(); }
+double right_first_heel_x(const SyntheticWalkOptions& o) { return 0.3 * o.speed_mps * o.stride_time_s - kAnkleMarker.x(); }
 
 FootPose foot_pose(double cycles, double first_heel_x, const SyntheticWalkOptions& o) {
   const double stride = o.speed_mps * o.stride_time_s;
@@ -126,13 +126,13 @@ SyntheticWalk make_synthetic_walk(const SyntheticWalkOptions& o) {
       // The left foot is half a cycle ahead in its cycle: its current stance began half a stride back.
       const double cycles = time / T + (side ? 0.5 : 0.0);
       const FootPose f = foot_pose(cycles, first_heel_x - (side ? 0.5 * v * T : 0.0), o);
-      const Eigen::Vector2d ankle = f.point(kAnkle);
+      const Eigen::Vector2d ankle = f.point(kAnkleMarker);
       const Eigen::Vector2d d = ankle - hip;
       const double dist = d.norm();
       if (dist > Lth + Lsh - 1e-3) throw InputError("synthetic walk: the leg cannot reach the foot (a longer stride than the legs allow)");
       const double alpha = std::acos(std::clamp((Lth * Lth + dist * dist - Lsh * Lsh) / (2 * Lth * dist), -1.0, 1.0));
       const Eigen::Vector2d knee = hip + Lth * rotated(d / dist, alpha);  // knee forward
-      const Eigen::Vector2d pts[] = {sho, hip, knee, ankle, f.point(kHeelMarker), f.point(kMtMarker), f.point(kHallux)};
+      const Eigen::Vector2d pts[] = {sho, hip, knee, ankle, f.point(kHeelMarker), f.point(kMtMarker), f.point(kHalluxMarker)};
       const double y = side == 0 ? -0.1 : 0.1;  // right foot at -Y (Y points left)
       for (int k = 0; k < 7; ++k) m.positions_m[static_cast<std::size_t>(7 * side + k)].row(i) << pts[k].x(), y, pts[k].y();
       if (f.stance) {
@@ -142,7 +142,7 @@ SyntheticWalk make_synthetic_walk(const SyntheticWalkOptions& o) {
         const double p = f.stance_phase * kStanceEnd;
         const double heel = f.point(Eigen::Vector2d::Zero()).x(), mt = f.point(kMtGround).x();
         w.sole_x_m[side](i, 0) = heel;
-        w.sole_x_m[side](i, 1) = f.point(kHallux).x();
+        w.sole_x_m[side](i, 1) = f.point(kHalluxMarker).x();
         w.nominal_cop_x_m[side][i] =
             p < kHeelRockerEnd ? heel : p < kFlatEnd ? heel + (mt - heel) * (p - kHeelRockerEnd) / (kFlatEnd - kHeelRockerEnd) : mt;
       }

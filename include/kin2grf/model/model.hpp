@@ -38,8 +38,12 @@ enum SegmentId : int {
 };
 enum FootSide : int { kRight = 0, kLeft = 1 };
 
-constexpr int landmark(int side, int which /*0 knee,1 ankle,2 heel,3 MT,4 hallux*/) { return 2 + 5 * side + which; }
-constexpr int segment(int side, int which /*0 thigh,1 shank,2 foot,3 toes*/) { return 1 + 4 * side + which; }
+/// A leg's landmarks and bodies, proximal to distal (the same order on both sides).
+enum LegLandmark : int { kKnee = 0, kAnkle = 1, kHeel = 2, kMt = 3, kHallux = 4 };
+enum LegSegment : int { kThigh = 0, kShank = 1, kFoot = 2, kToes = 3 };
+
+constexpr int landmark(int side, LegLandmark which) { return 2 + 5 * side + which; }
+constexpr int segment(int side, LegSegment which) { return 1 + 4 * side + which; }
 
 namespace coord {
 constexpr int kPoints = 0, kComs = 24, kTheta = 42, kPhi = 51, kDStar = 59, kCount = 63;
@@ -49,12 +53,24 @@ constexpr int theta(int s) { return kTheta + s; }
 constexpr int phi(int j) { return kPhi + j; }
 constexpr int dstar_x(int side) { return kDStar + 2 * side; }
 }  // namespace coord
-constexpr int kBilateralCount = 60;
 constexpr int kJointCount = 8;  ///< hip R, knee R, ankle R, MTP R, hip L, knee L, ankle L, MTP L
 
+/// The rows of the bilateral constraints Phi (60), in the order of the header above.
+namespace row {
+constexpr int kRigid = 0;       ///< 40: per body, each attached point and the COM, (x, y)
+constexpr int kRigidCount = 40;
+constexpr int kAngle = 40;      ///< 8: phi_j - theta_child + theta_parent = 0 (joint j)
+constexpr int kDriving = 48;    ///< 8: phi_j - phi_j(t) = 0, rheonomic (joint j)
+constexpr int kDStar = 56;      ///< 4: D* - A - R(theta_foot) rho_D = 0, (x, y) per side
+constexpr int kCount = 60;
+static_assert(kAngle == kRigid + kRigidCount && kDriving == kAngle + kJointCount && kDStar == kDriving + kJointCount &&
+              kCount == kDStar + 4);
+}  // namespace row
+constexpr int kBilateralCount = row::kCount;
+
 /// Parent and child body of joint j.
-constexpr int joint_parent(int j) { return (j % 4 == 0) ? kTorso : segment(j / 4, j % 4 - 1); }
-constexpr int joint_child(int j) { return segment(j / 4, j % 4); }
+constexpr int joint_parent(int j) { return (j % 4 == 0) ? kTorso : segment(j / 4, static_cast<LegSegment>(j % 4 - 1)); }
+constexpr int joint_child(int j) { return segment(j / 4, static_cast<LegSegment>(j % 4)); }
 const char* joint_name(int j);
 const char* segment_name(int s);
 
