@@ -1,7 +1,9 @@
 // kin2grf: small numeric helpers shared by the pipeline's steps.
 #pragma once
 
+#include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -13,6 +15,43 @@ inline double median(std::vector<double> v) {
   const auto mid = v.begin() + static_cast<long>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
   return *mid;
+}
+
+/// R(a): the plane rotation by a (rad, counter-clockwise).
+inline Eigen::Matrix2d rotation(double a) {
+  Eigen::Matrix2d R;
+  R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+  return R;
+}
+
+/// r turned by +90 degrees: d/da (R(a) rho) = perp(R(a) rho).
+inline Eigen::Vector2d perp(const Eigen::Vector2d& r) { return Eigen::Vector2d(-r.y(), r.x()); }
+
+/// Consecutive indices first..last (inclusive) where a condition holds.
+struct IndexRun {
+  Eigen::Index first = 0, last = -1;
+};
+
+/// The runs of 0..n-1 where holds(i) is true, in order.
+template <class Holds>
+std::vector<IndexRun> runs_where(Eigen::Index n, Holds holds) {
+  std::vector<IndexRun> out;
+  for (Eigen::Index i = 0; i < n;) {
+    if (!holds(i)) {
+      ++i;
+      continue;
+    }
+    Eigen::Index k = i;
+    while (k < n && holds(k)) ++k;
+    out.push_back({i, k - 1});
+    i = k;
+  }
+  return out;
+}
+
+/// The runs where v is above thr (NaN is not).
+inline std::vector<IndexRun> runs_above(const Eigen::Ref<const Eigen::VectorXd>& v, double thr) {
+  return runs_where(v.size(), [&](Eigen::Index i) { return std::isfinite(v[i]) && v[i] > thr; });
 }
 
 }  // namespace kin2grf

@@ -10,12 +10,6 @@
 namespace kin2grf {
 namespace {
 
-Eigen::Matrix2d rot(double a) {
-  Eigen::Matrix2d R;
-  R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
-  return R;
-}
-Eigen::Vector2d perp(const Eigen::Vector2d& r) { return Eigen::Vector2d(-r.y(), r.x()); }
 
 double half_cosine(double a, double b, double u) { return a + (b - a) * 0.5 * (1.0 - std::cos(M_PI * u)); }
 
@@ -60,8 +54,8 @@ std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, cons
   const int ankle = landmark(side, kAnkle), mt = landmark(side, kMt);
   const Eigen::Vector2d rA(m.q(i, coord::point_x(ankle)), m.q(i, coord::point_x(ankle) + 1));
   const Eigen::Vector2d rM(m.q(i, coord::point_x(mt)), m.q(i, coord::point_x(mt) + 1));
-  const Eigen::Matrix2d Rf = rot(m.q(i, coord::theta(foot)));
-  const Eigen::Matrix2d Rt = rot(m.q(i, coord::theta(toes)));
+  const Eigen::Matrix2d Rf = rotation(m.q(i, coord::theta(foot)));
+  const Eigen::Matrix2d Rt = rotation(m.q(i, coord::theta(toes)));
   const auto& fg = soles.feet[static_cast<std::size_t>(side)];
   return {rA + Rf * fg.heel_local, rA + Rf * fg.mt_local, rM + Rt * fg.hallux_local};
 }
@@ -181,11 +175,6 @@ std::vector<Eigen::Index> flat_frames(const SagittalLandmarks& lm, int side) {
 }
 /// Median, 0 for no samples (a foot with no flat frames keeps a neutral calibration).
 double median_or_zero(std::vector<double> v) { return v.empty() ? 0.0 : median(std::move(v)); }
-Eigen::Matrix2d rot2(double a) {
-  Eigen::Matrix2d R;
-  R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
-  return R;
-}
 }  // namespace
 
 ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_level) {
@@ -227,9 +216,9 @@ ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_
       const double thf = std::atan2(m.y() - a.y(), m.x() - a.x());
       const double tht = std::atan2(t.y() - m.y(), t.x() - m.x());
       ang.push_back(thf);
-      const Eigen::Vector2d la = rot2(-thf) * (Eigen::Vector2d(e.x(), ground) - a);
-      const Eigen::Vector2d lb = rot2(-thf) * (Eigen::Vector2d(m.x(), ground) - a);
-      const Eigen::Vector2d lc = rot2(-tht) * (Eigen::Vector2d(t.x(), ground) - m);
+      const Eigen::Vector2d la = rotation(-thf) * (Eigen::Vector2d(e.x(), ground) - a);
+      const Eigen::Vector2d lb = rotation(-thf) * (Eigen::Vector2d(m.x(), ground) - a);
+      const Eigen::Vector2d lc = rotation(-tht) * (Eigen::Vector2d(t.x(), ground) - m);
       ax.push_back(la.x()); ay.push_back(la.y());
       bx.push_back(lb.x()); by.push_back(lb.y());
       cx.push_back(lc.x()); cy.push_back(lc.y());

@@ -207,20 +207,4 @@ ForcePlateRecording compute_plates(const AnalogData& analog,
   return rec;
 }
 
-Eigen::MatrixX3d moment_about(const ForcePlate& plate, const Eigen::Vector3d& P) {
-  const Eigen::Index n = plate.force_N.rows();
-  Eigen::MatrixX3d M(n, 3);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const Eigen::Vector3d F = plate.force_N.row(i).transpose();
-    const Eigen::Vector3d c = plate.cop_m.row(i).transpose();
-    const Eigen::Vector3d T = plate.free_moment_Nm.row(i).transpose();
-    if (!c.allFinite() || !T.allFinite()) {
-      M.row(i) = (F.norm() < 1e-9 ? Eigen::Vector3d::Zero() : Eigen::Vector3d::Constant(kNaN)).transpose();
-      continue;
-    }
-    M.row(i) = ((c - P).cross(F) + T).transpose();
-  }
-  return M;
-}
-
 }  // namespace kin2grf

@@ -5,23 +5,19 @@
 #include <cstdio>
 #include <sstream>
 
+#include "kin2grf/numeric.hpp"
+
 namespace kin2grf {
 
 std::vector<LoadedInterval> loaded_intervals(const ForcePlateRecording& rec, const ForcePlate& plate,
                                              double threshold_N) {
   std::vector<LoadedInterval> out;
-  const int up = static_cast<int>(rec.up_axis);
-  const Eigen::Index n = plate.force_N.rows();
-  Eigen::Index i = 0;
-  while (i < n) {
-    if (!(plate.force_N(i, up) > threshold_N)) { ++i; continue; }
+  const auto vertical = plate.force_N.col(static_cast<int>(rec.up_axis));
+  for (const IndexRun& run : runs_above(vertical, threshold_N)) {
     LoadedInterval L;
-    L.first_sample = i;
-    while (i < n && plate.force_N(i, up) > threshold_N) {
-      L.peak_vertical_N = std::max(L.peak_vertical_N, plate.force_N(i, up));
-      ++i;
-    }
-    L.last_sample = i - 1;
+    L.first_sample = run.first;
+    L.last_sample = run.last;
+    L.peak_vertical_N = vertical.segment(run.first, run.last - run.first + 1).maxCoeff();
     L.start_s = rec.time_s[L.first_sample];
     L.end_s = rec.time_s[L.last_sample];
     // Bridge dips shorter than 10 ms (noise around the threshold) into the previous interval.

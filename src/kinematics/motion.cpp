@@ -5,21 +5,13 @@
 #include <vector>
 
 #include "kin2grf/error.hpp"
-#include "kin2grf/numeric.hpp"
 #include "kin2grf/kinematics/filter.hpp"
+#include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
 namespace {
 
-Eigen::Vector2d perp(const Eigen::Vector2d& r) { return Eigen::Vector2d(-r.y(), r.x()); }
-
 double angle_of(const Eigen::Vector2d& d) { return std::atan2(d.y(), d.x()); }
-
-Eigen::Matrix2d rot(double a) {
-  Eigen::Matrix2d R;
-  R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
-  return R;
-}
 
 }  // namespace
 
@@ -43,7 +35,7 @@ BodyGeometry measure_geometry(const SagittalLandmarks& lm) {
       const Eigen::Vector2d A = lm.p[landmark(s, kAnkle)].row(i).transpose();
       const Eigen::Vector2d M = lm.p[landmark(s, kMt)].row(i).transpose();
       const Eigen::Vector2d E = lm.p[landmark(s, kHeel)].row(i).transpose();
-      const Eigen::Vector2d local = rot(-angle_of(M - A)) * (E - A);
+      const Eigen::Vector2d local = rotation(-angle_of(M - A)) * (E - A);
       hx.push_back(local.x());
       hy.push_back(local.y());
     }
@@ -114,7 +106,7 @@ ModelMotion reconstruct_motion(const Model& model, const Eigen::MatrixXd& x, con
     }
     auto place = [&](const Body& b, int s, const Eigen::Vector2d& local, Eigen::Vector2d& rr, Eigen::Vector2d& vv,
                      Eigen::Vector2d& aa) {
-      const Eigen::Vector2d e = rot(th[s]) * local;
+      const Eigen::Vector2d e = rotation(th[s]) * local;
       const Eigen::Vector2d ed = w[s] * perp(e), edd = al[s] * perp(e) - w[s] * w[s] * e;
       // Other bodies: k = 1, k' = k'' = 0 (exactly the fixed-length forward kinematics).
       const bool scaled = s == kTorso;

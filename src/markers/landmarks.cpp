@@ -165,12 +165,6 @@ Eigen::MatrixX3d functional_joint_centre(const std::vector<Eigen::MatrixX3d>& pr
 
 }  // namespace
 
-const char* landmark_name(int id) { return kNames[id]; }
-
-bool MarkerSet::needs_static() const {
-  return std::any_of(rules.begin(), rules.end(), [](const LandmarkRule& r) { return r.kind == "static"; });
-}
-
 std::vector<std::string> MarkerSet::motion_markers() const {
   std::vector<std::string> out;
   for (const auto& r : rules) {

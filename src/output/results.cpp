@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "kin2grf/io/opensim.hpp"
+#include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
 
@@ -86,18 +87,9 @@ std::string format_results_csv(const EstimateResult& r) {
 
 namespace {
 
-/// The runs of frames in contact: (first, last) frame indices, inclusive.
-std::vector<std::pair<Eigen::Index, Eigen::Index>> contact_runs(const std::vector<bool>& c) {
-  std::vector<std::pair<Eigen::Index, Eigen::Index>> out;
-  const auto n = static_cast<Eigen::Index>(c.size());
-  for (Eigen::Index i = 0; i < n;) {
-    if (!c[static_cast<std::size_t>(i)]) { ++i; continue; }
-    Eigen::Index k = i;
-    while (k < n && c[static_cast<std::size_t>(k)]) ++k;
-    out.emplace_back(i, k - 1);
-    i = k;
-  }
-  return out;
+/// The runs of frames in contact.
+std::vector<IndexRun> contact_runs(const std::vector<bool>& c) {
+  return runs_where(static_cast<Eigen::Index>(c.size()), [&](Eigen::Index i) { return c[static_cast<std::size_t>(i)]; });
 }
 
 }  // namespace
@@ -124,7 +116,7 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
   json contacts = json::object();
   for (int s = 0; s < 2; ++s) {
     json iv = json::array();
-    for (const auto& [first, last] : contact_runs(r.feet[s].contact)) iv.push_back({{"start_s", r.time_s[first]}, {"end_s", r.time_s[last]}});
+    for (const auto& run : contact_runs(r.feet[s].contact)) iv.push_back({{"start_s", r.time_s[run.first]}, {"end_s", r.time_s[run.last]}});
     contacts[s ? "left" : "right"] = iv;
   }
   j["contact_intervals"] = contacts;

@@ -15,23 +15,6 @@ namespace {
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-struct Run {
-  Eigen::Index first, last;
-};
-
-std::vector<Run> runs_above(const Eigen::VectorXd& v, double thr) {
-  std::vector<Run> out;
-  Eigen::Index start = -1;
-  for (Eigen::Index i = 0; i <= v.size(); ++i) {
-    const bool on = i < v.size() && std::isfinite(v[i]) && v[i] > thr;
-    if (on && start < 0) start = i;
-    if (!on && start >= 0) {
-      out.push_back({start, i - 1});
-      start = -1;
-    }
-  }
-  return out;
-}
 
 std::string side_name(int foot) { return foot ? "left" : "right"; }
 
@@ -180,7 +163,7 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
 
   struct Candidate {
     int plate;
-    Run run;
+    IndexRun run;
     int foot;
     double distance;
     bool kept;
@@ -188,7 +171,7 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
   std::vector<Candidate> cands;
   for (int pi = 0; pi < static_cast<int>(v.plates.size()); ++pi) {
     const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(pi)];
-    for (const Run& run : runs_above(mp.force_N.col(1), o.threshold_N)) {
+    for (const IndexRun& run : runs_above(mp.force_N.col(1), o.threshold_N)) {
       const std::string where = "plate " + mp.name + " " + frames_text(e, run.first, run.last);
       if (run.last - run.first < 2) continue;  // a blip, not a stance
       if (run.first == 0 || run.last == n - 1 || !std::isfinite(mp.force_N(run.first - 1, 1)) ||

@@ -66,8 +66,4 @@ ForcePlateRecording compute_plates(const AnalogData& analog,
                                    const PlateProcessing& processing, const std::string& path,
                                    std::vector<std::string>& warnings);
 
-/// Sagittal/any moment of a plate's load about a lab point P: M_P = (cop - P) x F + T_free.
-/// NaN where the COP is undefined; zero force gives zero moment.
-Eigen::MatrixX3d moment_about(const ForcePlate& plate, const Eigen::Vector3d& point_m);
-
 }  // namespace kin2grf

@@ -66,12 +66,10 @@ struct MarkerSet {
   std::string description;
   std::vector<std::string> signature;  ///< markers whose presence recognises the set
   std::array<LandmarkRule, kLandmarkCount> rules;
-  [[nodiscard]] bool needs_static() const;
   /// Every marker a motion trial must have.
   [[nodiscard]] std::vector<std::string> motion_markers() const;
 };
 
-const char* landmark_name(int id);  ///< "shoulder", "hip", "knee_r", ...
 MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source);
 MarkerSet load_marker_set(const std::string& path);
 const std::vector<MarkerSet>& builtin_marker_sets();

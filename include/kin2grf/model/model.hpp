@@ -6,7 +6,7 @@
 // toes (MT head -> hallux), right and left. Landmarks I..XII: shoulder, hip (one point for both
 // thighs), and per side knee, ankle, heel, MT head, hallux.
 //
-// Generalised coordinates q (63, METHOD.md):
+// Generalised coordinates q (63; the paper's Sect. 2.2 with D* of Sect. 2.3, docs/METHOD-NOTES.md):
 //   [0, 24)  x, y of the 12 landmarks        [24, 42) x, y of the 9 centres of mass
 //   [42, 51) absolute angle theta_s of each body
 //   [51, 59) relative joint angles phi_j = theta_child - theta_parent (hip, knee, ankle, MTP x2)
