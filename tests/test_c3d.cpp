@@ -72,18 +72,6 @@ Trial small_trial() {
   return t;
 }
 
-void expect_near_matrix(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b, double tol, const std::string& what) {
-  ASSERT_EQ(a.rows(), b.rows()) << what;
-  for (Eigen::Index i = 0; i < a.rows(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      if (std::isnan(b(i, c))) {
-        EXPECT_TRUE(std::isnan(a(i, c))) << what << " row " << i;
-      } else {
-        EXPECT_NEAR(a(i, c), b(i, c), tol) << what << " row " << i << " col " << c;
-      }
-    }
-}
-
 std::string expect_input_error(const std::vector<std::uint8_t>& bytes, const std::string& name) {
   try {
     (void)read_c3d_bytes(bytes, name);
@@ -113,13 +101,13 @@ TEST(C3dRoundTrip, EveryEncodingReadsBackTheSameTrial) {
       EXPECT_EQ(r.markers.descriptions[0], "heel");
       const double tol = fl ? 1e-6 : 5.1e-5;  // float32 in mm, or 0.1 mm integer steps
       for (std::size_t k = 0; k < 3; ++k)
-        expect_near_matrix(r.markers.positions_m[k], t.markers.positions_m[k], tol, what + " marker");
+        EXPECT_TRUE(test::matrices_near(r.markers.positions_m[k], t.markers.positions_m[k], tol)) << what + " marker";
       ASSERT_TRUE(r.plates.has_value()) << what;
       ASSERT_EQ(r.plates->plates.size(), 1u);
       const auto& a = r.plates->plates[0];
       const auto& b = t.plates->plates[0];
       EXPECT_DOUBLE_EQ(r.plates->rate_hz, 400.0);
-      expect_near_matrix(a.force_N, b.force_N, fl ? 1e-3 : 0.05, what + " force");
+      EXPECT_TRUE(test::matrices_near(a.force_N, b.force_N, fl ? 1e-3 : 0.05)) << what + " force";
       for (Eigen::Index i = 0; i < a.force_N.rows(); ++i) {
         if (b.force_N(i, 2) < 50) continue;  // COP is ill-conditioned at tiny loads
         for (int c = 0; c < 2; ++c) EXPECT_NEAR(a.cop_m(i, c), b.cop_m(i, c), fl ? 1e-5 : 5e-4) << what << " cop " << i;
@@ -263,10 +251,10 @@ TEST(C3dShared, IntelDecSgiEncodingsReadIdentically) {
   for (const Trial* o : {&sr, &vr}) {
     ASSERT_EQ(o->markers.names, pi.markers.names);
     for (std::size_t k = 0; k < pi.markers.names.size(); ++k)
-      expect_near_matrix(o->markers.positions_m[k], pi.markers.positions_m[k], 1e-6, pi.markers.names[k]);
+      EXPECT_TRUE(test::matrices_near(o->markers.positions_m[k], pi.markers.positions_m[k], 1e-6)) << pi.markers.names[k];
     ASSERT_TRUE(o->plates && pi.plates);
     for (std::size_t p = 0; p < pi.plates->plates.size(); ++p)
-      expect_near_matrix(o->plates->plates[p].force_N, pi.plates->plates[p].force_N, 1e-3, "force");
+      EXPECT_TRUE(test::matrices_near(o->plates->plates[p].force_N, pi.plates->plates[p].force_N, 1e-3)) << "force";
   }
   // Marker 1 at frame 101 (README): (250.67, 227.25, 35.33) mm.
   EXPECT_NEAR(pi.markers.positions_m[0](100, 0) * 1000, 250.67, 0.01);

@@ -3,8 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <filesystem>
 #include <string>
+
+#include "kin2grf/dynamics/inverse_dynamics.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/synth/example.hpp"
 
 namespace kin2grf::test {
 
@@ -14,6 +19,28 @@ bool have_data();
 std::string data_file(const std::string& relative);
 /// A fresh temporary directory for one test.
 std::filesystem::path temp_dir(const std::string& name);
+
+/// Matrix matcher: same shape, every entry within tol, NaN only where the expected has NaN. On
+/// failure it names the first entry that differs: EXPECT_TRUE(matrices_near(a, b, 1e-9)).
+::testing::AssertionResult matrices_near(const Eigen::Ref<const Eigen::MatrixXd>& actual,
+                                         const Eigen::Ref<const Eigen::MatrixXd>& expected, double tol);
+
+/// The synthetic trial's markers are the landmarks themselves (x forward, z up).
+SagittalLandmarks synthetic_landmarks(const Trial& t);
+/// estimate() on a synthetic trial with the example marker set.
+EstimateResult run(const SyntheticOptions& so, EstimateOptions eo = {});
+/// A squat whose "plates" are the estimate's own forces, unloaded for 10 frames at each end so
+/// that the stances begin and end inside the trial.
+struct SyntheticWithPlates {
+  Trial trial;
+  EstimateResult estimate;
+  ForcePlateRecording plates;
+};
+SyntheticWithPlates synthetic_with_exact_plates();
+/// One foot's (anterior, vertical) force of a frame's solve: its contact points' multipliers.
+Eigen::Vector2d foot_force(const FrameSolution& s, const FrameContacts& fc, int side);
+/// Whether any of the foot's contact points is active.
+bool foot_active(const FrameSolution& s, const FrameContacts& fc, int side);
 
 }  // namespace kin2grf::test
 

@@ -359,19 +359,6 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
   for (int c = 0; c < k; ++c)
     if (lamC[c] != 0.0) lamB -= BpX.col(1 + c) * lamC[c];
   sol.joint_torque_Nm = lamB.segment<kJointCount>(row::kDriving);
-  for (int side = 0; side < 2; ++side) {
-    double fx = 0, fy = 0;
-    bool any = false;
-    for (int j = 0; j < np; ++j) {
-      const auto& p = fc.points[static_cast<std::size_t>(j)];
-      if (p.side != side || !(active >> j & 1U)) continue;
-      any = true;
-      fy += lamC[2 * j];
-      fx += lamC[2 * j + 1];
-    }
-    sol.active[side] = any;
-    sol.force_N[side] = Eigen::Vector2d(fx, fy);
-  }
   return sol;
 }
 

@@ -89,8 +89,6 @@ struct SolverOptions {
 double speed_gate_for(const SolverOptions& options, double progression_speed_mps);
 
 struct FrameSolution {
-  std::array<Eigen::Vector2d, 2> force_N{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};  ///< per foot (x, y)
-  std::array<bool, 2> active{false, false};
   Eigen::Matrix<double, kJointCount, 1> joint_torque_Nm = Eigen::Matrix<double, kJointCount, 1>::Zero();
   /// Per contact point (n, t) pairs (fixed capacity: a frame's solve allocates nothing).
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 2 * kMaxContactPoints, 1> contact_lambda;

@@ -1,4 +1,4 @@
-// Tests of validate, its metrics, the COP fit and the HTML report.
+// Tests of validation/validate: plates -> stances -> errors.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -24,62 +24,7 @@
 
 using namespace kin2grf;
 
-TEST(Metrics, RmseAndRrmseOfHandMadeSeries) {
-  // est - meas = (1, -1, 1, -1): RMSE 1. Ranges: est 0..10 -> 10... by construction below.
-  Eigen::VectorXd meas(4), est(4);
-  meas << 0, 4, 8, 10;
-  est << 1, 3, 9, 9;
-  const auto m = compare_series(est, meas);
-  ASSERT_TRUE(m);
-  EXPECT_EQ(m->samples, 4);
-  EXPECT_DOUBLE_EQ(m->rmse, 1.0);
-  // range(est) = 8, range(meas) = 10 -> mean range 9 -> rRMSE = 100/9 %.
-  EXPECT_NEAR(m->rrmse_percent, 100.0 / 9.0, 1e-12);
-  EXPECT_DOUBLE_EQ(m->max_abs_error, 1.0);
-  EXPECT_DOUBLE_EQ(m->peak_difference, -1.0);
-  EXPECT_GT(m->pearson_r, 0.95);
-  EXPECT_LT(m->pearson_r, 1.0);
-  // NaN pairs are left out; identical series give zero error and r = 1.
-  Eigen::VectorXd a(5), b(5);
-  a << 1, 2, NAN, 4, 8;
-  b << 1, 2, 3, NAN, 8;
-  const auto z = compare_series(a, b);
-  ASSERT_TRUE(z);
-  EXPECT_EQ(z->samples, 3);
-  EXPECT_DOUBLE_EQ(z->rmse, 0.0);
-  EXPECT_DOUBLE_EQ(z->rrmse_percent, 0.0);
-  EXPECT_NEAR(z->pearson_r, 1.0, 1e-12);
-  EXPECT_FALSE(compare_series(Eigen::VectorXd::Constant(3, NAN), Eigen::VectorXd::Zero(3)));
-}
-
-TEST(Metrics, ThresholdCrossingsAreInterpolated) {
-  Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(6, 0.0, 0.05), v(6);
-  v << 0, 10, 30, 50, 30, 0;
-  EXPECT_NEAR(*rising_crossing(v, t, 20.0, 0, 5), 0.015, 1e-12);
-  EXPECT_NEAR(*falling_crossing(v, t, 20.0, 0, 5), 0.04 + 0.01 * 10.0 / 30.0, 1e-12);
-  EXPECT_FALSE(rising_crossing(v, t, 60.0, 0, 5));
-}
-
-namespace {
-
-struct Synthetic {
-  Trial trial;
-  EstimateResult estimate;
-  ForcePlateRecording plates;
-};
-
-/// A squat whose "plates" are the estimate's own forces, unloaded for 10 frames at each end so
-/// that the stances begin and end inside the trial.
-Synthetic synthetic_with_exact_plates() {
-  Synthetic s;
-  SyntheticOptions so;
-  s.trial = make_synthetic_trial(so);
-  s.estimate = estimate(s.trial, nullptr, *find_marker_set("kin2grf-example"), {});
-  s.plates = example_plates(s.estimate, s.trial, 10);
-  return s;
-}
-
-}  // namespace
+using kin2grf::test::synthetic_with_exact_plates;
 
 TEST(Validate, ExactPlatesGiveNearZeroError) {
   const auto s = synthetic_with_exact_plates();
@@ -165,88 +110,6 @@ TEST(Validate, FootPartlyOffItsPlateIsExcluded) {
   EXPECT_TRUE(said);
 }
 
-TEST(CopFit, RecoversTheEventPositionsOfNoiseFreeSamples) {
-  CopFunction truth = CopFunction::paper();
-  truth.s_hs = 0.1, truth.s_ho = 0.35, truth.s_mo = 0.7, truth.s_to = 0.95;
-  CopSamples smp;
-  for (int k = 0; k <= 200; ++k) {
-    const double th = -0.5 + 1.7 * k / 200.0;
-    smp.theta_rad.push_back(th);
-    smp.fraction.push_back(truth.fraction(th));
-  }
-  const auto fit = fit_cop_function(smp, CopFunction::paper());
-  EXPECT_NEAR(fit.function.s_hs, 0.1, 1e-5);
-  EXPECT_NEAR(fit.function.s_ho, 0.35, 1e-5);
-  EXPECT_NEAR(fit.function.s_mo, 0.7, 1e-5);
-  EXPECT_NEAR(fit.function.s_to, 0.95, 1e-5);
-  EXPECT_LT(fit.rms_fraction, 1e-6);
-  CopSamples few;
-  few.theta_rad = {0.0};
-  few.fraction = {0.5};
-  EXPECT_THROW(fit_cop_function(few, CopFunction::paper()), InputError);
-}
-
-TEST(CopFit, JsonRoundTripAndFieldErrors) {
-  const CopFunction f = CopFunction::paper();
-  const CopFunction g = cop_function_from_json(cop_function_json(f), "x.json");
-  EXPECT_DOUBLE_EQ(g.s_mo, f.s_mo);
-  EXPECT_DOUBLE_EQ(g.delta_to, f.delta_to);
-  auto j = cop_function_json(f);
-  j.erase("s_ho");
-  try {
-    (void)cop_function_from_json(j, "cop.json");
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("cop.json"), std::string::npos);
-    EXPECT_NE(std::string(e.what()).find("s_ho"), std::string::npos);
-  }
-  j = cop_function_json(f);
-  j["delta_mo"] = 2.0;  // after delta_to
-  EXPECT_THROW((void)cop_function_from_json(j, "cop.json"), InputError);
-}
-
-TEST(CopFit, BuiltInDefaultIsTheCommittedFit) {
-  // The built-in COP function (contact.hpp) is the fit stored with its provenance.
-  const CopFunction f = read_cop_function(std::string(KIN2GRF_SOURCE_DIR) + "/data/cop-function/walking-fitted.json");
-  const CopFunction d;
-  for (auto [a, b] : {std::pair{f.delta_hs, d.delta_hs}, {f.delta_ho, d.delta_ho}, {f.delta_mo, d.delta_mo}, {f.delta_to, d.delta_to},
-                      {f.s_hs, d.s_hs}, {f.s_ho, d.s_ho}, {f.s_mo, d.s_mo}, {f.s_to, d.s_to}})
-    EXPECT_NEAR(a, b, 5e-4);
-  // The running function likewise.
-  const CopFunction fr = read_cop_function(std::string(KIN2GRF_SOURCE_DIR) + "/data/cop-function/running-fitted.json");
-  const CopFunction dr = CopFunction::running();
-  for (auto [a, b] : {std::pair{fr.delta_hs, dr.delta_hs}, {fr.delta_ho, dr.delta_ho}, {fr.delta_mo, dr.delta_mo},
-                      {fr.delta_to, dr.delta_to}, {fr.s_hs, dr.s_hs}, {fr.s_ho, dr.s_ho}, {fr.s_mo, dr.s_mo}, {fr.s_to, dr.s_to}})
-    EXPECT_NEAR(a, b, 5e-4);
-}
-
-TEST(Report, RendersInHeadlessChromium) {
-  const char* candidates[] = {"/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"};
-  std::string browser;
-  for (const char* c : candidates)
-    if (std::filesystem::exists(c)) browser = c;
-  if (browser.empty()) GTEST_SKIP() << "no Chromium found (scripts/setup.sh installs Debian's chromium)";
-  const auto s = synthetic_with_exact_plates();
-  const auto v = validate(s.estimate, s.plates);
-  const auto j = validation_json("synthetic", s.estimate, v, nlohmann::json::object());
-  const auto dir = test::temp_dir("report");
-  const auto html = dir / "report.html";
-  write_file_text(html.string(), validation_report_html("synthetic", s.estimate, v, j));
-  const std::string cmd = browser + " --headless --no-sandbox --disable-gpu --user-data-dir=" + (dir / "profile").string() +
-                          " --dump-dom file://" + html.string() + " 2>/dev/null";
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-  ASSERT_TRUE(pipe);
-  std::string dom;
-  char buf[4096];
-  while (std::size_t k = std::fread(buf, 1, sizeof buf, pipe.get())) dom.append(buf, k);
-  // 3 figures per foot and 2 totals, each drawn by Chart.js (the script sets the attribute
-  // only after every chart was constructed).
-  EXPECT_NE(dom.find("data-charts-rendered=\"8\""), std::string::npos) << dom.substr(0, 400);
-  const auto p = dom.find("data-points=\"");
-  ASSERT_NE(p, std::string::npos);
-  EXPECT_GT(std::stoi(dom.substr(p + 13)), 1000);
-}
-
 // Regression guards on the development walking and running trials: the mean per-stance vertical rRMSE
 // stays within 25 % (+1 point) of what was measured when the guard was set (docs/VALIDATION.md),
 // and every kept plate stance is found in contact at mid-stance by the estimate.
@@ -305,43 +168,6 @@ TEST(SharedValidate, TrialsStayWithinTheirMeasuredErrors) {
     EXPECT_LT(vertical, 1.25 * c.measured_vertical + 1.0) << c.trial;
     EXPECT_GT(vertical, 0.5) << c.trial << ": suspiciously exact";
   }
-}
-
-namespace {
-StudyTrialResult fake_trial(const char* name, const char* lab, double rrmse) {
-  StanceValidation st;
-  SeriesMetrics m;
-  m.rrmse_percent = rrmse;
-  st.metrics.vertical = st.metrics.anterior = st.metrics.cop = m;
-  return StudyTrialResult{name, "walking", lab, {st}, std::nan(""), false};
-}
-}  // namespace
-
-// Leave-one-lab-out: lab A fits setting "low", labs B and C fit "high". In-sample picks "high"
-// (two labs of three); with B or C held out, the other two labs tie and the first setting is kept,
-// so B and C are scored at "low" and A at "high": the held-out figure shows what a lab unlike the
-// others would meet, where the in-sample one hides it.
-TEST(Study, LeaveOneLabOutScoresEachLabAtTheOthersChoice) {
-  StudyResult s;
-  s.kind = "test";
-  s.rows = {{"low", 0, {}}, {"high", 1, {}}};
-  s.per_trial = {{fake_trial("a1", "A", 2), fake_trial("b1", "B", 10), fake_trial("c1", "C", 10)},
-                 {fake_trial("a1", "A", 8), fake_trial("b1", "B", 4), fake_trial("c1", "C", 4)}};
-  const CrossValidation cv = cross_validate(s);
-  EXPECT_EQ(cv.in_sample_choice, "high");
-  ASSERT_EQ(cv.lab_choice.size(), 3u);
-  EXPECT_EQ(cv.lab_choice[0].second, "high");  // without A
-  EXPECT_EQ(cv.lab_choice[1].second, "low");   // without B: A (2) + C (10) = 6 against A (8) + C (4) = 6: tie, first kept
-  EXPECT_EQ(cv.lab_choice[2].second, "low");
-  ASSERT_EQ(cv.cells.size(), 1u);
-  EXPECT_NEAR(cv.cells[0].in_sample.vertical, (8 + 4 + 4) / 3.0, 1e-12);
-  EXPECT_NEAR(cv.cells[0].held_out.vertical, (8 + 10 + 10) / 3.0, 1e-12);  // worse than in-sample, as it should be
-  EXPECT_EQ(cv.cells[0].worst_trial, "b1");
-  // One lab only: refused with a message that says how to name labs.
-  StudyResult one = s;
-  for (auto& row : one.per_trial)
-    for (auto& t : row) t.lab.assign(1, 'A');
-  EXPECT_THROW((void)cross_validate(one), InputError);
 }
 
 // A foot standing beside the plates (issue 9): the squat's left plate reads nothing, as if the

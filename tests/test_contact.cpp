@@ -1,0 +1,121 @@
+// Tests of dynamics/contact: foot models, COP function, contact calibration, ground level, flight frames.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "kin2grf/dynamics/inverse_dynamics.hpp"
+#include "kin2grf/kinematics/filter.hpp"
+#include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/io/text.hpp"
+#include "kin2grf/error.hpp"
+#include "kin2grf/numeric.hpp"
+#include "kin2grf/synth/example.hpp"
+#include "test_support.hpp"
+
+using namespace kin2grf;
+
+using kin2grf::test::run;
+using kin2grf::test::synthetic_landmarks;
+
+// Running frames are told from the kinematics: near a flight the whole body's vertical force
+// sum m (a_y + g) falls to about zero (free fall); standing, squatting and walking never do.
+TEST(Contact, FlightFramesAreFoundFromTheKinematicsAlone) {
+  SyntheticOptions so;
+  so.squat_depth = 0.0;
+  so.flight_height_m = 0.3;  // flight 1.253-1.747 s
+  const Trial t = make_synthetic_trial(so);
+  const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+  ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
+  const auto run = flight_frames(r.model, mm);
+  ASSERT_EQ(run.size(), static_cast<std::size_t>(mm.frames()));
+  for (Eigen::Index i = 0; i < mm.frames(); ++i) {
+    const double time = mm.time_s[i];
+    if (time > 1.3 && time < 1.7) {
+      EXPECT_TRUE(run[static_cast<std::size_t>(i)]) << time;  // in the flight
+    } else if (time < 0.7 || time > 2.3) {
+      EXPECT_FALSE(run[static_cast<std::size_t>(i)]) << time;  // far from it
+    }
+  }
+  for (const double depth : {0.0, 1.0}) {  // quiet standing and squats: never
+    SyntheticOptions sq;
+    sq.squat_depth = depth;
+    const Trial ts = make_synthetic_trial(sq);
+    const auto rs = estimate(ts, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+    ModelMotion ms = compute_motion(rs.model, synthetic_landmarks(ts), 6.0);
+    const auto none = flight_frames(rs.model, ms);
+    EXPECT_EQ(std::count(none.begin(), none.end(), true), 0) << depth;
+  }
+}
+
+// Model 2's COP function (Eq. 2): constant outside the event angles, through each event's
+// position, continuous, and (for the defaults and the paper's) never moving back toward the heel.
+TEST(Contact, CopFractionPassesThroughTheEventsAndStaysMonotone) {
+  for (const CopFunction& F : {CopFunction{}, CopFunction::paper(), CopFunction::running()}) {
+    EXPECT_DOUBLE_EQ(F.fraction(F.delta_hs - 1.0), F.s_hs);
+    EXPECT_DOUBLE_EQ(F.fraction(F.delta_to + 1.0), F.s_to);
+    EXPECT_NEAR(F.fraction(F.delta_hs), F.s_hs, 1e-12);
+    EXPECT_NEAR(F.fraction(F.delta_ho), F.s_ho, 1e-12);
+    EXPECT_NEAR(F.fraction(F.delta_mo), F.s_mo, 1e-12);
+    EXPECT_NEAR(F.fraction(F.delta_to), F.s_to, 1e-12);
+    double last = F.fraction(-2.0);
+    for (double th = -2.0; th <= 2.0; th += 1e-3) {
+      const double s = F.fraction(th);
+      EXPECT_GE(s, last - 1e-12) << th;
+      EXPECT_LT(std::abs(s - last), 0.01) << "a jump at " << th;  // continuous at 1 mrad steps
+      last = s;
+    }
+  }
+}
+
+// The contact calibration (Sect. 2.3) puts A and B on the floor under the heel and MT landmarks in
+// the foot-flat frames; a foot that never stands on the floor takes the other foot's soles.
+TEST(Contact, CalibrationPutsTheSolesOnTheFloorInFlatFrames) {
+  SyntheticOptions so;
+  const Trial t = make_synthetic_trial(so);
+  const SagittalLandmarks lm = synthetic_landmarks(t);
+  const ContactCalibration cal = calibrate_contact(lm, 0.0);
+  EXPECT_TRUE(cal.message.empty()) << cal.message;
+  for (int side = 0; side < 2; ++side) {
+    ASSERT_GE(cal.flat_frames[static_cast<std::size_t>(side)], 10) << side;
+    const auto& fg = cal.feet[static_cast<std::size_t>(side)];
+    for (Eigen::Index i = 0; i < lm.frames(); i += 25) {
+      const Eigen::Vector2d a = lm.p[landmark(side, kAnkle)].row(i).transpose(), m = lm.p[landmark(side, kMt)].row(i).transpose();
+      const Eigen::Matrix2d R = rotation(std::atan2(m.y() - a.y(), m.x() - a.x()));
+      const Eigen::Vector2d A = a + R * fg.heel_local, B = a + R * fg.mt_local;
+      EXPECT_NEAR(A.y(), 0.0, 2e-3) << "side " << side << " frame " << i;  // the squat keeps its feet flat
+      EXPECT_NEAR(B.y(), 0.0, 2e-3) << "side " << side << " frame " << i;
+      EXPECT_NEAR(A.x(), lm.p[landmark(side, kHeel)](i, 0), 2e-3);
+      EXPECT_NEAR(B.x(), m.x(), 2e-3);
+    }
+  }
+  SyntheticOptions hop;
+  hop.left_leg_raised_rad = 0.6;
+  const ContactCalibration one = calibrate_contact(synthetic_landmarks(make_synthetic_trial(hop)), 0.0);
+  EXPECT_NE(one.message.find("left foot never stands on the floor"), std::string::npos) << one.message;
+  EXPECT_EQ(one.feet[1].heel_local, one.feet[0].heel_local);
+  EXPECT_EQ(one.feet[1].flat_angle_rad, one.feet[0].flat_angle_rad);
+}
+
+// The ground level: the lab floor (0) when the flat-stance landmarks stand 0-150 mm above it,
+// otherwise the lowest of them (a raised walkway, a floor below the origin), with a message.
+TEST(Contact, GroundLevelIsTheLabFloorUnlessTheFeetSayOtherwise) {
+  const SagittalLandmarks lm = synthetic_landmarks(make_synthetic_trial({}));
+  auto lifted = [&](double dy) {
+    SagittalLandmarks l = lm;
+    for (auto& p : l.p) p.col(1).array() += dy;
+    return l;
+  };
+  double lowest = 1e9;
+  for (int side = 0; side < 2; ++side) lowest = std::min(lowest, lm.p[landmark(side, kMt)].col(1).minCoeff());
+  std::string msg;
+  EXPECT_EQ(estimate_ground_level(lm, msg), 0.0);
+  EXPECT_NE(msg.find("lab floor"), std::string::npos) << msg;
+  EXPECT_EQ(estimate_ground_level(lifted(0.10), msg), 0.0) << "still within 150 mm";
+  EXPECT_NEAR(estimate_ground_level(lifted(0.50), msg), 0.50 + lowest, 0.01) << "a raised walkway";
+  EXPECT_NE(msg.find("lowest of them"), std::string::npos) << msg;
+  EXPECT_NEAR(estimate_ground_level(lifted(-0.30), msg), -0.30 + lowest, 0.01) << "the origin above the floor";
+}

@@ -1,0 +1,80 @@
+// Tests of validation/cop_fit: the COP function fitted to plate COPs.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/cop_function.hpp"
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/io/text.hpp"
+#include "kin2grf/output/report.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/synth/example.hpp"
+#include "kin2grf/validation/cop_fit.hpp"
+#include "kin2grf/validation/metrics.hpp"
+#include "kin2grf/validation/study.hpp"
+#include "kin2grf/validation/validate.hpp"
+#include "test_support.hpp"
+
+using namespace kin2grf;
+
+TEST(CopFit, RecoversTheEventPositionsOfNoiseFreeSamples) {
+  CopFunction truth = CopFunction::paper();
+  truth.s_hs = 0.1, truth.s_ho = 0.35, truth.s_mo = 0.7, truth.s_to = 0.95;
+  CopSamples smp;
+  for (int k = 0; k <= 200; ++k) {
+    const double th = -0.5 + 1.7 * k / 200.0;
+    smp.theta_rad.push_back(th);
+    smp.fraction.push_back(truth.fraction(th));
+  }
+  const auto fit = fit_cop_function(smp, CopFunction::paper());
+  EXPECT_NEAR(fit.function.s_hs, 0.1, 1e-5);
+  EXPECT_NEAR(fit.function.s_ho, 0.35, 1e-5);
+  EXPECT_NEAR(fit.function.s_mo, 0.7, 1e-5);
+  EXPECT_NEAR(fit.function.s_to, 0.95, 1e-5);
+  EXPECT_LT(fit.rms_fraction, 1e-6);
+  CopSamples few;
+  few.theta_rad = {0.0};
+  few.fraction = {0.5};
+  EXPECT_THROW(fit_cop_function(few, CopFunction::paper()), InputError);
+}
+
+TEST(CopFit, JsonRoundTripAndFieldErrors) {
+  const CopFunction f = CopFunction::paper();
+  const CopFunction g = cop_function_from_json(cop_function_json(f), "x.json");
+  EXPECT_DOUBLE_EQ(g.s_mo, f.s_mo);
+  EXPECT_DOUBLE_EQ(g.delta_to, f.delta_to);
+  auto j = cop_function_json(f);
+  j.erase("s_ho");
+  try {
+    (void)cop_function_from_json(j, "cop.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cop.json"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("s_ho"), std::string::npos);
+  }
+  j = cop_function_json(f);
+  j["delta_mo"] = 2.0;  // after delta_to
+  EXPECT_THROW((void)cop_function_from_json(j, "cop.json"), InputError);
+}
+
+TEST(CopFit, BuiltInDefaultIsTheCommittedFit) {
+  // The built-in COP function (contact.hpp) is the fit stored with its provenance.
+  const CopFunction f = read_cop_function(std::string(KIN2GRF_SOURCE_DIR) + "/data/cop-function/walking-fitted.json");
+  const CopFunction d;
+  for (auto [a, b] : {std::pair{f.delta_hs, d.delta_hs}, {f.delta_ho, d.delta_ho}, {f.delta_mo, d.delta_mo}, {f.delta_to, d.delta_to},
+                      {f.s_hs, d.s_hs}, {f.s_ho, d.s_ho}, {f.s_mo, d.s_mo}, {f.s_to, d.s_to}})
+    EXPECT_NEAR(a, b, 5e-4);
+  // The running function likewise.
+  const CopFunction fr = read_cop_function(std::string(KIN2GRF_SOURCE_DIR) + "/data/cop-function/running-fitted.json");
+  const CopFunction dr = CopFunction::running();
+  for (auto [a, b] : {std::pair{fr.delta_hs, dr.delta_hs}, {fr.delta_ho, dr.delta_ho}, {fr.delta_mo, dr.delta_mo},
+                      {fr.delta_to, dr.delta_to}, {fr.s_hs, dr.s_hs}, {fr.s_ho, dr.s_ho}, {fr.s_mo, dr.s_mo}, {fr.s_to, dr.s_to}})
+    EXPECT_NEAR(a, b, 5e-4);
+}

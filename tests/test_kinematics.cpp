@@ -1,0 +1,96 @@
+// Tests of kinematics/motion: model coordinates from the landmarks.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "kin2grf/dynamics/inverse_dynamics.hpp"
+#include "kin2grf/kinematics/filter.hpp"
+#include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/io/text.hpp"
+#include "kin2grf/error.hpp"
+#include "kin2grf/synth/example.hpp"
+#include "test_support.hpp"
+
+using namespace kin2grf;
+
+using kin2grf::test::run;
+using kin2grf::test::synthetic_landmarks;
+
+TEST(Kinematics, ReconstructionSatisfiesTheBilateralConstraints) {
+  const Trial t = make_synthetic_trial({});
+  SyntheticOptions so;
+  const auto r = run(so);
+  // Rebuild the motion and check Phi(q) ~ 0 via Phi_q qd = 0 and finite differences of q.
+  const SagittalLandmarks lm = synthetic_landmarks(t);
+  ModelMotion mm = compute_motion(r.model, lm, 6.0);
+  (void)prepare_contacts(r.model, r.calibration.contact, ContactModelOptions{}, mm);
+  ContactSolver solver(r.model, r.calibration, {});
+  for (Eigen::Index i = 5; i < mm.frames(); i += 37) {
+    const Eigen::MatrixXd Phi = solver.bilateral_jacobian(mm.q.row(i).transpose());
+    // Velocity level: Phi_q qd = 0 except the rheonomic rows (their time derivative is phi_dot).
+    Eigen::VectorXd v = Phi * mm.qd.row(i).transpose();
+    v.segment(row::kDriving, kJointCount) -= mm.qd.row(i).segment(coord::kPhi, 8).transpose();
+    EXPECT_LT(v.cwiseAbs().maxCoeff(), 1e-9) << "frame " << i;
+  }
+}
+
+TEST(Kinematics, ReconstructedPositionsKeepTheSegmentLengths) {
+  SyntheticOptions so;
+  so.left_leg_raised_rad = 0.3;
+  const Trial t = make_synthetic_trial(so);
+  const auto r = run(so);
+  const ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
+  // Position level: every landmark attached to a body stays at its body-fixed place, so the
+  // distance to the proximal landmark is the same in every frame (fixed-length model).
+  for (int s = 0; s < kSegmentCount; ++s) {
+    const Body& b = r.model.bodies[s];
+    for (int k = 0; k < 2; ++k) {
+      if (b.points[k] < 0) continue;
+      const double L = b.points_local[k].norm();
+      for (Eigen::Index i = 0; i < mm.frames(); i += 13) {
+        const Eigen::Vector2d p(mm.q(i, coord::point_x(b.points[k])), mm.q(i, coord::point_x(b.points[k]) + 1));
+        const Eigen::Vector2d o(mm.q(i, coord::point_x(b.proximal)), mm.q(i, coord::point_x(b.proximal) + 1));
+        EXPECT_NEAR((p - o).norm(), L, 1e-12) << "segment " << s << " frame " << i;
+      }
+    }
+  }
+}
+
+// The torso takes its measured hip-shoulder length (TorsoLength::Measured): the shoulders
+// moving 2 cm up and down against the hip make the reconstructed torso follow, and its points'
+// accelerations are the second derivatives of their positions (the k' and k'' terms).
+TEST(Kinematics, MeasuredTorsoLengthIsFollowedAndDifferentiated) {
+  Trial t = make_synthetic_trial({});
+  const auto r = run({});
+  const Eigen::ArrayXd bob = 0.02 * (2.0 * M_PI * 1.5 * t.markers.time_s.array()).sin();
+  for (const char* s : {"RSHO", "LSHO"}) t.markers.positions_m[static_cast<std::size_t>(t.markers.find(s))].col(2).array() += bob;
+  const SagittalLandmarks lm = synthetic_landmarks(t);
+  const ModelMotion measured = compute_motion(r.model, lm, 6.0, TorsoLength::Measured);
+  const ModelMotion fixed = compute_motion(r.model, lm, 6.0, TorsoLength::Fixed);
+  const double dt = 1.0 / lm.rate_hz, L0 = r.model.bodies[kTorso].length_m;
+  auto point = [](const Eigen::MatrixXd& q, int col, Eigen::Index i) {
+    return Eigen::Vector2d(q(i, col), q(i, col + 1));
+  };
+  double worst_len = 0, worst_acc = 0, fixed_spread = 0, acc_scale = 0;
+  const int sh = coord::point_x(kShoulder), hip = coord::point_x(kHip), com = coord::com_x(kTorso);
+  for (Eigen::Index i = 20; i < measured.frames() - 20; ++i) {
+    const double len = (point(measured.q, sh, i) - point(measured.q, hip, i)).norm();
+    const double truth = (lm.p[kShoulder].row(i) - lm.p[kHip].row(i)).norm();
+    worst_len = std::max(worst_len, std::abs(len - truth));
+    fixed_spread = std::max(fixed_spread, std::abs((point(fixed.q, sh, i) - point(fixed.q, hip, i)).norm() - L0));
+    // Second central difference of the torso COM position against its reconstructed acceleration.
+    const Eigen::Vector2d fd = (point(measured.q, com, i + 1) - 2 * point(measured.q, com, i) +
+                                point(measured.q, com, i - 1)) / (dt * dt);
+    const Eigen::Vector2d a(measured.qdd(i, com), measured.qdd(i, com + 1));
+    worst_acc = std::max(worst_acc, (fd - a).norm());
+    acc_scale = std::max(acc_scale, a.norm());
+  }
+  EXPECT_LT(worst_len, 2e-3);           // follows the measured length (6 Hz filtered, 1.5 Hz bob)
+  EXPECT_LT(fixed_spread, 1e-12);       // the paper's rigid torso does not
+  EXPECT_LT(worst_acc, 0.02 * acc_scale);  // the scaled kinematics are differentiated consistently
+  EXPECT_GT(acc_scale, 0.5);
+}

@@ -1,0 +1,91 @@
+// Tests of validation/study: parameter studies and leave-one-lab-out.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/cop_function.hpp"
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/io/text.hpp"
+#include "kin2grf/output/report.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/synth/example.hpp"
+#include "kin2grf/validation/cop_fit.hpp"
+#include "kin2grf/validation/metrics.hpp"
+#include "kin2grf/validation/study.hpp"
+#include "kin2grf/validation/validate.hpp"
+#include "test_support.hpp"
+
+using namespace kin2grf;
+
+namespace {
+StudyTrialResult fake_trial(const char* name, const char* lab, double rrmse) {
+  StanceValidation st;
+  SeriesMetrics m;
+  m.rrmse_percent = rrmse;
+  st.metrics.vertical = st.metrics.anterior = st.metrics.cop = m;
+  return StudyTrialResult{name, "walking", lab, {st}, std::nan(""), false};
+}
+}  // namespace
+
+// Leave-one-lab-out: lab A fits setting "low", labs B and C fit "high". In-sample picks "high"
+// (two labs of three); with B or C held out, the other two labs tie and the first setting is kept,
+// so B and C are scored at "low" and A at "high": the held-out figure shows what a lab unlike the
+// others would meet, where the in-sample one hides it.
+TEST(Study, LeaveOneLabOutScoresEachLabAtTheOthersChoice) {
+  StudyResult s;
+  s.kind = "test";
+  s.rows = {{"low", 0, {}}, {"high", 1, {}}};
+  s.per_trial = {{fake_trial("a1", "A", 2), fake_trial("b1", "B", 10), fake_trial("c1", "C", 10)},
+                 {fake_trial("a1", "A", 8), fake_trial("b1", "B", 4), fake_trial("c1", "C", 4)}};
+  const CrossValidation cv = cross_validate(s);
+  EXPECT_EQ(cv.in_sample_choice, "high");
+  ASSERT_EQ(cv.lab_choice.size(), 3u);
+  EXPECT_EQ(cv.lab_choice[0].second, "high");  // without A
+  EXPECT_EQ(cv.lab_choice[1].second, "low");   // without B: A (2) + C (10) = 6 against A (8) + C (4) = 6: tie, first kept
+  EXPECT_EQ(cv.lab_choice[2].second, "low");
+  ASSERT_EQ(cv.cells.size(), 1u);
+  EXPECT_NEAR(cv.cells[0].in_sample.vertical, (8 + 4 + 4) / 3.0, 1e-12);
+  EXPECT_NEAR(cv.cells[0].held_out.vertical, (8 + 10 + 10) / 3.0, 1e-12);  // worse than in-sample, as it should be
+  EXPECT_EQ(cv.cells[0].worst_trial, "b1");
+  // One lab only: refused with a message that says how to name labs.
+  StudyResult one = s;
+  for (auto& row : one.per_trial)
+    for (auto& t : row) t.lab.assign(1, 'A');
+  EXPECT_THROW((void)cross_validate(one), InputError);
+}
+
+// A study runs every setting on every trial, and its centre row is what validate gives with the
+// default; an unknown kind is refused by name.
+TEST(Study, EachSettingRunsOnEveryTrialAndTheDefaultRowIsValidates) {
+  const Trial walk = make_example_walk();
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  std::vector<StudyTrial> trials(2);
+  for (int k = 0; k < 2; ++k) {
+    trials[static_cast<std::size_t>(k)].name = k ? "walk-b" : "walk-a";
+    trials[static_cast<std::size_t>(k)].activity = "walking";
+    trials[static_cast<std::size_t>(k)].lab = k ? "lab-b" : "lab-a";
+    trials[static_cast<std::size_t>(k)].trial = &walk;
+    trials[static_cast<std::size_t>(k)].plates = &*walk.plates;
+    trials[static_cast<std::size_t>(k)].marker_set = &set;
+  }
+  const StudyResult s = run_study("ground-shift", trials);
+  ASSERT_EQ(s.rows.size(), 3u);  // -10, 0, +10 mm
+  ASSERT_EQ(s.per_trial.size(), 3u);
+  EXPECT_TRUE(s.failures.empty());
+  const auto direct = validate(estimate(walk, nullptr, set, EstimateOptions{}), *walk.plates, ValidationOptions{});
+  for (const auto& r : s.per_trial[1]) {
+    ASSERT_EQ(r.stances.size(), direct.stances.size()) << r.name;
+    for (std::size_t k = 0; k < r.stances.size(); ++k) {
+      ASSERT_TRUE(r.stances[k].metrics.vertical && direct.stances[k].metrics.vertical);
+      EXPECT_DOUBLE_EQ(r.stances[k].metrics.vertical->rrmse_percent, direct.stances[k].metrics.vertical->rrmse_percent);
+    }
+  }
+  EXPECT_THROW((void)run_study("no-such-study", trials), InputError);
+}
