@@ -59,31 +59,15 @@ py::dict validate(const std::string& trial, const std::vector<std::string>& word
                   double threshold_N, const std::string& zero_offset) {
   const auto s = settings_from(trial, words);
   kin2grf::ValidationOptions vo;
-  if (!(std::isfinite(threshold_N) && threshold_N > 0))
-    throw kin2grf::InputError("threshold " + std::to_string(threshold_N) + ": must be a force above 0 N");
   vo.threshold_N = threshold_N;
-  std::optional<kin2grf::EstimateResult> r;
-  std::optional<kin2grf::ValidationResult> v;
-  kin2grf::EstimateOptions o;
+  std::optional<kin2grf::ValidationRun> run;
   {
     py::gil_scoped_release nogil;
-    const auto t = kin2grf::load_trial(s.trial, kin2grf::load_options(zero_offset));
-    std::optional<kin2grf::Trial> pf;
-    if (!plates.empty()) pf = kin2grf::load_trial(plates, kin2grf::load_options(zero_offset));
-    const kin2grf::Trial& source = pf ? *pf : t;
-    if (!source.plates || source.plates->plates.empty())
-      throw kin2grf::InputError(source.path + ": no force plates to validate against" + (pf ? "" : "; give plates=FILE"));
-    o = kin2grf::to_options(s);
-    r = kin2grf::estimate_trial(s, o, t);
-    v = kin2grf::validate(*r, *source.plates, vo);
+    run = kin2grf::validate_trial(s, plates, vo, zero_offset);
   }
-  auto settings = kin2grf::settings_json(s, o);
-  settings["plates"] = plates;
-  settings["threshold_N"] = threshold_N;
-  settings["zero_offset"] = zero_offset;
   py::dict d;
-  d["validation"] = to_python(kin2grf::validation_json(s.trial, *r, *v, settings));
-  d["estimate"] = estimate_dict(s, o, *r);
+  d["validation"] = to_python(kin2grf::validation_json(s.trial, run->estimate, run->validation, run->settings));
+  d["estimate"] = estimate_dict(s, kin2grf::to_options(s), run->estimate);
   return d;
 }
 

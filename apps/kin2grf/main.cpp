@@ -72,10 +72,10 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
 }
 
 /// Long inputs report the contact solve's progress on stderr, on one line when it is a terminal.
-std::function<void(long, long)> progress_printer(const kin2grf::Trial& trial) {
-  if (trial.markers.frames() < kProgressFrames) return {};
+std::function<void(long, long)> progress_printer() {
   const bool tty = isatty(fileno(stderr)) != 0;
   return [tty, last = -1](long done, long all) mutable {
+    if (all < kProgressFrames) return;
     const int pct = static_cast<int>(100 * done / std::max(1L, all));
     if (pct / 10 == last / 10 && pct != 100 && !tty) return;
     if (pct == last) return;
@@ -86,36 +86,29 @@ std::function<void(long, long)> progress_printer(const kin2grf::Trial& trial) {
   };
 }
 
-kin2grf::EstimateResult run_estimate_core(const EstimateArgs& a, kin2grf::EstimateOptions options, const kin2grf::Trial& trial) {
-  options.progress = progress_printer(trial);
-  auto r = kin2grf::estimate_trial(a, std::move(options), trial);
+/// The estimate's notes and its speed, on stderr.
+void print_messages(const kin2grf::EstimateResult& r) {
   for (const auto& m : r.messages) std::cerr << "kin2grf: " << m << "\n";
   std::cerr << "kin2grf: " << r.time_s.size() << " frames, mass " << r.mass_kg << " kg, "
             << static_cast<long>(static_cast<double>(r.time_s.size()) / std::max(1e-9, r.seconds_kinematics + r.seconds_dynamics))
             << " frames/s\n";
-  return r;
 }
 
 void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
   for (const auto& o : outputs) kin2grf::ensure_not_an_input(o, inputs);
 }
 
-/// The three files of --opensim (write_opensim_export's names), or none.
-std::vector<std::string> opensim_outputs(const EstimateArgs& a) {
-  if (a.opensim_dir.empty()) return {};
-  const std::string stem = std::filesystem::path(a.trial).stem().string();
-  std::vector<std::string> out;
-  for (const char* suffix : {"_grf.mot", "_markers.trc", "_external_loads.xml"})
-    out.push_back((std::filesystem::path(a.opensim_dir) / (stem + suffix)).string());
-  return out;
-}
-
 int run_estimate(const EstimateArgs& a) {
   check_outputs({a.out_mot, a.out_csv, a.out_json}, kin2grf::input_files(a));
-  check_outputs(opensim_outputs(a), kin2grf::input_files(a));
+  if (!a.opensim_dir.empty()) {
+    const auto f = kin2grf::opensim_export_paths(a.opensim_dir, std::filesystem::path(a.trial).stem().string());
+    check_outputs({f.grf_mot, f.markers_trc, f.external_loads_xml}, kin2grf::input_files(a));
+  }
   const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
-  const auto options = kin2grf::to_options(a);
-  const auto r = run_estimate_core(a, options, trial);
+  auto options = kin2grf::to_options(a);
+  options.progress = progress_printer();
+  const auto r = kin2grf::estimate_trial(a, options, trial);
+  print_messages(r);
   const std::string settings_line = kin2grf::settings_json(a, options).dump();
   if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r, settings_line);
   if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::format_results_csv(r));
@@ -143,31 +136,15 @@ struct ValidateArgs {
 };
 
 int run_validate(const ValidateArgs& a) {
-  {
-    auto in = kin2grf::input_files(a.est);
-    in.push_back(a.plates);
-    check_outputs({a.out_json, a.report}, in);
-  }
-  if (!(std::isfinite(a.options.threshold_N) && a.options.threshold_N > 0))
-    throw kin2grf::InputError("--threshold " + std::to_string(a.options.threshold_N) + ": must be a force above 0 N");
-  const kin2grf::Trial trial = kin2grf::load_trial(a.est.trial, kin2grf::load_options(a.zero_offset));
-  std::optional<kin2grf::Trial> plates_file;
-  if (!a.plates.empty()) plates_file = kin2grf::load_trial(a.plates, kin2grf::load_options(a.zero_offset));
-  const kin2grf::Trial& source = plates_file ? *plates_file : trial;
-  if (!source.plates || source.plates->plates.empty())
-    throw kin2grf::InputError(source.path + ": no force plates to validate against" +
-                              (plates_file ? std::string() : std::string("; give --plates GRF.mot")));
-  const auto options = kin2grf::to_options(a.est);
-  const auto r = run_estimate_core(a.est, options, trial);
-  const auto v = kin2grf::validate(r, *source.plates, a.options);
-  nlohmann::json settings = kin2grf::settings_json(a.est, options);
-  settings["plates"] = source.path;
-  settings["threshold_N"] = a.options.threshold_N;
-  settings["zero_offset"] = a.zero_offset;
-  std::cout << kin2grf::format_validation_table(a.est.trial, v);
-  const auto j = kin2grf::validation_json(a.est.trial, r, v, settings);
+  auto in = kin2grf::input_files(a.est);
+  in.push_back(a.plates);
+  check_outputs({a.out_json, a.report}, in);
+  const auto run = kin2grf::validate_trial(a.est, a.plates, a.options, a.zero_offset, progress_printer());
+  print_messages(run.estimate);
+  std::cout << kin2grf::format_validation_table(a.est.trial, run.validation);
+  const auto j = kin2grf::validation_json(a.est.trial, run.estimate, run.validation, run.settings);
   if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(j));
-  if (!a.report.empty()) kin2grf::write_file_text(a.report, kin2grf::validation_report_html(a.est.trial, r, v, j));
+  if (!a.report.empty()) kin2grf::write_file_text(a.report, kin2grf::validation_report_html(a.est.trial, run.estimate, run.validation, j));
   return 0;
 }
 
@@ -177,42 +154,6 @@ struct StudyArgs {
   EstimateArgs est;
   std::string plates;
 };
-
-/// Trials of a study or fit, loaded once (the containers are reserved: pointers stay valid).
-struct LoadedTrials {
-  std::vector<kin2grf::Trial> trials, statics, plates;
-  std::vector<kin2grf::MarkerSet> sets;
-  std::vector<kin2grf::StudyTrial> study;
-};
-
-void load_study_trials(const std::vector<kin2grf::TrialListEntry>& inputs, LoadedTrials& L) {
-  L.trials.reserve(inputs.size()), L.statics.reserve(inputs.size()), L.plates.reserve(inputs.size()), L.sets.reserve(inputs.size());
-  for (const auto& in : inputs) {
-    L.trials.push_back(kin2grf::load_trial(in.settings.trial, kin2grf::load_options("unloaded")));
-    kin2grf::StudyTrial x;
-    x.name = in.name;
-    x.activity = in.activity;
-    x.lab = in.lab;
-    x.trial = &L.trials.back();
-    if (!in.settings.static_trial.empty()) {
-      L.statics.push_back(kin2grf::load_trial(in.settings.static_trial));
-      x.static_trial = &L.statics.back();
-    }
-    const kin2grf::Trial* source = x.trial;
-    if (!in.plates.empty()) {
-      L.plates.push_back(kin2grf::load_trial(in.plates, kin2grf::load_options("unloaded")));
-      source = &L.plates.back();
-    }
-    if (!source->plates || source->plates->plates.empty())
-      throw kin2grf::InputError(source->path + ": no force plates; give --plates");
-    x.plates = &*source->plates;
-    kin2grf::MarkerSet custom;
-    L.sets.push_back(kin2grf::resolve_marker_set(in.settings, *x.trial, custom));
-    x.marker_set = &L.sets.back();
-    x.options = kin2grf::to_options(in.settings);
-    L.study.push_back(x);
-  }
-}
 
 int run_study(const StudyArgs& a) {
   {
@@ -233,8 +174,7 @@ int run_study(const StudyArgs& a) {
     inputs.push_back(si);
   }
   if (inputs.empty()) throw kin2grf::InputError("study: give TRIAL files or --trial-list FILE");
-  LoadedTrials L;
-  load_study_trials(inputs, L);
+  const kin2grf::LoadedTrials L = kin2grf::load_trials(inputs);
   const auto& st = L.study;
   std::cerr << "kin2grf: study " << a.kind << " on " << st.size() << " trials\n";
   const auto res = kin2grf::run_study(a.kind, st);
@@ -263,43 +203,18 @@ int run_fit_cop(const FitCopArgs& a) {
   for (auto& in : kin2grf::read_trial_list(a.trial_list))
     if (a.activity.empty() || in.activity == a.activity) inputs.push_back(in);
   if (inputs.empty()) throw kin2grf::InputError(a.trial_list + ": no trial of activity '" + a.activity + "'");
-  LoadedTrials L;
-  load_study_trials(inputs, L);
+  const kin2grf::LoadedTrials L = kin2grf::load_trials(inputs);
   // Start (and, without --fit-angles, keep) the paper's event angles.
   const kin2grf::CopFunction start = kin2grf::CopFunction::paper();
   const auto res = kin2grf::fit_cop_on_trials(L.study, start, a.min_force, a.fit_angles, a.leave_one_out);
-  const auto& fit = res.fit;
-  nlohmann::json j = kin2grf::cop_function_json(fit.function);
-  nlohmann::json prov;
-  prov["command"] = "kin2grf fit-cop --trial-list " + a.trial_list + " --activity " + a.activity +
-                    (a.fit_angles ? " --fit-angles" : "") + (a.leave_one_out ? " --leave-one-out" : "");
-  prov["kin2grf_version"] = KIN2GRF_VERSION;
-  prov["trials"] = nlohmann::json::array();
-  for (std::size_t k = 0; k < L.study.size(); ++k)
-    prov["trials"].push_back({{"name", L.study[k].name}, {"samples", res.samples_per_trial[k]}});
-  prov["samples"] = fit.samples;
-  prov["event_angles"] = a.fit_angles ? "fitted" : "fixed (the paper's)";
-  prov["min_force_fraction_of_body_weight"] = a.min_force;
-  prov["rms_fraction_before"] = fit.rms_fraction_before;
-  prov["rms_fraction_after"] = fit.rms_fraction;
-  prov["start"] = kin2grf::cop_function_json(start);
-  std::printf("COP function fitted on %d samples of %zu trials (%s)\n", fit.samples, L.study.size(), a.activity.c_str());
-  std::printf("  event angles (rad)   HS %.3f  HO %.3f  MO %.3f  TO %.3f\n", fit.function.delta_hs, fit.function.delta_ho,
-              fit.function.delta_mo, fit.function.delta_to);
-  std::printf("  positions (fraction) HS %.3f  HO %.3f  MO %.3f  TO %.3f   (start %.3f %.3f %.3f %.3f)\n", fit.function.s_hs,
-              fit.function.s_ho, fit.function.s_mo, fit.function.s_to, start.s_hs, start.s_ho, start.s_mo, start.s_to);
-  std::printf("  RMS of F(theta) - s: %.3f (start: %.3f)\n", fit.rms_fraction, fit.rms_fraction_before);
-  if (a.leave_one_out) {
-    std::printf("\nleave-one-lab-out: COP rRMSE %% (mean over the trial's stances; 'other labs': fitted without the trial's lab)\n"
-                "%-26s %8s %8s %11s\n", "trial", "start", "all", "other labs");
-    nlohmann::json loo = nlohmann::json::array();
-    for (const auto& l : res.leave_one_out) {
-      std::printf("%-26s %8.1f %8.1f %11.1f\n", l.trial.c_str(), l.start, l.all, l.others);
-      loo.push_back({{"trial", l.trial}, {"start", l.start}, {"all", l.all}, {"other_labs", l.others}});
-    }
-    prov["leave_one_lab_out_cop_rrmse_percent"] = loo;
-  }
-  j["provenance"] = prov;
+  kin2grf::CopFitProvenance prov;
+  prov.command = "kin2grf fit-cop --trial-list " + a.trial_list + " --activity " + a.activity + (a.fit_angles ? " --fit-angles" : "") +
+                 (a.leave_one_out ? " --leave-one-out" : "");
+  prov.activity = a.activity;
+  prov.min_force_fraction = a.min_force;
+  prov.fit_angles = a.fit_angles;
+  std::cout << kin2grf::format_cop_fit(res, L.study, start, prov);
+  const nlohmann::json j = kin2grf::cop_fit_json(res, L.study, start, prov);
   if (!a.out.empty()) kin2grf::write_file_text(a.out, kin2grf::json_text(j));
   return 0;
 }

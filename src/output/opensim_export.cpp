@@ -36,6 +36,12 @@ std::string external_loads_xml(const std::string& mot, const OpenSimExportOption
   return os.str();
 }
 
+OpenSimExportFiles opensim_export_paths(const std::string& dir, const std::string& stem) {
+  namespace fs = std::filesystem;
+  return {(fs::path(dir) / (stem + "_grf.mot")).string(), (fs::path(dir) / (stem + "_markers.trc")).string(),
+          (fs::path(dir) / (stem + "_external_loads.xml")).string()};
+}
+
 OpenSimExportFiles write_opensim_export(const std::string& dir, const std::string& stem, const Trial& trial,
                                         const EstimateResult& r, const OpenSimExportOptions& o) {
   namespace fs = std::filesystem;
@@ -83,17 +89,14 @@ OpenSimExportFiles write_opensim_export(const std::string& dir, const std::strin
   t.header["DataType"] = "double";
   t.header["kin2grf_version"] = KIN2GRF_VERSION;
   if (!o.settings.empty()) t.header["kin2grf_settings"] = o.settings;
-  OpenSimExportFiles out;
-  out.grf_mot = (fs::path(dir) / (stem + "_grf.mot")).string();
+  const OpenSimExportFiles out = opensim_export_paths(dir, stem);
   write_file_text(out.grf_mot, format_sto(t));
 
   MarkerTrajectories m = trial.markers;
   for (auto& P : m.positions_m) P = (P * R.transpose()).eval();  // NaN stays NaN (a blank in the TRC)
   m.up_axis = Axis::Y;
-  out.markers_trc = (fs::path(dir) / (stem + "_markers.trc")).string();
   write_file_text(out.markers_trc, format_trc(m, stem + "_markers.trc"));
 
-  out.external_loads_xml = (fs::path(dir) / (stem + "_external_loads.xml")).string();
   write_file_text(out.external_loads_xml, external_loads_xml(stem + "_grf.mot", o));
   return out;
 }

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/cop_function.hpp"
 
 namespace kin2grf {
 namespace {
@@ -154,6 +156,58 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
       return mean_rrmse(validate(e, *t.plates).stances).cop;
     };
     out.leave_one_out.push_back({t.name, cop_rrmse(start), cop_rrmse(out.fit.function), cop_rrmse(fit_fn(others).function)});
+  }
+  return out;
+}
+
+nlohmann::json cop_fit_json(const CopFitOnTrials& res, const std::vector<StudyTrial>& trials, const CopFunction& start,
+                            const CopFitProvenance& how) {
+  const CopFit& fit = res.fit;
+  nlohmann::json j = cop_function_json(fit.function);
+  nlohmann::json prov;
+  prov["command"] = how.command;
+  prov["kin2grf_version"] = KIN2GRF_VERSION;
+  prov["trials"] = nlohmann::json::array();
+  for (std::size_t k = 0; k < trials.size(); ++k) prov["trials"].push_back({{"name", trials[k].name}, {"samples", res.samples_per_trial[k]}});
+  prov["samples"] = fit.samples;
+  prov["event_angles"] = how.fit_angles ? "fitted" : "fixed (the paper's)";
+  prov["min_force_fraction_of_body_weight"] = how.min_force_fraction;
+  prov["rms_fraction_before"] = fit.rms_fraction_before;
+  prov["rms_fraction_after"] = fit.rms_fraction;
+  prov["start"] = cop_function_json(start);
+  if (!res.leave_one_out.empty()) {
+    nlohmann::json loo = nlohmann::json::array();
+    for (const auto& l : res.leave_one_out) loo.push_back({{"trial", l.trial}, {"start", l.start}, {"all", l.all}, {"other_labs", l.others}});
+    prov["leave_one_lab_out_cop_rrmse_percent"] = loo;
+  }
+  j["provenance"] = prov;
+  return j;
+}
+
+std::string format_cop_fit(const CopFitOnTrials& res, const std::vector<StudyTrial>& trials, const CopFunction& start,
+                           const CopFitProvenance& how) {
+  const CopFunction& f = res.fit.function;
+  std::string out;
+  char b[256];
+  std::snprintf(b, sizeof b, "COP function fitted on %d samples of %zu trials (%s)\n", res.fit.samples, trials.size(), how.activity.c_str());
+  out += b;
+  std::snprintf(b, sizeof b, "  event angles (rad)   HS %.3f  HO %.3f  MO %.3f  TO %.3f\n", f.delta_hs, f.delta_ho, f.delta_mo, f.delta_to);
+  out += b;
+  std::snprintf(b, sizeof b, "  positions (fraction) HS %.3f  HO %.3f  MO %.3f  TO %.3f   (start %.3f %.3f %.3f %.3f)\n", f.s_hs, f.s_ho,
+                f.s_mo, f.s_to, start.s_hs, start.s_ho, start.s_mo, start.s_to);
+  out += b;
+  std::snprintf(b, sizeof b, "  RMS of F(theta) - s: %.3f (start: %.3f)\n", res.fit.rms_fraction, res.fit.rms_fraction_before);
+  out += b;
+  if (!res.leave_one_out.empty()) {
+    std::snprintf(b, sizeof b,
+                  "\nleave-one-lab-out: COP rRMSE %% (mean over the trial's stances; 'other labs': fitted without the trial's lab)\n"
+                  "%-26s %8s %8s %11s\n",
+                  "trial", "start", "all", "other labs");
+    out += b;
+    for (const auto& l : res.leave_one_out) {
+      std::snprintf(b, sizeof b, "%-26s %8.1f %8.1f %11.1f\n", l.trial.c_str(), l.start, l.all, l.others);
+      out += b;
+    }
   }
   return out;
 }

@@ -40,6 +40,29 @@ void fill_validation(BatchRow& row, const ValidationResult& v) {
 
 }  // namespace
 
+ValidationRun validate_trial(const Settings& s, const std::string& plates_file, const ValidationOptions& vo,
+                             const std::string& zero_offset, std::function<void(long, long)> progress) {
+  if (!(std::isfinite(vo.threshold_N) && vo.threshold_N > 0))
+    throw InputError("setting threshold (N) = " + std::to_string(vo.threshold_N) + ": must be a force above 0 N");
+  const Trial trial = load_trial(s.trial, load_options(zero_offset));
+  std::optional<Trial> measured;
+  if (!plates_file.empty()) measured = load_trial(plates_file, load_options(zero_offset));
+  const Trial& source = measured ? *measured : trial;
+  if (!source.plates || source.plates->plates.empty())
+    throw InputError(source.path + ": no force plates to validate against" + (measured ? "" : "; give a plates file"));
+  EstimateOptions options = to_options(s);
+  options.progress = std::move(progress);
+  ValidationRun run;
+  run.estimate = estimate_trial(s, options, trial);
+  run.validation = validate(run.estimate, *source.plates, vo);
+  run.settings = settings_json(s, options);
+  run.settings["plates"] = source.path;
+  run.settings["threshold_N"] = vo.threshold_N;
+  run.settings["zero_offset"] = zero_offset;
+  run.plates_path = source.path;
+  return run;
+}
+
 BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& options) {
   BatchRow row;
   row.activity = entry.activity, row.lab = entry.lab, row.name = entry.name, row.trial = entry.settings.trial;

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/load.hpp"
 
 namespace kin2grf {
 
@@ -45,6 +46,37 @@ std::vector<TrialListEntry> read_trial_list(const std::string& path) {
   }
   if (out.empty()) throw InputError(path + ": no trials in the list");
   return out;
+}
+
+LoadedTrials load_trials(const std::vector<TrialListEntry>& entries) {
+  LoadedTrials L;
+  // Reserved up front: StudyTrial points into these vectors.
+  L.trials.reserve(entries.size()), L.statics.reserve(entries.size()), L.plates.reserve(entries.size()), L.sets.reserve(entries.size());
+  for (const auto& in : entries) {
+    L.trials.push_back(load_trial(in.settings.trial, load_options("unloaded")));
+    StudyTrial x;
+    x.name = in.name;
+    x.activity = in.activity;
+    x.lab = in.lab;
+    x.trial = &L.trials.back();
+    if (!in.settings.static_trial.empty()) {
+      L.statics.push_back(load_trial(in.settings.static_trial));
+      x.static_trial = &L.statics.back();
+    }
+    const Trial* source = x.trial;
+    if (!in.plates.empty()) {
+      L.plates.push_back(load_trial(in.plates, load_options("unloaded")));
+      source = &L.plates.back();
+    }
+    if (!source->plates || source->plates->plates.empty()) throw InputError(source->path + ": no force plates; give --plates");
+    x.plates = &*source->plates;
+    MarkerSet custom;
+    L.sets.push_back(resolve_marker_set(in.settings, *x.trial, custom));
+    x.marker_set = &L.sets.back();
+    x.options = to_options(in.settings);
+    L.study.push_back(x);
+  }
+  return L;
 }
 
 }  // namespace kin2grf

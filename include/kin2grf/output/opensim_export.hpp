@@ -36,6 +36,10 @@ struct OpenSimExportFiles {
   std::string grf_mot, markers_trc, external_loads_xml;  ///< paths written
 };
 
+/// The three files' paths in `dir` for `stem` (what write_opensim_export writes; checked against
+/// the inputs before a run).
+OpenSimExportFiles opensim_export_paths(const std::string& dir, const std::string& stem);
+
 /// Write the three files into `dir` (created if needed), names starting with `stem`.
 OpenSimExportFiles write_opensim_export(const std::string& dir, const std::string& stem, const Trial& trial,
                                         const EstimateResult& estimate, const OpenSimExportOptions& options = {});

@@ -10,6 +10,8 @@
 // linear weights), so the fit is an ordinary linear least-squares problem, solved by QR.
 #pragma once
 
+#include <nlohmann/json.hpp>
+#include <string>
 #include <vector>
 
 #include "kin2grf/dynamics/contact.hpp"
@@ -59,5 +61,19 @@ struct CopFitOnTrials {
 };
 CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const CopFunction& start, double min_force_fraction,
                                  bool fit_angles, bool leave_one_out);
+
+/// How a fit was made, written with it.
+struct CopFitProvenance {
+  std::string command, activity;
+  double min_force_fraction = 0.2;
+  bool fit_angles = false;
+};
+/// The fitted function as a COP-function file (io/cop_function.hpp) with its provenance: the
+/// command, version, trials and their samples, the RMS before and after, the leave-one-lab-out table.
+nlohmann::json cop_fit_json(const CopFitOnTrials& res, const std::vector<StudyTrial>& trials, const CopFunction& start,
+                            const CopFitProvenance& how);
+/// The fit as text: event angles, positions, RMS, and the leave-one-lab-out table when made.
+std::string format_cop_fit(const CopFitOnTrials& res, const std::vector<StudyTrial>& trials, const CopFunction& start,
+                           const CopFitProvenance& how);
 
 }  // namespace kin2grf

@@ -45,6 +45,20 @@ struct BatchOptions {
   std::function<void(std::size_t, std::size_t, const BatchRow&)> progress;
 };
 
+/// validate on one trial, as the CLI and Python run it: the trial and the measured forces (the
+/// trial's own plates, or those of `plates_file`) read with the zero-offset rule ("none", "zero",
+/// "unloaded"), estimate_trial(), validate(). `settings` records the run (settings_json plus the
+/// plates file, threshold and zero offset). InputError when the threshold is not a force above 0 N
+/// or there is nothing to validate against.
+struct ValidationRun {
+  EstimateResult estimate;
+  ValidationResult validation;
+  nlohmann::json settings;
+  std::string plates_path;  ///< the file the measured forces came from
+};
+ValidationRun validate_trial(const Settings& settings, const std::string& plates_file, const ValidationOptions& validation,
+                             const std::string& zero_offset, std::function<void(long, long)> progress = {});
+
 /// One trial: never throws for the trial's own faults (they are the row's error).
 BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& options = {});
 /// Every trial, rows in the list's order.

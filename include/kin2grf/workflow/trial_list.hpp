@@ -7,6 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "kin2grf/io/trial.hpp"
+#include "kin2grf/markers/landmarks.hpp"
+#include "kin2grf/validation/study.hpp"
 #include "kin2grf/workflow/settings.hpp"
 
 namespace kin2grf {
@@ -22,5 +25,21 @@ struct TrialListEntry {
 TrialListEntry parse_trial_list_line(const std::string& line, const std::string& where);
 /// Every trial of the file; InputError naming the file and line on a bad one, or when empty.
 std::vector<TrialListEntry> read_trial_list(const std::string& path);
+
+/// A list's trials loaded once for a study or a fit: each entry's trial, static trial, plates
+/// (its own or --plates; plate offsets removed from unloaded samples) and marker set, and the
+/// StudyTrial that points into them. Movable, not copyable (the pointers stay valid on a move).
+struct LoadedTrials {
+  std::vector<Trial> trials, statics, plates;
+  std::vector<MarkerSet> sets;
+  std::vector<StudyTrial> study;
+  LoadedTrials() = default;
+  LoadedTrials(const LoadedTrials&) = delete;
+  LoadedTrials& operator=(const LoadedTrials&) = delete;
+  LoadedTrials(LoadedTrials&&) = default;
+  LoadedTrials& operator=(LoadedTrials&&) = default;
+};
+/// InputError naming the file when an entry's trial cannot be read or has no plates.
+LoadedTrials load_trials(const std::vector<TrialListEntry>& entries);
 
 }  // namespace kin2grf
