@@ -6,20 +6,14 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <optional>
 #include <thread>
 
 #include "kin2grf/error.hpp"
-#include "kin2grf/io/c3d.hpp"
-#include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/load.hpp"
-#include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/summary.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/output/opensim_export.hpp"
@@ -29,23 +23,15 @@
 #include "kin2grf/synth/example.hpp"
 #include "kin2grf/validation/cop_fit.hpp"
 #include "kin2grf/validation/study.hpp"
-#include "kin2grf/validation/validate.hpp"
 #include "kin2grf/workflow/batch.hpp"
+#include "kin2grf/workflow/progress.hpp"
 #include "kin2grf/workflow/settings.hpp"
 #include "kin2grf/workflow/trial_list.hpp"
 
 namespace {
 
-constexpr long kProgressFrames = 20000;  ///< inputs at least this long report progress
-
 int run_info(const std::string& file, bool json, double threshold, const std::string& zero, const std::string& up_axis) {
-  if (!(std::isfinite(threshold) && threshold > 0)) throw kin2grf::InputError("--load-threshold must be a force above 0 N");
-  kin2grf::Trial t = kin2grf::load_trial(file, kin2grf::load_options(zero));
-  if (const auto up = kin2grf::parse_axis(up_axis)) {  // the user's word over the data's
-    t.markers.up_axis = *up;
-    if (t.plates) t.plates->up_axis = *up;
-  }
-  const auto s = kin2grf::trial_summary(t, threshold);
+  const auto s = kin2grf::describe_file(file, threshold, kin2grf::load_options(zero), kin2grf::parse_axis(up_axis));
   if (json) std::cout << kin2grf::json_text(s);
   else std::cout << kin2grf::format_summary(s);
   return 0;
@@ -71,21 +57,6 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
       ->expected(2);
 }
 
-/// Long inputs report the contact solve's progress on stderr, on one line when it is a terminal.
-std::function<void(long, long)> progress_printer() {
-  const bool tty = isatty(fileno(stderr)) != 0;
-  return [tty, last = -1](long done, long all) mutable {
-    if (all < kProgressFrames) return;
-    const int pct = static_cast<int>(100 * done / std::max(1L, all));
-    if (pct / 10 == last / 10 && pct != 100 && !tty) return;
-    if (pct == last) return;
-    last = pct;
-    std::fprintf(stderr, tty ? "\rkin2grf: contact solve %3d %% (%ld of %ld frames)" : "kin2grf: contact solve %3d %% (%ld of %ld frames)\n",
-                 pct, done, all);
-    if (tty && pct == 100) std::fputc('\n', stderr);
-  };
-}
-
 /// The estimate's notes and its speed, on stderr.
 void print_messages(const kin2grf::EstimateResult& r) {
   for (const auto& m : r.messages) std::cerr << "kin2grf: " << m << "\n";
@@ -106,7 +77,7 @@ int run_estimate(const EstimateArgs& a) {
   }
   const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
   auto options = kin2grf::to_options(a);
-  options.progress = progress_printer();
+  options.progress = kin2grf::solve_progress(stderr);
   const auto r = kin2grf::estimate_trial(a, options, trial);
   print_messages(r);
   const std::string settings_line = kin2grf::settings_json(a, options).dump();
@@ -139,7 +110,7 @@ int run_validate(const ValidateArgs& a) {
   auto in = kin2grf::input_files(a.est);
   in.push_back(a.plates);
   check_outputs({a.out_json, a.report}, in);
-  const auto run = kin2grf::validate_trial(a.est, a.plates, a.options, a.zero_offset, progress_printer());
+  const auto run = kin2grf::validate_trial(a.est, a.plates, a.options, a.zero_offset, kin2grf::solve_progress(stderr));
   print_messages(run.estimate);
   std::cout << kin2grf::format_validation_table(a.est.trial, run.validation);
   const auto j = kin2grf::validation_json(a.est.trial, run.estimate, run.validation, run.settings);
@@ -161,18 +132,8 @@ int run_study(const StudyArgs& a) {
     in.push_back(a.trial_list);
     check_outputs({a.out_json, a.report}, in);
   }
-  std::vector<kin2grf::TrialListEntry> inputs;
-  if (!a.trial_list.empty()) inputs = kin2grf::read_trial_list(a.trial_list);
-  for (const auto& t : a.trials) {
-    kin2grf::TrialListEntry si;
-    si.activity = "trials";
-    si.name = std::filesystem::path(t).filename().string();
-    si.lab = si.name;
-    si.settings = a.est;
-    si.settings.trial = t;
-    si.plates = a.plates;
-    inputs.push_back(si);
-  }
+  auto inputs = a.trial_list.empty() ? std::vector<kin2grf::TrialListEntry>{} : kin2grf::read_trial_list(a.trial_list);
+  for (auto& e : kin2grf::trial_list_of_files(a.trials, a.est, a.plates)) inputs.push_back(std::move(e));
   if (inputs.empty()) throw kin2grf::InputError("study: give TRIAL files or --trial-list FILE");
   const kin2grf::LoadedTrials L = kin2grf::load_trials(inputs);
   const auto& st = L.study;
@@ -231,21 +192,8 @@ int run_batch(const BatchArgs& a) {
   kin2grf::BatchOptions o;
   o.jobs = a.jobs > 0 ? a.jobs : static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   o.out_dir = a.out_dir;
-  const bool tty = isatty(fileno(stderr)) != 0;
+  o.progress = kin2grf::batch_progress(stderr);
   const auto start = std::chrono::steady_clock::now();
-  o.progress = [&](std::size_t done, std::size_t all, const kin2grf::BatchRow& row) {
-    // A bar on a terminal; one line a trial in a log.
-    const int width = 30;
-    const int filled = static_cast<int>(width * done / std::max<std::size_t>(1, all));
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const std::string what = row.ok ? row.name : row.name + " FAILED";
-    if (tty)
-      std::fprintf(stderr, "\r[%s%s] %zu/%zu  %.0f s  %-40.40s", std::string(static_cast<std::size_t>(filled), '#').c_str(),
-                   std::string(static_cast<std::size_t>(width - filled), '.').c_str(), done, all, elapsed, what.c_str());
-    else
-      std::fprintf(stderr, "kin2grf: batch %zu/%zu (%.0f s): %s\n", done, all, elapsed, what.c_str());
-    if (tty && done == all) std::fputc('\n', stderr);
-  };
   std::cerr << "kin2grf: batch of " << entries.size() << " trials on " << o.jobs << " threads\n";
   const auto rows = kin2grf::run_batch(entries, o);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

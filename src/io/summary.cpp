@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "kin2grf/error.hpp"
 #include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
@@ -96,6 +97,17 @@ nlohmann::json trial_summary(const Trial& t, double thr) {
   s["height_m"] = t.height_m ? json(*t.height_m) : json(nullptr);
   s["warnings"] = t.warnings;
   return s;
+}
+
+nlohmann::json describe_file(const std::string& path, double threshold, const LoadOptions& load, std::optional<Axis> up_axis) {
+  if (!(std::isfinite(threshold) && threshold > 0))
+    throw InputError("setting load threshold (N) = " + std::to_string(threshold) + ": must be a force above 0 N");
+  Trial t = load_trial(path, load);
+  if (up_axis) {
+    t.markers.up_axis = *up_axis;
+    if (t.plates) t.plates->up_axis = *up_axis;
+  }
+  return trial_summary(t, threshold);
 }
 
 std::string format_summary(const nlohmann::json& s) {

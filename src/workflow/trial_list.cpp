@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
 #include <fstream>
 
 #include "kin2grf/error.hpp"
@@ -45,6 +46,22 @@ std::vector<TrialListEntry> read_trial_list(const std::string& path) {
     out.back().line = number;
   }
   if (out.empty()) throw InputError(path + ": no trials in the list");
+  return out;
+}
+
+std::vector<TrialListEntry> trial_list_of_files(const std::vector<std::string>& files, const Settings& settings,
+                                                const std::string& plates) {
+  std::vector<TrialListEntry> out;
+  for (const auto& f : files) {
+    TrialListEntry e;
+    e.activity = "trials";
+    e.name = std::filesystem::path(f).filename().string();
+    e.lab = e.name;
+    e.settings = settings;
+    e.settings.trial = f;
+    e.plates = plates;
+    out.push_back(std::move(e));
+  }
   return out;
 }
 

@@ -12,8 +12,10 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
+#include "kin2grf/io/load.hpp"
 #include "kin2grf/io/trial.hpp"
 
 namespace kin2grf {
@@ -29,6 +31,10 @@ std::vector<LoadedInterval> loaded_intervals(const ForcePlateRecording& rec, con
                                              double threshold_N = 20.0);
 
 nlohmann::json trial_summary(const Trial& t, double load_threshold_N = 20.0);
+/// `kin2grf info`: the file read with `load`, the up axis set to `up_axis` when given (the user's
+/// word over the data's), then trial_summary. InputError for a threshold that is not above 0 N.
+nlohmann::json describe_file(const std::string& path, double load_threshold_N, const LoadOptions& load,
+                             std::optional<Axis> up_axis = std::nullopt);
 std::string format_summary(const nlohmann::json& s);
 
 }  // namespace kin2grf

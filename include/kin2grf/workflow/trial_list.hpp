@@ -26,6 +26,11 @@ TrialListEntry parse_trial_list_line(const std::string& line, const std::string&
 /// Every trial of the file; InputError naming the file and line on a bad one, or when empty.
 std::vector<TrialListEntry> read_trial_list(const std::string& path);
 
+/// Entries for trial files given one by one (the same settings and plates file for all): each its
+/// own lab, named by its file name, activity "trials".
+std::vector<TrialListEntry> trial_list_of_files(const std::vector<std::string>& files, const Settings& settings,
+                                                const std::string& plates);
+
 /// A list's trials loaded once for a study or a fit: each entry's trial, static trial, plates
 /// (its own or --plates; plate offsets removed from unloaded samples) and marker set, and the
 /// StudyTrial that points into them. Movable, not copyable (the pointers stay valid on a move).
