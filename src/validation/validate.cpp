@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 #include "kin2grf/numeric.hpp"
 
@@ -140,34 +141,25 @@ std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const
   return out;
 }
 
-ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& rec, const ValidationOptions& o) {
-  ValidationResult v;
-  v.mass_kg = e.mass_kg;
-  v.first_frame_number = e.first_frame_number;
-  const double bw = e.mass_kg * e.model.gravity_mps2;
-  const Eigen::Index n = e.time_s.size();
-  v.plates = resample_plates(rec, e.frame, e.time_s, rec.cop_threshold_N, e.first_index);
-  const double rate = e.landmarks.rate_hz;
-  const Eigen::Index search = static_cast<Eigen::Index>(std::lround(0.2 * rate));
-  const double ground = e.ground_level_m();
-  for (int f = 0; f < 2; ++f) {
-    v.measured_force_N[static_cast<std::size_t>(f)] = Eigen::MatrixX2d::Constant(n, 2, kNaN);
-    v.measured_cop_x_m[static_cast<std::size_t>(f)] = Eigen::VectorXd::Constant(n, kNaN);
-  }
-  bool noted_geometry = false;
-  bool any_plate_data = false;
-  for (const auto& mp : v.plates) any_plate_data = any_plate_data || mp.force_N.col(1).array().isFinite().any();
-  if (!any_plate_data)
-    v.notes.push_back("the plate recording does not overlap the processed frames (" + frames_text(e, 0, n - 1) +
-                      "): check that markers and plates share one clock");
+namespace {
 
-  struct Candidate {
-    int plate;
-    IndexRun run;
-    int foot;
-    double distance;
-    bool kept;
-  };
+/// A plate's stance and the foot it is assigned to.
+struct Candidate {
+  int plate;
+  IndexRun run;
+  int foot;
+  double distance;
+  bool kept;
+};
+
+/// Plate stances -> candidates: runs above the threshold, cut ones and blips out, each assigned
+/// to the foot its COP lies under, and set aside (kept = false, with the reason in v.excluded)
+/// when the other foot also stands on the plate, the foot is partly off it, or a foot stands on
+/// two plates at once.
+std::vector<Candidate> assign_stances(const EstimateResult& e, ValidationResult& v, const ValidationOptions& o) {
+  const Eigen::Index n = e.time_s.size();
+  const double ground = e.ground_level_m();
+  bool noted_geometry = false;
   std::vector<Candidate> cands;
   for (int pi = 0; pi < static_cast<int>(v.plates.size()); ++pi) {
     const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(pi)];
@@ -257,81 +249,103 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
       ca.kept = cb.kept = false;
     }
 
-  for (const Candidate& c : cands) {
-    if (!c.kept) continue;
-    const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(c.plate)];
-    const FootResult& fe = e.feet[static_cast<std::size_t>(c.foot)];
-    const Eigen::Index a = c.run.first, len = c.run.last - c.run.first + 1;
-    StanceValidation s;
-    s.foot = c.foot;
-    s.plate = mp.name;
-    s.first = c.run.first;
-    s.last = c.run.last;
-    s.assign_distance_m = c.distance;
-    const Eigen::VectorXd mv = mp.force_N.col(1).segment(a, len), ma = mp.force_N.col(0).segment(a, len);
-    s.metrics.vertical = compare_series(fe.force_N.col(1).segment(a, len), mv);
-    s.metrics.anterior = compare_series(fe.force_N.col(0).segment(a, len), ma);
-    Eigen::VectorXd mc = mp.cop_x_m.segment(a, len);
-    for (Eigen::Index i = 0; i < len; ++i)
-      if (!(mv[i] > o.cop_min_force_fraction * bw)) mc[i] = kNaN;
-    s.metrics.cop = compare_series(fe.cop_x_m.segment(a, len), mc);
-    s.moment_reference_m = {mp.has_geometry ? mp.centre_m.x() : mean_finite(mc), mp.surface_y_m};
-    const double rx = s.moment_reference_m.x(), ry = s.moment_reference_m.y();
-    Eigen::VectorXd me(len), mm(len);
-    for (Eigen::Index i = 0; i < len; ++i) {
-      const Eigen::Index k = a + i;
-      const double cx = std::isfinite(fe.cop_x_m[k]) ? fe.cop_x_m[k] : rx;
-      me[i] = (cx - rx) * fe.force_N(k, 1) - (ground - ry) * fe.force_N(k, 0);
-      mm[i] = mp.moment_origin_Nm[k] - (rx * mp.force_N(k, 1) - ry * mp.force_N(k, 0));
-    }
-    s.metrics.moment = compare_series(me, mm);
-    // Contact timing: threshold crossings of the estimate near the plate's, + = estimate late.
-    const Eigen::VectorXd ev = fe.force_N.col(1);
-    const Eigen::VectorXd pv = mp.force_N.col(1);
-    const auto m_on = rising_crossing(pv, e.time_s, o.threshold_N, a - 1, c.run.last);
-    const auto m_off = falling_crossing(pv, e.time_s, o.threshold_N, a, c.run.last + 1);
-    const Eigen::Index from = std::max<Eigen::Index>(0, a - search), to = std::min<Eigen::Index>(n - 1, c.run.last + search);
-    if (m_on && !(ev[from] > o.threshold_N))
-      if (const auto e_on = rising_crossing(ev, e.time_s, o.threshold_N, from, c.run.last)) s.onset_error_ms = 1000 * (*e_on - *m_on);
-    if (m_off && !(ev[to] > o.threshold_N))
-      if (const auto e_off = falling_crossing(ev, e.time_s, o.threshold_N, a, to)) s.offset_error_ms = 1000 * (*e_off - *m_off);
-    {
-      // Lag: RMSE of est(i + k) against plate(i) over the stance for shifts k of up to 60 ms.
-      const int kmax = static_cast<int>(std::lround(0.06 * rate));
-      std::vector<double> err;
-      for (int k = -kmax; k <= kmax; ++k) {
-        double se = 0;
-        int cnt = 0;
-        for (Eigen::Index i = a; i <= c.run.last; ++i) {
-          const Eigen::Index j = i + k;
-          if (j < 0 || j >= n) continue;
-          se += std::pow(ev[j] - pv[i], 2), ++cnt;
-        }
-        err.push_back(cnt ? std::sqrt(se / cnt) : std::numeric_limits<double>::infinity());
-      }
-      const auto best = static_cast<int>(std::min_element(err.begin(), err.end()) - err.begin());
-      if (best > 0 && best + 1 < static_cast<int>(err.size())) {
-        const double y0 = err[static_cast<std::size_t>(best - 1)], y1 = err[static_cast<std::size_t>(best)],
-                     y2 = err[static_cast<std::size_t>(best + 1)];
-        const double den = y0 - 2 * y1 + y2;
-        const double frac = den > 0 ? 0.5 * (y0 - y2) / den : 0.0;
-        // est(i + k) matching plate(i): with est(t) = plate(t + L) (the estimate leading by L),
-        // k = -L, so k itself is the lag (negative when the estimate leads).
-        s.vertical_lag_ms = 1000.0 * (best - kmax + frac) / rate;
-      }
-    }
-    for (Eigen::Index i = 0; i < len; ++i) {
-      auto& mf = v.measured_force_N[static_cast<std::size_t>(c.foot)];
-      if (!std::isfinite(mf(a + i, 1))) mf.row(a + i).setZero();
-      mf.row(a + i) += mp.force_N.row(a + i);
-      v.measured_cop_x_m[static_cast<std::size_t>(c.foot)][a + i] = mc[i];
-    }
-    v.stances.push_back(std::move(s));
-  }
-  std::sort(v.stances.begin(), v.stances.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  return cands;
+}
 
-  // Total: every loaded plate in a kept stance, and the plates carrying the whole body.
+/// The time shift (ms) of the estimate's vertical force that best matches the plate's over
+/// frames a..last: RMSE of est(i + k) against plate(i) for shifts k of up to 60 ms, refined by a
+/// parabola through the best three. + = the estimate lags; none when the best is at a limit.
+std::optional<double> vertical_lag_ms(const Eigen::VectorXd& ev, const Eigen::VectorXd& pv, Eigen::Index a, Eigen::Index last,
+                                      double rate) {
+  const Eigen::Index n = ev.size();
+  const int kmax = static_cast<int>(std::lround(0.06 * rate));
+  std::vector<double> err;
+  for (int k = -kmax; k <= kmax; ++k) {
+    double se = 0;
+    int cnt = 0;
+    for (Eigen::Index i = a; i <= last; ++i) {
+      const Eigen::Index j = i + k;
+      if (j < 0 || j >= n) continue;
+      se += std::pow(ev[j] - pv[i], 2), ++cnt;
+    }
+    err.push_back(cnt ? std::sqrt(se / cnt) : std::numeric_limits<double>::infinity());
+  }
+  const auto best = static_cast<int>(std::min_element(err.begin(), err.end()) - err.begin());
+  if (best > 0 && best + 1 < static_cast<int>(err.size())) {
+    const double y0 = err[static_cast<std::size_t>(best - 1)], y1 = err[static_cast<std::size_t>(best)],
+                 y2 = err[static_cast<std::size_t>(best + 1)];
+    const double den = y0 - 2 * y1 + y2;
+    const double frac = den > 0 ? 0.5 * (y0 - y2) / den : 0.0;
+    // est(i + k) matching plate(i): with est(t) = plate(t + L) (the estimate leading by L),
+    // k = -L, so k itself is the lag (negative when the estimate leads).
+    return 1000.0 * (best - kmax + frac) / rate;
+  }
+  return std::nullopt;
+}
+
+/// One kept stance compared (per-foot metrics, timing, lag); its measured force and COP go into
+/// v's per-foot series.
+StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, const Candidate& c, const ValidationOptions& o) {
+  const Eigen::Index n = e.time_s.size();
+  const double bw = e.mass_kg * e.model.gravity_mps2, rate = e.landmarks.rate_hz, ground = e.ground_level_m();
+  const Eigen::Index search = static_cast<Eigen::Index>(std::lround(0.2 * rate));
+  const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(c.plate)];
+  const FootResult& fe = e.feet[static_cast<std::size_t>(c.foot)];
+  const Eigen::Index a = c.run.first, len = c.run.last - c.run.first + 1;
+  StanceValidation s;
+  s.foot = c.foot;
+  s.plate = mp.name;
+  s.first = c.run.first;
+  s.last = c.run.last;
+  s.assign_distance_m = c.distance;
+  const Eigen::VectorXd mv = mp.force_N.col(1).segment(a, len), ma = mp.force_N.col(0).segment(a, len);
+  s.metrics.vertical = compare_series(fe.force_N.col(1).segment(a, len), mv);
+  s.metrics.anterior = compare_series(fe.force_N.col(0).segment(a, len), ma);
+  Eigen::VectorXd mc = mp.cop_x_m.segment(a, len);
+  for (Eigen::Index i = 0; i < len; ++i)
+    if (!(mv[i] > o.cop_min_force_fraction * bw)) mc[i] = kNaN;
+  s.metrics.cop = compare_series(fe.cop_x_m.segment(a, len), mc);
+  s.moment_reference_m = {mp.has_geometry ? mp.centre_m.x() : mean_finite(mc), mp.surface_y_m};
+  const double rx = s.moment_reference_m.x(), ry = s.moment_reference_m.y();
+  Eigen::VectorXd me(len), mm(len);
+  for (Eigen::Index i = 0; i < len; ++i) {
+    const Eigen::Index k = a + i;
+    const double cx = std::isfinite(fe.cop_x_m[k]) ? fe.cop_x_m[k] : rx;
+    me[i] = (cx - rx) * fe.force_N(k, 1) - (ground - ry) * fe.force_N(k, 0);
+    mm[i] = mp.moment_origin_Nm[k] - (rx * mp.force_N(k, 1) - ry * mp.force_N(k, 0));
+  }
+  s.metrics.moment = compare_series(me, mm);
+  // Contact timing: threshold crossings of the estimate near the plate's, + = estimate late.
+  const Eigen::VectorXd ev = fe.force_N.col(1);
+  const Eigen::VectorXd pv = mp.force_N.col(1);
+  const auto m_on = rising_crossing(pv, e.time_s, o.threshold_N, a - 1, c.run.last);
+  const auto m_off = falling_crossing(pv, e.time_s, o.threshold_N, a, c.run.last + 1);
+  const Eigen::Index from = std::max<Eigen::Index>(0, a - search), to = std::min<Eigen::Index>(n - 1, c.run.last + search);
+  if (m_on && !(ev[from] > o.threshold_N))
+    if (const auto e_on = rising_crossing(ev, e.time_s, o.threshold_N, from, c.run.last)) s.onset_error_ms = 1000 * (*e_on - *m_on);
+  if (m_off && !(ev[to] > o.threshold_N))
+    if (const auto e_off = falling_crossing(ev, e.time_s, o.threshold_N, a, to)) s.offset_error_ms = 1000 * (*e_off - *m_off);
+  s.vertical_lag_ms = vertical_lag_ms(ev, pv, a, c.run.last, rate);
+  for (Eigen::Index i = 0; i < len; ++i) {
+    auto& mf = v.measured_force_N[static_cast<std::size_t>(c.foot)];
+    if (!std::isfinite(mf(a + i, 1))) mf.row(a + i).setZero();
+    mf.row(a + i) += mp.force_N.row(a + i);
+    v.measured_cop_x_m[static_cast<std::size_t>(c.foot)][a + i] = mc[i];
+  }
+  return s;
+}
+
+/// The frames of the total comparison and, per frame, the plates loaded (bit per plate): where
+/// every loaded plate is in a kept stance, no foot is planted beside the plates, and the loaded
+/// plates' vertical sum matches the whole body's (runs of equal plates and contacts, median
+/// mismatch below total_mismatch_fraction of body weight).
+std::pair<std::vector<Eigen::Index>, std::vector<unsigned>> total_frames(const EstimateResult& e, const ValidationResult& v,
+                                                                         const std::vector<Candidate>& cands,
+                                                                         const ValidationOptions& o) {
+  const Eigen::Index n = e.time_s.size();
+  const double bw = e.mass_kg * e.model.gravity_mps2;
   const int np = static_cast<int>(v.plates.size());
+  // Total: every loaded plate in a kept stance, and the plates carrying the whole body.
   std::vector<unsigned> mask(static_cast<std::size_t>(n), 0u);
   std::vector<bool> ok(static_cast<std::size_t>(n), true);
   for (int pi = 0; pi < np && pi < 32; ++pi)
@@ -361,7 +375,7 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
       if (!covered) ok[static_cast<std::size_t>(i)] = false;
     }
   }
-  TotalValidation tv;
+  std::vector<Eigen::Index> frames;
   for (Eigen::Index i = 0; i < n;) {
     Eigen::Index j = i;
     // Runs of frames with the same plates loaded and the same estimated contacts (the latter
@@ -383,13 +397,25 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
       }
       if (median(mis) < o.total_mismatch_fraction * bw)
         for (Eigen::Index k = i; k <= j; ++k)
-          if (!off_plate[static_cast<std::size_t>(k)]) tv.frames.push_back(k);
+          if (!off_plate[static_cast<std::size_t>(k)]) frames.push_back(k);
     }
     i = j + 1;
   }
+  return {std::move(frames), std::move(mask)};
+}
+
+/// The whole body's comparison: the frames where every loaded plate is in a kept stance, no foot
+/// stands beside the plates and the plates carry the whole body; there the totals and the GRM.
+void compare_totals(const EstimateResult& e, ValidationResult& v, const std::vector<Candidate>& cands, const ValidationOptions& o) {
+  const Eigen::Index n = e.time_s.size();
+  const double ground = e.ground_level_m();
+  const int np = static_cast<int>(v.plates.size());
+  TotalValidation tv;
+  std::vector<unsigned> mask;
+  std::tie(tv.frames, mask) = total_frames(e, v, cands, o);
   if (tv.frames.size() < 10) {
     v.excluded.push_back("total: no window of 10 frames or more where every loaded foot stands on a kept plate stance");
-    return v;
+    return;
   }
   // GRM reference: midpoint of the plate centres in use (geometry), else the mean measured COP.
   unsigned used = 0;
@@ -451,6 +477,31 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
   tv.metrics.anterior = compare_series(ea, ma);
   tv.metrics.moment = compare_series(eg, mg);
   v.total = std::move(tv);
+}
+
+
+}  // namespace
+
+ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& rec, const ValidationOptions& o) {
+  ValidationResult v;
+  v.mass_kg = e.mass_kg;
+  v.first_frame_number = e.first_frame_number;
+  const Eigen::Index n = e.time_s.size();
+  v.plates = resample_plates(rec, e.frame, e.time_s, rec.cop_threshold_N, e.first_index);
+  for (int f = 0; f < 2; ++f) {
+    v.measured_force_N[static_cast<std::size_t>(f)] = Eigen::MatrixX2d::Constant(n, 2, kNaN);
+    v.measured_cop_x_m[static_cast<std::size_t>(f)] = Eigen::VectorXd::Constant(n, kNaN);
+  }
+  bool any_plate_data = false;
+  for (const auto& mp : v.plates) any_plate_data = any_plate_data || mp.force_N.col(1).array().isFinite().any();
+  if (!any_plate_data)
+    v.notes.push_back("the plate recording does not overlap the processed frames (" + frames_text(e, 0, n - 1) +
+                      "): check that markers and plates share one clock");
+  const std::vector<Candidate> cands = assign_stances(e, v, o);
+  for (const Candidate& c : cands)
+    if (c.kept) v.stances.push_back(compare_stance(e, v, c, o));
+  std::sort(v.stances.begin(), v.stances.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  compare_totals(e, v, cands, o);
   return v;
 }
 
