@@ -251,6 +251,21 @@ void ContactSolver::contact_columns(const FrameVector& qdd, const FrameContacts&
   }
 }
 
+double ContactSolver::moment_direction_weight(const FrameContacts& fc, unsigned active) const {
+  if (!(options_.min_split_distance_m > 0)) return 1.0;
+  std::array<bool, 2> side_on{false, false};
+  double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
+  for (std::size_t j = 0; j < fc.points.size(); ++j) {
+    if (!(active >> j & 1U)) continue;
+    const auto& p = fc.points[j];
+    side_on[static_cast<std::size_t>(p.side)] = true;
+    xmin = std::min(xmin, p.position.x()), xmax = std::max(xmax, p.position.x());
+  }
+  if (!(side_on[0] && side_on[1])) return 1.0;
+  const double u = std::clamp(2.0 * (xmax - xmin) / options_.min_split_distance_m - 1.0, 0.0, 1.0);
+  return u * u * (3.0 - 2.0 * u);  // smoothstep: 0 below half the distance, 1 above it
+}
+
 FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixXd>& BpX, const Eigen::Ref<const Eigen::MatrixXd>& UtX,
                                            const FrameContacts& fc) {
   // Fixed capacities: at most 6 contact points (12 multipliers), so nothing here touches the
@@ -319,21 +334,7 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
       // Feet side by side: with all 3 global directions fitted, the weakest is the moment that
       // only a couple between the feet can make (its singular value shrinks with their distance
       // along x and height); fade it out of the fit. Feet exactly together already leave it out.
-      double keep = 1.0;
-      if (options_.min_split_distance_m > 0 && rank == neq) {
-        std::array<bool, 2> side_on{false, false};
-        double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
-        for (int j = 0; j < np; ++j) {
-          if (!(active >> j & 1U)) continue;
-          const auto& p = fc.points[static_cast<std::size_t>(j)];
-          side_on[static_cast<std::size_t>(p.side)] = true;
-          xmin = std::min(xmin, p.position.x()), xmax = std::max(xmax, p.position.x());
-        }
-        if (side_on[0] && side_on[1]) {
-          const double u = std::clamp(2.0 * (xmax - xmin) / options_.min_split_distance_m - 1.0, 0.0, 1.0);
-          keep = u * u * (3.0 - 2.0 * u);  // smoothstep: 0 below half the distance, 1 above it
-        }
-      }
+      const double keep = rank == neq ? moment_direction_weight(fc, active) : 1.0;
       SmallVector lam = fit(rank);
       if (keep < 1.0) lam = keep * lam + (1.0 - keep) * fit(rank - 1);
       for (int c = 0; c < ka; ++c) lamC[cols[static_cast<std::size_t>(c)]] = lam[c];

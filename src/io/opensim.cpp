@@ -48,9 +48,16 @@ MarkerTrajectories read_trc(const std::string& path, std::vector<std::string>* w
   return parse_trc(read_file_text(path), path, warnings);
 }
 
-MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
-                             std::vector<std::string>* warnings) {
-  const auto lines = lines_of(text);
+namespace {
+
+/// A TRC's five header lines: rate, units, declared counts and the marker names (a name used
+/// twice made unique, with a warning).
+struct TrcHeader {
+  double rate_hz = 0.0, frames_declared = 0.0, to_m = 1e-3;
+  std::vector<std::string> names;
+};
+
+TrcHeader parse_trc_header(const std::vector<std::string_view>& lines, const std::string& path, std::vector<std::string>* warnings) {
   if (lines.size() < 5 || lines[0].rfind("PathFileType", 0) != 0) {
     throw InputError(path + ": not a TRC file (the first line must start with 'PathFileType' and the "
                             "header has 5 lines)");
@@ -70,17 +77,15 @@ MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
       throw InputError(where(path, 2) + ": header field " + k + " is missing or not a number");
     return v;
   };
-  MarkerTrajectories m;
-  m.rate_hz = num("DataRate");
-  if (m.rate_hz <= 0) throw InputError(where(path, 2) + ": DataRate must be positive");
+  TrcHeader th;
+  th.rate_hz = num("DataRate");
+  if (th.rate_hz <= 0) throw InputError(where(path, 2) + ": DataRate must be positive");
   const double nmark_decl = num("NumMarkers");
-  const double nframes_decl = num("NumFrames");
+  th.frames_declared = num("NumFrames");
   const std::string units = h.count("Units") ? to_lower(h["Units"]) : "mm";
-  double to_m = 1e-3;
-  if (units == "m") to_m = 1.0;
-  else if (units == "cm") to_m = 1e-2;
+  if (units == "m") th.to_m = 1.0;
+  else if (units == "cm") th.to_m = 1e-2;
   else if (units != "mm") throw InputError(where(path, 2) + ": Units '" + h["Units"] + "' is not mm, cm or m");
-  m.up_axis = Axis::Y;
 
   const auto name_cells = split(lines[3], "\t", true);
   std::vector<std::string> names;
@@ -94,16 +99,30 @@ MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
   {
     std::vector<std::string> unique;  // a label used twice: the later one is NAME#k (unique_label)
     for (std::size_t i = 0; i < names.size(); ++i) unique.push_back(unique_label(unique, names[i], i, warnings));
-    names = std::move(unique);
+    th.names = std::move(unique);
   }
-  if (static_cast<double>(names.size()) != nmark_decl) {
+  if (static_cast<double>(th.names.size()) != nmark_decl) {
     throw InputError(where(path, 3) + ": NumMarkers says " + fmt(nmark_decl) + " but " +
-                     std::to_string(names.size()) + " marker names follow");
+                     std::to_string(th.names.size()) + " marker names follow");
   }
-  const std::size_t nm = names.size();
+  return th;
+}
+
+/// The data rows after the header: per row the time and 3 values per marker (NaN for a blank
+/// cell), and the Frame# column. A row with spaces for tabs is read too; a short row's trailing
+/// markers are missing (counted in short_rows).
+struct TrcRows {
   std::vector<std::vector<double>> rows;
   std::vector<int> frames;
   std::size_t short_rows = 0;
+};
+
+TrcRows parse_trc_rows(const std::vector<std::string_view>& lines, const std::vector<std::string>& names, const std::string& path) {
+  const std::size_t nm = names.size();
+  TrcRows out;
+  auto& rows = out.rows;
+  auto& frames = out.frames;
+  std::size_t& short_rows = out.short_rows;
   rows.reserve(lines.size());
   std::vector<std::string_view> cells;
   for (std::size_t li = 5; li < lines.size(); ++li) {
@@ -143,6 +162,25 @@ MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
     frames.push_back(static_cast<int>(fr));
     rows.push_back(std::move(r));
   }
+  return out;
+}
+
+}  // namespace
+
+MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
+                             std::vector<std::string>* warnings) {
+  const auto lines = lines_of(text);
+  const TrcHeader th = parse_trc_header(lines, path, warnings);
+  const std::vector<std::string>& names = th.names;
+  const std::size_t nm = names.size();
+  const TrcRows data = parse_trc_rows(lines, names, path);
+  const auto& rows = data.rows;
+  const auto& frames = data.frames;
+  const double nframes_decl = th.frames_declared, to_m = th.to_m;
+  const std::size_t short_rows = data.short_rows;
+  MarkerTrajectories m;
+  m.rate_hz = th.rate_hz;
+  m.up_axis = Axis::Y;
   if (rows.empty()) throw InputError(path + ": no data rows after the header");
   if (static_cast<double>(rows.size()) != nframes_decl && warnings) {
     warnings->push_back("NumFrames says " + fmt(nframes_decl) + " but " + std::to_string(rows.size()) +

@@ -119,6 +119,9 @@ class ContactSolver {
   bool factorise_normal_equations();
   FrameSolution solve_reduced(const Eigen::Ref<const Eigen::MatrixXd>& BpX, const Eigen::Ref<const Eigen::MatrixXd>& UtX,
                               const FrameContacts& contacts);
+  /// Feet side by side (SolverOptions::min_split_distance_m): the weight, 1 down to 0, kept of the
+  /// 3-equation fit's weakest (moment) direction for this active set.
+  [[nodiscard]] double moment_direction_weight(const FrameContacts& contacts, unsigned active) const;
   FrameSolution solve_dense(const Eigen::MatrixXd& B, const FrameVector& qdd, const FrameContacts& contacts);
   const Model& model_;
   SolverOptions options_;
