@@ -319,23 +319,31 @@ Trial read_c3d(const std::string& path, const C3dReadOptions& options) {
   return read_c3d_bytes(read_file_bytes(path), path, options);
 }
 
-Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& path,
-                     const C3dReadOptions& options) {
-  const C3dFile f = read_c3d_header(bytes, path);
-  Bytes b(bytes, path);
-  b.set_processor(f.processor == "Intel" ? 84 : f.processor == "DEC" ? 85 : 86);
-  Trial t;
-  t.path = path;
-  t.format = "C3D";
-  t.encoding = f.processor + (f.float_data ? ", float" : ", integer");
+namespace {
 
-  const long nframes = static_cast<long>(f.last_frame) - f.first_frame + 1;
-  const int npoints = f.point_count;
+/// Where a C3D's frames are and how they are laid out: checked against the header, the
+/// parameters and the file's size before anything is allocated.
+struct C3dLayout {
+  long nframes = 0;
+  int npoints = 0, nchannels = 0, spf = 0;  ///< spf: analog samples per point frame
+  int analog_slots = 0;                      ///< analog channels stored per sample
+  double analog_rate = 0.0;
+  std::size_t word = 4, frame_bytes = 0, data_start = 0;
+};
+
+C3dLayout c3d_layout(const C3dFile& f, std::size_t file_size, const std::string& path, std::vector<std::string>& warnings) {
+  C3dLayout l;
+  l.nframes = static_cast<long>(f.last_frame) - f.first_frame + 1;
+  l.npoints = f.point_count;
+  const long nframes = l.nframes;
+  const int npoints = l.npoints;
   // Analog layout.
-  int nchannels = count_value(number(f, "ANALOG:USED", 0));
+  int& nchannels = l.nchannels;
+  nchannels = count_value(number(f, "ANALOG:USED", 0));
   if (nchannels < 0) throw InputError(path + ": ANALOG:USED is not a count");
-  double analog_rate = number(f, "ANALOG:RATE", 0);
-  int spf = 0;  // analog samples per point frame
+  double& analog_rate = l.analog_rate;
+  analog_rate = number(f, "ANALOG:RATE", 0);
+  int& spf = l.spf;  // analog samples per point frame
   if (nchannels > 0) {
     if (!std::isfinite(analog_rate) || analog_rate <= 0) {
       throw InputError(path + ": ANALOG:RATE is " + std::to_string(analog_rate) +
@@ -352,7 +360,7 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
     }
     if (f.analog_per_frame != nchannels * spf) {
       if (f.analog_per_frame % spf == 0 && f.analog_per_frame / spf >= nchannels) {
-        t.warnings.push_back("header analog values per frame (" + std::to_string(f.analog_per_frame) +
+        warnings.push_back("header analog values per frame (" + std::to_string(f.analog_per_frame) +
                              ") differs from ANALOG:USED x samples per frame; using the header");
       } else {
         throw InputError(path + ": header analog values per frame (" +
@@ -362,20 +370,20 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
       }
     }
   }
-  const int analog_slots = nchannels > 0 ? f.analog_per_frame / spf : 0;  // channels stored
-  const std::size_t word = f.float_data ? 4 : 2;
-  const std::size_t frame_bytes =
-      (static_cast<std::size_t>(npoints) * 4 + static_cast<std::size_t>(analog_slots) * static_cast<std::size_t>(spf)) * word;
+  l.analog_slots = nchannels > 0 ? f.analog_per_frame / spf : 0;  // channels stored
+  l.word = f.float_data ? 4 : 2;
+  const std::size_t frame_bytes = l.frame_bytes =
+      (static_cast<std::size_t>(npoints) * 4 + static_cast<std::size_t>(l.analog_slots) * static_cast<std::size_t>(spf)) * l.word;
   // Frame counts are checked before anything is allocated: against the data the file holds
   // (below), and, for a file with no point or analog data (nothing to check them against), a
   // frame count that only a data section could justify.
   if (nframes > 50'000'000) throw InputError(path + ": absurd frame count " + std::to_string(nframes));
   if (frame_bytes == 0 && nframes > 1'000'000)
     throw InputError(path + ": claims " + std::to_string(nframes) + " frames but holds no point or analog data");
-  const std::size_t data_start = (static_cast<std::size_t>(f.data_start_block) - 1) * 512;
+  const std::size_t data_start = l.data_start = (static_cast<std::size_t>(f.data_start_block) - 1) * 512;
   const std::size_t needed = frame_bytes * static_cast<std::size_t>(nframes);
-  if (data_start > bytes.size() || needed > bytes.size() - data_start) {
-    const std::size_t avail = data_start > bytes.size() ? 0 : (bytes.size() - data_start);
+  if (data_start > file_size || needed > file_size - data_start) {
+    const std::size_t avail = data_start > file_size ? 0 : (file_size - data_start);
     const long complete = frame_bytes ? static_cast<long>(avail / frame_bytes) : 0;
     throw InputError(path + ": truncated file: the data section at byte " +
                      std::to_string(data_start) + " needs " + std::to_string(needed) +
@@ -384,7 +392,15 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
                      " remain (the data stop in frame " +
                      std::to_string(f.first_frame + complete) + ")");
   }
+  return l;
+}
 
+/// The markers (model outputs stored as points set aside by name): a negative residual or a point
+/// at exactly (0, 0, 0) is missing. Returns POINT:UNITS's scale to metres.
+double read_c3d_points(const C3dFile& f, const Bytes& b, const C3dLayout& l, const std::string& path, Trial& t) {
+  const long nframes = l.nframes;
+  const int npoints = l.npoints;
+  const std::size_t word = l.word, frame_bytes = l.frame_bytes, data_start = l.data_start;
   // ---- Points -----------------------------------------------------------------------------
   const auto* units = f.find("POINT:UNITS");
   const std::string unit_str = units && !units->strings.empty() ? units->strings[0] : "mm";
@@ -451,7 +467,15 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
       }
     }
   }
+  return to_m;
+}
 
+/// The analog channels, scaled (ANALOG:SCALE, OFFSET, GEN_SCALE, FORMAT), one row per sample.
+AnalogData read_c3d_analog(const C3dFile& f, const Bytes& b, const C3dLayout& l, const std::string& path) {
+  const long nframes = l.nframes;
+  const int npoints = l.npoints, nchannels = l.nchannels, spf = l.spf, analog_slots = l.analog_slots;
+  const double analog_rate = l.analog_rate;
+  const std::size_t word = l.word, frame_bytes = l.frame_bytes, data_start = l.data_start;
   // ---- Analog ---------------------------------------------------------------------------
   AnalogData analog;
   if (nchannels > 0) {
@@ -497,7 +521,14 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
       }
     }
   }
+  return analog;
+}
 
+/// The force plates of FORCE_PLATFORM (types 1-4) from the analog data; none, with a note, when
+/// the file describes plates but holds no analog data.
+void read_c3d_plates(const C3dFile& f, const C3dLayout& l, const AnalogData& analog, double to_m, const C3dReadOptions& options,
+                     const std::string& path, Trial& t) {
+  const int nchannels = l.nchannels, spf = l.spf;
   // ---- Force plates -----------------------------------------------------------------------
   const int nplates = count_value(number(f, "FORCE_PLATFORM:USED", 0));
   if (nplates < 0) throw InputError(path + ": FORCE_PLATFORM:USED is not a count");
@@ -581,7 +612,10 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
     t.plates = compute_plates(analog, descs_fp, proc, path, t.warnings);
     t.plates->up_axis = Axis::Z;
   }
+}
 
+/// EVENT times, and the body mass and height where labs store them.
+void read_c3d_events_and_subject(const C3dFile& f, Trial& t) {
   // ---- Events, subject ----------------------------------------------------------------------
   if (const auto* times = f.find("EVENT:TIMES")) {
     const int used = count_value(number(f, "EVENT:USED", static_cast<double>(times->numbers.size() / 2)));
@@ -613,6 +647,24 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
                                                      std::isfinite(h->numbers[0]) && h->numbers[0] > 0) {
     t.height_m = h->numbers[0] > 10 ? h->numbers[0] / 1000.0 : h->numbers[0];  // stored in mm
   }
+}
+
+}  // namespace
+
+Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& path,
+                     const C3dReadOptions& options) {
+  const C3dFile f = read_c3d_header(bytes, path);
+  Bytes b(bytes, path);
+  b.set_processor(f.processor == "Intel" ? 84 : f.processor == "DEC" ? 85 : 86);
+  Trial t;
+  t.path = path;
+  t.format = "C3D";
+  t.encoding = f.processor + (f.float_data ? ", float" : ", integer");
+  const C3dLayout layout = c3d_layout(f, bytes.size(), path, t.warnings);
+  const double to_m = read_c3d_points(f, b, layout, path, t);
+  const AnalogData analog = read_c3d_analog(f, b, layout, path);
+  read_c3d_plates(f, layout, analog, to_m, options, path, t);
+  read_c3d_events_and_subject(f, t);
   return t;
 }
 
