@@ -82,27 +82,15 @@ Param strs(const std::string& g, const std::string& n, const std::vector<std::st
 
 }  // namespace
 
-std::vector<std::uint8_t> write_c3d_bytes(const Trial& trial, const C3dWriteOptions& o) {
-  const MarkerTrajectories& m = trial.markers;
-  const auto nframes = static_cast<long>(m.frames());
-  if (nframes < 1) throw InputError("write_c3d: the trial has no frames");
-  if (nframes > 65535) throw InputError("write_c3d: more than 65535 frames are not supported by the writer");
-  if (m.names.size() > 255 * 255) throw InputError("write_c3d: too many markers");
-  const int spf = o.analog_samples_per_frame;
-  const ForcePlateRecording* fpr = trial.plates ? &*trial.plates : nullptr;
+namespace {
+
+/// The plates' analog channels: force and moment about the sensor origin in plate axes (N, N mm),
+/// and each channel's ANALOG:SCALE (1 for float data; 16-bit integers use the full range).
+std::pair<Eigen::MatrixXd, std::vector<double>> plate_channels(const ForcePlateRecording* fpr, long samples, bool float_data) {
   const int nplates = fpr ? static_cast<int>(fpr->plates.size()) : 0;
   const int nchan = 6 * nplates;
-  if (nplates > 0) {
-    if (std::abs(fpr->rate_hz - m.rate_hz * spf) > 1e-6 * fpr->rate_hz ||
-        fpr->samples() != nframes * spf) {
-      throw InputError("write_c3d: plate rate/samples must be marker rate/frames x analog_samples_per_frame");
-    }
-    for (const auto& p : fpr->plates)
-      if (!p.has_geometry) throw InputError("write_c3d: plate " + p.name + " has no geometry");
-  }
-
   // Plate channels: force and moment about the sensor origin, in plate axes, N and N mm.
-  Eigen::MatrixXd analog(nframes * spf, nchan);
+  Eigen::MatrixXd analog(samples, nchan);
   for (int p = 0; p < nplates; ++p) {
     const ForcePlate& fp = fpr->plates[static_cast<std::size_t>(p)];
     const Eigen::Matrix3d Rt = fp.lab_R_plate.transpose();
@@ -122,15 +110,25 @@ std::vector<std::uint8_t> write_c3d_bytes(const Trial& trial, const C3dWriteOpti
     }
   }
   std::vector<double> ch_scale(static_cast<std::size_t>(nchan), 1.0);
-  if (!o.float_data) {
+  if (!float_data) {
     for (int c = 0; c < nchan; ++c) {
       const double mx = analog.col(c).cwiseAbs().maxCoeff();
       ch_scale[static_cast<std::size_t>(c)] = mx > 0 ? mx / 30000.0 : 1.0;
     }
   }
 
+  return {std::move(analog), std::move(ch_scale)};
+}
+
+/// The parameters the writer stores (POINT, ANALOG, FORCE_PLATFORM, EVENT, PROCESSING, TRIAL).
+std::vector<Param> c3d_parameters(const Trial& trial, const C3dWriteOptions& o, const std::vector<double>& ch_scale, double pscale) {
+  const MarkerTrajectories& m = trial.markers;
+  const auto nframes = static_cast<long>(m.frames());
+  const int spf = o.analog_samples_per_frame;
+  const ForcePlateRecording* fpr = trial.plates ? &*trial.plates : nullptr;
+  const int nplates = fpr ? static_cast<int>(fpr->plates.size()) : 0;
+  const int nchan = 6 * nplates;
   std::vector<Param> params;
-  const double pscale = o.float_data ? -std::abs(o.point_scale_mm) : std::abs(o.point_scale_mm);
   params.push_back(ints("POINT", "USED", {static_cast<double>(m.names.size())}));
   params.push_back(ints("POINT", "FRAMES", {static_cast<double>(nframes)}));
   params.push_back(floats("POINT", "SCALE", {pscale}));
@@ -195,9 +193,12 @@ std::vector<std::uint8_t> write_c3d_bytes(const Trial& trial, const C3dWriteOpti
   params.push_back(ints("TRIAL", "ACTUAL_END_FIELD", {static_cast<double>(o.first_frame + nframes - 1), 0}));
   params.push_back(ints("POINT", "DATA_START", {0}));  // patched below
 
-  // Parameter section.
-  Writer w(static_cast<C3dProcessor>(o.processor));
-  w.out.assign(512, 0);
+  return params;
+}
+
+/// The parameter section after the header block; returns where POINT:DATA_START's value is (to
+/// patch once the data block is known).
+std::size_t write_parameter_section(Writer& w, const std::vector<Param>& params) {
   w.u8(0); w.u8(0); w.u8(0); w.u8(w.proc());  // block count patched below
   std::vector<std::string> groups;
   for (const auto& p : params)
@@ -236,6 +237,36 @@ std::vector<std::uint8_t> write_c3d_bytes(const Trial& trial, const C3dWriteOpti
     }
   }
   w.u8(0); w.u8(0);  // terminator
+  return data_start_pos;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> write_c3d_bytes(const Trial& trial, const C3dWriteOptions& o) {
+  const MarkerTrajectories& m = trial.markers;
+  const auto nframes = static_cast<long>(m.frames());
+  if (nframes < 1) throw InputError("write_c3d: the trial has no frames");
+  if (nframes > 65535) throw InputError("write_c3d: more than 65535 frames are not supported by the writer");
+  if (m.names.size() > 255 * 255) throw InputError("write_c3d: too many markers");
+  const int spf = o.analog_samples_per_frame;
+  const ForcePlateRecording* fpr = trial.plates ? &*trial.plates : nullptr;
+  const int nplates = fpr ? static_cast<int>(fpr->plates.size()) : 0;
+  const int nchan = 6 * nplates;
+  if (nplates > 0) {
+    if (std::abs(fpr->rate_hz - m.rate_hz * spf) > 1e-6 * fpr->rate_hz ||
+        fpr->samples() != nframes * spf) {
+      throw InputError("write_c3d: plate rate/samples must be marker rate/frames x analog_samples_per_frame");
+    }
+    for (const auto& p : fpr->plates)
+      if (!p.has_geometry) throw InputError("write_c3d: plate " + p.name + " has no geometry");
+  }
+
+  const auto [analog, ch_scale] = plate_channels(fpr, nframes * spf, o.float_data);
+  const double pscale = o.float_data ? -std::abs(o.point_scale_mm) : std::abs(o.point_scale_mm);
+  const std::vector<Param> params = c3d_parameters(trial, o, ch_scale, pscale);
+  Writer w(static_cast<C3dProcessor>(o.processor));
+  w.out.assign(512, 0);
+  const std::size_t data_start_pos = write_parameter_section(w, params);
   w.pad_to_block();
   const std::size_t pblocks = (w.out.size() - 512) / 512;
   w.out[512 + 2] = static_cast<std::uint8_t>(pblocks);
