@@ -304,7 +304,7 @@ void totals_stage(const EstimateOptions& o, EstimateResult& r, const ModelMotion
       const Eigen::Vector2d pos(motion.q(i, coord::com_x(s)), motion.q(i, coord::com_x(s) + 1));
       const Eigen::Vector2d F = b.mass_kg * Eigen::Vector2d(motion.qdd(i, coord::com_x(s)), motion.qdd(i, coord::com_x(s) + 1) + g);
       seg_force[static_cast<std::size_t>(s)] = F;
-      kin += Eigen::Vector3d(F.x(), F.y(), pos.x() * F.y() - pos.y() * F.x() + b.inertia_kgm2 * motion.qdd(i, coord::theta(s)));
+      kin += Eigen::Vector3d(F.x(), F.y(), sagittal_moment(pos.x(), pos.y(), F.x(), F.y()) + b.inertia_kgm2 * motion.qdd(i, coord::theta(s)));
     }
     Eigen::Vector3d ext = Eigen::Vector3d::Zero();
     for (int side = 0; side < 2; ++side) {
@@ -312,8 +312,8 @@ void totals_stage(const EstimateOptions& o, EstimateResult& r, const ModelMotion
       if (!f.contact[static_cast<std::size_t>(i)]) continue;
       const double x = f.cop_x_m[i], y = r.ground_level_m();
       const double fx = f.force_N(i, 0), fy = f.force_N(i, 1);
-      r.grm_Nm[i] += (x - o.grm_reference_m.x()) * fy - (y - o.grm_reference_m.y()) * fx;
-      ext += Eigen::Vector3d(fx, fy, x * fy - y * fx);
+      r.grm_Nm[i] += sagittal_moment(x - o.grm_reference_m.x(), y - o.grm_reference_m.y(), fx, fy);
+      ext += Eigen::Vector3d(fx, fy, sagittal_moment(x, y, fx, fy));
     }
     r.residual.row(i) = (kin - ext).transpose();
     r.kinematic_total.row(i) = kin.transpose();

@@ -24,6 +24,10 @@ inline Eigen::Matrix2d rotation(double a) {
   return R;
 }
 
+/// The sagittal moment (N m, counter-clockwise +) about the origin of a force (fx, fy) (N)
+/// applied at (rx, ry) (m): rx fy - ry fx. The one place kin2grf writes it.
+inline double sagittal_moment(double rx, double ry, double fx, double fy) { return rx * fy - ry * fx; }
+
 /// r turned by +90 degrees: d/da (R(a) rho) = perp(R(a) rho).
 inline Eigen::Vector2d perp(const Eigen::Vector2d& r) { return Eigen::Vector2d(-r.y(), r.x()); }
 

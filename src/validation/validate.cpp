@@ -311,8 +311,8 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
   for (Eigen::Index i = 0; i < len; ++i) {
     const Eigen::Index k = a + i;
     const double cx = std::isfinite(fe.cop_x_m[k]) ? fe.cop_x_m[k] : rx;
-    me[i] = (cx - rx) * fe.force_N(k, 1) - (ground - ry) * fe.force_N(k, 0);
-    mm[i] = mp.moment_origin_Nm[k] - (rx * mp.force_N(k, 1) - ry * mp.force_N(k, 0));
+    me[i] = sagittal_moment(cx - rx, ground - ry, fe.force_N(k, 0), fe.force_N(k, 1));
+    mm[i] = mp.moment_origin_Nm[k] - sagittal_moment(rx, ry, mp.force_N(k, 0), mp.force_N(k, 1));
   }
   s.metrics.moment = compare_series(me, mm);
   // Contact timing: threshold crossings of the estimate near the plate's, + = estimate late.
@@ -446,13 +446,13 @@ void compare_totals(const EstimateResult& e, ValidationResult& v, const std::vec
       const FootResult& fe = e.feet[static_cast<std::size_t>(f)];
       ev[q] += fe.force_N(k, 1), ea[q] += fe.force_N(k, 0);
       if (std::isfinite(fe.cop_x_m[k]))
-        eg[q] += (fe.cop_x_m[k] - tv.grm_reference_m.x()) * fe.force_N(k, 1) - (ground - tv.grm_reference_m.y()) * fe.force_N(k, 0);
+        eg[q] += sagittal_moment(fe.cop_x_m[k] - tv.grm_reference_m.x(), ground - tv.grm_reference_m.y(), fe.force_N(k, 0), fe.force_N(k, 1));
     }
     for (int pi = 0; pi < np && pi < 32; ++pi) {
       if (!(mask[static_cast<std::size_t>(k)] & (1u << pi))) continue;
       const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(pi)];
       mv[q] += mp.force_N(k, 1), ma[q] += mp.force_N(k, 0);
-      mg[q] += mp.moment_origin_Nm[k] - (tv.grm_reference_m.x() * mp.force_N(k, 1) - tv.grm_reference_m.y() * mp.force_N(k, 0));
+      mg[q] += mp.moment_origin_Nm[k] - sagittal_moment(tv.grm_reference_m.x(), tv.grm_reference_m.y(), mp.force_N(k, 0), mp.force_N(k, 1));
     }
     tv.grm_estimated_Nm[k] = eg[q];
     tv.grm_measured_Nm[k] = mg[q];
