@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -123,6 +124,39 @@ std::string json_text(const nlohmann::json& j) {
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
+namespace {
+
+/// Clinger's fast path for the plain decimals text files are made of ([-]digits.digits): the
+/// digits as an integer w <= 2^53 and 10^k with k <= 22 are both exact doubles, so w / 10^k is
+/// one correctly rounded division, the same double from_chars gives, in a fraction of its time.
+/// Anything else (exponents, more digits, "1.", ".5") returns false for from_chars to read.
+bool plain_decimal(const char* b, const char* e, double& out) {
+  static constexpr double kPow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                        1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  const bool negative = b < e && *b == '-';
+  if (negative) ++b;
+  if (b == e || *b < '0' || *b > '9') return false;
+  std::uint64_t w = 0;
+  int digits = 0, fraction = -1;  // digits after the point; -1: no point
+  for (const char* p = b; p < e; ++p) {
+    if (*p >= '0' && *p <= '9') {
+      if (++digits > 19) return false;
+      w = w * 10 + static_cast<std::uint64_t>(*p - '0');
+      if (fraction >= 0) ++fraction;
+    } else if (*p == '.' && fraction < 0) {
+      fraction = 0;
+    } else {
+      return false;
+    }
+  }
+  if (fraction == 0 || fraction > 22 || w > (std::uint64_t{1} << 53)) return false;
+  const double v = static_cast<double>(w) / kPow10[fraction < 0 ? 0 : fraction];
+  out = negative ? -v : v;
+  return true;
+}
+
+}  // namespace
+
 bool parse_double(std::string_view s, double& out) {
   // Called for every cell of a text file: views only, no allocation, and the blanks skipped by
   // hand (find_first_not_of over a set of six was a third of reading a TRC).
@@ -135,6 +169,7 @@ bool parse_double(std::string_view s, double& out) {
   const char* b = t.data();
   const char* e = t.data() + t.size();
   if (*b == '+') ++b;
+  if (plain_decimal(b, e, out)) return true;
   auto r = std::from_chars(b, e, out);
   if (r.ec == std::errc() && r.ptr == e) return true;
   // Missing-value spellings of other tools (NaN, -nan, MATLAB's and MSVC's): NaN.

@@ -1,0 +1,53 @@
+// Tests of io/text: the number parser every text reader uses.
+#include <gtest/gtest.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+
+#include "kin2grf/io/text.hpp"
+
+using namespace kin2grf;
+
+namespace {
+
+double by_from_chars(const std::string& s) {
+  double v = 0;
+  const char* b = s.data() + (s[0] == '+' ? 1 : 0);
+  const auto r = std::from_chars(b, s.data() + s.size(), v);
+  EXPECT_TRUE(r.ec == std::errc() && r.ptr == s.data() + s.size()) << s;
+  return v;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+}  // namespace
+
+// Plain decimals take a fast path (Clinger's): it must give the very double from_chars gives
+// (correct rounding) for every number a capture system writes, and leave the rest to from_chars.
+TEST(Text, ParseDoubleGivesTheCorrectlyRoundedDouble) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> mm(-5000.0, 5000.0);
+  std::uniform_int_distribution<int> decimals(0, 17);
+  char buf[64];
+  for (int k = 0; k < 200000; ++k) {
+    std::snprintf(buf, sizeof buf, "%.*f", decimals(rng), mm(rng) * std::pow(10.0, static_cast<double>(k % 9) - 4));
+    double v = 0;
+    ASSERT_TRUE(parse_double(buf, v)) << buf;
+    ASSERT_TRUE(same_bits(v, by_from_chars(buf))) << buf;
+  }
+  for (const char* s : {"0", "-0", "-0.0", "+12.5", "9007199254740993", "9007199254740992.5", "0.1", "1e-3", "-2.5E+04",
+                        "123456789012345678901", "1.", ".5", "0.0000000000000000000001", "4.9406564584124654e-324"}) {
+    double v = 0;
+    ASSERT_TRUE(parse_double(s, v)) << s;
+    EXPECT_TRUE(same_bits(v, by_from_chars(s))) << s;
+  }
+  double v = 0;
+  EXPECT_TRUE(parse_double("  -1.25\r", v));
+  EXPECT_EQ(v, -1.25);
+  EXPECT_TRUE(parse_double("NaN", v) && std::isnan(v));
+  for (const char* bad : {"", "  ", "-", "1.2.3", "12a", "--1", "0x10"}) EXPECT_FALSE(parse_double(bad, v)) << bad;
+}
