@@ -14,6 +14,7 @@
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
+#include "kin2grf/markers/presets.hpp"
 
 // Every heap allocation of the process is counted (the per-frame solve must make none): malloc,
 // calloc and realloc are interposed and passed to glibc's own (operator new and Eigen allocate

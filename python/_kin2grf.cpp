@@ -15,6 +15,7 @@
 #include "kin2grf/workflow/batch.hpp"
 #include "kin2grf/workflow/settings.hpp"
 #include "kin2grf/workflow/trial_list.hpp"
+#include "kin2grf/io/json.hpp"
 
 namespace py = pybind11;
 

@@ -14,6 +14,7 @@
 #include "kin2grf/error.hpp"
 #include "kin2grf/numeric.hpp"
 #include "kin2grf/synth/example.hpp"
+#include "kin2grf/markers/presets.hpp"
 #include "test_support.hpp"
 
 using namespace kin2grf;

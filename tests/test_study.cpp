@@ -20,6 +20,7 @@
 #include "kin2grf/validation/metrics.hpp"
 #include "kin2grf/validation/study.hpp"
 #include "kin2grf/validation/validate.hpp"
+#include "kin2grf/markers/presets.hpp"
 #include "test_support.hpp"
 
 using namespace kin2grf;

@@ -1,4 +1,5 @@
 #include "test_support.hpp"
+#include "kin2grf/markers/presets.hpp"
 
 #include <cmath>
 #include <cstdlib>

@@ -27,6 +27,7 @@
 #include "kin2grf/workflow/progress.hpp"
 #include "kin2grf/workflow/settings.hpp"
 #include "kin2grf/workflow/trial_list.hpp"
+#include "kin2grf/io/json.hpp"
 
 namespace {
 

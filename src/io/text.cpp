@@ -119,11 +119,6 @@ void ensure_not_an_input(const std::string& output, const std::vector<std::strin
   }
 }
 
-std::string json_text(const nlohmann::json& j) {
-  // Labels and paths come from files: invalid UTF-8 is replaced (U+FFFD), not an internal error.
-  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-}
-
 namespace {
 
 /// Clinger's fast path for the plain decimals text files are made of ([-]digits.digits): the
@@ -200,14 +195,6 @@ void split_views(std::string_view s, char delim, std::vector<std::string_view>& 
 std::string extension(const std::string& path) {
   const auto ext = std::filesystem::path(path).extension().string();
   return ext.empty() ? "" : to_lower(ext.substr(1));
-}
-
-nlohmann::json read_json_file(const std::string& path) {
-  try {
-    return nlohmann::json::parse(read_file_text(path));
-  } catch (const nlohmann::json::exception& e) {  // parse errors, and numbers out of range (1e400)
-    throw InputError(path + ": not valid JSON: " + e.what());
-  }
 }
 
 }  // namespace kin2grf

@@ -14,6 +14,7 @@
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/output/results.hpp"
+#include "kin2grf/io/json.hpp"
 
 namespace kin2grf {
 

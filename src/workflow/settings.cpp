@@ -8,6 +8,7 @@
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/trial.hpp"
+#include "kin2grf/markers/presets.hpp"
 
 namespace kin2grf {
 

@@ -2,7 +2,6 @@
 #pragma once
 
 #include <cstdint>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -24,13 +23,9 @@ void write_file_text(const std::string& path, std::string_view text);
 /// InputError when `output` is one of `inputs` (the same file by any name): an output never
 /// overwrites a run's input.
 void ensure_not_an_input(const std::string& output, const std::vector<std::string>& inputs);
-/// JSON as text, 2-space indent and a newline; invalid UTF-8 from files is replaced, not fatal.
-std::string json_text(const nlohmann::json& j);
 /// Largest file the readers take (a 10-minute trial at 2 kHz markers and 10 kHz analog is
 /// about 2 GB; more is refused before anything is allocated).
 inline constexpr std::uintmax_t kMaxInputBytes = std::uintmax_t{4} << 30;
-/// A JSON file; InputError naming the file (and the parser's position) when it is not JSON.
-nlohmann::json read_json_file(const std::string& path);
 /// Strict number parse ("nan"/"NaN" accepted as NaN, empty -> NaN when allow_empty).
 bool parse_double(std::string_view s, double& out);
 /// Lower-case file extension without the dot ("c3d", "trc", "mot", "sto").

@@ -32,7 +32,6 @@
 #include <algorithm>
 #include <array>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -70,15 +69,8 @@ struct MarkerSet {
   [[nodiscard]] std::vector<std::string> motion_markers() const;
 };
 
-MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source);
-MarkerSet load_marker_set(const std::string& path);
-const std::vector<MarkerSet>& builtin_marker_sets();
-/// Preset by name, or nullptr.
-const MarkerSet* find_marker_set(const std::string& name);
-/// The built-in set for a trial, or nullptr: among the sets whose signature markers are in the
-/// file, the one whose markers all hold data in the most frames (ties: the one using more
-/// markers). `why`, when given, lists each candidate's count of complete frames.
-const MarkerSet* recognise_marker_set(const MarkerTrajectories& m, std::string* why = nullptr);
+/// A landmark's name in marker-set files ("shoulder", "hip", "knee_r", ...).
+const char* landmark_name(int id);
 
 struct LandmarkOptions {
   int max_gap_frames = 10;

@@ -1,0 +1,119 @@
+// Marker-set presets: the JSON files of data/presets (embedded at build time) and users' mapping
+// files, read into MarkerSets, and the recognition of a trial's set. An adapter around the core:
+// the core's landmark computation takes a MarkerSet and knows no file format.
+#include "kin2grf/markers/presets.hpp"
+
+#include <algorithm>
+#include <map>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/json.hpp"
+
+namespace kin2grf {
+
+const std::vector<std::pair<std::string, std::string>>& builtin_preset_texts();  // generated
+
+MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
+  MarkerSet s;
+  try {
+    s.name = j.at("name").get<std::string>();
+    s.description = j.value("description", "");
+    s.signature = j.value("signature", std::vector<std::string>{});
+    const auto& lm = j.at("landmarks");
+    for (int id = 0; id < kLandmarkCount; ++id) {
+      if (!lm.contains(landmark_name(id))) throw InputError(source + ": landmark '" + landmark_name(id) + "' has no rule");
+      const auto& r = lm.at(landmark_name(id));
+      LandmarkRule rule;
+      if (r.contains("marker")) { rule.kind = "marker"; rule.markers = {r["marker"].get<std::string>()}; }
+      else if (r.contains("mean")) { rule.kind = "mean"; rule.markers = r["mean"].get<std::vector<std::string>>(); }
+      else if (r.contains("harrington")) { rule.kind = "harrington"; rule.pelvis = r["harrington"].get<std::map<std::string, std::string>>(); }
+      else if (r.contains("static")) {
+        rule.kind = "static";
+        rule.markers = r["static"].get<std::vector<std::string>>();
+        rule.cluster = r.at("cluster").get<std::vector<std::string>>();
+        if (rule.cluster.size() < 3) throw InputError(source + ": landmark '" + landmark_name(id) + "': a cluster needs 3 or more markers");
+      } else if (r.contains("functional")) {
+        // A joint centre from the motion itself (SCoRE): the point fixed in both segments.
+        rule.kind = "functional";
+        const auto& f = r["functional"];
+        rule.cluster = f.at("proximal").get<std::vector<std::string>>();
+        rule.markers = f.at("distal").get<std::vector<std::string>>();
+        if (rule.cluster.size() < 3 || rule.markers.size() < 3)
+          throw InputError(source + ": landmark '" + landmark_name(id) + "': a functional joint needs 3 or more markers on each segment");
+      } else if (r.contains("pelvis_up")) {
+        rule.kind = "pelvis_up";
+        rule.value = r["pelvis_up"].get<double>();
+        rule.sway_gain = r.value("sway_gain", kTrunkSwayGain);
+        if (!(rule.sway_gain >= 0.0 && rule.sway_gain <= 1.5))
+          throw InputError(source + ": landmark '" + landmark_name(id) + "': sway_gain " + std::to_string(rule.sway_gain) +
+                           " is outside 0-1.5 (0.5: measured walking; 1: a rigid upright torso)");
+        rule.pelvis = r.at("pelvis").get<std::map<std::string, std::string>>();
+      } else if (r.contains("virtual_hallux")) {
+        rule.kind = "virtual_hallux";
+        rule.value = r["virtual_hallux"].get<double>();
+      } else {
+        throw InputError(source + ": landmark '" + landmark_name(id) + "': unknown rule " + r.dump());
+      }
+      if ((rule.kind == "marker" || rule.kind == "mean" || rule.kind == "static") && rule.markers.empty())
+        throw InputError(source + ": landmark '" + landmark_name(id) + "' names no marker");
+      s.rules[static_cast<std::size_t>(id)] = rule;
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(source + ": invalid marker-set file: " + e.what());
+  }
+  return s;
+}
+
+MarkerSet load_marker_set(const std::string& path) { return parse_marker_set(read_json_file(path), path); }
+
+const std::vector<MarkerSet>& builtin_marker_sets() {
+  static const std::vector<MarkerSet> sets = [] {
+    std::vector<MarkerSet> v;
+    for (const auto& [name, text] : builtin_preset_texts()) v.push_back(parse_marker_set(nlohmann::json::parse(text), name));
+    // Recognition order: the more specific sets first.
+    std::stable_sort(v.begin(), v.end(), [](const MarkerSet& a, const MarkerSet& b) { return a.signature.size() > b.signature.size(); });
+    return v;
+  }();
+  return sets;
+}
+
+const MarkerSet* find_marker_set(const std::string& name) {
+  for (const auto& s : builtin_marker_sets())
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+const MarkerSet* recognise_marker_set(const MarkerTrajectories& m, std::string* why) {
+  // Among the presets whose signature markers are in the file, the one whose markers all hold
+  // data in the most frames: a label with no sample (LSHO/RSHO kept empty in a lower-body
+  // capture) does not count as present. Ties go to the set that uses more markers (the more
+  // specific one, e.g. full Plug-in Gait over its lower-body variant).
+  const MarkerSet* best = nullptr;
+  long best_frames = -1;
+  std::size_t best_used = 0;
+  std::string report;
+  for (const auto& s : builtin_marker_sets()) {
+    if (!std::all_of(s.signature.begin(), s.signature.end(), [&](const std::string& n) { return m.find(n) >= 0; })) continue;
+    std::vector<std::string> used = s.motion_markers();
+    std::sort(used.begin(), used.end());
+    used.erase(std::unique(used.begin(), used.end()), used.end());
+    long frames = 0;
+    std::vector<int> idx;
+    bool all_there = true;
+    for (const auto& u : used) {
+      const int k = m.find(u);
+      if (k < 0) all_there = false;
+      else idx.push_back(k);
+    }
+    if (all_there)
+      for (Eigen::Index i = 0; i < m.frames(); ++i)
+        frames += std::all_of(idx.begin(), idx.end(), [&](int k) { return m.positions_m[static_cast<std::size_t>(k)].row(i).allFinite(); });
+    report += (report.empty() ? "" : ", ") + s.name + " " + std::to_string(frames) + " frames";
+    if (frames > best_frames || (frames == best_frames && used.size() > best_used)) best = &s, best_frames = frames, best_used = used.size();
+  }
+  if (best && best_frames == 0) best = nullptr;  // no set has a single complete frame
+  if (why) *why = report.empty() ? "no preset's signature markers are in the file" : "frames with every marker of the set: " + report;
+  return best;
+}
+
+}  // namespace kin2grf
