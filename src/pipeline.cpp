@@ -112,10 +112,9 @@ void sagittal_stage(const Trial& trial, const Trial* static_trial, const MarkerS
 /// trial's floor and soles (ground level, contact calibration).
 std::pair<Model, ContactCalibration> model_stage(const EstimateOptions& o, EstimateResult& r) {
   const SagittalLandmarks& lm = r.landmarks;
-  std::string gmsg;
-  const double ground = o.ground_level_m ? *o.ground_level_m : estimate_ground_level(lm, gmsg);
-  if (!gmsg.empty()) r.messages.push_back(gmsg);
-  ContactCalibration soles = calibrate_contact(lm, ground);
+  const GroundLevel ground = o.ground_level_m ? GroundLevel{*o.ground_level_m, ""} : estimate_ground_level(lm);
+  if (!ground.message.empty()) r.messages.push_back(ground.message);
+  ContactCalibration soles = calibrate_contact(lm, ground.level_m);
   if (!soles.message.empty()) r.messages.push_back(soles.message);
   for (int s = 0; s < 2; ++s)
     if (soles.flat_frames[static_cast<std::size_t>(s)] < 3)

@@ -6,15 +6,15 @@
 #include <random>
 
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
-#include "kin2grf/kinematics/filter.hpp"
-#include "kin2grf/kinematics/motion.hpp"
-#include "kin2grf/pipeline.hpp"
+#include "kin2grf/error.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/text.hpp"
-#include "kin2grf/error.hpp"
-#include "kin2grf/numeric.hpp"
-#include "kin2grf/synth/example.hpp"
+#include "kin2grf/kinematics/filter.hpp"
+#include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/markers/presets.hpp"
+#include "kin2grf/numeric.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/synth/example.hpp"
 #include "test_support.hpp"
 
 using namespace kin2grf;
@@ -112,11 +112,12 @@ TEST(Contact, GroundLevelIsTheLabFloorUnlessTheFeetSayOtherwise) {
   };
   double lowest = 1e9;
   for (int side = 0; side < 2; ++side) lowest = std::min(lowest, lm.p[landmark(side, kMt)].col(1).minCoeff());
-  std::string msg;
-  EXPECT_EQ(estimate_ground_level(lm, msg), 0.0);
-  EXPECT_NE(msg.find("lab floor"), std::string::npos) << msg;
-  EXPECT_EQ(estimate_ground_level(lifted(0.10), msg), 0.0) << "still within 150 mm";
-  EXPECT_NEAR(estimate_ground_level(lifted(0.50), msg), 0.50 + lowest, 0.01) << "a raised walkway";
-  EXPECT_NE(msg.find("lowest of them"), std::string::npos) << msg;
-  EXPECT_NEAR(estimate_ground_level(lifted(-0.30), msg), -0.30 + lowest, 0.01) << "the origin above the floor";
+  const GroundLevel floor = estimate_ground_level(lm);
+  EXPECT_EQ(floor.level_m, 0.0);
+  EXPECT_NE(floor.message.find("lab floor"), std::string::npos) << floor.message;
+  EXPECT_EQ(estimate_ground_level(lifted(0.10)).level_m, 0.0) << "still within 150 mm";
+  const GroundLevel raised = estimate_ground_level(lifted(0.50));
+  EXPECT_NEAR(raised.level_m, 0.50 + lowest, 0.01) << "a raised walkway";
+  EXPECT_NE(raised.message.find("lowest of them"), std::string::npos) << raised.message;
+  EXPECT_NEAR(estimate_ground_level(lifted(-0.30)).level_m, -0.30 + lowest, 0.01) << "the origin above the floor";
 }

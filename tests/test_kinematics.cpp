@@ -6,12 +6,12 @@
 #include <random>
 
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
+#include "kin2grf/error.hpp"
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/pipeline.hpp"
-#include "kin2grf/io/load.hpp"
-#include "kin2grf/io/text.hpp"
-#include "kin2grf/error.hpp"
 #include "kin2grf/synth/example.hpp"
 #include "test_support.hpp"
 

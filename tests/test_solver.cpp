@@ -6,14 +6,14 @@
 #include <random>
 
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
-#include "kin2grf/kinematics/filter.hpp"
-#include "kin2grf/kinematics/motion.hpp"
-#include "kin2grf/pipeline.hpp"
+#include "kin2grf/error.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/text.hpp"
-#include "kin2grf/error.hpp"
-#include "kin2grf/synth/example.hpp"
+#include "kin2grf/kinematics/filter.hpp"
+#include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/markers/presets.hpp"
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/synth/example.hpp"
 #include "test_support.hpp"
 
 using namespace kin2grf;

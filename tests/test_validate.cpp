@@ -13,6 +13,7 @@
 #include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/markers/presets.hpp"
 #include "kin2grf/output/report.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
@@ -20,7 +21,6 @@
 #include "kin2grf/validation/metrics.hpp"
 #include "kin2grf/validation/study.hpp"
 #include "kin2grf/validation/validate.hpp"
-#include "kin2grf/markers/presets.hpp"
 #include "test_support.hpp"
 
 using namespace kin2grf;

@@ -247,7 +247,7 @@ ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_
   return cal;
 }
 
-double estimate_ground_level(const SagittalLandmarks& lm, std::string& message) {
+GroundLevel estimate_ground_level(const SagittalLandmarks& lm) {
   double lowest = std::numeric_limits<double>::infinity();
   for (int side = 0; side < 2; ++side) {
     const auto f = flat_frames(lm, side);
@@ -259,12 +259,11 @@ double estimate_ground_level(const SagittalLandmarks& lm, std::string& message) 
     lowest = std::min({lowest, median_or_zero(he), median_or_zero(hm)});
   }
   if (lowest >= 0.0 && lowest <= 0.15) {
-    message = "ground level 0 m (lab floor; lowest flat-stance foot landmark " + std::to_string(lowest * 1000).substr(0, 5) + " mm above it)";
-    return 0.0;
+    return {0.0, "ground level 0 m (lab floor; lowest flat-stance foot landmark " + std::to_string(lowest * 1000).substr(0, 5) +
+                     " mm above it)"};
   }
-  message = "ground level " + std::to_string(lowest).substr(0, 6) +
-            " m: the flat-stance foot landmarks are not 0-150 mm above the lab floor, so the lowest of them is taken";
-  return lowest;
+  return {lowest, "ground level " + std::to_string(lowest).substr(0, 6) +
+                     " m: the flat-stance foot landmarks are not 0-150 mm above the lab floor, so the lowest of them is taken"};
 }
 
 }  // namespace kin2grf

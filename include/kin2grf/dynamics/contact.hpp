@@ -153,6 +153,10 @@ std::optional<double> measure_belt_velocity(const std::vector<FrameContacts>& co
 /// Automatic ground level: 0 (the lab floor, where capture systems put it) when the feet's
 /// flat-stance landmarks stand 0-150 mm above it; otherwise the lowest of them (a raised or
 /// offset walkway), with a message.
-double estimate_ground_level(const SagittalLandmarks& lm, std::string& message);
+struct GroundLevel {
+  double level_m = 0.0;  ///< the floor's height in the sagittal frame
+  std::string message;   ///< how it was chosen
+};
+GroundLevel estimate_ground_level(const SagittalLandmarks& lm);
 
 }  // namespace kin2grf
