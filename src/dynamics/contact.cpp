@@ -10,7 +10,6 @@
 namespace kin2grf {
 namespace {
 
-
 double half_cosine(double a, double b, double u) { return a + (b - a) * 0.5 * (1.0 - std::cos(M_PI * u)); }
 
 /// Material point of body s at lab position X this frame: its velocity, acceleration and the
@@ -197,9 +196,9 @@ ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_
     if (std::min(h[0], h[1]) - ground_level > kMaxHeelHeight) {
       for (int side = 0; side < 2; ++side) sole[static_cast<std::size_t>(side)] = h[static_cast<std::size_t>(side)] - kNominalHeelHeight;
       cal.message = "neither foot stands on the floor in the processed window (heel landmarks " +
-              std::to_string(static_cast<int>(1000 * (std::min(h[0], h[1]) - ground_level))) +
-              " mm above it at their lowest): soles placed " + std::to_string(static_cast<int>(1000 * kNominalHeelHeight)) +
-              " mm below the heel landmarks";
+                    std::to_string(static_cast<int>(1000 * (std::min(h[0], h[1]) - ground_level))) +
+                    " mm above it at their lowest): soles placed " + std::to_string(static_cast<int>(1000 * kNominalHeelHeight)) +
+                    " mm below the heel landmarks";
     }
   }
   for (int side = 0; side < 2; ++side) {
@@ -240,8 +239,8 @@ ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_
     if (heel_height[static_cast<std::size_t>(side)] > heel_height[static_cast<std::size_t>(other)] + 0.03) {
       cal.feet[static_cast<std::size_t>(side)] = cal.feet[static_cast<std::size_t>(other)];
       cal.message = std::string(side ? "left" : "right") + " foot never stands on the floor (heel landmark " +
-              std::to_string(static_cast<int>(1000 * heel_height[static_cast<std::size_t>(side)])) +
-              " mm above it at its lowest): its sole geometry is taken from the " + (side ? "right" : "left") + " foot";
+                    std::to_string(static_cast<int>(1000 * heel_height[static_cast<std::size_t>(side)])) +
+                    " mm above it at its lowest): its sole geometry is taken from the " + (side ? "right" : "left") + " foot";
     }
   }
   return cal;

@@ -143,7 +143,7 @@ namespace kin2grf {
 /// below the heel, MT and hallux landmarks. A foot whose flat frames stand more than 30 mm
 /// higher than the other's never touches the floor: it takes the other foot's geometry. When
 /// both feet's heel landmarks stay more than 150 mm above the floor, neither foot stands on it:
-/// the soles go 40 mm below the heel landmarks (no stance is invented). `message` says which.
+/// the soles go 40 mm below the heel landmarks (no stance is invented). Its `message` says which.
 ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_level_m);
 
 /// The belt velocity of a treadmill trial (m/s): the median horizontal velocity of the contact
