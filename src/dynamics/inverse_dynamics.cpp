@@ -215,17 +215,17 @@ FrameSolution ContactSolver::solve(const FrameVector& q, const FrameVector& qdd,
   // U's rotation column, the body turned about the origin: every (x, y) of q moves by (-y, x),
   // every absolute angle by 1, the relative angles not at all; orthonormal to the translations
   // (Gram-Schmidt, twice for round-off).
-  auto rotation = U_.col(2);
-  rotation.setZero();
+  auto turn = U_.col(2);
+  turn.setZero();
   for (int k = 0; k < kXyPairs; ++k) {
     const int c = xy_coordinate(k);
-    rotation[c] = -q[c + 1];
-    rotation[c + 1] = q[c];
+    turn[c] = -q[c + 1];
+    turn[c + 1] = q[c];
   }
-  for (int s = 0; s < kSegmentCount; ++s) rotation[coord::theta(s)] = 1.0;
+  for (int s = 0; s < kSegmentCount; ++s) turn[coord::theta(s)] = 1.0;
   for (int pass = 0; pass < 2; ++pass)
-    for (int b = 0; b < 2; ++b) rotation -= U_.col(b).dot(rotation) * U_.col(b);
-  rotation.normalize();
+    for (int b = 0; b < 2; ++b) turn -= U_.col(b).dot(turn) * U_.col(b);
+  turn.normalize();
   UtX_.leftCols(m).noalias() = U_.transpose() * X_;
   return solve_reduced(BpX_, UtX_.leftCols(m), fc);
 }

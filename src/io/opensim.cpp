@@ -126,19 +126,14 @@ TrcRows parse_trc_rows(const std::vector<std::string_view>& lines, const std::ve
   rows.reserve(lines.size());
   std::vector<std::string_view> cells;
   for (std::size_t li = 5; li < lines.size(); ++li) {
-    if (lines[li].find_first_not_of(" \t\r\n\v\f") == std::string_view::npos) continue;
+    if (is_blank(lines[li])) continue;
     split_views(lines[li], '\t', cells);
     std::vector<std::string> ws;  // some writers separate by spaces
     if (cells.size() < nm * 3 + 2) {
       ws = split(lines[li], " \t", false);
       if (ws.size() == nm * 3 + 2) cells.assign(ws.begin(), ws.end());
     }
-    auto blank = [](std::string_view c) {
-      for (const char ch : c)
-        if (ch != ' ' && ch != '\t' && ch != '\r' && ch != '\n' && ch != '\v' && ch != '\f') return false;
-      return true;
-    };
-    while (cells.size() > nm * 3 + 2 && blank(cells.back())) cells.pop_back();
+    while (cells.size() > nm * 3 + 2 && is_blank(cells.back())) cells.pop_back();
     if (cells.size() > nm * 3 + 2) {
       throw InputError(where(path, li) + ": " + std::to_string(cells.size()) + " columns, but " +
                        std::to_string(nm) + " markers make " + std::to_string(nm * 3 + 2));
@@ -151,7 +146,7 @@ TrcRows parse_trc_rows(const std::vector<std::string_view>& lines, const std::ve
     if (cells.size() < 2 || !parse_double(cells[1], r[0]) || !std::isfinite(r[0]))
       throw InputError(where(path, li) + ": Time is missing or not a number");
     for (std::size_t c = 2; c < cells.size(); ++c) {
-      if (blank(cells[c])) continue;
+      if (is_blank(cells[c])) continue;
       double v;
       if (!parse_double(cells[c], v)) {
         throw InputError(where(path, li) + ": marker " + names[(c - 2) / 3] + " " +

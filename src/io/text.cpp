@@ -119,6 +119,12 @@ void ensure_not_an_input(const std::string& output, const std::vector<std::strin
   }
 }
 
+bool is_blank(std::string_view s) {
+  for (const char c : s)
+    if (c != ' ' && c != '\t' && c != '\r' && c != '\n' && c != '\v' && c != '\f') return false;
+  return true;
+}
+
 namespace {
 
 /// Clinger's fast path for the plain decimals text files are made of ([-]digits.digits): the

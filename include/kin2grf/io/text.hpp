@@ -26,6 +26,8 @@ void ensure_not_an_input(const std::string& output, const std::vector<std::strin
 /// Largest file the readers take (a 10-minute trial at 2 kHz markers and 10 kHz analog is
 /// about 2 GB; more is refused before anything is allocated).
 inline constexpr std::uintmax_t kMaxInputBytes = std::uintmax_t{4} << 30;
+/// Whether a cell or line holds only blanks (space, tab, CR, LF, VT, FF).
+bool is_blank(std::string_view s);
 /// Strict number parse ("nan"/"NaN" accepted as NaN, empty -> NaN when allow_empty).
 bool parse_double(std::string_view s, double& out);
 /// Lower-case file extension without the dot ("c3d", "trc", "mot", "sto").
