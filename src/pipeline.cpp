@@ -10,6 +10,7 @@
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/numeric.hpp"
+#include "kin2grf/parallel.hpp"
 
 namespace kin2grf {
 
@@ -197,27 +198,35 @@ struct RawSolve {
 RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResult& r, const ModelMotion& motion,
                      const std::vector<FrameContacts>& contacts) {
   const Eigen::Index n = motion.frames();
-  ContactSolver solver(r.model, r.calibration, o.solver);
   const int np = static_cast<int>(contacts.front().points.size());
   RawSolve raw;
   raw.lambda.resize(n, 2 * np);
   raw.torque.resize(n, kJointCount);
   raw.active.resize(static_cast<std::size_t>(n));
-  Eigen::MatrixXd& lam = raw.lambda;
-  Eigen::MatrixXd& torque = raw.torque;
-  auto& act = raw.active;
   r.iterations.resize(static_cast<std::size_t>(n));
-  const Eigen::Index step = std::max<Eigen::Index>(1, n / 100);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (o.progress && i % step == 0) o.progress(static_cast<long>(i), static_cast<long>(n));
-    const FrameSolution s = solver.solve(motion.q.row(i).transpose(), motion.qdd.row(i).transpose(), contacts[static_cast<std::size_t>(i)]);
-    lam.row(i) = s.contact_lambda.transpose();
-    torque.row(i) = s.joint_torque_Nm.transpose();
-    act[static_cast<std::size_t>(i)] = s.contact_active;
-    r.iterations[static_cast<std::size_t>(i)] = s.iterations;
-    r.cycled_frames += s.cycled;
-    r.capped_frames += s.capped;
-  }
+  std::vector<char> cycled(static_cast<std::size_t>(n)), capped(static_cast<std::size_t>(n));
+  // Frames are independent: each chunk of frames has its own solver (workspace) and writes only
+  // its own rows. The first chunk, on the calling thread, reports the progress.
+  for_chunks(static_cast<std::size_t>(n), 128, [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+    ContactSolver solver(r.model, r.calibration, o.solver);
+    const auto step = std::max<std::size_t>(1, (end - begin) / 100);
+    for (std::size_t k = begin; k < end; ++k) {
+      const auto i = static_cast<Eigen::Index>(k);
+      if (chunk == 0 && o.progress && (k - begin) % step == 0)
+        o.progress(static_cast<long>(static_cast<double>(k) / static_cast<double>(end) * static_cast<double>(n)), static_cast<long>(n));
+      const FrameSolution s = solver.solve(motion.q.row(i).transpose(), motion.qdd.row(i).transpose(), contacts[k]);
+      raw.lambda.row(i) = s.contact_lambda.transpose();
+      raw.torque.row(i) = s.joint_torque_Nm.transpose();
+      raw.active[k] = s.contact_active;
+      r.iterations[k] = s.iterations;
+      cycled[k] = s.cycled;
+      capped[k] = s.capped;
+    }
+  });
+  r.cycled_frames += static_cast<int>(std::count(cycled.begin(), cycled.end(), 1));
+  r.capped_frames += static_cast<int>(std::count(capped.begin(), capped.end(), 1));
+  const Eigen::MatrixXd& lam = raw.lambda;
+  const Eigen::MatrixXd& torque = raw.torque;
   if (o.progress) o.progress(static_cast<long>(n), static_cast<long>(n));
   // No NaN leaves the library: a frame the solve could not make finite is named, not written.
   for (Eigen::Index i = 0; i < n; ++i)

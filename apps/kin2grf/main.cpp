@@ -1,8 +1,5 @@
 // kin2grf command line: a thin front end that wires the library's steps together and prints.
 #include <CLI/CLI.hpp>
-#include <malloc.h>
-#include <sys/mman.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -24,6 +21,7 @@
 #include "kin2grf/validation/cop_fit.hpp"
 #include "kin2grf/validation/study.hpp"
 #include "kin2grf/workflow/batch.hpp"
+#include "kin2grf/workflow/process.hpp"
 #include "kin2grf/workflow/progress.hpp"
 #include "kin2grf/workflow/settings.hpp"
 #include "kin2grf/workflow/trial_list.hpp"
@@ -218,25 +216,8 @@ int run_make_example(const std::string& dir, double seconds) {
 
 }  // namespace
 
-/// One short run touches a few MB of fresh heap, and on a virtual machine each 4 KB page fault
-/// costs about 10 us: half of a 500-frame estimate. The heap grows in 32 MB steps backed by huge
-/// pages where the kernel allows (madvise), and freed blocks are reused rather than unmapped.
-void tune_allocator() {
-  mallopt(M_MMAP_THRESHOLD, 256 << 20);
-  mallopt(M_TRIM_THRESHOLD, 512 << 20);
-  mallopt(M_TOP_PAD, 32 << 20);
-  char* before = static_cast<char*>(sbrk(0));
-  void* volatile grow = std::malloc(1 << 20);  // grows the heap by this and the pad (volatile: kept)
-  std::free(grow);
-  char* after = static_cast<char*>(sbrk(0));
-  const auto huge = std::uintptr_t{2} << 20;
-  const auto start = (reinterpret_cast<std::uintptr_t>(before) + huge - 1) & ~(huge - 1);
-  if (after > before && reinterpret_cast<std::uintptr_t>(after) > start)
-    madvise(reinterpret_cast<void*>(start), reinterpret_cast<std::uintptr_t>(after) - start, MADV_HUGEPAGE);
-}
-
 int main(int argc, char** argv) {
-  tune_allocator();
+  kin2grf::tune_allocator_for_a_short_run();
   CLI::App app{"kin2grf: ground reaction forces, centre of pressure and joint torques from "
                "motion-capture markers alone (no force plates)"};
   app.set_version_flag("--version", std::string("kin2grf ") + KIN2GRF_VERSION);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstdio>
 #include <limits>
 
@@ -41,10 +42,12 @@ std::optional<Axis> up_axis_from_data(const Trial& t, std::string* why) {
     if (c[0].size() < 4) continue;
     // 10th-90th percentile, so that a stray or unlabelled point far from the body does not count.
     for (int a = 0; a < 3; ++a) {
-      std::sort(c[a].begin(), c[a].end());
       const std::size_t k = c[a].size() - 1;
-      spread[a].push_back(c[a][static_cast<std::size_t>(0.9 * static_cast<double>(k) + 0.5)] -
-                          c[a][static_cast<std::size_t>(0.1 * static_cast<double>(k) + 0.5)]);
+      const auto lo = c[a].begin() + static_cast<std::ptrdiff_t>(0.1 * static_cast<double>(k) + 0.5);
+      const auto hi = c[a].begin() + static_cast<std::ptrdiff_t>(0.9 * static_cast<double>(k) + 0.5);
+      std::nth_element(c[a].begin(), hi, c[a].end());  // two selections, not a sort: same values
+      std::nth_element(c[a].begin(), lo, hi);
+      spread[a].push_back(*hi - *lo);
     }
   }
   if (spread[0].size() < 3) return std::nullopt;

@@ -6,10 +6,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <numeric>
 #include <sstream>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/parallel.hpp"
 
 namespace kin2grf {
 namespace {
@@ -17,7 +19,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// The lines of a text, views into it (no copy), without their '\r'.
-std::vector<std::string_view> lines_of(const std::string& text) {
+std::vector<std::string_view> lines_of(std::string_view text) {
   std::vector<std::string_view> lines;
   split_views(text, '\n', lines);
   for (auto& l : lines)
@@ -45,7 +47,8 @@ int Table::column(const std::string& label) const {
 }
 
 MarkerTrajectories read_trc(const std::string& path, std::vector<std::string>* warnings) {
-  return parse_trc(read_file_text(path), path, warnings);
+  const MappedFile file(path);
+  return parse_trc(file.text(), path, warnings);
 }
 
 namespace {
@@ -108,103 +111,92 @@ TrcHeader parse_trc_header(const std::vector<std::string_view>& lines, const std
   return th;
 }
 
-/// The data rows after the header: per row the time and 3 values per marker (NaN for a blank
-/// cell), and the Frame# column. A row with spaces for tabs is read too; a short row's trailing
-/// markers are missing (counted in short_rows).
-struct TrcRows {
-  std::vector<std::vector<double>> rows;
-  std::vector<int> frames;
-  std::size_t short_rows = 0;
-};
-
-TrcRows parse_trc_rows(const std::vector<std::string_view>& lines, const std::vector<std::string>& names, const std::string& path) {
-  const std::size_t nm = names.size();
-  TrcRows out;
-  auto& rows = out.rows;
-  auto& frames = out.frames;
-  std::size_t& short_rows = out.short_rows;
-  rows.reserve(lines.size());
-  std::vector<std::string_view> cells;
-  for (std::size_t li = 5; li < lines.size(); ++li) {
-    if (is_blank(lines[li])) continue;
-    split_views(lines[li], '\t', cells);
-    std::vector<std::string> ws;  // some writers separate by spaces
-    if (cells.size() < nm * 3 + 2) {
-      ws = split(lines[li], " \t", false);
-      if (ws.size() == nm * 3 + 2) cells.assign(ws.begin(), ws.end());
-    }
-    while (cells.size() > nm * 3 + 2 && is_blank(cells.back())) cells.pop_back();
-    if (cells.size() > nm * 3 + 2) {
-      throw InputError(where(path, li) + ": " + std::to_string(cells.size()) + " columns, but " +
-                       std::to_string(nm) + " markers make " + std::to_string(nm * 3 + 2));
-    }
-    if (cells.size() < nm * 3 + 2) ++short_rows;
-    std::vector<double> r(nm * 3 + 1, kNaN);
-    double fr = kNaN;
-    if (!parse_double(cells[0], fr) || !std::isfinite(fr) || std::abs(fr) > 1e9)
-      throw InputError(where(path, li) + ": Frame# '" + std::string(cells[0]) + "' is not a frame number");
-    if (cells.size() < 2 || !parse_double(cells[1], r[0]) || !std::isfinite(r[0]))
-      throw InputError(where(path, li) + ": Time is missing or not a number");
-    for (std::size_t c = 2; c < cells.size(); ++c) {
-      if (is_blank(cells[c])) continue;
-      double v;
-      if (!parse_double(cells[c], v)) {
-        throw InputError(where(path, li) + ": marker " + names[(c - 2) / 3] + " " +
-                         "XYZ"[(c - 2) % 3] + " = '" + trim(cells[c]) + "' is not a number");
-      }
-      r[c - 1] = v;
-    }
-    frames.push_back(static_cast<int>(fr));
-    rows.push_back(std::move(r));
+/// One data row (line `li`) into row i of `m` (time, positions in metres, NaN for a marker with
+/// a blank cell) and its Frame#. A row with spaces for tabs is read too; returns true when the
+/// row ends early (its trailing markers are missing). `cells` is reused.
+bool read_trc_row(std::string_view line, std::size_t li, const TrcHeader& th, const std::string& path,
+                  std::vector<std::string_view>& cells, MarkerTrajectories& m, Eigen::Index i, int& frame) {
+  const std::size_t nm = th.names.size(), width = nm * 3 + 2;
+  split_views(line, '\t', cells);
+  std::vector<std::string> ws;  // some writers separate by spaces
+  if (cells.size() < width) {
+    ws = split(line, " \t", false);
+    if (ws.size() == width) cells.assign(ws.begin(), ws.end());
   }
-  return out;
+  while (cells.size() > width && is_blank(cells.back())) cells.pop_back();
+  if (cells.size() > width) {
+    throw InputError(where(path, li) + ": " + std::to_string(cells.size()) + " columns, but " + std::to_string(nm) +
+                     " markers make " + std::to_string(width));
+  }
+  double fr = kNaN;
+  if (!parse_double(cells[0], fr) || !std::isfinite(fr) || std::abs(fr) > 1e9)
+    throw InputError(where(path, li) + ": Frame# '" + std::string(cells[0]) + "' is not a frame number");
+  if (cells.size() < 2 || !parse_double(cells[1], m.time_s[i]) || !std::isfinite(m.time_s[i]))
+    throw InputError(where(path, li) + ": Time is missing or not a number");
+  frame = static_cast<int>(fr);
+  for (std::size_t k = 0; k < nm; ++k) {
+    double v[3] = {kNaN, kNaN, kNaN};
+    for (std::size_t a = 0; a < 3; ++a) {
+      const std::size_t c = 2 + 3 * k + a;
+      if (c >= cells.size() || is_blank(cells[c])) continue;
+      if (!parse_double(cells[c], v[a]))
+        throw InputError(where(path, li) + ": marker " + th.names[k] + " " + "XYZ"[a] + " = '" + trim(cells[c]) +
+                         "' is not a number");
+    }
+    auto P = m.positions_m[k].row(i);
+    if (std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2])) P << v[0] * th.to_m, v[1] * th.to_m, v[2] * th.to_m;
+    else P.setConstant(kNaN);
+  }
+  return cells.size() < width;
+}
+
+/// Every data row (line 6 on, blank lines skipped) straight into `m` and `frames`; returns the
+/// number of rows that end early. Rows are independent: chunks of them are read on the
+/// machine's cores, each into its own rows (no second copy of the data).
+std::size_t parse_trc_rows(const std::vector<std::string_view>& lines, const TrcHeader& th, const std::string& path,
+                           MarkerTrajectories& m, std::vector<int>& frames) {
+  std::vector<std::size_t> data_lines;
+  data_lines.reserve(lines.size());
+  for (std::size_t li = std::min<std::size_t>(5, lines.size()); li < lines.size(); ++li)
+    if (!is_blank(lines[li])) data_lines.push_back(li);
+  const auto n = static_cast<Eigen::Index>(data_lines.size());
+  m.time_s.resize(n);
+  frames.resize(data_lines.size());
+  m.positions_m.clear();
+  m.positions_m.reserve(th.names.size());
+  for (std::size_t k = 0; k < th.names.size(); ++k) m.positions_m.emplace_back(n, 3);
+  std::vector<std::size_t> short_rows(static_cast<std::size_t>(thread_count()), 0);
+  for_chunks(data_lines.size(), 128, [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+    std::vector<std::string_view> cells;
+    for (std::size_t r = begin; r < end; ++r)
+      short_rows[chunk] += read_trc_row(lines[data_lines[r]], data_lines[r], th, path, cells, m, static_cast<Eigen::Index>(r), frames[r]);
+  });
+  return std::accumulate(short_rows.begin(), short_rows.end(), std::size_t{0});
 }
 
 }  // namespace
 
-MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
+MarkerTrajectories parse_trc(std::string_view text, const std::string& path,
                              std::vector<std::string>* warnings) {
   const auto lines = lines_of(text);
   const TrcHeader th = parse_trc_header(lines, path, warnings);
-  const std::vector<std::string>& names = th.names;
-  const std::size_t nm = names.size();
-  const TrcRows data = parse_trc_rows(lines, names, path);
-  const auto& rows = data.rows;
-  const auto& frames = data.frames;
-  const double nframes_decl = th.frames_declared, to_m = th.to_m;
-  const std::size_t short_rows = data.short_rows;
   MarkerTrajectories m;
+  std::vector<int> frames;
+  const std::size_t short_rows = parse_trc_rows(lines, th, path, m, frames);
+  const auto n = m.frames();
   m.rate_hz = th.rate_hz;
   m.up_axis = Axis::Y;
-  if (rows.empty()) throw InputError(path + ": no data rows after the header");
-  if (static_cast<double>(rows.size()) != nframes_decl && warnings) {
-    warnings->push_back("NumFrames says " + fmt(nframes_decl) + " but " + std::to_string(rows.size()) +
-                        " data rows were read");
-  }
-  if (short_rows && warnings) {
-    warnings->push_back(std::to_string(short_rows) +
-                        " rows end early; their trailing markers are treated as missing");
-  }
-  const auto n = static_cast<Eigen::Index>(rows.size());
+  if (n == 0) throw InputError(path + ": no data rows after the header");
+  if (static_cast<double>(n) != th.frames_declared && warnings)
+    warnings->push_back("NumFrames says " + fmt(th.frames_declared) + " but " + std::to_string(n) + " data rows were read");
+  if (short_rows && warnings)
+    warnings->push_back(std::to_string(short_rows) + " rows end early; their trailing markers are treated as missing");
   m.first_frame = frames.front();
-  m.time_s.resize(n);
-  m.names = names;
-  m.descriptions.assign(nm, "");
-  m.positions_m.assign(nm, Eigen::MatrixX3d(n, 3));
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const auto& r = rows[static_cast<std::size_t>(i)];
-    m.time_s[i] = r[0];
-    for (std::size_t k = 0; k < nm; ++k) {
-      const double x = r[1 + 3 * k], y = r[2 + 3 * k], z = r[3 + 3 * k];
-      if (std::isfinite(x) && std::isfinite(y) && std::isfinite(z)) {
-        m.positions_m[k].row(i) << x * to_m, y * to_m, z * to_m;
-      } else {
-        m.positions_m[k].row(i).setConstant(kNaN);
-      }
-    }
-    if (i > 0 && !(m.time_s[i] > m.time_s[i - 1]))
+  m.names = th.names;
+  m.descriptions.assign(th.names.size(), "");
+  for (Eigen::Index i = 1; i < n; ++i)
+    if (!(m.time_s[i] > m.time_s[i - 1]))
       throw InputError(path + ": Time does not increase at frame " + std::to_string(frames[static_cast<std::size_t>(i)]));
-  }
   if (n >= 3) {
     // DataRate against the Time column: the samples' own spacing wins (a wrong DataRate scales
     // every derivative), with a warning. The spacing over the whole column, not a median step:
@@ -250,9 +242,12 @@ void write_trc(const std::string& path, const MarkerTrajectories& m) {
   write_file_text(path, format_trc(m, std::filesystem::path(path).filename().string()));
 }
 
-Table read_sto(const std::string& path) { return parse_sto(read_file_text(path), path); }
+Table read_sto(const std::string& path) {
+  const MappedFile file(path);
+  return parse_sto(file.text(), path);
+}
 
-Table parse_sto(const std::string& text, const std::string& path) {
+Table parse_sto(std::string_view text, const std::string& path) {
   const auto lines = lines_of(text);
   Table t;
   std::size_t li = 0;

@@ -10,6 +10,10 @@
 #include <limits>
 #include <sstream>
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
 #include "kin2grf/error.hpp"
 
 namespace kin2grf {
@@ -82,6 +86,23 @@ Buffer read_whole_file(const std::string& path) {
 std::vector<std::uint8_t> read_file_bytes(const std::string& path) { return read_whole_file<std::vector<std::uint8_t>>(path); }
 
 std::string read_file_text(const std::string& path) { return read_whole_file<std::string>(path); }
+
+MappedFile::MappedFile(const std::string& path) {
+  const std::size_t size = checked_input_size(path);
+  const int fd = size > 0 ? ::open(path.c_str(), O_RDONLY | O_CLOEXEC) : -1;
+  void* p = fd >= 0 ? ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0) : MAP_FAILED;
+  if (fd >= 0) ::close(fd);  // the mapping keeps the file
+  if (p == MAP_FAILED) {
+    copy_ = read_file_text(path);
+    return;
+  }
+  mapped_ = static_cast<const char*>(p);
+  size_ = size;
+}
+
+MappedFile::~MappedFile() {
+  if (mapped_) ::munmap(const_cast<char*>(mapped_), size_);
+}
 
 void write_file_text(const std::string& path, std::string_view text) {
   // Through a temporary file in the same folder, renamed at the end: a failed or interrupted run

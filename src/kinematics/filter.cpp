@@ -1,4 +1,5 @@
 #include "kin2grf/kinematics/filter.hpp"
+#include "kin2grf/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -74,7 +75,12 @@ Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, d
 
 Eigen::MatrixXd butterworth_filtfilt(const Eigen::MatrixXd& x, double rate_hz, double cutoff_hz) {
   Eigen::MatrixXd y(x.rows(), x.cols());
-  for (Eigen::Index c = 0; c < x.cols(); ++c) y.col(c) = butterworth_filtfilt(Eigen::VectorXd(x.col(c)), rate_hz, cutoff_hz);
+  // Columns are independent: on the machine's cores when long enough to pay for a thread.
+  const std::size_t min_columns = std::max<std::size_t>(1, 20000 / std::max<std::size_t>(1, static_cast<std::size_t>(x.rows())));
+  for_chunks(static_cast<std::size_t>(x.cols()), min_columns, [&](std::size_t, std::size_t begin, std::size_t end) {
+    for (auto c = static_cast<Eigen::Index>(begin); c < static_cast<Eigen::Index>(end); ++c)
+      y.col(c) = butterworth_filtfilt(Eigen::VectorXd(x.col(c)), rate_hz, cutoff_hz);
+  });
   return y;
 }
 
@@ -102,41 +108,44 @@ Eigen::MatrixXd second_difference(const Eigen::MatrixXd& x, double dt) {
 
 namespace kin2grf {
 
+namespace {
+
+/// One column's choice for residual_analysis_cutoff (+inf: above upper_hz).
+double residual_cutoff_of(const Eigen::VectorXd& col, double rate_hz, double upper_hz, double f_lo, double f_hi) {
+  const auto n = static_cast<double>(col.size());
+  auto residual = [&](double f) { return std::sqrt((col - butterworth_filtfilt(col, rate_hz, f)).squaredNorm() / n); };
+  // The noise line R = a + b f, least squares on 8 points of the noise region.
+  constexpr int m = 8;
+  double sf = 0, sr = 0, sff = 0, sfr = 0;
+  for (int k = 0; k < m; ++k) {
+    const double f = f_lo + (f_hi - f_lo) * k / (m - 1), r = residual(f);
+    sf += f, sr += r, sff += f * f, sfr += f * r;
+  }
+  const double b = (m * sfr - sf * sr) / (m * sff - sf * sf), a = (sr - b * sf) / m;
+  // R falls as f rises: the lowest f with R(f) <= a, by bisection, only when it is below
+  // upper_hz (most clean recordings stop at this one test).
+  if (!(a > 0) || residual(upper_hz) > a) return std::numeric_limits<double>::infinity();
+  double lo = 0.5, hi = upper_hz;
+  if (residual(lo) <= a) return lo;
+  for (int it = 0; it < 16; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (residual(mid) > a ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+}  // namespace
+
 double residual_analysis_cutoff(const Eigen::MatrixXd& x, double rate_hz, double upper_hz) {
   // At most a minute of frames: the noise of a recording does not change along it.
   const Eigen::Index n = std::min<Eigen::Index>(x.rows(), static_cast<Eigen::Index>(60 * rate_hz));
   const double nyq = 0.5 * rate_hz;
   const double f_lo = 0.5 * nyq, f_hi = 0.8 * nyq;  // where the residual is mostly noise
   if (n < 20 || x.cols() == 0 || !(upper_hz > 0.5 && upper_hz < f_lo)) return upper_hz;
-  std::vector<double> choice;  // per column; +inf: above upper_hz
-  for (Eigen::Index c = 0; c < x.cols(); ++c) {
-    const Eigen::VectorXd col = x.col(c).head(n);
-    auto residual = [&](double f) { return std::sqrt((col - butterworth_filtfilt(col, rate_hz, f)).squaredNorm() / static_cast<double>(n)); };
-    // The noise line R = a + b f, least squares on 8 points of the noise region.
-    constexpr int m = 8;
-    double sf = 0, sr = 0, sff = 0, sfr = 0;
-    for (int k = 0; k < m; ++k) {
-      const double f = f_lo + (f_hi - f_lo) * k / (m - 1), r = residual(f);
-      sf += f, sr += r, sff += f * f, sfr += f * r;
-    }
-    const double b = (m * sfr - sf * sr) / (m * sff - sf * sf), a = (sr - b * sf) / m;
-    // R falls as f rises: the lowest f with R(f) <= a, by bisection, only when it is below
-    // upper_hz (most clean recordings stop at this one test).
-    if (!(a > 0) || residual(upper_hz) > a) {
-      choice.push_back(std::numeric_limits<double>::infinity());
-      continue;
-    }
-    double lo = 0.5, hi = upper_hz;
-    if (residual(lo) <= a) {
-      choice.push_back(lo);
-      continue;
-    }
-    for (int it = 0; it < 16; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (residual(mid) > a ? lo : hi) = mid;
-    }
-    choice.push_back(hi);
-  }
+  std::vector<double> choice(static_cast<std::size_t>(x.cols()));  // per column; +inf: above upper_hz
+  for_chunks(choice.size(), 2, [&](std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) choice[c] = residual_cutoff_of(x.col(static_cast<Eigen::Index>(c)).head(n), rate_hz, upper_hz, f_lo, f_hi);
+  });
   std::nth_element(choice.begin(), choice.begin() + static_cast<long>(choice.size() / 2), choice.end());
   return std::min(upper_hz, choice[choice.size() / 2]);
 }

@@ -15,6 +15,7 @@
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/output/results.hpp"
 #include "kin2grf/io/json.hpp"
+#include "kin2grf/parallel.hpp"
 
 namespace kin2grf {
 
@@ -129,7 +130,10 @@ std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, cons
   std::atomic<std::size_t> next{0};
   std::size_t done = 0;
   std::mutex progress_mutex;
+  const auto n = std::min<std::size_t>(static_cast<std::size_t>(options.jobs), std::max<std::size_t>(1, entries.size()));
   auto work = [&] {
+    // Several trials at once: each runs on its own thread only (no threads within a trial).
+    const ThreadCountScope per_trial(n > 1 ? 1 : thread_count());
     for (std::size_t k; (k = next++) < entries.size();) {
       rows[k] = run_batch_entry(entries[k], options);
       std::lock_guard lock(progress_mutex);
@@ -137,7 +141,6 @@ std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, cons
       if (options.progress) options.progress(done, entries.size(), rows[k]);
     }
   };
-  const auto n = std::min<std::size_t>(static_cast<std::size_t>(options.jobs), std::max<std::size_t>(1, entries.size()));
   std::vector<std::thread> threads;
   for (std::size_t t = 1; t < n; ++t) threads.emplace_back(work);
   work();

@@ -13,6 +13,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "kin2grf/io/trial.hpp"
@@ -31,14 +32,14 @@ struct Table {
 };
 
 MarkerTrajectories read_trc(const std::string& path, std::vector<std::string>* warnings = nullptr);
-MarkerTrajectories parse_trc(const std::string& text, const std::string& path,
+MarkerTrajectories parse_trc(std::string_view text, const std::string& path,
                              std::vector<std::string>* warnings = nullptr);
 /// Writes millimetres (the TRC norm), `up_axis` kept as in memory.
 std::string format_trc(const MarkerTrajectories& m, const std::string& file_name);
 void write_trc(const std::string& path, const MarkerTrajectories& m);
 
 Table read_sto(const std::string& path);
-Table parse_sto(const std::string& text, const std::string& path);
+Table parse_sto(std::string_view text, const std::string& path);
 /// OpenSim 4 header (version=1, nRows, nColumns, inDegrees, endheader).
 std::string format_sto(const Table& t);
 void write_sto(const std::string& path, const Table& t);

@@ -1,0 +1,33 @@
+#include "kin2grf/workflow/process.hpp"
+
+#include <malloc.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdlib>
+
+namespace kin2grf {
+
+namespace {
+void* g_heap_below_huge_pages = nullptr;  // kept, never freed (reachable, for leak checkers)
+}
+
+void tune_allocator_for_a_short_run() {
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
+  mallopt(M_TOP_PAD, 32 << 20);
+  mallopt(M_ARENA_MAX, 1);
+  // Huge pages start at a 2 MB boundary of the heap. The part below it is taken by one block that
+  // is never used (its untouched pages cost no memory), so that every allocation lands where pages
+  // are huge. Nothing above the boundary may be written before the madvise, or that 2 MB would be
+  // mapped page by page: the block ends (and malloc writes the top chunk's header) 32 KB below it.
+  const auto huge = std::uintptr_t{2} << 20;
+  const auto before = reinterpret_cast<std::uintptr_t>(sbrk(0));
+  const auto start = (before + (64 << 10) + huge - 1) & ~(huge - 1);
+  g_heap_below_huge_pages = std::malloc(start - before - (32 << 10));  // the heap grows by it and the pad
+  const auto after = reinterpret_cast<std::uintptr_t>(sbrk(0));
+  if (g_heap_below_huge_pages && after > start) madvise(reinterpret_cast<void*>(start), after - start, MADV_HUGEPAGE);
+}
+
+}  // namespace kin2grf
