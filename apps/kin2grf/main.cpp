@@ -222,51 +222,62 @@ int main(int argc, char** argv) {
                "motion-capture markers alone (no force plates)"};
   app.set_version_flag("--version", std::string("kin2grf ") + KIN2GRF_VERSION);
   app.require_subcommand(1);
+  // Only the subcommand asked for is built (building all of them was a twentieth of a short
+  // run); with no known subcommand first, all are, for the overview and the error.
+  const std::vector<std::string> commands = {"info", "estimate", "validate", "study", "fit-cop", "batch", "make-example"};
+  const bool one = argc > 1 && std::find(commands.begin(), commands.end(), argv[1]) != commands.end();
+  auto wanted = [&](const char* name) { return !one || name == std::string(argv[1]); };
+  CLI::App *info = nullptr, *estimate = nullptr, *validate = nullptr, *study = nullptr, *fit_cop = nullptr, *batch = nullptr,
+           *make_example = nullptr;
 
-  std::string info_file;
+  std::string info_file, info_zero = "none", info_up_axis;
   bool info_json = false;
   double info_threshold = 20.0;
-  auto* info = app.add_subcommand("info", "Describe a recording (C3D, TRC, MOT/STO) before processing it");
-  info->add_option("FILE", info_file, "The recording")->required();
-  info->add_flag("--json", info_json, "Write the description as JSON (schema in docs/FORMATS.md)");
-  std::string info_zero = "none";
-  info->add_option("--zero-offset", info_zero,
-                   "C3D plate offsets: none, zero (FORCE_PLATFORM:ZERO frames) or unloaded (median of unloaded samples)")
-      ->check(CLI::IsMember({"none", "zero", "unloaded"}))->capture_default_str();
-  std::string info_up_axis;
-  info->add_option("--up-axis", info_up_axis, "The lab up axis (X, Y or Z); default: the data's (plates' normal, markers' spread)");
-  info->add_option("--load-threshold", info_threshold, "Vertical force (N) above which a plate counts as loaded")
-      ->capture_default_str();
+  if (wanted("info")) {
+    info = app.add_subcommand("info", "Describe a recording (C3D, TRC, MOT/STO) before processing it");
+    info->add_option("FILE", info_file, "The recording")->required();
+    info->add_flag("--json", info_json, "Write the description as JSON (schema in docs/FORMATS.md)");
+    info->add_option("--zero-offset", info_zero,
+                     "C3D plate offsets: none, zero (FORCE_PLATFORM:ZERO frames) or unloaded (median of unloaded samples)")
+        ->check(CLI::IsMember({"none", "zero", "unloaded"}))->capture_default_str();
+    info->add_option("--up-axis", info_up_axis, "The lab up axis (X, Y or Z); default: the data's (plates' normal, markers' spread)");
+    info->add_option("--load-threshold", info_threshold, "Vertical force (N) above which a plate counts as loaded")
+        ->capture_default_str();
+  }
 
   EstimateArgs est;
-  auto* estimate = app.add_subcommand("estimate", "Estimate GRF, COP, GRM and joint torques from markers");
-  add_estimate_options(estimate, est);
+  if (wanted("estimate")) {
+    estimate = app.add_subcommand("estimate", "Estimate GRF, COP, GRM and joint torques from markers");
+    add_estimate_options(estimate, est);
+  }
 
   ValidateArgs val;
-  auto* validate = app.add_subcommand("validate", "Estimate, then compare with the trial's force plates (paper's Eqs. 11-12)");
-  add_estimate_options(validate, val.est, false);
-  validate->add_option("--plates", val.plates, "Measured forces from this file (GRF .mot/.sto or C3D) instead of the trial's plates");
-  validate->add_option("--json", val.out_json, "Validation results as JSON (schema in docs/FORMATS.md)");
-  validate->add_option("--report", val.report, "Self-contained HTML report with plots");
-  validate->add_option("--threshold", val.options.threshold_N, "Stance: measured vertical force above this, N")->capture_default_str();
-  validate->add_option("--zero-offset", val.zero_offset, "C3D plate offsets: none, zero or unloaded")
-      ->check(CLI::IsMember({"none", "zero", "unloaded"}))->capture_default_str();
+  if (wanted("validate")) {
+    validate = app.add_subcommand("validate", "Estimate, then compare with the trial's force plates (paper's Eqs. 11-12)");
+    add_estimate_options(validate, val.est, false);
+    validate->add_option("--plates", val.plates, "Measured forces from this file (GRF .mot/.sto or C3D) instead of the trial's plates");
+    validate->add_option("--json", val.out_json, "Validation results as JSON (schema in docs/FORMATS.md)");
+    validate->add_option("--report", val.report, "Self-contained HTML report with plots");
+    validate->add_option("--threshold", val.options.threshold_N, "Stance: measured vertical force above this, N")->capture_default_str();
+    validate->add_option("--zero-offset", val.zero_offset, "C3D plate offsets: none, zero or unloaded")
+        ->check(CLI::IsMember({"none", "zero", "unloaded"}))->capture_default_str();
+  }
 
   StudyArgs study_args;
-  auto* study = app.add_subcommand("study", "The paper's parameter studies on trials with plates: r, ground-shift, cutoff, "
-                                            "kinematic-cutoff, speed-gate, split-distance, torso-length, foot-model");
-  study->add_option("KIND", study_args.kind, "r | ground-shift | cutoff | kinematic-cutoff | speed-gate | split-distance | torso-length | foot-model")
-      ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "kinematic-cutoff", "speed-gate", "speed-gate-ratio", "noise", "split-distance", "torso-length", "foot-model"}));
-  study->add_option("TRIAL", study_args.trials, "Trials with plates (the options below apply to all of them)");
-  study->add_option("--trial-list", study_args.trial_list,
-                    "File of lines 'activity|lab|name|TRIAL [options]', each trial with its own options");
-  study->add_option("--cross-validate", study_args.cross_validate,
-                    "Also choose the setting leave-one-lab-out and print in-sample against held-out figures")
-      ->check(CLI::IsMember({"lab"}));
-  study->add_option("--plates", study_args.plates, "Measured forces for the TRIAL arguments (GRF .mot)");
-  study->add_option("--json", study_args.out_json, "Study results as JSON");
-  study->add_option("--report", study_args.report, "HTML report with the rRMSE-against-setting plots");
-  {
+  if (wanted("study")) {
+    study = app.add_subcommand("study", "The paper's parameter studies on trials with plates: r, ground-shift, cutoff, "
+                                        "kinematic-cutoff, speed-gate, split-distance, torso-length, foot-model");
+    study->add_option("KIND", study_args.kind, "r | ground-shift | cutoff | kinematic-cutoff | speed-gate | split-distance | torso-length | foot-model")
+        ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "kinematic-cutoff", "speed-gate", "speed-gate-ratio", "noise", "split-distance", "torso-length", "foot-model"}));
+    study->add_option("TRIAL", study_args.trials, "Trials with plates (the options below apply to all of them)");
+    study->add_option("--trial-list", study_args.trial_list,
+                      "File of lines 'activity|lab|name|TRIAL [options]', each trial with its own options");
+    study->add_option("--cross-validate", study_args.cross_validate,
+                      "Also choose the setting leave-one-lab-out and print in-sample against held-out figures")
+        ->check(CLI::IsMember({"lab"}));
+    study->add_option("--plates", study_args.plates, "Measured forces for the TRIAL arguments (GRF .mot)");
+    study->add_option("--json", study_args.out_json, "Study results as JSON");
+    study->add_option("--report", study_args.report, "HTML report with the rRMSE-against-setting plots");
     // Estimate options for the TRIAL arguments (without outputs; TRIAL is positional above).
     auto& e = study_args.est;
     study->add_option("--static", e.static_trial, "Static trial");
@@ -276,29 +287,35 @@ int main(int argc, char** argv) {
   }
 
   FitCopArgs fit_args;
-  auto* fit_cop = app.add_subcommand("fit-cop", "Fit foot model 2's COP function to the plate COPs of trials with plates");
-  fit_cop->add_option("--trial-list", fit_args.trial_list, "File of lines 'activity|lab|name|TRIAL [options]'")->required();
-  fit_cop->add_option("--activity", fit_args.activity, "Use the trials of this activity ('' = all)")->capture_default_str();
-  fit_cop->add_option("--min-force", fit_args.min_force, "Frames where the plate carries at least this fraction of body weight")
-      ->capture_default_str();
-  fit_cop->add_flag("--fit-angles", fit_args.fit_angles, "Fit the event angles too (default: the paper's, fixed)");
-  fit_cop->add_flag("--leave-one-out", fit_args.leave_one_out,
-                    "Also report each trial's COP error with a fit on the other labs' trials (leave one lab out)");
-  fit_cop->add_option("-o,--output", fit_args.out, "Write the fitted function and its provenance (JSON)");
+  if (wanted("fit-cop")) {
+    fit_cop = app.add_subcommand("fit-cop", "Fit foot model 2's COP function to the plate COPs of trials with plates");
+    fit_cop->add_option("--trial-list", fit_args.trial_list, "File of lines 'activity|lab|name|TRIAL [options]'")->required();
+    fit_cop->add_option("--activity", fit_args.activity, "Use the trials of this activity ('' = all)")->capture_default_str();
+    fit_cop->add_option("--min-force", fit_args.min_force, "Frames where the plate carries at least this fraction of body weight")
+        ->capture_default_str();
+    fit_cop->add_flag("--fit-angles", fit_args.fit_angles, "Fit the event angles too (default: the paper's, fixed)");
+    fit_cop->add_flag("--leave-one-out", fit_args.leave_one_out,
+                      "Also report each trial's COP error with a fit on the other labs' trials (leave one lab out)");
+    fit_cop->add_option("-o,--output", fit_args.out, "Write the fitted function and its provenance (JSON)");
+  }
 
   BatchArgs batch_args;
-  auto* batch = app.add_subcommand("batch", "Estimate (and validate, where plates exist) every trial of a trial list, on all cores");
-  batch->add_option("LIST", batch_args.trial_list, "File of lines 'activity|lab|name|TRIAL [options] [--plates F]'")->required();
-  batch->add_option("-j,--jobs", batch_args.jobs, "Worker threads (default: every core)")->check(CLI::Range(0, 1024));
-  batch->add_option("--csv", batch_args.out_csv, "Summary table, one line per trial (CSV)");
-  batch->add_option("--json", batch_args.out_json, "Summary table as JSON, with each trial's messages");
-  batch->add_option("--out-dir", batch_args.out_dir, "Write NAME.csv, NAME_grf.mot and NAME.json per trial into this folder");
+  if (wanted("batch")) {
+    batch = app.add_subcommand("batch", "Estimate (and validate, where plates exist) every trial of a trial list, on all cores");
+    batch->add_option("LIST", batch_args.trial_list, "File of lines 'activity|lab|name|TRIAL [options] [--plates F]'")->required();
+    batch->add_option("-j,--jobs", batch_args.jobs, "Worker threads (default: every core)")->check(CLI::Range(0, 1024));
+    batch->add_option("--csv", batch_args.out_csv, "Summary table, one line per trial (CSV)");
+    batch->add_option("--json", batch_args.out_json, "Summary table as JSON, with each trial's messages");
+    batch->add_option("--out-dir", batch_args.out_dir, "Write NAME.csv, NAME_grf.mot and NAME.json per trial into this folder");
+  }
 
   std::string example_dir = "example";
   double example_seconds = 3.0;
-  auto* make_example = app.add_subcommand("make-example", "Write the synthetic example trial (C3D with plates, TRC, GRF .mot)");
-  make_example->add_option("--out-dir", example_dir, "Output folder")->capture_default_str();
-  make_example->add_option("--seconds", example_seconds, "Duration, s")->capture_default_str();
+  if (wanted("make-example")) {
+    make_example = app.add_subcommand("make-example", "Write the synthetic example trial (C3D with plates, TRC, GRF .mot)");
+    make_example->add_option("--out-dir", example_dir, "Output folder")->capture_default_str();
+    make_example->add_option("--seconds", example_seconds, "Duration, s")->capture_default_str();
+  }
 
   try {
     app.parse(argc, argv);
@@ -307,13 +324,14 @@ int main(int argc, char** argv) {
   }
   try {
     int rc = 0;
-    if (*info) rc = run_info(info_file, info_json, info_threshold, info_zero, info_up_axis);
-    else if (*estimate) rc = run_estimate(est);
-    else if (*validate) rc = run_validate(val);
-    else if (*study) rc = run_study(study_args);
-    else if (*fit_cop) rc = run_fit_cop(fit_args);
-    else if (*batch) rc = run_batch(batch_args);
-    else if (*make_example) rc = run_make_example(example_dir, example_seconds);
+    auto chosen = [](const CLI::App* c) { return c && c->parsed(); };
+    if (chosen(info)) rc = run_info(info_file, info_json, info_threshold, info_zero, info_up_axis);
+    else if (chosen(estimate)) rc = run_estimate(est);
+    else if (chosen(validate)) rc = run_validate(val);
+    else if (chosen(study)) rc = run_study(study_args);
+    else if (chosen(fit_cop)) rc = run_fit_cop(fit_args);
+    else if (chosen(batch)) rc = run_batch(batch_args);
+    else if (chosen(make_example)) rc = run_make_example(example_dir, example_seconds);
     // Standard output closed or full: the output is lost, so the run failed.
     std::cout.flush();
     if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout))
