@@ -49,9 +49,9 @@ py::dict estimate(const std::string& trial, const std::vector<std::string>& word
   kin2grf::EstimateOptions o;
   {
     py::gil_scoped_release nogil;
-    const auto t = kin2grf::load_trial(s.trial);
+    const auto files = kin2grf::load_trial_and_static(s);
     o = kin2grf::to_options(s);
-    r = kin2grf::estimate_trial(s, o, t);
+    r = kin2grf::estimate_trial(s, o, files.trial, files.static_trial);
   }
   return estimate_dict(s, o, r);
 }

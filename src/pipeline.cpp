@@ -205,9 +205,10 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
   raw.active.resize(static_cast<std::size_t>(n));
   r.iterations.resize(static_cast<std::size_t>(n));
   std::vector<char> cycled(static_cast<std::size_t>(n)), capped(static_cast<std::size_t>(n));
-  // Frames are independent: each chunk of frames has its own solver (workspace) and writes only
-  // its own rows. The first chunk, on the calling thread, reports the progress.
-  for_chunks(static_cast<std::size_t>(n), 128, [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+  // Frames are independent: each chunk of frames (about 10 us each) has its own solver
+  // (workspace) and writes only its own rows. The first chunk, on the calling thread, reports
+  // the progress.
+  for_chunks(static_cast<std::size_t>(n), min_chunk_for(10e-6), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
     ContactSolver solver(r.model, r.calibration, o.solver);
     const auto step = std::max<std::size_t>(1, (end - begin) / 100);
     for (std::size_t k = begin; k < end; ++k) {

@@ -74,10 +74,11 @@ int run_estimate(const EstimateArgs& a) {
     const auto f = kin2grf::opensim_export_paths(a.opensim_dir, std::filesystem::path(a.trial).stem().string());
     check_outputs({f.grf_mot, f.markers_trc, f.external_loads_xml}, kin2grf::input_files(a));
   }
-  const kin2grf::Trial trial = kin2grf::load_trial(a.trial);
+  const auto files = kin2grf::load_trial_and_static(a);
+  const kin2grf::Trial& trial = files.trial;
   auto options = kin2grf::to_options(a);
   options.progress = kin2grf::solve_progress(stderr);
-  const auto r = kin2grf::estimate_trial(a, options, trial);
+  const auto r = kin2grf::estimate_trial(a, options, trial, files.static_trial);
   print_messages(r);
   const std::string settings_line = kin2grf::settings_json(a, options).dump();
   if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r, settings_line);

@@ -34,6 +34,17 @@ class ThreadCountScope {
   int previous_;
 };
 
+/// The least work worth a thread of its own, in seconds. Starting a thread and waking an idle
+/// core takes 0.1-2 ms on a virtual machine (measured on a 2-core VM), and threads of a short run
+/// wait on each other at the allocator's lock; below this a loop stays on its thread (a
+/// 500-frame trial is read and solved on one core, a 12,000-frame one on all of them).
+inline constexpr double kMinSecondsPerChunk = 0.005;
+
+/// The fewest items per chunk for items that take about `seconds_per_item` each.
+inline std::size_t min_chunk_for(double seconds_per_item) {
+  return seconds_per_item > 0 ? static_cast<std::size_t>(kMinSecondsPerChunk / seconds_per_item) + 1 : 1;
+}
+
 /// The chunks [begin, end) that for_chunks() gives n items with at least `min_chunk` per chunk.
 std::vector<std::size_t> chunk_bounds(std::size_t n, std::size_t min_chunk, int threads);
 

@@ -153,8 +153,8 @@ bool read_trc_row(std::string_view line, std::size_t li, const TrcHeader& th, co
 /// Every data row (line 6 on, blank lines skipped) straight into `m` and `frames`; returns the
 /// number of rows that end early. Rows are independent: chunks of them are read on the
 /// machine's cores, each into its own rows (no second copy of the data).
-std::size_t parse_trc_rows(const std::vector<std::string_view>& lines, const TrcHeader& th, const std::string& path,
-                           MarkerTrajectories& m, std::vector<int>& frames) {
+std::size_t parse_trc_rows(const std::vector<std::string_view>& lines, std::size_t text_bytes, const TrcHeader& th,
+                           const std::string& path, MarkerTrajectories& m, std::vector<int>& frames) {
   std::vector<std::size_t> data_lines;
   data_lines.reserve(lines.size());
   for (std::size_t li = std::min<std::size_t>(5, lines.size()); li < lines.size(); ++li)
@@ -166,7 +166,9 @@ std::size_t parse_trc_rows(const std::vector<std::string_view>& lines, const Trc
   m.positions_m.reserve(th.names.size());
   for (std::size_t k = 0; k < th.names.size(); ++k) m.positions_m.emplace_back(n, 3);
   std::vector<std::size_t> short_rows(static_cast<std::size_t>(thread_count()), 0);
-  for_chunks(data_lines.size(), 128, [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+  // About 5 ns a byte of text (splitting and parsing).
+  const double bytes_per_row = static_cast<double>(text_bytes) / static_cast<double>(std::max<std::size_t>(1, data_lines.size()));
+  for_chunks(data_lines.size(), min_chunk_for(5e-9 * bytes_per_row), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
     std::vector<std::string_view> cells;
     for (std::size_t r = begin; r < end; ++r)
       short_rows[chunk] += read_trc_row(lines[data_lines[r]], data_lines[r], th, path, cells, m, static_cast<Eigen::Index>(r), frames[r]);
@@ -182,7 +184,7 @@ MarkerTrajectories parse_trc(std::string_view text, const std::string& path,
   const TrcHeader th = parse_trc_header(lines, path, warnings);
   MarkerTrajectories m;
   std::vector<int> frames;
-  const std::size_t short_rows = parse_trc_rows(lines, th, path, m, frames);
+  const std::size_t short_rows = parse_trc_rows(lines, text.size(), th, path, m, frames);
   const auto n = m.frames();
   m.rate_hz = th.rate_hz;
   m.up_axis = Axis::Y;

@@ -75,8 +75,9 @@ Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, d
 
 Eigen::MatrixXd butterworth_filtfilt(const Eigen::MatrixXd& x, double rate_hz, double cutoff_hz) {
   Eigen::MatrixXd y(x.rows(), x.cols());
-  // Columns are independent: on the machine's cores when long enough to pay for a thread.
-  const std::size_t min_columns = std::max<std::size_t>(1, 20000 / std::max<std::size_t>(1, static_cast<std::size_t>(x.rows())));
+  // Columns are independent: on the machine's cores when long enough to pay for a thread (two
+  // passes of a biquad, about 10 ns a sample).
+  const std::size_t min_columns = min_chunk_for(10e-9 * static_cast<double>(x.rows()));
   for_chunks(static_cast<std::size_t>(x.cols()), min_columns, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (auto c = static_cast<Eigen::Index>(begin); c < static_cast<Eigen::Index>(end); ++c)
       y.col(c) = butterworth_filtfilt(Eigen::VectorXd(x.col(c)), rate_hz, cutoff_hz);
@@ -143,7 +144,8 @@ double residual_analysis_cutoff(const Eigen::MatrixXd& x, double rate_hz, double
   const double f_lo = 0.5 * nyq, f_hi = 0.8 * nyq;  // where the residual is mostly noise
   if (n < 20 || x.cols() == 0 || !(upper_hz > 0.5 && upper_hz < f_lo)) return upper_hz;
   std::vector<double> choice(static_cast<std::size_t>(x.cols()));  // per column; +inf: above upper_hz
-  for_chunks(choice.size(), 2, [&](std::size_t, std::size_t begin, std::size_t end) {
+  // About 30 filtfilt passes a column.
+  for_chunks(choice.size(), min_chunk_for(30 * 10e-9 * static_cast<double>(n)), [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t c = begin; c < end; ++c) choice[c] = residual_cutoff_of(x.col(static_cast<Eigen::Index>(c)).head(n), rate_hz, upper_hz, f_lo, f_hi);
   });
   std::nth_element(choice.begin(), choice.begin() + static_cast<long>(choice.size() / 2), choice.end());

@@ -46,7 +46,8 @@ ValidationRun validate_trial(const Settings& s, const std::string& plates_file, 
                              const std::string& zero_offset, std::function<void(long, long)> progress) {
   if (!(std::isfinite(vo.threshold_N) && vo.threshold_N > 0))
     throw InputError("setting threshold (N) = " + std::to_string(vo.threshold_N) + ": must be a force above 0 N");
-  const Trial trial = load_trial(s.trial, load_options(zero_offset));
+  const TrialAndStatic files = load_trial_and_static(s, load_options(zero_offset));
+  const Trial& trial = files.trial;
   std::optional<Trial> measured;
   if (!plates_file.empty()) measured = load_trial(plates_file, load_options(zero_offset));
   const Trial& source = measured ? *measured : trial;
@@ -55,7 +56,7 @@ ValidationRun validate_trial(const Settings& s, const std::string& plates_file, 
   EstimateOptions options = to_options(s);
   options.progress = std::move(progress);
   ValidationRun run;
-  run.estimate = estimate_trial(s, options, trial);
+  run.estimate = estimate_trial(s, options, trial, files.static_trial);
   run.validation = validate(run.estimate, *source.plates, vo);
   run.settings = settings_json(s, options);
   run.settings["plates"] = source.path;
@@ -70,11 +71,12 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
   row.activity = entry.activity, row.lab = entry.lab, row.name = entry.name, row.trial = entry.settings.trial;
   const auto start = std::chrono::steady_clock::now();
   try {
-    const Trial trial = load_trial(entry.settings.trial, load_options("unloaded"));
+    const TrialAndStatic files = load_trial_and_static(entry.settings, load_options("unloaded"));
+    const Trial& trial = files.trial;
     std::optional<Trial> plates_file;
     if (!entry.plates.empty()) plates_file = load_trial(entry.plates, load_options("unloaded"));
     const EstimateOptions estimate_options = to_options(entry.settings);
-    const EstimateResult r = estimate_trial(entry.settings, estimate_options, trial);
+    const EstimateResult r = estimate_trial(entry.settings, estimate_options, trial, files.static_trial);
     row.frames = static_cast<long>(r.time_s.size());
     row.duration_s = r.time_s.size() > 1 ? r.time_s[r.time_s.size() - 1] - r.time_s[0] : 0.0;
     row.mass_kg = r.mass_kg;

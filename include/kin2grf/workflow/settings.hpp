@@ -65,9 +65,21 @@ const MarkerSet& resolve_marker_set(const Settings& s, const Trial& trial, Marke
 /// The files a run with these settings reads (no output may be one of them).
 std::vector<std::string> input_files(const Settings& s);
 
-/// Loads the static trial, resolves the marker set and runs estimate() on `trial` with `options`
-/// (to_options(s), resolved once by the caller, who also records them); the marker set's
-/// recognition goes into the result's messages.
+/// The settings' trial and static trial (none when the settings name none).
+struct TrialAndStatic {
+  Trial trial;
+  std::optional<Trial> static_trial;
+};
+
+/// Reads the trial (with `load`) and the static trial at the same time, one on each of two
+/// threads when thread_count() allows; an error is the trial's first, as when read in turn.
+TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load = {});
+
+/// Resolves the marker set and runs estimate() on `trial` (with its static trial `st`) with
+/// `options` (to_options(s), resolved once by the caller, who also records them); the marker
+/// set's recognition goes into the result's messages.
+EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial, const std::optional<Trial>& st);
+/// The same, reading the settings' static trial first.
 EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial);
 
 }  // namespace kin2grf
