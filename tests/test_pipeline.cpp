@@ -157,7 +157,7 @@ TEST(Estimate, PrescribedSingleSupportRecoversTheExactContactForce) {
   ContactSolver solver(r.model, r.calibration, sopt);  // no speed gate (eo's)
   const Eigen::MatrixXd Phi = solver.bilateral_jacobian(q);
   Eigen::MatrixXd A(kBilateralCount + 2, coord::kCount);
-  A << Phi, fc.points[0].jac_normal.transpose(), fc.points[0].jac_tangent.transpose();
+  A << Phi, fc.points[0].jac_normal.dense().transpose(), fc.points[0].jac_tangent.dense().transpose();
   Eigen::VectorXd c = Eigen::VectorXd::Zero(kBilateralCount + 2);
   const double phidd[kJointCount] = {0.8, -1.5, 2.0, 0.3, -0.4, 0.9, 0.0, -0.2};  // rad/s^2 (qd = 0)
   for (int j = 0; j < kJointCount; ++j) c[48 + j] = phidd[j];

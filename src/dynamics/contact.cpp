@@ -16,7 +16,7 @@ double half_cosine(double a, double b, double u) { return a + (b - a) * 0.5 * (1
 /// Jacobian rows of its x and y with respect to q (through the proximal landmark and theta_s).
 struct MaterialPoint {
   Eigen::Vector2d v, a;
-  Eigen::VectorXd jx, jy;
+  ContactJacobian jx, jy;
 };
 
 MaterialPoint material_point(const Model& model, const ModelMotion& m, Eigen::Index i, int s, const Eigen::Vector2d& X) {
@@ -29,12 +29,10 @@ MaterialPoint material_point(const Model& model, const ModelMotion& m, Eigen::In
   MaterialPoint mp;
   mp.v = vP + w * perp(d);
   mp.a = aP + al * perp(d) - w * w * d;
-  mp.jx = Eigen::VectorXd::Zero(coord::kCount);
-  mp.jy = Eigen::VectorXd::Zero(coord::kCount);
-  mp.jx[coord::point_x(P)] = 1.0;
-  mp.jx[coord::theta(s)] = -d.y();
-  mp.jy[coord::point_x(P) + 1] = 1.0;
-  mp.jy[coord::theta(s)] = d.x();
+  mp.jx.add(coord::point_x(P), 1.0);
+  mp.jx.add(coord::theta(s), -d.y());
+  mp.jy.add(coord::point_x(P) + 1, 1.0);
+  mp.jy.add(coord::theta(s), d.x());
   return mp;
 }
 
@@ -135,10 +133,8 @@ std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCal
       cp.position = D;
       cp.velocity = mp.v;
       cp.gap_m = D.y() - ground;
-      cp.jac_normal = Eigen::VectorXd::Zero(coord::kCount);
-      cp.jac_tangent = Eigen::VectorXd::Zero(coord::kCount);
-      cp.jac_normal[c + 1] = 1.0;
-      cp.jac_tangent[c] = 1.0;
+      cp.jac_normal.add(c + 1, 1.0);
+      cp.jac_tangent.add(c, 1.0);
       fc.points.push_back(std::move(cp));
     }
   }

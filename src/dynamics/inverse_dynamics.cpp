@@ -246,8 +246,13 @@ void ContactSolver::contact_columns(const FrameVector& qdd, const FrameContacts&
   X.resize(coord::kCount, 1 + 2 * np);
   X.col(0) = mass_.cwiseProduct(qdd) - gravity_;
   for (int j = 0; j < np; ++j) {
-    X.col(1 + 2 * j) = fc.points[static_cast<std::size_t>(j)].jac_normal;
-    X.col(2 + 2 * j) = fc.points[static_cast<std::size_t>(j)].jac_tangent;
+    const ContactPoint& p = fc.points[static_cast<std::size_t>(j)];
+    X.col(1 + 2 * j).setZero();
+    X.col(2 + 2 * j).setZero();
+    for (int e = 0; e < p.jac_normal.entries; ++e)
+      X(p.jac_normal.coordinate[static_cast<std::size_t>(e)], 1 + 2 * j) = p.jac_normal.value[static_cast<std::size_t>(e)];
+    for (int e = 0; e < p.jac_tangent.entries; ++e)
+      X(p.jac_tangent.coordinate[static_cast<std::size_t>(e)], 2 + 2 * j) = p.jac_tangent.value[static_cast<std::size_t>(e)];
   }
 }
 

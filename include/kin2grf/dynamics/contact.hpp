@@ -89,12 +89,32 @@ struct CopFunction {
 };
 
 /// One potential contact point this frame (model 2: D*, model 1: A, B or C).
+/// One row of a contact point's Jacobian, d(y)/dq or d(x)/dq (63 wide), by its non-zeros: a
+/// point fixed on a body moves with the body's proximal point and its angle, so two entries at
+/// most (model 2's D* is a coordinate of q: one). Stored dense it was 1 KB a point a frame.
+struct ContactJacobian {
+  static constexpr int kMaxEntries = 2;
+  std::array<int, kMaxEntries> coordinate{};
+  std::array<double, kMaxEntries> value{};
+  int entries = 0;
+  void add(int q_index, double v) {
+    coordinate[static_cast<std::size_t>(entries)] = q_index;
+    value[static_cast<std::size_t>(entries++)] = v;
+  }
+  /// The row as a dense 63-vector.
+  [[nodiscard]] Eigen::VectorXd dense() const {
+    Eigen::VectorXd d = Eigen::VectorXd::Zero(coord::kCount);
+    for (int e = 0; e < entries; ++e) d[coordinate[static_cast<std::size_t>(e)]] = value[static_cast<std::size_t>(e)];
+    return d;
+  }
+};
+
 struct ContactPoint {
   int side = 0;
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< lab sagittal, m
   Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  ///< of the material point, m/s
   double gap_m = 0.0;                                  ///< y - ground
-  Eigen::VectorXd jac_normal, jac_tangent;             ///< d(y)/dq and d(x)/dq, 63 each
+  ContactJacobian jac_normal, jac_tangent;             ///< d(y)/dq and d(x)/dq
 };
 
 /// Contact points of one frame at most: three per foot (model 1).
