@@ -53,6 +53,20 @@ std::string example_trc() { return (example_dir() / "example_squat.trc").string(
 
 }  // namespace
 
+TEST(CliInput, TheOverviewListsEverySubcommandAndEachSubcommandHasItsOwnHelp) {
+  // The program builds only the subcommand asked for; without one (or with a wrong one) all.
+  const auto overview = run("--help");
+  EXPECT_EQ(overview.status, 0);
+  for (const char* c : {"info", "estimate", "validate", "study", "fit-cop", "batch", "make-example"})
+    EXPECT_NE(overview.out.find(std::string("  ") + c + " "), std::string::npos) << c << "\n" << overview.out;
+  const auto typo = run("estimat x.trc");
+  EXPECT_NE(typo.status, 0);
+  const auto help = run("validate --help");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.out.find("--plates"), std::string::npos);
+  EXPECT_NE(run("estimate").out.find("TRIAL is required"), std::string::npos);
+}
+
 TEST(CliInput, EveryBadNumericOptionIsRefusedNamingTheSetting) {
   const std::string trc = example_trc();
   ASSERT_TRUE(std::filesystem::exists(trc));

@@ -1,14 +1,17 @@
-// Tests of io/text: the number parser every text reader uses.
+// Tests of io/text: the number parser every text reader uses, and reading a file.
 #include <gtest/gtest.h>
 
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <random>
 #include <string>
 
+#include "kin2grf/error.hpp"
 #include "kin2grf/io/text.hpp"
+#include "test_support.hpp"
 
 using namespace kin2grf;
 
@@ -50,4 +53,24 @@ TEST(Text, ParseDoubleGivesTheCorrectlyRoundedDouble) {
   EXPECT_EQ(v, -1.25);
   EXPECT_TRUE(parse_double("NaN", v) && std::isnan(v));
   for (const char* bad : {"", "  ", "-", "1.2.3", "12a", "--1", "0x10"}) EXPECT_FALSE(parse_double(bad, v)) << bad;
+}
+
+TEST(Text, AMappedFileHasTheFilesTextAndAnEmptyOrOddFileIsHandled) {
+  const auto dir = test::temp_dir("mapped_file");
+  const std::string path = (dir / "a.txt").string(), empty = (dir / "empty.txt").string();
+  const std::string text = "PathFileType\t4\n1\t2.5\t\n" + std::string(10000, 'x');
+  { std::ofstream(path, std::ios::binary) << text; }
+  { std::ofstream(empty, std::ios::binary); }
+  EXPECT_EQ(MappedFile(path).text(), text);
+  EXPECT_EQ(read_file_text(path), text);
+  EXPECT_TRUE(MappedFile(empty).text().empty());
+  // The checks of read_file_text: a missing file, a folder and a device are named errors.
+  for (const std::string& bad : {(dir / "missing.txt").string(), dir.string(), std::string("/dev/null")}) {
+    try {
+      const MappedFile f(bad);
+      ADD_FAILURE() << "no error for " << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+    }
+  }
 }
