@@ -8,6 +8,8 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/text.hpp"
@@ -73,4 +75,28 @@ TEST(Text, AMappedFileHasTheFilesTextAndAnEmptyOrOddFileIsHandled) {
       EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
     }
   }
+}
+
+TEST(Text, SplitViewsMatchesAPlainSplitOnEveryByte) {
+  // The split reads eight bytes at a time: check it against a plain split on random texts of
+  // every length, with the delimiter's neighbours in value (0x08, 0x0a, 0x89) and runs of it.
+  auto plain = [](std::string_view s, char delim) {
+    std::vector<std::string_view> f;
+    std::size_t start = 0;
+    for (std::size_t i = 0; i <= s.size(); ++i)
+      if (i == s.size() || s[i] == delim) f.push_back(s.substr(start, i - start)), start = i + 1;
+    return f;
+  };
+  std::mt19937 rng(7);
+  const std::string alphabet = std::string("\t\t\t\x08\x0a\x0b\x01\x89\x88 .-0123456789") + '\0';
+  std::vector<std::string_view> got;
+  for (int len = 0; len < 80; ++len)
+    for (int rep = 0; rep < 50; ++rep) {
+      std::string s(static_cast<std::size_t>(len), ' ');
+      for (auto& c : s) c = alphabet[rng() % alphabet.size()];
+      for (char delim : {'\t', '\n', ','}) {
+        split_views(s, delim, got);
+        ASSERT_EQ(got, plain(s, delim)) << "length " << len;
+      }
+    }
 }

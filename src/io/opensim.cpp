@@ -344,11 +344,23 @@ std::string format_sto(const Table& t) {
   os << "\nendheader\n";
   for (std::size_t c = 0; c < t.labels.size(); ++c) os << (c ? "\t" : "") << t.labels[c];
   os << "\n";
+  // The numbers straight into the text (as fmt() writes them), not through the stream.
+  std::string out = os.str();
+  out.reserve(out.size() + static_cast<std::size_t>(t.data.size()) * 14);
+  char buf[64];
   for (Eigen::Index r = 0; r < t.data.rows(); ++r) {
-    for (Eigen::Index c = 0; c < t.data.cols(); ++c) os << (c ? "\t" : "") << fmt(t.data(r, c));
-    os << "\n";
+    for (Eigen::Index c = 0; c < t.data.cols(); ++c) {
+      if (c) out += '\t';
+      const double v = t.data(r, c);
+      if (!std::isfinite(v)) {
+        out += "NaN";
+        continue;
+      }
+      out.append(buf, std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 8).ptr);
+    }
+    out += '\n';
   }
-  return os.str();
+  return out;
 }
 
 void write_sto(const std::string& path, const Table& t) { write_file_text(path, format_sto(t)); }

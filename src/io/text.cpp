@@ -1,5 +1,6 @@
 #include "kin2grf/io/text.hpp"
 
+#include <bit>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -209,17 +210,35 @@ bool parse_double(std::string_view s, double& out) {
 }
 
 void split_views(std::string_view s, char delim, std::vector<std::string_view>& out) {
-  // A plain scan: the fields of a text table are a few characters long, where a call to memchr
-  // per field cost more than the scan (a third of splitting a TRC row).
+  // The fields of a text table are a few characters long: a call to memchr per field cost more
+  // than the scan (a third of splitting a TRC row). Eight bytes at a time: the bytes equal to
+  // the delimiter are the zero bytes of word ^ pattern, found exactly (no borrow between bytes).
   out.clear();
-  const char* const data = s.data();
-  std::size_t start = 0;
-  for (std::size_t i = 0; i < s.size(); ++i)
-    if (data[i] == delim) {
-      out.emplace_back(data + start, i - start);
+  const char* const d = s.data();
+  const std::size_t n = s.size();
+  std::size_t start = 0, i = 0;
+  if constexpr (std::endian::native == std::endian::little) {
+    constexpr std::uint64_t low7 = 0x7F7F7F7F7F7F7F7FULL;
+    const std::uint64_t pattern = 0x0101010101010101ULL * static_cast<unsigned char>(delim);
+    for (; i + 8 <= n; i += 8) {
+      std::uint64_t w;
+      std::memcpy(&w, d + i, 8);
+      const std::uint64_t x = w ^ pattern;
+      std::uint64_t zero = ~(((x & low7) + low7) | x | low7);  // high bit of each zero byte
+      while (zero) {
+        const std::size_t at = i + static_cast<std::size_t>(std::countr_zero(zero) >> 3);
+        out.emplace_back(d + start, at - start);
+        start = at + 1;
+        zero &= zero - 1;
+      }
+    }
+  }
+  for (; i < n; ++i)
+    if (d[i] == delim) {
+      out.emplace_back(d + start, i - start);
       start = i + 1;
     }
-  out.emplace_back(data + start, s.size() - start);
+  out.emplace_back(d + start, n - start);
 }
 
 std::string extension(const std::string& path) {
