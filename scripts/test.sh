@@ -10,7 +10,7 @@ cmake --build --preset ci
 ctest --preset ci -j2
 cmake --preset asan >/dev/null
 cmake --build --preset asan --target kin2grf_tests
-ctest --preset asan -j2 -R 'C3d|Trc|Sto|Corrupt|Fuzz|Solver|NoisyMarkers|SyntheticWalk'
+ctest --preset asan -j2 -R 'C3d|Trc|Sto|Corrupt|Fuzz|Solver|NoisyMarkers|SyntheticWalk|Parallel|Text'
 # The parsers under libFuzzer with the library instrumented (ASan/UBSan), 20 s each, seeded with
 # the project's own files; scripts/fuzz.sh 600 is the long run.
 bash scripts/fuzz.sh 20
