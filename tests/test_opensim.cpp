@@ -182,3 +182,19 @@ TEST(Trc, ARepeatedLabelIsNamedNotSilentlyShadowed) {
   ASSERT_FALSE(w.empty());
   EXPECT_NE(w[0].find("repeated"), std::string::npos) << w[0];
 }
+
+TEST(Trc, AHeaderOfManyMarkersOverManyShortRowsIsRefusedBeforeAllocating) {
+  // 20,000 markers named, 20,000 rows holding only Frame# and Time: 1.2e9 values (9.6 GB) from a
+  // file of a few hundred KB.
+  std::string s = "PathFileType\t4\t(X/Y/Z)\tx.trc\nDataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\n";
+  s += "100\t100\t20000\t20000\tmm\nFrame#\tTime";
+  for (int k = 0; k < 20000; ++k) s += "\tM" + std::to_string(k) + "\t\t";
+  s += "\n\t\n";
+  for (int i = 0; i < 20000; ++i) s += std::to_string(i + 1) + "\t" + std::to_string(i) + "\n";
+  try {
+    (void)parse_trc(s, "big.trc");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("markers over 20000 rows"), std::string::npos) << e.what();
+  }
+}

@@ -15,8 +15,9 @@
 
 namespace kin2grf {
 
-/// The threads kin2grf's loops may use: set_thread_count()'s value on this thread, else the
-/// machine's cores (at most 8). A batch running several trials at once sets 1 on its workers.
+/// The threads kin2grf's loops may use: set_thread_count()'s value on this thread, else
+/// KIN2GRF_THREADS (as OMP_NUM_THREADS), else the machine's cores (at most 8). A batch running
+/// several trials at once sets 1 on its workers.
 int thread_count();
 
 /// n >= 1 sets the count for the calling thread; 0 returns it to the default.

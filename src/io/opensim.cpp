@@ -160,6 +160,13 @@ std::size_t parse_trc_rows(const std::vector<std::string_view>& lines, std::size
   for (std::size_t li = std::min<std::size_t>(5, lines.size()); li < lines.size(); ++li)
     if (!is_blank(lines[li])) data_lines.push_back(li);
   const auto n = static_cast<Eigen::Index>(data_lines.size());
+  // Limits before allocation: a complete row holds fewer values than bytes; rows that end early
+  // hold fewer, but a file whose header's markers over its rows would need far more memory than
+  // the file's size is refused, not allocated.
+  const double values = static_cast<double>(n) * static_cast<double>(th.names.size()) * 3.0;
+  if (values > 8.0 * static_cast<double>(text_bytes) + 1e7)
+    throw InputError(path + ": " + std::to_string(th.names.size()) + " markers over " + std::to_string(n) + " rows make " +
+                     fmt(values) + " values, more than a file of " + std::to_string(text_bytes) + " bytes holds");
   m.time_s.resize(n);
   frames.resize(data_lines.size());
   m.positions_m.clear();

@@ -88,7 +88,6 @@ struct CopFunction {
   static CopFunction running() { return {-0.3, 0.0, 0.15, 1.0, 0.000, 0.709, 0.840, 1.078}; }
 };
 
-/// One potential contact point this frame (model 2: D*, model 1: A, B or C).
 /// One row of a contact point's Jacobian, d(y)/dq or d(x)/dq (63 wide), by its non-zeros: a
 /// point fixed on a body moves with the body's proximal point and its angle, so two entries at
 /// most (model 2's D* is a coordinate of q: one). Stored dense it was 1 KB a point a frame.
@@ -109,6 +108,7 @@ struct ContactJacobian {
   }
 };
 
+/// One potential contact point this frame (model 2: D*, model 1: A, B or C).
 struct ContactPoint {
   int side = 0;
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< lab sagittal, m
