@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <numeric>
+#include <atomic>
 #include <sstream>
 
 #include "kin2grf/error.hpp"
@@ -172,15 +172,17 @@ std::size_t parse_trc_rows(const std::vector<std::string_view>& lines, std::size
   m.positions_m.clear();
   m.positions_m.reserve(th.names.size());
   for (std::size_t k = 0; k < th.names.size(); ++k) m.positions_m.emplace_back(n, 3);
-  std::vector<std::size_t> short_rows(static_cast<std::size_t>(thread_count()), 0);
+  std::atomic<std::size_t> short_rows{0};
   // About 5 ns a byte of text (splitting and parsing).
   const double bytes_per_row = static_cast<double>(text_bytes) / static_cast<double>(std::max<std::size_t>(1, data_lines.size()));
-  for_chunks(data_lines.size(), min_chunk_for(5e-9 * bytes_per_row), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+  for_chunks(data_lines.size(), min_chunk_for(5e-9 * bytes_per_row), [&](std::size_t, std::size_t begin, std::size_t end) {
     std::vector<std::string_view> cells;
+    std::size_t short_here = 0;
     for (std::size_t r = begin; r < end; ++r)
-      short_rows[chunk] += read_trc_row(lines[data_lines[r]], data_lines[r], th, path, cells, m, static_cast<Eigen::Index>(r), frames[r]);
+      short_here += read_trc_row(lines[data_lines[r]], data_lines[r], th, path, cells, m, static_cast<Eigen::Index>(r), frames[r]);
+    short_rows += short_here;
   });
-  return std::accumulate(short_rows.begin(), short_rows.end(), std::size_t{0});
+  return short_rows;
 }
 
 }  // namespace

@@ -191,20 +191,18 @@ TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load)
   std::error_code ec;
   const auto bytes = [&](const std::string& f) { return static_cast<double>(std::filesystem::file_size(f, ec)); };
   const bool both = !s.static_trial.empty() && std::min(bytes(s.trial), bytes(s.static_trial)) * 5e-9 >= kMinSecondsPerChunk;
-  for_chunks(both ? 2 : 1, 1, [&](std::size_t, std::size_t begin, std::size_t end) {
+  if (!both) {
+    out.trial = load_trial(s.trial, load);
+    if (!s.static_trial.empty()) out.static_trial = load_trial(s.static_trial);
+    return out;
+  }
+  for_chunks(2, 1, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       if (i == 0) out.trial = load_trial(s.trial, load);
       else out.static_trial = load_trial(s.static_trial);
     }
   });
-  if (!both && !s.static_trial.empty()) out.static_trial = load_trial(s.static_trial);
   return out;
-}
-
-EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial) {
-  std::optional<Trial> st;
-  if (!s.static_trial.empty()) st = load_trial(s.static_trial);
-  return estimate_trial(s, std::move(options), trial, st);
 }
 
 EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial, const std::optional<Trial>& st) {

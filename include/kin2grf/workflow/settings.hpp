@@ -79,7 +79,5 @@ TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load 
 /// `options` (to_options(s), resolved once by the caller, who also records them); the marker
 /// set's recognition goes into the result's messages.
 EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial, const std::optional<Trial>& st);
-/// The same, reading the settings' static trial first.
-EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial);
 
 }  // namespace kin2grf
