@@ -90,3 +90,22 @@ TEST(Study, EachSettingRunsOnEveryTrialAndTheDefaultRowIsValidates) {
   }
   EXPECT_THROW((void)run_study("no-such-study", trials), InputError);
 }
+
+// The noise study pools 8 seeded draws per level (one draw measures its seed as much as the
+// method): the 0 mm row is validate itself, the 2 mm row holds 8 times its stances, and the draws
+// differ (the same draw eight times would repeat one stance's figure).
+TEST(Study, NoiseStudyPoolsEightDistinctDraws) {
+  const Trial walk = make_example_walk();
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  StudyTrial t;
+  t.name = "walk", t.activity = "walking", t.trial = &walk, t.plates = &*walk.plates, t.marker_set = &set;
+  const StudyResult s = run_study("noise", {t});
+  ASSERT_EQ(s.rows.size(), 4u);  // 0, 1, 2, 3 mm
+  ASSERT_TRUE(s.failures.empty());
+  const std::size_t clean = s.per_trial[0][0].stances.size();
+  ASSERT_GT(clean, 0u);
+  const auto& noisy = s.per_trial[2][0].stances;
+  ASSERT_EQ(noisy.size(), 8 * clean);
+  ASSERT_TRUE(noisy[0].metrics.vertical && noisy[clean].metrics.vertical);
+  EXPECT_NE(noisy[0].metrics.vertical->rrmse_percent, noisy[clean].metrics.vertical->rrmse_percent);
+}

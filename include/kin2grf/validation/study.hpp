@@ -9,8 +9,9 @@
 //   kinematic-cutoff  the marker/coordinate low-pass cut-off (paper: 6 Hz)
 //   speed-gate    kin2grf's contact speed gate, off .. 3 m/s (not in the paper)
 //   speed-gate-ratio  the gate as a multiple of the progression speed (1 .. 3, floor 0.5 or 0.75 m/s)
-//   noise         0-3 mm of seeded Gaussian noise on every marker coordinate (robustness)
 //                 against the fixed 1.5 m/s
+//   noise         0-3 mm of Gaussian noise on every marker coordinate, 8 seeded draws per level
+//                 pooled (robustness)
 //   split-distance  kin2grf's side-by-side feet distance, off .. 0.2 m (not in the paper)
 //   torso-length  the torso's hip-shoulder length fixed (the paper) or measured per frame
 //   foot-model    model 1 (three points) against model 2 (moving COP) (paper: Fig. 6)
