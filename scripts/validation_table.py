@@ -45,6 +45,7 @@ print("## Means per activity\n")
 print("| activity | configuration | stances (trials) | vertical | anterior | COP | COP RMSE mm | moment (plate centre) | total GRM (trials) |")
 print("|---|---|---|---|---|---|---|---|---|")
 activities = []
+suspect = {}
 for a, _, _ in rows:
     if a not in activities:
         activities.append(a)
@@ -60,8 +61,14 @@ for act in activities:
             st += j["per_foot"]
             if j["total"] is not None:
                 tot.append(j["total"]["rrmse_percent"]["moment"])
-        r = lambda k: mean_sd([s["rrmse_percent"][k] for s in st])
-        cop_mm = mean_sd([s["rmse"]["cop_mm"] for s in st])
+        # COP and moment: only stances whose plate passes validate's registration check.
+        ok = lambda s, k: k in ("vertical", "anterior") or not s.get("cop_reference_suspect", False)
+        r = lambda k: mean_sd([s["rrmse_percent"][k] for s in st if ok(s, k)])
+        cop_mm = mean_sd([s["rmse"]["cop_mm"] for s in st if ok(s, "cop")])
+        if config == "defaults":
+            suspect[act] = (sum(1 for s in st if not ok(s, "cop")),
+                            mean_sd([s["rrmse_percent"]["cop"] for s in st]),
+                            mean_sd([s["rmse"]["cop_mm"] for s in st]))
         print(f"| {act} | {config} | {len(st)} ({trials}) | {r('vertical')} | {r('anterior')} | {r('cop')} | {cop_mm} | "
               f"{r('moment')} | {mean_sd(tot)} ({len(tot)}) |")
 print("| walking | the paper, Table 1 (24 trials, total) | | 4.1 (1.1) | 11.2 (1.7) | | | | 5.3 (1.1) |")
@@ -69,7 +76,12 @@ print("| walking | Fluit et al. (paper's Table 1) | | 2.7 | 9.3 | | | | 7.4 |")
 print("| walking | an independent implementation (METHOD.md) | 16 (7) | 17.5 | 12.9 | 10.4 | about 30 | 19.0 | 10.0 |")
 print("| running | an independent implementation (METHOD.md) | 14 | 6.1 | 21.5 | 13.5 | | 17.3 | 10.8 |")
 print("| jump landing | an independent implementation (METHOD.md) | | 52 | 31 | 107 | | 79 | 20 |")
-print("\nMean (SD) over stances; total GRM: mean (SD) over the trials that have a total window.\n")
+print("\nMean (SD) over stances; total GRM: mean (SD) over the trials that have a total window. COP, COP RMSE "
+      "and moment leave out the stances whose plate fails `validate`'s registration check (under more than half "
+      "the body weight the plate's COP lies a median of more than 15 mm beyond the foot's heel and toe markers: "
+      "the plate and the markers disagree on where the foot is; shown in brackets below)"
+      + "".join(f"; {act}: {n} stance(s) left out, with them COP {c} %, {mm} mm" for act, (n, c, mm) in suspect.items() if n)
+      + ".\n")
 
 cv_kinds = [k for k in ("speed-gate-ratio", "r", "split-distance", "torso-length")
             if os.path.exists(os.path.join(out, f"cv-{k}.json"))]
@@ -93,6 +105,12 @@ if cv_kinds:
                   f"{c['worst_trial']['name']} {f1(c['worst_trial']['vertical'])} |")
     print()
 
+def br(s, k):
+    """A COP or moment figure; in brackets where the plate fails the registration check."""
+    x = f1(s["rrmse_percent"][k])
+    return f"[{x}]" if s.get("cop_reference_suspect", False) else x
+
+
 print("## Per trial and foot (defaults)\n")
 print("| activity | trial | foot | plate | frames | vertical | anterior | COP | moment | vertical RMSE %BW | onset ms | offset ms | lag ms | `--paper` vertical / anterior / COP |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -104,8 +122,8 @@ for a, name, _ in rows:
         paper = "-" if q is None else " / ".join(f1(q["rrmse_percent"][k]) for k in ("vertical", "anterior", "cop"))
         t = s["timing_ms"]
         print(f"| {a} | {name} | {s['foot']} | {s['plate']} | {s['frames'][0]}-{s['frames'][1]} | "
-              f"{f1(s['rrmse_percent']['vertical'])} | {f1(s['rrmse_percent']['anterior'])} | {f1(s['rrmse_percent']['cop'])} | "
-              f"{f1(s['rrmse_percent']['moment'])} | {f1(s['rmse_percent_bw']['vertical'])} | "
+              f"{f1(s['rrmse_percent']['vertical'])} | {f1(s['rrmse_percent']['anterior'])} | {br(s, 'cop')} | "
+              f"{br(s, 'moment')} | {f1(s['rmse_percent_bw']['vertical'])} | "
               f"{'-' if t['onset'] is None else round(t['onset'])} | {'-' if t['offset'] is None else round(t['offset'])} | "
               f"{'-' if t.get('vertical_lag') is None else round(t['vertical_lag'])} | {paper} |")
     if j["total"] is not None:

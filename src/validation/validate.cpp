@@ -305,6 +305,27 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
   for (Eigen::Index i = 0; i < len; ++i)
     if (!(mv[i] > o.cop_min_force_fraction * bw)) mc[i] = kNaN;
   s.metrics.cop = compare_series(fe.cop_x_m.segment(a, len), mc);
+  {
+    // Registration check (step 4).
+    const int heel = c.foot ? kHeelL : kHeelR, toe = c.foot ? kHalluxL : kHalluxR;
+    std::vector<double> beyond;
+    for (Eigen::Index i = 0; i < len; ++i) {
+      if (!(mv[i] > 0.5 * bw) || !std::isfinite(mc[i])) continue;
+      const double xa = e.landmarks.p[heel](a + i, 0), xb = e.landmarks.p[toe](a + i, 0);
+      beyond.push_back(std::max({0.0, std::min(xa, xb) - mc[i], mc[i] - std::max(xa, xb)}));
+    }
+    s.cop_beyond_foot_m = beyond.empty() ? kNaN : median(beyond);
+    if (s.cop_beyond_foot_m > o.max_cop_beyond_foot_m) {
+      s.cop_reference_suspect = true;
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    ": under more than half the body weight its COP lies a median %.0f mm beyond the %s foot's heel-toe "
+                    "markers (limit %.0f mm): the plate is not registered with the markers; COP and moment are shown "
+                    "but not scored",
+                    1000 * s.cop_beyond_foot_m, side_name(c.foot).c_str(), 1000 * o.max_cop_beyond_foot_m);
+      v.notes.push_back("plate " + mp.name + " " + frames_text(e, c.run.first, c.run.last) + buf);
+    }
+  }
   s.moment_reference_m = {mp.has_geometry ? mp.centre_m.x() : mean_finite(mc), mp.surface_y_m};
   const double rx = s.moment_reference_m.x(), ry = s.moment_reference_m.y();
   Eigen::VectorXd me(len), mm(len);
@@ -513,7 +534,8 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
     const std::array<const std::optional<SeriesMetrics>*, 4> c = {&s.metrics.vertical, &s.metrics.anterior, &s.metrics.cop,
                                                                    &s.metrics.moment};
     for (std::size_t k = 0; k < 4; ++k)
-      if (*c[k] && std::isfinite((*c[k])->rrmse_percent)) vals[k].push_back((*c[k])->rrmse_percent);
+      if (*c[k] && std::isfinite((*c[k])->rrmse_percent) && !(k >= 2 && s.cop_reference_suspect))
+        vals[k].push_back((*c[k])->rrmse_percent);
     ++mm.n;
   }
   std::array<double*, 4> mean = {&mm.vertical, &mm.anterior, &mm.cop, &mm.moment};
@@ -577,6 +599,8 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     x["frames"] = {e.first_frame_number + s.first, e.first_frame_number + s.last};
     x["time_s"] = {e.time_s[s.first], e.time_s[s.last]};
     x["assign_distance_mm"] = 1000 * s.assign_distance_m;
+    x["cop_beyond_foot_mm"] = num(1000 * s.cop_beyond_foot_m);
+    x["cop_reference_suspect"] = s.cop_reference_suspect;
     x["timing_ms"] = {{"onset", opt(s.onset_error_ms)}, {"offset", opt(s.offset_error_ms)}, {"vertical_lag", opt(s.vertical_lag_ms)}};
     j["per_foot"].push_back(x);
   }
@@ -616,6 +640,13 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
     std::snprintf(b, sizeof b, "%.1f", m->rrmse_percent);
     return text(b);
   };
+  // A stance whose plate fails the registration check: its COP and moment in brackets (not scored).
+  auto bracketed = [&](const std::optional<SeriesMetrics>& m) {
+    char b[40];
+    if (!(m && std::isfinite(m->rrmse_percent))) return text("-");
+    std::snprintf(b, sizeof b, "[%.1f]", m->rrmse_percent);
+    return text(b);
+  };
   auto msd = [&](double mean, double sd) {
     char b[40];
     if (!std::isfinite(mean)) return text("-");
@@ -632,7 +663,8 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
      << "   frames\n";
   for (const auto& s : v.stances) {
     os << label(side_name(s.foot) + " foot on " + s.plate) << cell(s.metrics.vertical) << cell(s.metrics.anterior)
-       << cell(s.metrics.cop) << cell(s.metrics.moment);
+       << (s.cop_reference_suspect ? bracketed(s.metrics.cop) : cell(s.metrics.cop))
+       << (s.cop_reference_suspect ? bracketed(s.metrics.moment) : cell(s.metrics.moment));
     std::snprintf(buf, sizeof buf, "   %ld-%ld\n", static_cast<long>(v.first_frame_number + s.first),
                   static_cast<long>(v.first_frame_number + s.last));
     os << buf;

@@ -21,6 +21,13 @@
 //    cop_min_force_fraction of body weight: a barely loaded plate's COP is noise), and the
 //    sagittal moment about the plate centre (without geometry: about the stance's mean
 //    measured COP). Contact onset/offset: threshold crossings, interpolated, estimate - plate.
+//    Registration check: under more than half the body weight a foot's COP lies between its heel
+//    and toe markers, which sit within 1-2 cm of the sole's ends, except briefly at push-off. When
+//    the median over those frames of the plate COP's distance beyond that span exceeds
+//    max_cop_beyond_foot_m, the plate and the markers disagree on where the foot is (a plate
+//    origin or a lab alignment off by centimetres): the stance's COP and moment, which measure
+//    that disagreement, are reported but left out of the means and of fit-cop, with a note.
+//    Forces do not depend on where the plate is, so vertical and anterior are scored.
 // 5. Total: frames where every plate in use belongs to a kept stance and the plates carry the
 //    whole body (median |sum of plate F_y - sum m (a_y + g)| < 15 % of body weight over each run
 //    of frames with the same plates loaded, sum m(a+g) from the kinematics alone), i.e. every
@@ -68,6 +75,9 @@ struct ValidationOptions {
   double threshold_N = 20.0;               ///< stance: measured vertical force above this
   double cop_min_force_fraction = 0.05;    ///< COP compared where vertical > this x body weight
   double max_assign_distance_m = 0.15;     ///< COP to foot distance for an assignment
+  /// Registration check (step 4): the median distance of the loaded COP beyond the heel-toe span.
+  /// Every development trial's well-registered plates give 0 mm, the Camargo export's 19-46 mm.
+  double max_cop_beyond_foot_m = 0.015;
   double ground_contact_height_m = 0.02;   ///< a sole point this close to the ground touches it
   /// A sole point may lie this far outside a plate edge before the foot counts as partly off:
   /// A and B are under the heel and MT markers, a few cm behind and beside the loaded area.
@@ -85,6 +95,12 @@ struct StanceValidation {
   std::string plate;
   Eigen::Index first = 0, last = 0;  ///< frames in the estimate's window (inclusive)
   double assign_distance_m = 0.0;
+  /// Step 4's registration check: median over the frames above half the body weight of the plate
+  /// COP's distance beyond the foot's heel-toe landmark span (0: inside); NaN without such frames.
+  double cop_beyond_foot_m = 0.0;
+  /// cop_beyond_foot_m > max_cop_beyond_foot_m: metrics.cop and metrics.moment are kept for the
+  /// record but left out of mean_rrmse and of the COP fit.
+  bool cop_reference_suspect = false;
   ComponentMetrics metrics;
   std::optional<double> onset_error_ms, offset_error_ms;  ///< estimate - plate; + = late
   /// Time shift of the estimate's vertical force that best matches the plate over the stance
