@@ -153,7 +153,7 @@ std::pair<std::vector<FrameContacts>, TrialCalibration> contact_stage(const Esti
   const ContactModelOptions& co = o.contact;
   std::vector<bool> running;
   if (co.foot_model == FootModel::Cop && co.running_cop) {
-    running = flight_frames(model, motion);
+    running = flight_frames(model, motion, soles);
     const auto nrun = std::count(running.begin(), running.end(), true);
     if (nrun > 0) {
       char b[160];

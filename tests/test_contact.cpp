@@ -31,7 +31,7 @@ TEST(Contact, FlightFramesAreFoundFromTheKinematicsAlone) {
   const Trial t = make_synthetic_trial(so);
   const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
   ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
-  const auto run = flight_frames(r.model, mm);
+  const auto run = flight_frames(r.model, mm, r.calibration.contact);
   ASSERT_EQ(run.size(), static_cast<std::size_t>(mm.frames()));
   for (Eigen::Index i = 0; i < mm.frames(); ++i) {
     const double time = mm.time_s[i];
@@ -47,9 +47,26 @@ TEST(Contact, FlightFramesAreFoundFromTheKinematicsAlone) {
     const Trial ts = make_synthetic_trial(sq);
     const auto rs = estimate(ts, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
     ModelMotion ms = compute_motion(rs.model, synthetic_landmarks(ts), 6.0);
-    const auto none = flight_frames(rs.model, ms);
+    const auto none = flight_frames(rs.model, ms, rs.calibration.contact);
     EXPECT_EQ(std::count(none.begin(), none.end(), true), 0) << depth;
   }
+}
+
+// A fast walk's mid-stance dip (UWA's 2 m/s walk: the kinematic force sum falls to 0.10 body
+// weight, its plate to 0.26) is not a flight: the stance foot stays on the ground. Here squats at
+// 2.5 Hz with both feet flat (deep and fast enough that m (a_y + g) falls below 0.2 body weight,
+// as the force sum alone shows) must give no running frame.
+TEST(Contact, ADeepDipWithAFootOnTheGroundIsNotAFlight) {
+  SyntheticOptions so;
+  so.squat_depth = 1.0;
+  so.squat_period_s = 0.4;
+  const Trial t = make_synthetic_trial(so);
+  const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+  ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
+  const auto by_force_alone = flight_frames(r.model, mm, r.calibration.contact, 0.2, 0.4, -1e9);
+  ASSERT_GT(std::count(by_force_alone.begin(), by_force_alone.end(), true), 0) << "the bounce must dip below 0.2 body weight";
+  const auto run = flight_frames(r.model, mm, r.calibration.contact);
+  EXPECT_EQ(std::count(run.begin(), run.end(), true), 0);
 }
 
 // Model 2's COP function (Eq. 2): constant outside the event angles, through each event's

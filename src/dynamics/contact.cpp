@@ -57,7 +57,8 @@ std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, cons
   return {rA + Rf * fg.heel_local, rA + Rf * fg.mt_local, rM + Rt * fg.hallux_local};
 }
 
-std::vector<bool> flight_frames(const Model& model, const ModelMotion& m, double flight_fraction, double window_s) {
+std::vector<bool> flight_frames(const Model& model, const ModelMotion& m, const ContactCalibration& soles, double flight_fraction,
+                                double window_s, double clearance_m) {
   const Eigen::Index n = m.frames();
   double mass = 0;
   for (const Body& b : model.bodies) mass += b.mass_kg;
@@ -67,7 +68,11 @@ std::vector<bool> flight_frames(const Model& model, const ModelMotion& m, double
     double fy = 0;
     for (int s = 0; s < kSegmentCount; ++s)
       fy += model.bodies[static_cast<std::size_t>(s)].mass_kg * (m.qdd(i, coord::com_x(s) + 1) + model.gravity_mps2);
-    flight[static_cast<std::size_t>(i)] = fy < limit;
+    if (!(fy < limit)) continue;
+    bool airborne = true;
+    for (int side = 0; side < 2 && airborne; ++side)
+      for (const Eigen::Vector2d& p : sole_points(soles, m, i, side)) airborne = airborne && p.y() - soles.ground_level_m > clearance_m;
+    flight[static_cast<std::size_t>(i)] = airborne;
   }
   const Eigen::Index w = static_cast<Eigen::Index>(std::lround(window_s * m.rate_hz));
   Eigen::Index last = -1 - w;  // the latest flight frame at or before i
