@@ -92,7 +92,9 @@ if cv_kinds:
           "vertical, anterior and COP; then the mean over labs) and scores that lab with it. In-sample: every "
           "trial at the choice made on all trials. Labs are the trial list's second field "
           f"({len(set(lab_of.values()))} labs). Worst trial: the held-out trial with the highest mean vertical rRMSE. "
-          "The COP function's fit (`fit-cop`) is not yet cross-validated by lab.\n")
+          "The walking COP function (last row, COP only): in-sample is the built-in function (fitted in session 3 "
+          "on 7 of these trials, so partly in-sample), held-out each trial's COP with the function refitted by "
+          "`kin2grf fit-cop --fit-angles` on the other labs' walking trials (mean over trials).\n")
     print("| setting | chosen on all trials | activity | in-sample vertical / anterior / COP, GRM | "
           "held-out vertical / anterior / COP, GRM | worst held-out trial (vertical) |")
     print("|---|---|---|---|---|---|")
@@ -103,6 +105,16 @@ if cv_kinds:
             fmt = lambda m: " / ".join(f1(m[x]) for x in ("vertical", "anterior", "cop")) + f", {f1(m['total_grm'])}"
             print(f"| {k} | {cv['in_sample_choice']} | {act} | {fmt(c['in_sample'])} | {fmt(c['held_out'])} | "
                   f"{c['worst_trial']['name']} {f1(c['worst_trial']['vertical'])} |")
+    cop_cv = os.path.join(out, "cv-cop-function.json")
+    if os.path.exists(cop_cv):
+        with open(cop_cv) as f:
+            loo = [x for x in json.load(f)["provenance"]["leave_one_lab_out_cop_rrmse_percent"]
+                   if x["builtin"] is not None and x["other_labs"] is not None]
+        if loo:
+            worst = max(loo, key=lambda x: x["other_labs"])
+            mean = lambda k: statistics.mean(x[k] for x in loo)
+            print(f"| cop-function | built in (7 walking trials, session 3) | walking | - / - / {mean('builtin'):.1f}, - | "
+                  f"- / - / {mean('other_labs'):.1f}, - | {worst['trial']} {worst['other_labs']:.1f} (COP) |")
     print()
 
 def br(s, k):

@@ -156,7 +156,8 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
       const auto e = estimate(*t.trial, t.static_trial, *t.marker_set, o);
       return mean_rrmse(validate(e, *t.plates).stances).cop;
     };
-    out.leave_one_out.push_back({t.name, cop_rrmse(start), cop_rrmse(out.fit.function), cop_rrmse(fit_fn(others).function)});
+    out.leave_one_out.push_back(
+        {t.name, cop_rrmse(start), cop_rrmse(CopFunction{}), cop_rrmse(out.fit.function), cop_rrmse(fit_fn(others).function)});
   }
   return out;
 }
@@ -178,7 +179,7 @@ nlohmann::json cop_fit_json(const CopFitOnTrials& res, const std::vector<StudyTr
   prov["start"] = cop_function_json(start);
   if (!res.leave_one_out.empty()) {
     nlohmann::json loo = nlohmann::json::array();
-    for (const auto& l : res.leave_one_out) loo.push_back({{"trial", l.trial}, {"start", l.start}, {"all", l.all}, {"other_labs", l.others}});
+    for (const auto& l : res.leave_one_out) loo.push_back({{"trial", l.trial}, {"start", l.start}, {"builtin", l.builtin}, {"all", l.all}, {"other_labs", l.others}});
     prov["leave_one_lab_out_cop_rrmse_percent"] = loo;
   }
   j["provenance"] = prov;
@@ -201,12 +202,13 @@ std::string format_cop_fit(const CopFitOnTrials& res, const std::vector<StudyTri
   out += b;
   if (!res.leave_one_out.empty()) {
     std::snprintf(b, sizeof b,
-                  "\nleave-one-lab-out: COP rRMSE %% (mean over the trial's stances; 'other labs': fitted without the trial's lab)\n"
-                  "%-26s %8s %8s %11s\n",
-                  "trial", "start", "all", "other labs");
+                  "\nleave-one-lab-out: COP rRMSE %% (mean over the trial's stances; 'built-in': kin2grf's default function;\n"
+                  "'all': this fit; 'other labs': fitted without the trial's lab)\n"
+                  "%-26s %8s %9s %8s %11s\n",
+                  "trial", "start", "built-in", "all", "other labs");
     out += b;
     for (const auto& l : res.leave_one_out) {
-      std::snprintf(b, sizeof b, "%-26s %8.1f %8.1f %11.1f\n", l.trial.c_str(), l.start, l.all, l.others);
+      std::snprintf(b, sizeof b, "%-26s %8.1f %9.1f %8.1f %11.1f\n", l.trial.c_str(), l.start, l.builtin, l.all, l.others);
       out += b;
     }
   }

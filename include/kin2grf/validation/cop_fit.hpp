@@ -48,14 +48,15 @@ CopFit fit_cop_function_and_angles(const CopSamples& samples, const CopFunction&
 
 /// fit-cop on a set of trials with plates: samples from each trial's kept stances (estimated
 /// with the trial's own options), one pooled fit and, on request, leave-one-lab-out: each
-/// trial's mean COP rRMSE with the starting function, the pooled fit and a fit on the other
-/// labs' trials (StudyTrial::lab; a trial without a lab is its own).
+/// trial's mean COP rRMSE with the starting function, kin2grf's built-in walking function
+/// (CopFunction{}), the pooled fit and a fit on the other labs' trials (StudyTrial::lab; a trial
+/// without a lab is its own).
 struct CopFitOnTrials {
   CopFit fit;
   std::vector<std::size_t> samples_per_trial;
   struct LeaveOneOut {
     std::string trial;
-    double start = 0, all = 0, others = 0;
+    double start = 0, builtin = 0, all = 0, others = 0;
   };
   std::vector<LeaveOneOut> leave_one_out;
 };
