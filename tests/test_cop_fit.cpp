@@ -13,6 +13,7 @@
 #include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/markers/presets.hpp"
 #include "kin2grf/output/report.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
@@ -77,4 +78,31 @@ TEST(CopFit, BuiltInDefaultIsTheCommittedFit) {
   for (auto [a, b] : {std::pair{fr.delta_hs, dr.delta_hs}, {fr.delta_ho, dr.delta_ho}, {fr.delta_mo, dr.delta_mo},
                       {fr.delta_to, dr.delta_to}, {fr.s_hs, dr.s_hs}, {fr.s_ho, dr.s_ho}, {fr.s_mo, dr.s_mo}, {fr.s_to, dr.s_to}})
     EXPECT_NEAR(a, b, 5e-4);
+}
+
+// fit-cop's leave-one-lab-out table: per trial the starting function's COP error, the built-in
+// function's (what kin2grf runs by default, on every frame), the pooled fit's and a fit without
+// the trial's lab; two labs here, so each held-out fit comes from the other lab alone.
+TEST(CopFit, LeaveOneLabOutReportsTheBuiltInFunctionBesideTheRefits) {
+  const Trial walk = make_example_walk();
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  std::vector<StudyTrial> trials(2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    trials[k].name = k ? "walk-b" : "walk-a";
+    trials[k].activity = "walking";
+    trials[k].lab = k ? "lab-b" : "lab-a";
+    trials[k].trial = &walk;
+    trials[k].plates = &*walk.plates;
+    trials[k].marker_set = &set;
+  }
+  const CopFitOnTrials res = fit_cop_on_trials(trials, CopFunction::paper(), 0.2, false, true);
+  ASSERT_EQ(res.leave_one_out.size(), 2u);
+  EstimateOptions o;
+  o.contact.running_cop.reset();
+  const double builtin = mean_rrmse(validate(estimate(walk, nullptr, set, o), *walk.plates).stances).cop;
+  for (const auto& l : res.leave_one_out) {
+    EXPECT_DOUBLE_EQ(l.builtin, builtin) << l.trial;
+    EXPECT_NE(l.start, l.builtin) << l.trial;  // the paper's function is not the built-in one
+    EXPECT_TRUE(std::isfinite(l.others)) << l.trial;
+  }
 }
