@@ -122,7 +122,7 @@ TEST(Validate, MisregisteredPlateCopIsFlaggedNotScored) {
   EXPECT_EQ(m.moment, fp2.metrics.moment->rrmse_percent);
   EXPECT_NEAR(m.vertical, 0.0, 1e-6);
   bool noted = false;
-  for (const auto& n : v.notes) noted = noted || (n.find("FP1") != std::string::npos && n.find("not registered") != std::string::npos);
+  for (const auto& n : v.notes) noted = noted || (n.find("FP1") != std::string::npos && n.find("not seem registered") != std::string::npos);
   EXPECT_TRUE(noted);
   // And the COP fit does not learn from it.
   CopSamples smp;

@@ -283,6 +283,22 @@ std::optional<double> vertical_lag_ms(const Eigen::VectorXd& ev, const Eigen::Ve
   return std::nullopt;
 }
 
+/// The registration check (step 4): over the stance's frames where the plate carries more than
+/// half the body weight, the median distance of its COP (`mc`, from frame `a` of the window)
+/// beyond the foot's heel-toe landmark span along x; NaN without such frames.
+double cop_beyond_foot_m(const EstimateResult& e, const Candidate& c, const Eigen::VectorXd& mv, const Eigen::VectorXd& mc,
+                         Eigen::Index a) {
+  const double bw = e.mass_kg * e.model.gravity_mps2;
+  const int heel = c.foot ? kHeelL : kHeelR, toe = c.foot ? kHalluxL : kHalluxR;
+  std::vector<double> beyond;
+  for (Eigen::Index i = 0; i < mv.size(); ++i) {
+    if (!(mv[i] > 0.5 * bw) || !std::isfinite(mc[i])) continue;
+    const double xa = e.landmarks.p[heel](a + i, 0), xb = e.landmarks.p[toe](a + i, 0);
+    beyond.push_back(std::max({0.0, std::min(xa, xb) - mc[i], mc[i] - std::max(xa, xb)}));
+  }
+  return beyond.empty() ? kNaN : median(beyond);
+}
+
 /// One kept stance compared (per-foot metrics, timing, lag); its measured force and COP go into
 /// v's per-foot series.
 StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, const Candidate& c, const ValidationOptions& o) {
@@ -305,26 +321,16 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
   for (Eigen::Index i = 0; i < len; ++i)
     if (!(mv[i] > o.cop_min_force_fraction * bw)) mc[i] = kNaN;
   s.metrics.cop = compare_series(fe.cop_x_m.segment(a, len), mc);
-  {
-    // Registration check (step 4).
-    const int heel = c.foot ? kHeelL : kHeelR, toe = c.foot ? kHalluxL : kHalluxR;
-    std::vector<double> beyond;
-    for (Eigen::Index i = 0; i < len; ++i) {
-      if (!(mv[i] > 0.5 * bw) || !std::isfinite(mc[i])) continue;
-      const double xa = e.landmarks.p[heel](a + i, 0), xb = e.landmarks.p[toe](a + i, 0);
-      beyond.push_back(std::max({0.0, std::min(xa, xb) - mc[i], mc[i] - std::max(xa, xb)}));
-    }
-    s.cop_beyond_foot_m = beyond.empty() ? kNaN : median(beyond);
-    if (s.cop_beyond_foot_m > o.max_cop_beyond_foot_m) {
-      s.cop_reference_suspect = true;
-      char buf[320];
-      std::snprintf(buf, sizeof buf,
-                    ": under more than half the body weight its COP lies a median %.0f mm beyond the %s foot's heel-toe "
-                    "markers (limit %.0f mm): the plate is not registered with the markers; COP and moment are shown "
-                    "but not scored",
-                    1000 * s.cop_beyond_foot_m, side_name(c.foot).c_str(), 1000 * o.max_cop_beyond_foot_m);
-      v.notes.push_back("plate " + mp.name + " " + frames_text(e, c.run.first, c.run.last) + buf);
-    }
+  s.cop_beyond_foot_m = cop_beyond_foot_m(e, c, mv, mc, a);
+  if (s.cop_beyond_foot_m > o.max_cop_beyond_foot_m) {
+    s.cop_reference_suspect = true;
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  ": under more than half the body weight its COP lies a median %.0f mm beyond the %s foot's heel-toe "
+                  "markers (limit %.0f mm): the plate does not seem registered with the markers; COP and moment are "
+                  "shown but not scored",
+                  1000 * s.cop_beyond_foot_m, side_name(c.foot).c_str(), 1000 * o.max_cop_beyond_foot_m);
+    v.notes.push_back("plate " + mp.name + " " + frames_text(e, c.run.first, c.run.last) + buf);
   }
   s.moment_reference_m = {mp.has_geometry ? mp.centre_m.x() : mean_finite(mc), mp.surface_y_m};
   const double rx = s.moment_reference_m.x(), ry = s.moment_reference_m.y();
