@@ -84,12 +84,21 @@ TEST(Validate, AssignmentFollowsTheCopNotThePlateName) {
   for (const auto& st : v.stances) EXPECT_EQ(st.plate, st.foot == 0 ? "FP2" : "FP1");
 }
 
-TEST(Validate, ShiftedPlateIsNotAssignedAndSaysWhy) {
+namespace {
+/// The exact synthetic plates with FP1's measured COP moved `dx_m` forward and its moments
+/// dropped (so that the COP speaks): a plate registered in the wrong place.
+kin2grf::test::SyntheticWithPlates with_fp1_cop_moved(double dx_m) {
   auto s = synthetic_with_exact_plates();
-  // Move FP1's measured COP 40 cm forward (as a plate registered in the wrong place would).
   auto& p = s.plates.plates[0];
-  for (Eigen::Index i = 0; i < p.cop_m.rows(); ++i) p.cop_m(i, 0) += 0.4;
-  p.moment_centre_Nm.setConstant(NAN);  // let the COP speak
+  for (Eigen::Index i = 0; i < p.cop_m.rows(); ++i) p.cop_m(i, 0) += dx_m;
+  p.moment_centre_Nm.setConstant(NAN);
+  return s;
+}
+}  // namespace
+
+TEST(Validate, ShiftedPlateIsNotAssignedAndSaysWhy) {
+  // Move FP1's measured COP 40 cm forward (as a plate registered in the wrong place would).
+  const auto s = with_fp1_cop_moved(0.4);
   const auto v = validate(s.estimate, s.plates);
   ASSERT_EQ(v.stances.size(), 1u);
   EXPECT_EQ(v.stances[0].plate, "FP2");
@@ -103,10 +112,7 @@ TEST(Validate, ShiftedPlateIsNotAssignedAndSaysWhy) {
 // its foot, but under load its COP stands beyond the foot's heel-toe markers, so its COP and
 // moment are flagged and left out of the means and the COP fit; its forces are still scored.
 TEST(Validate, MisregisteredPlateCopIsFlaggedNotScored) {
-  auto s = synthetic_with_exact_plates();
-  auto& p = s.plates.plates[0];
-  for (Eigen::Index i = 0; i < p.cop_m.rows(); ++i) p.cop_m(i, 0) += 0.2;
-  p.moment_centre_Nm.setConstant(NAN);  // let the COP speak
+  const auto s = with_fp1_cop_moved(0.2);
   const auto v = validate(s.estimate, s.plates);
   ASSERT_EQ(v.stances.size(), 2u);
   const StanceValidation& fp1 = v.stances[0].plate == "FP1" ? v.stances[0] : v.stances[1];
