@@ -1,12 +1,12 @@
 #include "kin2grf/io/opensim.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <atomic>
 #include <sstream>
 
 #include "kin2grf/error.hpp"

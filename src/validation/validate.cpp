@@ -152,6 +152,9 @@ struct Candidate {
   bool kept;
 };
 
+/// How far x lies outside the span between a and b (0 inside): a COP beyond a foot's heel-toe span.
+double beyond_span(double x, double a, double b) { return std::max({0.0, std::min(a, b) - x, x - std::max(a, b)}); }
+
 /// Plate stances -> candidates: runs above the threshold, cut ones and blips out, each assigned
 /// to the foot its COP lies under, and set aside (kept = false, with the reason in v.excluded)
 /// when the other foot also stands on the plate, the foot is partly off it, or a foot stands on
@@ -178,7 +181,7 @@ std::vector<Candidate> assign_stances(const EstimateResult& e, ValidationResult&
         for (Eigen::Index i = run.first; i <= run.last; ++i) {
           if (!std::isfinite(mp.cop_x_m[i])) continue;
           const double xa = e.landmarks.p[heel](i, 0), xb = e.landmarks.p[hal](i, 0);
-          const double dx = std::max({0.0, std::min(xa, xb) - mp.cop_x_m[i], mp.cop_x_m[i] - std::max(xa, xb)});
+          const double dx = beyond_span(mp.cop_x_m[i], xa, xb);
           const double dl = std::isfinite(mp.cop_lateral_m[i]) ? mp.cop_lateral_m[i] - e.foot_lateral_m[f][i] : 0.0;
           d.push_back(std::hypot(dx, dl));
         }
@@ -294,7 +297,7 @@ double cop_beyond_foot_m(const EstimateResult& e, const Candidate& c, const Eige
   for (Eigen::Index i = 0; i < mv.size(); ++i) {
     if (!(mv[i] > 0.5 * bw) || !std::isfinite(mc[i])) continue;
     const double xa = e.landmarks.p[heel](a + i, 0), xb = e.landmarks.p[toe](a + i, 0);
-    beyond.push_back(std::max({0.0, std::min(xa, xb) - mc[i], mc[i] - std::max(xa, xb)}));
+    beyond.push_back(beyond_span(mc[i], xa, xb));
   }
   return beyond.empty() ? kNaN : median(beyond);
 }
