@@ -10,6 +10,7 @@
 
 #include "kin2grf/io/c3d.hpp"
 #include "kin2grf/io/load.hpp"
+#include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/pipeline.hpp"
@@ -63,6 +64,27 @@ void BM_ReadC3dWalking2(benchmark::State& state) {
   state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_ReadC3dWalking2)->Unit(benchmark::kMillisecond);
+
+/// Reading text: Rajagopal's treadmill run (TRC, 42 markers, 510 rows of printf-padded
+/// numbers), the file's text already in memory, so that only the parse is timed.
+void BM_ParseTrcRun(benchmark::State& state) {
+  const std::string path = data_file("rajagopal2016_treadmill_run/motion_capture_run.trc");
+  if (!std::filesystem::exists(path)) {
+    state.SkipWithError("shared data not found");
+    return;
+  }
+  const std::string text = kin2grf::read_file_text(path);
+  long frames = 0;
+  for (auto _ : state) {
+    const auto m = kin2grf::parse_trc(text, path);
+    frames += m.frames();
+    benchmark::DoNotOptimize(m);
+  }
+  state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
+  state.counters["MB_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * static_cast<double>(text.size()) / 1e6, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_ParseTrcRun)->Unit(benchmark::kMillisecond);
 
 /// A trial to run the method on: Rajagopal's overground walk (shared data) or, without the
 /// data, the synthetic squat (always available).

@@ -100,3 +100,51 @@ TEST(Text, SplitViewsMatchesAPlainSplitOnEveryByte) {
       }
     }
 }
+
+TEST(Text, ParsePlainFieldsReadsARowAsSplittingAndParsingWould) {
+  // The fused fast path of TRC and STO rows: whenever it accepts a row, every value must be the
+  // double parse_double gives for that cell (trailing blank cells dropped, as the readers do);
+  // and the rows capture software writes (plain or printf-padded numbers, a trailing tab or CR)
+  // must take it.
+  auto reference = [](std::string_view line, std::size_t width, std::vector<double>& v) {
+    std::vector<std::string_view> cells;
+    split_views(line, '\t', cells);
+    while (cells.size() > width && is_blank(cells.back())) cells.pop_back();
+    if (cells.size() != width) return false;
+    v.assign(width, 0.0);
+    for (std::size_t c = 0; c < width; ++c)
+      if (is_blank(cells[c]) || !parse_double(cells[c], v[c])) return false;
+    return true;
+  };
+  std::mt19937 rng(11);
+  const std::vector<std::string> plain = {"0", "-0", "12", "-463.902787", "  0.230000", " 95.849552 ", "1082.20154",
+                                          "0.0000001", "9007199254740992", "123456.7890123"};
+  const std::vector<std::string> odd = {"", " ", "1e-3", "nan", "+1.5", "1.", ".5", "1 2", "12a", "-", "1.2.3",
+                                        "12345678901234567890", "\r"};
+  std::vector<double> fast, slow;
+  int accepted = 0;
+  for (int rep = 0; rep < 20000; ++rep) {
+    const std::size_t width = 1 + rng() % 7;
+    const bool only_plain = rng() % 2 == 0;
+    std::string line;
+    for (std::size_t c = 0; c < width; ++c) {
+      if (c) line += '\t';
+      line += only_plain || rng() % 4 ? plain[rng() % plain.size()] : odd[rng() % odd.size()];
+    }
+    const char* tails[] = {"", "\t", "\r", "\t\r", "\t\t", "\t7"};
+    const std::string tail = tails[rng() % (only_plain ? 5 : 6)];
+    line += tail;
+    fast.assign(width, 0.0);
+    const bool ok = parse_plain_fields(line, '\t', fast);
+    if (only_plain) {
+      ASSERT_TRUE(ok) << line;
+    }
+    if (!ok) continue;
+    ++accepted;
+    ASSERT_TRUE(reference(line, width, slow)) << line;
+    for (std::size_t c = 0; c < width; ++c) ASSERT_TRUE(same_bits(fast[c], slow[c])) << line << " field " << c;
+  }
+  EXPECT_GT(accepted, 10000);
+  EXPECT_FALSE(parse_plain_fields("1\t2", '\t', fast = std::vector<double>(3)));  // too few fields
+  EXPECT_FALSE(parse_plain_fields("1\t2\t3\t4", '\t', fast = std::vector<double>(3)));  // too many
+}

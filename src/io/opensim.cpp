@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <span>
 #include <sstream>
 
 #include "kin2grf/error.hpp"
@@ -113,10 +114,19 @@ TrcHeader parse_trc_header(const std::vector<std::string_view>& lines, const std
 
 /// One data row (line `li`) into row i of `m` (time, positions in metres, NaN for a marker with
 /// a blank cell) and its Frame#. A row with spaces for tabs is read too; returns true when the
-/// row ends early (its trailing markers are missing). `cells` is reused.
+/// row ends early (its trailing markers are missing). `cells` and `values` are reused.
 bool read_trc_row(std::string_view line, std::size_t li, const TrcHeader& th, const std::string& path,
-                  std::vector<std::string_view>& cells, MarkerTrajectories& m, Eigen::Index i, int& frame) {
+                  std::vector<std::string_view>& cells, std::vector<double>& values, MarkerTrajectories& m,
+                  Eigen::Index i, int& frame) {
   const std::size_t nm = th.names.size(), width = nm * 3 + 2;
+  values.resize(width);
+  if (parse_plain_fields(line, '\t', values) && std::abs(values[0]) <= 1e9) {  // the usual row: every cell a number
+    frame = static_cast<int>(values[0]);
+    m.time_s[i] = values[1];
+    for (std::size_t k = 0; k < nm; ++k)
+      m.positions_m[k].row(i) << values[2 + 3 * k] * th.to_m, values[3 + 3 * k] * th.to_m, values[4 + 3 * k] * th.to_m;
+    return false;
+  }
   split_views(line, '\t', cells);
   std::vector<std::string> ws;  // some writers separate by spaces
   if (cells.size() < width) {
@@ -177,9 +187,11 @@ std::size_t parse_trc_rows(const std::vector<std::string_view>& lines, std::size
   const double bytes_per_row = static_cast<double>(text_bytes) / static_cast<double>(std::max<std::size_t>(1, data_lines.size()));
   for_chunks(data_lines.size(), min_chunk_for(5e-9 * bytes_per_row), [&](std::size_t, std::size_t begin, std::size_t end) {
     std::vector<std::string_view> cells;
+    std::vector<double> row_values;
     std::size_t short_here = 0;
     for (std::size_t r = begin; r < end; ++r)
-      short_here += read_trc_row(lines[data_lines[r]], data_lines[r], th, path, cells, m, static_cast<Eigen::Index>(r), frames[r]);
+      short_here += read_trc_row(lines[data_lines[r]], data_lines[r], th, path, cells, row_values, m, static_cast<Eigen::Index>(r),
+                                 frames[r]);
     short_rows += short_here;
   });
   return short_rows;
@@ -317,6 +329,13 @@ Table parse_sto(std::string_view text, const std::string& path) {
   long nrows = 0;
   for (++li; li < lines.size(); ++li) {
     if (trim(lines[li]).empty()) continue;
+    const std::size_t at = values.size();
+    values.resize(at + ncol);
+    if (parse_plain_fields(lines[li], '\t', std::span<double>(values).subspan(at))) {  // the usual row
+      ++nrows;
+      continue;
+    }
+    values.resize(at);
     const auto cells = split(lines[li], " \t", false);
     if (cells.size() != ncol) {
       throw InputError(where(path, li) + ": " + std::to_string(cells.size()) + " values but " +

@@ -152,29 +152,37 @@ namespace {
 /// Clinger's fast path for the plain decimals text files are made of ([-]digits.digits): the
 /// digits as an integer w <= 2^53 and 10^k with k <= 22 are both exact doubles, so w / 10^k is
 /// one correctly rounded division, the same double from_chars gives, in a fraction of its time.
-/// Anything else (exponents, more digits, "1.", ".5") returns false for from_chars to read.
-bool plain_decimal(const char* b, const char* e, double& out) {
+/// Reads from p up to e, the first `stop` byte, a space or a CR and returns where it stopped; nullptr for
+/// anything else (exponents, more digits, "1.", ".5"), which from_chars then reads.
+const char* scan_plain_decimal(const char* p, const char* e, char stop, double& out) {
   static constexpr double kPow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
                                         1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
-  const bool negative = b < e && *b == '-';
-  if (negative) ++b;
-  if (b == e || *b < '0' || *b > '9') return false;
+  const bool negative = p < e && *p == '-';
+  if (negative) ++p;
+  if (p == e || *p < '0' || *p > '9') return nullptr;
   std::uint64_t w = 0;
   int digits = 0, fraction = -1;  // digits after the point; -1: no point
-  for (const char* p = b; p < e; ++p) {
+  for (; p < e && *p != stop && *p != ' ' && *p != '\r'; ++p) {
     if (*p >= '0' && *p <= '9') {
-      if (++digits > 19) return false;
+      if (++digits > 19) return nullptr;
       w = w * 10 + static_cast<std::uint64_t>(*p - '0');
       if (fraction >= 0) ++fraction;
     } else if (*p == '.' && fraction < 0) {
       fraction = 0;
     } else {
-      return false;
+      return nullptr;
     }
   }
-  if (fraction == 0 || fraction > 22 || w > (std::uint64_t{1} << 53)) return false;
+  if (fraction == 0 || fraction > 22 || w > (std::uint64_t{1} << 53)) return nullptr;
   const double v = static_cast<double>(w) / kPow10[fraction < 0 ? 0 : fraction];
   out = negative ? -v : v;
+  return p;
+}
+
+bool plain_decimal(const char* b, const char* e, double& out) {
+  double v = 0;
+  if (scan_plain_decimal(b, e, '\0', v) != e) return false;  // a NUL inside is not a number either
+  out = v;
   return true;
 }
 
@@ -207,6 +215,25 @@ bool parse_double(std::string_view s, double& out) {
     return true;
   }
   return false;
+}
+
+bool parse_plain_fields(std::string_view line, char delim, std::span<double> out) {
+  // Splitting and parsing in one pass over the bytes: the rows of marker files are made of
+  // nothing else, and the split cost as much as the parse.
+  const char* p = line.data();
+  const char* const e = p + line.size();
+  for (std::size_t c = 0; c < out.size(); ++c) {
+    if (c > 0) {
+      if (p == e) return false;
+      ++p;  // the delimiter
+    }
+    while (p < e && *p == ' ') ++p;  // printf's padding ("%10f"), as parse_double trims it
+    p = scan_plain_decimal(p, e, delim, out[c]);
+    if (p == nullptr) return false;
+    while (p < e && *p == ' ') ++p;
+    if (p < e && *p != delim && c + 1 < out.size()) return false;
+  }
+  return is_blank(std::string_view(p, static_cast<std::size_t>(e - p)));  // trailing tabs or CR are no field
 }
 
 void split_views(std::string_view s, char delim, std::vector<std::string_view>& out) {
