@@ -194,6 +194,7 @@ int run_batch(const BatchArgs& a) {
   o.out_dir = a.out_dir;
   o.progress = kin2grf::batch_progress(stderr);
   const auto start = std::chrono::steady_clock::now();
+  kin2grf::allow_allocator_arenas(o.jobs);
   std::cerr << "kin2grf: batch of " << entries.size() << " trials on " << o.jobs << " threads\n";
   const auto rows = kin2grf::run_batch(entries, o);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

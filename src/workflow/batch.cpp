@@ -1,5 +1,6 @@
 #include "kin2grf/workflow/batch.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <chrono>
@@ -7,8 +8,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
+#include <numeric>
 #include <set>
 #include <sstream>
+#include <system_error>
 #include <thread>
 
 #include "kin2grf/error.hpp"
@@ -129,6 +132,24 @@ std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, cons
     std::filesystem::create_directories(options.out_dir);
   }
   std::vector<BatchRow> rows(entries.size());
+  // Longest first (the bytes of a trial's files stand for its work): a long trial left to the
+  // end would keep one thread busy while the others idle. Rows stay in the list's order.
+  std::vector<std::size_t> order(entries.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  if (options.jobs > 1) {
+    std::vector<std::uintmax_t> bytes(entries.size(), 0);
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      auto files = input_files(entries[k].settings);
+      files.push_back(entries[k].plates);
+      for (const auto& f : files) {
+        std::error_code ec;
+        if (f.empty()) continue;
+        const auto b = std::filesystem::file_size(f, ec);
+        if (!ec) bytes[k] += b;
+      }
+    }
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return bytes[a] > bytes[b]; });
+  }
   std::atomic<std::size_t> next{0};
   std::size_t done = 0;
   std::mutex progress_mutex;
@@ -136,7 +157,8 @@ std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, cons
   auto work = [&] {
     // Several trials at once: each runs on its own thread only (no threads within a trial).
     const ThreadCountScope per_trial(n > 1 ? 1 : thread_count());
-    for (std::size_t k; (k = next++) < entries.size();) {
+    for (std::size_t i; (i = next++) < entries.size();) {
+      const std::size_t k = order[i];
       rows[k] = run_batch_entry(entries[k], options);
       std::lock_guard lock(progress_mutex);
       ++done;

@@ -30,4 +30,8 @@ void tune_allocator_for_a_short_run() {
   if (g_heap_below_huge_pages && after > start) madvise(reinterpret_cast<void*>(start), after - start, MADV_HUGEPAGE);
 }
 
+void allow_allocator_arenas(int threads) {
+  if (threads > 1) mallopt(M_ARENA_MAX, threads);
+}
+
 }  // namespace kin2grf
