@@ -58,6 +58,8 @@ void check_options(const EstimateOptions& o) {
           "speed gate floor (m/s)", o.solver.speed_gate_floor_mps, "between 0 and 20");
   require(finite(o.solver.min_split_distance_m) && o.solver.min_split_distance_m >= 0 && o.solver.min_split_distance_m <= 1,
           "split distance (m)", o.solver.min_split_distance_m, "between 0 (none) and 1");
+  require(finite(o.torso_lag_s) && o.torso_lag_s >= 0 && o.torso_lag_s <= 0.2, "torso lag (s)", o.torso_lag_s,
+          "between 0 (none, the paper) and 0.2");
   require(o.grm_reference_m.allFinite(), "GRM reference (m)", o.grm_reference_m.x() + o.grm_reference_m.y(), "finite");
   if (o.mass_kg)
     require(finite(*o.mass_kg) && *o.mass_kg > 0 && (o.allow_unusual_mass || (*o.mass_kg >= kMassRangeKg[0] && *o.mass_kg <= kMassRangeKg[1])),
@@ -350,6 +352,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   auto [model, soles] = model_stage(o, r);
   r.model = std::move(model);
   ModelMotion motion = kinematics_stage(o, r.model, r);
+  lag_torso_fore_aft(motion, o.torso_lag_s);
   auto [contacts, calibration] = contact_stage(o, r.model, std::move(soles), r, motion);
   r.calibration = std::move(calibration);
   const auto t1 = clock::now();

@@ -81,6 +81,7 @@ TEST(CliInput, EveryBadNumericOptionIsRefusedNamingTheSetting) {
       {"--ground-shift inf", "ground shift"},          {"--ground-level nan", "ground level"},
       {"--max-gap -5", "longest gap"},                 {"--mass -70", "body mass"},
       {"--mass 0.5", "body mass"},                     {"--mass nan", "body mass"},
+      {"--torso-lag -0.01", "torso-lag"},              {"--torso-lag 1", "torso-lag"},
   };
   for (const auto& c : cases) {
     const CliRun r = run("estimate " + trc + " --mass 70 " + c.option);

@@ -94,3 +94,43 @@ TEST(Kinematics, MeasuredTorsoLengthIsFollowedAndDifferentiated) {
   EXPECT_LT(worst_acc, 0.02 * acc_scale);  // the scaled kinematics are differentiated consistently
   EXPECT_GT(acc_scale, 0.5);
 }
+
+// The upper body's fore-aft lag (lag_torso_fore_aft): only the HAT COM's fore-aft acceleration
+// changes, causally (nothing before a step moves), with a first-order step response that reaches
+// about 1 - 1/e after one time constant; tau = 0 changes nothing. In the whole estimate the vertical
+// force sum is untouched and the fore-aft one is not.
+TEST(Kinematics, TorsoLagDelaysOnlyTheTorsosForeAftAcceleration) {
+  const Trial t = make_synthetic_trial({});
+  const auto r = run({});
+  const ModelMotion base = compute_motion(r.model, synthetic_landmarks(t), 6.0);
+  const int c = coord::com_x(kTorso);
+  ModelMotion step = base;
+  const Eigen::Index i0 = 100;
+  for (Eigen::Index i = 0; i < step.frames(); ++i) step.qdd(i, c) = i < i0 ? 0.0 : 1.0;
+  const ModelMotion before = step;
+  const double tau = 0.03;
+  lag_torso_fore_aft(step, tau);
+  for (Eigen::Index i = 0; i < i0; ++i) ASSERT_EQ(step.qdd(i, c), 0.0) << i;  // causal
+  const auto one_tau = static_cast<Eigen::Index>(std::lround(tau * step.rate_hz));
+  ASSERT_GE(one_tau, 2);
+  const double at_tau = step.qdd(i0 + one_tau - 1, c);
+  EXPECT_GT(at_tau, 0.55);  // (3/4)^3 = 0.42 left at 100 Hz (backward Euler); 1/e = 0.37 for fine steps
+  EXPECT_LT(at_tau, 0.66);
+  EXPECT_NEAR(step.qdd(step.frames() - 1, c), 1.0, 1e-6);
+  for (Eigen::Index i = 1; i < step.frames(); ++i) ASSERT_GE(step.qdd(i, c), step.qdd(i - 1, c));  // no overshoot
+  Eigen::MatrixXd others = step.qdd - before.qdd;
+  others.col(c).setZero();
+  EXPECT_EQ(others.cwiseAbs().maxCoeff(), 0.0);  // vertical, angles, every other segment
+  EXPECT_EQ(step.q, before.q);
+  EXPECT_EQ(step.qd, before.qd);
+  ModelMotion same = base;
+  lag_torso_fore_aft(same, 0.0);
+  EXPECT_EQ(same.qdd, base.qdd);
+
+  EstimateOptions none, lagged;
+  none.torso_lag_s = 0.0;
+  lagged.torso_lag_s = tau;
+  const auto a = run({}, none), b = run({}, lagged);
+  EXPECT_EQ(a.kinematic_total.col(1), b.kinematic_total.col(1));
+  EXPECT_GT((a.kinematic_total.col(0) - b.kinematic_total.col(0)).cwiseAbs().maxCoeff(), 1.0);  // N
+}

@@ -282,3 +282,16 @@ TEST(Estimate, AMarkerSampleNoBodyCanProduceIsAGap) {
     EXPECT_TRUE(said) << off;
   }
 }
+
+TEST(Estimate, ATorsoLagOutsideItsRangeIsRefusedNamingTheSetting) {
+  for (const double bad : {-0.01, 0.5, std::nan("")}) {
+    EstimateOptions o;
+    o.torso_lag_s = bad;
+    try {
+      run({}, o);
+      ADD_FAILURE() << "no error for torso lag " << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("torso lag"), std::string::npos) << e.what();
+    }
+  }
+}

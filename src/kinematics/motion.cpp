@@ -153,6 +153,17 @@ ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, doub
   return reconstruct_motion(model, x, xd, xdd, lm.rate_hz, lm.time_s);
 }
 
+void lag_torso_fore_aft(ModelMotion& m, double tau_s) {
+  if (!(tau_s > 0) || m.frames() == 0) return;
+  const int c = coord::com_x(kTorso);
+  const double dt = 1.0 / m.rate_hz, k = dt / (tau_s + dt);
+  double a = m.qdd(0, c);
+  for (Eigen::Index i = 0; i < m.frames(); ++i) {
+    a += k * (m.qdd(i, c) - a);
+    m.qdd(i, c) = a;
+  }
+}
+
 double noise_limited_cutoff(const SagittalLandmarks& lm, double upper_hz) {
   Eigen::MatrixXd xy(lm.frames(), 2 * kLandmarkCount);
   for (int k = 0; k < kLandmarkCount; ++k) xy.middleCols(2 * k, 2) = lm.p[static_cast<std::size_t>(k)];

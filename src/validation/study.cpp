@@ -77,11 +77,16 @@ std::vector<Setting> settings_for(const std::string& kind) {
   } else if (kind == "torso-length") {
     s.push_back({"fixed (the paper)", 0, [](EstimateOptions& o) { o.torso_length = TorsoLength::Fixed; }});
     s.push_back({"measured", 1, [](EstimateOptions& o) { o.torso_length = TorsoLength::Measured; }});
+  } else if (kind == "torso-lag") {
+    for (double t : {0.0, 0.01, 0.02, 0.03, 0.04}) {
+      std::snprintf(b, sizeof b, t > 0 ? "%.0f ms" : "off", 1000 * t);
+      s.push_back({b, t, [t](EstimateOptions& o) { o.torso_lag_s = t; }});
+    }
   } else if (kind == "foot-model") {
     s.push_back({"three-point (model 1)", 1, [](EstimateOptions& o) { o.contact.foot_model = FootModel::ThreePoint; }});
     s.push_back({"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }});
   } else {
-    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, speed-gate, speed-gate-ratio, noise, split-distance, torso-length, foot-model)");
+    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, speed-gate, speed-gate-ratio, noise, split-distance, torso-length, torso-lag, foot-model)");
   }
   return s;
 }

@@ -55,6 +55,10 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("--torso-length", a.torso_length,
                 "measured (the hip-shoulder distance of each frame, filtered) or fixed (its median, the paper's rigid HAT)")
       ->check(CLI::IsMember({"measured", "fixed"}))->capture_default_str();
+  c->add_option("--torso-lag", a.torso_lag,
+                "The upper body's fore-aft lag behind the pelvis, s: the HAT's fore-aft inertial force lags by this time "
+                "constant (0 = none, the paper)")
+      ->check(CLI::Range(0.0, 0.2))->capture_default_str();
   c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
       ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
   c->add_option_function<std::string>(
@@ -67,7 +71,7 @@ void add_settings_options(CLI::App* c, Settings& a) {
                 "COP function near flight phases (running): builtin (kin2grf's running fit), off, or a JSON file")
       ->capture_default_str();
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
-  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length");
+  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length, no torso lag");
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
 }
 
@@ -122,6 +126,7 @@ EstimateOptions to_options(const Settings& a) {
   o.solver.speed_gate_floor_mps = a.speed_gate_floor;
   o.solver.min_split_distance_m = a.paper ? 0.0 : a.split_distance;
   o.torso_length = (a.paper || a.torso_length == "fixed") ? TorsoLength::Fixed : TorsoLength::Measured;
+  o.torso_lag_s = a.paper ? 0.0 : a.torso_lag;
   o.landmarks.max_gap_frames = a.max_gap;
   o.landmarks.up_axis = parse_axis(a.up_axis);
   return o;
@@ -149,6 +154,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"speed_gate_floor_mps", o.solver.speed_gate_floor_mps},
           {"min_split_distance_m", o.solver.min_split_distance_m},
           {"torso_length", torso_length_name(o.torso_length)},
+          {"torso_lag_s", o.torso_lag_s},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"kinematic_cutoff_rule", o.cutoff_from_noise ? "noise" : "fixed"},
           {"post_cutoff_hz", o.post_cutoff_hz},

@@ -70,4 +70,17 @@ enum class TorsoLength {
 ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz,
                            TorsoLength torso = TorsoLength::Measured);
 
+/// The upper body's fore-aft lag (kin2grf, not in the paper). The HAT is one rigid segment whose
+/// COM follows the hip and shoulder landmarks, but most of its mass (viscera, arms, head, soft
+/// tissue) hangs on a compliant spine and follows the pelvis's fore-aft oscillation late: upper-
+/// body accelerations lag and are attenuated against the pelvis's in walking. With the skeleton's
+/// timing the model's braking force and ground moment lead the plates in double support and load
+/// moves to the leading foot early (docs/METHOD-NOTES.md). The HAT COM's fore-aft acceleration
+/// (its inertial force m a_x, paper Eq. 5's M qdd) is replaced by its first-order causal lag with
+/// time constant tau (backward Euler of tau a' + a = a_x, started at a_x(0)):
+///   a[i] = a[i-1] + dt / (tau + dt) (a_x[i] - a[i-1]).
+/// Its position and velocity, its vertical and angular accelerations and every other segment are
+/// unchanged. tau_s = 0 leaves the motion as it is (the paper).
+void lag_torso_fore_aft(ModelMotion& m, double tau_s);
+
 }  // namespace kin2grf

@@ -31,7 +31,7 @@ struct Settings {
   double r = SolverOptions{}.r_N_per_m, kinematic_cutoff = EstimateOptions{}.kinematic_cutoff_hz,
          post_cutoff = EstimateOptions{}.post_cutoff_hz, ground_shift = 0, speed_gate = SolverOptions{}.speed_gate_mps,
          split_distance = SolverOptions{}.min_split_distance_m, speed_gate_ratio = SolverOptions{}.speed_gate_ratio,
-         speed_gate_floor = SolverOptions{}.speed_gate_floor_mps;
+         speed_gate_floor = SolverOptions{}.speed_gate_floor_mps, torso_lag = EstimateOptions{}.torso_lag_s;
   bool paper = false, r_given = false, anthropometry_given = false;
   std::optional<double> ground_level;
   std::vector<double> grm_reference;
