@@ -191,8 +191,7 @@ int run_batch(const BatchArgs& a) {
   const auto entries = kin2grf::read_trial_list(a.trial_list);
   kin2grf::BatchOptions o;
   o.jobs = a.jobs > 0 ? a.jobs : static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
-  o.out_dir = a.out_dir;
-  o.progress = kin2grf::batch_progress(stderr);
+  o.out_dir = a.out_dir, o.progress = kin2grf::batch_progress(stderr);
   const auto start = std::chrono::steady_clock::now();
   kin2grf::allow_allocator_arenas(o.jobs);
   std::cerr << "kin2grf: batch of " << entries.size() << " trials on " << o.jobs << " threads\n";

@@ -152,8 +152,8 @@ namespace {
 /// Clinger's fast path for the plain decimals text files are made of ([-]digits.digits): the
 /// digits as an integer w <= 2^53 and 10^k with k <= 22 are both exact doubles, so w / 10^k is
 /// one correctly rounded division, the same double from_chars gives, in a fraction of its time.
-/// Reads from p up to e, the first `stop` byte, a space or a CR and returns where it stopped; nullptr for
-/// anything else (exponents, more digits, "1.", ".5"), which from_chars then reads.
+/// Reads from p up to e, the first `stop` byte, a space or a CR, and returns where it stopped;
+/// nullptr for anything else (exponents, more digits, "1.", ".5"), which from_chars then reads.
 const char* scan_plain_decimal(const char* p, const char* e, char stop, double& out) {
   static constexpr double kPow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
                                         1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};

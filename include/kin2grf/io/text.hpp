@@ -51,9 +51,10 @@ bool is_blank(std::string_view s);
 /// Strict number parse ("nan"/"NaN" accepted as NaN, empty -> NaN when allow_empty).
 bool parse_double(std::string_view s, double& out);
 /// The common case of a text table's row, fast: exactly out.size() fields separated by `delim`
-/// (trailing blanks and delimiters aside, as TRC writers leave them), each a plain decimal ([-]digits[.digits]), read into `out` as
-/// parse_double would read them. False for anything else (blanks, spaces, exponents, NaN, more
-/// or fewer fields), and then `out` is undefined: the caller takes its general path.
+/// (trailing blanks and delimiters aside, as TRC writers leave them), each a plain decimal
+/// ([-]digits[.digits], space-padded or not), read into `out` as parse_double would read them.
+/// False for anything else (blank fields, exponents, NaN, more or fewer fields), and then `out`
+/// is undefined: the caller takes its general path.
 bool parse_plain_fields(std::string_view line, char delim, std::span<double> out);
 /// Lower-case file extension without the dot ("c3d", "trc", "mot", "sto").
 std::string extension(const std::string& path);
