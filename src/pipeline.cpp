@@ -145,6 +145,21 @@ ModelMotion kinematics_stage(const EstimateOptions& o, const Model& model, Estim
   return compute_motion(model, lm, r.kinematic_cutoff_hz, o.torso_length);
 }
 
+/// The upper body's fore-aft lag: what the trunk markers do not already show of it
+/// (lag_torso_fore_aft, measured_torso_lag_s).
+void lag_torso_stage(const EstimateOptions& o, ModelMotion& motion, EstimateResult& r) {
+  if (!(o.torso_lag_s > 0)) return;
+  const double measured = measured_torso_lag_s(motion);
+  const double added = std::clamp(o.torso_lag_s - measured, 0.0, o.torso_lag_s);
+  if (added < o.torso_lag_s) {
+    char b[200];
+    std::snprintf(b, sizeof b, "torso lag: the trunk markers already lag the hip by %.0f ms; %.0f of the %.0f ms added",
+                  1000 * measured, 1000 * added, 1000 * o.torso_lag_s);
+    r.messages.emplace_back(b);
+  }
+  lag_torso_fore_aft(motion, added);
+}
+
 /// The contact points of every frame (D* filled into the motion), and from them the rest of the
 /// trial's calibration: the belt velocity (always, on a treadmill), the progression speed and the
 /// speed gate.
@@ -352,7 +367,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   auto [model, soles] = model_stage(o, r);
   r.model = std::move(model);
   ModelMotion motion = kinematics_stage(o, r.model, r);
-  lag_torso_fore_aft(motion, o.torso_lag_s);
+  lag_torso_stage(o, motion, r);
   auto [contacts, calibration] = contact_stage(o, r.model, std::move(soles), r, motion);
   r.calibration = std::move(calibration);
   const auto t1 = clock::now();

@@ -134,3 +134,33 @@ TEST(Kinematics, TorsoLagDelaysOnlyTheTorsosForeAftAcceleration) {
   EXPECT_EQ(a.kinematic_total.col(1), b.kinematic_total.col(1));
   EXPECT_GT((a.kinematic_total.col(0) - b.kinematic_total.col(0)).cwiseAbs().maxCoeff(), 1.0);  // N
 }
+
+// How late the trunk already follows the hip (measured_torso_lag_s): a HAT whose fore-aft
+// acceleration is the hip's 20 ms later (a trunk-marker set whose shoulders lag the pelvis) is
+// measured at 20 ms, between frames too; in phase 0, ahead negative; too short a trial 0. The
+// torso lag adds only the rest (the pipeline's lag_torso_stage).
+TEST(Kinematics, TheTrunksOwnLagBehindTheHipIsMeasured) {
+  const auto r = run({});
+  ModelMotion m = compute_motion(r.model, synthetic_landmarks(make_synthetic_trial({})), 6.0);
+  const int c = coord::com_x(kTorso), h = coord::point_x(kHip);
+  auto with_delay = [&](double delay_s) {
+    ModelMotion d = m;
+    for (Eigen::Index i = 0; i < d.frames(); ++i) {
+      const double t = static_cast<double>(i) / d.rate_hz;
+      d.qdd(i, h) = std::sin(2 * M_PI * 1.8 * t) + 0.4 * std::sin(2 * M_PI * 3.6 * t + 0.7);
+      d.qdd(i, c) = std::sin(2 * M_PI * 1.8 * (t - delay_s)) + 0.4 * std::sin(2 * M_PI * 3.6 * (t - delay_s) + 0.7);
+    }
+    return measured_torso_lag_s(d);
+  };
+  ASSERT_GE(m.rate_hz, 50.0);
+  EXPECT_NEAR(with_delay(0.0), 0.0, 1e-3);
+  EXPECT_NEAR(with_delay(0.02), 0.02, 2e-3);
+  EXPECT_NEAR(with_delay(0.025), 0.025, 2e-3);  // between frames
+  EXPECT_NEAR(with_delay(-0.015), -0.015, 2e-3);
+  ModelMotion short_trial = m;
+  short_trial.time_s = short_trial.time_s.head(10).eval();
+  short_trial.q = short_trial.q.topRows(10).eval();
+  short_trial.qd = short_trial.qd.topRows(10).eval();
+  short_trial.qdd = short_trial.qdd.topRows(10).eval();
+  EXPECT_EQ(measured_torso_lag_s(short_trial), 0.0);
+}

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "kin2grf/error.hpp"
@@ -162,6 +163,35 @@ void lag_torso_fore_aft(ModelMotion& m, double tau_s) {
     a += k * (m.qdd(i, c) - a);
     m.qdd(i, c) = a;
   }
+}
+
+double measured_torso_lag_s(const ModelMotion& m) {
+  const Eigen::Index n = m.frames(), m0 = n / 10, m1 = n - n / 10;
+  if (n < 20 || !(m.rate_hz > 0)) return 0.0;
+  const int c = coord::com_x(kTorso), h = coord::point_x(kHip);
+  const int reach = std::max(1, static_cast<int>(0.08 * m.rate_hz));
+  // The peak lag of y behind x, in frames (parabola through the peak); NaN without a positive peak.
+  auto peak_lag = [&](int x, int y) {
+    std::vector<double> r(static_cast<std::size_t>(2 * reach + 1));
+    for (int lag = -reach; lag <= reach; ++lag) {
+      double sum = 0;
+      for (Eigen::Index i = m0; i < m1; ++i)
+        if (const Eigen::Index j = i + lag; j >= 0 && j < n) sum += m.qdd(i, x) * m.qdd(j, y);
+      r[static_cast<std::size_t>(lag + reach)] = sum;
+    }
+    const auto k = static_cast<int>(std::max_element(r.begin(), r.end()) - r.begin());
+    if (!(r[static_cast<std::size_t>(k)] > 0)) return std::numeric_limits<double>::quiet_NaN();
+    double offset = 0;
+    if (k > 0 && k < 2 * reach) {
+      const double a = r[static_cast<std::size_t>(k - 1)], b = r[static_cast<std::size_t>(k)], d = r[static_cast<std::size_t>(k + 1)];
+      if (a - 2 * b + d < 0) offset = 0.5 * (a - d) / (a - 2 * b + d);
+    }
+    return k - reach + offset;
+  };
+  // Both ways round and halved: a finite window biases each estimate by the same amount (a
+  // quarter of a frame for a stride's harmonics), and the difference cancels it.
+  const double lag = 0.5 * (peak_lag(h, c) - peak_lag(c, h));
+  return std::isfinite(lag) ? lag / m.rate_hz : 0.0;
 }
 
 double noise_limited_cutoff(const SagittalLandmarks& lm, double upper_hz) {
