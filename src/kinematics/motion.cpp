@@ -166,8 +166,11 @@ void lag_torso_fore_aft(ModelMotion& m, double tau_s) {
 }
 
 double measured_torso_lag_s(const ModelMotion& m) {
-  const Eigen::Index n = m.frames(), m0 = n / 10, m1 = n - n / 10;
-  if (n < 20 || !(m.rate_hz > 0)) return 0.0;
+  if (m.frames() < 20 || !(m.rate_hz > 0)) return 0.0;
+  // The middle 80 %, at most a minute of it: the trunk's timing does not change along a trial,
+  // and a 10-minute trial at 2 kHz would otherwise take 0.5 s here.
+  const Eigen::Index n = m.frames(), m0 = n / 10;
+  const Eigen::Index m1 = std::min(n - n / 10, m0 + static_cast<Eigen::Index>(std::min(60.0 * m.rate_hz, static_cast<double>(n))));
   const int c = coord::com_x(kTorso), h = coord::point_x(kHip);
   const int reach = std::max(1, static_cast<int>(0.08 * m.rate_hz));
   // The peak lag of y behind x, in frames (parabola through the peak); NaN without a positive peak.

@@ -84,10 +84,11 @@ ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, doub
 void lag_torso_fore_aft(ModelMotion& m, double tau_s);
 
 /// How late the HAT COM's fore-aft acceleration already follows the hip's in `m`, s: the lag of
-/// the peak of their cross-correlation within +-80 ms over the middle 80 % of the frames, refined
-/// by a parabola through the peak. Trunk markers that lag the pelvis carry part of the upper
-/// body's lag themselves (0 for the model torso without them, which follows the hip in phase).
-/// 0 for fewer than 20 frames or no positive correlation.
+/// the peak of their cross-correlation within +-80 ms over the middle 80 % of the frames (at most
+/// a minute of them), refined by a parabola through the peak, taken both ways round and halved.
+/// Trunk markers that lag the pelvis carry part of the upper body's lag themselves (0 for the
+/// model torso without them, which follows the hip in phase). 0 for fewer than 20 frames or no
+/// positive correlation.
 double measured_torso_lag_s(const ModelMotion& m);
 
 }  // namespace kin2grf
