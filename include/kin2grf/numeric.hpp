@@ -28,6 +28,14 @@ inline Eigen::Matrix2d rotation(double a) {
 /// applied at (rx, ry) (m): rx fy - ry fx. The one place kin2grf writes it.
 inline double sagittal_moment(double rx, double ry, double fx, double fy) { return rx * fy - ry * fx; }
 
+/// Where the parabola through (-1, y0), (0, y1), (1, y2) has its vertex, as an offset from 0:
+/// refines an extremum found at a sample between it and its neighbours. 0 unless the parabola
+/// opens the way the extremum needs (upward for a minimum, downward for a maximum).
+inline double parabola_vertex_offset(double y0, double y1, double y2, bool maximum) {
+  const double den = y0 - 2 * y1 + y2;
+  return (maximum ? den < 0 : den > 0) ? 0.5 * (y0 - y2) / den : 0.0;
+}
+
 /// r turned by +90 degrees: d/da (R(a) rho) = perp(R(a) rho).
 inline Eigen::Vector2d perp(const Eigen::Vector2d& r) { return Eigen::Vector2d(-r.y(), r.x()); }
 

@@ -184,11 +184,8 @@ double measured_torso_lag_s(const ModelMotion& m) {
     }
     const auto k = static_cast<int>(std::max_element(r.begin(), r.end()) - r.begin());
     if (!(r[static_cast<std::size_t>(k)] > 0)) return std::numeric_limits<double>::quiet_NaN();
-    double offset = 0;
-    if (k > 0 && k < 2 * reach) {
-      const double a = r[static_cast<std::size_t>(k - 1)], b = r[static_cast<std::size_t>(k)], d = r[static_cast<std::size_t>(k + 1)];
-      if (a - 2 * b + d < 0) offset = 0.5 * (a - d) / (a - 2 * b + d);
-    }
+    const auto at = [&](int i) { return r[static_cast<std::size_t>(i)]; };
+    const double offset = k > 0 && k < 2 * reach ? parabola_vertex_offset(at(k - 1), at(k), at(k + 1), true) : 0.0;
     return k - reach + offset;
   };
   // Both ways round and halved: a finite window biases each estimate by the same amount (a

@@ -275,10 +275,8 @@ std::optional<double> vertical_lag_ms(const Eigen::VectorXd& ev, const Eigen::Ve
   }
   const auto best = static_cast<int>(std::min_element(err.begin(), err.end()) - err.begin());
   if (best > 0 && best + 1 < static_cast<int>(err.size())) {
-    const double y0 = err[static_cast<std::size_t>(best - 1)], y1 = err[static_cast<std::size_t>(best)],
-                 y2 = err[static_cast<std::size_t>(best + 1)];
-    const double den = y0 - 2 * y1 + y2;
-    const double frac = den > 0 ? 0.5 * (y0 - y2) / den : 0.0;
+    const double frac = parabola_vertex_offset(err[static_cast<std::size_t>(best - 1)], err[static_cast<std::size_t>(best)],
+                                               err[static_cast<std::size_t>(best + 1)], false);
     // est(i + k) matching plate(i): with est(t) = plate(t + L) (the estimate leading by L),
     // k = -L, so k itself is the lag (negative when the estimate leads).
     return 1000.0 * (best - kmax + frac) / rate;

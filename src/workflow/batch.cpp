@@ -121,6 +121,32 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
   return row;
 }
 
+namespace {
+std::vector<std::size_t> in_list_order(std::size_t n) {
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  return order;
+}
+
+/// The entries longest first, the bytes of each trial's files standing for its work: a long trial
+/// left to the end would keep one thread busy while the others idle.
+std::vector<std::size_t> longest_first(const std::vector<TrialListEntry>& entries) {
+  std::vector<std::uintmax_t> bytes(entries.size(), 0);
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    auto files = input_files(entries[k].settings);
+    files.push_back(entries[k].plates);
+    for (const auto& f : files) {
+      std::error_code ec;
+      const auto b = f.empty() ? 0 : std::filesystem::file_size(f, ec);
+      if (!ec) bytes[k] += b;
+    }
+  }
+  auto order = in_list_order(entries.size());
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return bytes[a] > bytes[b]; });
+  return order;
+}
+}  // namespace
+
 std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, const BatchOptions& options) {
   if (options.jobs < 1) throw InputError("jobs " + std::to_string(options.jobs) + ": must be at least 1");
   if (!options.out_dir.empty()) {
@@ -132,24 +158,8 @@ std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, cons
     std::filesystem::create_directories(options.out_dir);
   }
   std::vector<BatchRow> rows(entries.size());
-  // Longest first (the bytes of a trial's files stand for its work): a long trial left to the
-  // end would keep one thread busy while the others idle. Rows stay in the list's order.
-  std::vector<std::size_t> order(entries.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  if (options.jobs > 1) {
-    std::vector<std::uintmax_t> bytes(entries.size(), 0);
-    for (std::size_t k = 0; k < entries.size(); ++k) {
-      auto files = input_files(entries[k].settings);
-      files.push_back(entries[k].plates);
-      for (const auto& f : files) {
-        std::error_code ec;
-        if (f.empty()) continue;
-        const auto b = std::filesystem::file_size(f, ec);
-        if (!ec) bytes[k] += b;
-      }
-    }
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return bytes[a] > bytes[b]; });
-  }
+  // Rows stay in the list's order whatever order the trials run in.
+  const std::vector<std::size_t> order = options.jobs > 1 ? longest_first(entries) : in_list_order(entries.size());
   std::atomic<std::size_t> next{0};
   std::size_t done = 0;
   std::mutex progress_mutex;
