@@ -89,7 +89,8 @@ if cv_kinds:
     print("## Leave-one-lab-out (the settings chosen from data)\n")
     print("Each setting below was chosen from the development data. `kin2grf study KIND --cross-validate lab` "
           "chooses it again for each lab on the other labs' trials (criterion: per lab, mean stance rRMSE of "
-          "vertical, anterior and COP; then the mean over labs) and scores that lab with it. In-sample: every "
+          "vertical, anterior and COP; then the mean over labs; a tie keeps kin2grf's default, since a default changes "
+          "only when the figure improves) and scores that lab with it. In-sample: every "
           "trial at the choice made on all trials. Labs are the trial list's second field "
           f"({len(set(lab_of.values()))} labs). Worst trial: the held-out trial with the highest mean vertical rRMSE. "
           "The walking COP function (last row, COP only): in-sample is the built-in function (fitted in session 3 "

@@ -42,7 +42,7 @@ StudyTrialResult fake_trial(const char* name, const char* lab, double rrmse) {
 TEST(Study, LeaveOneLabOutScoresEachLabAtTheOthersChoice) {
   StudyResult s;
   s.kind = "test";
-  s.rows = {{"low", 0, {}}, {"high", 1, {}}};
+  s.rows = {{"low", 0, false, {}}, {"high", 1, false, {}}};
   s.per_trial = {{fake_trial("a1", "A", 2), fake_trial("b1", "B", 10), fake_trial("c1", "C", 10)},
                  {fake_trial("a1", "A", 8), fake_trial("b1", "B", 4), fake_trial("c1", "C", 4)}};
   const CrossValidation cv = cross_validate(s);
@@ -60,6 +60,30 @@ TEST(Study, LeaveOneLabOutScoresEachLabAtTheOthersChoice) {
   for (auto& row : one.per_trial)
     for (auto& t : row) t.lab.assign(1, 'A');
   EXPECT_THROW((void)cross_validate(one), InputError);
+}
+
+// A default changes only when the figure improves: where the other labs cannot tell the settings
+// apart (a split distance on trials whose feet are never side by side), the held-out lab gets
+// kin2grf's default, not the lowest setting; where they can, the best setting wins, default or not.
+TEST(Study, ATieKeepsTheDefaultAndABetterSettingStillWins) {
+  StudyResult s;
+  s.kind = "test";
+  s.rows = {{"off", 0, false, {}}, {"on", 1, true, {}}};
+  // Lab A is helped by "on"; labs B and C do not care.
+  s.per_trial = {{fake_trial("a1", "A", 30), fake_trial("b1", "B", 5), fake_trial("c1", "C", 7)},
+                 {fake_trial("a1", "A", 10), fake_trial("b1", "B", 5), fake_trial("c1", "C", 7)}};
+  const CrossValidation cv = cross_validate(s);
+  EXPECT_EQ(cv.in_sample_choice, "on");
+  ASSERT_EQ(cv.lab_choice.size(), 3u);
+  EXPECT_EQ(cv.lab_choice[0].second, "on") << "without A the labs tie, and the default stays";
+  EXPECT_EQ(cv.lab_choice[1].second, "on");
+  EXPECT_NEAR(cv.cells[0].held_out.vertical, (10 + 5 + 7) / 3.0, 1e-12);
+  // With "off" the default, B and C still tie without A, so A is scored at "off"; with A in, "on" wins.
+  s.rows[0].is_default = true, s.rows[1].is_default = false;
+  const CrossValidation cv2 = cross_validate(s);
+  EXPECT_EQ(cv2.in_sample_choice, "on");
+  EXPECT_EQ(cv2.lab_choice[0].second, "off");
+  EXPECT_NEAR(cv2.cells[0].held_out.vertical, (30 + 5 + 7) / 3.0, 1e-12);
 }
 
 // A study runs every setting on every trial, and its centre row is what validate gives with the
@@ -80,6 +104,9 @@ TEST(Study, EachSettingRunsOnEveryTrialAndTheDefaultRowIsValidates) {
   ASSERT_EQ(s.rows.size(), 3u);  // -10, 0, +10 mm
   ASSERT_EQ(s.per_trial.size(), 3u);
   EXPECT_TRUE(s.failures.empty());
+  EXPECT_FALSE(s.rows[0].is_default);
+  EXPECT_TRUE(s.rows[1].is_default) << "0 mm is kin2grf's default";
+  EXPECT_FALSE(s.rows[2].is_default);
   const auto direct = validate(estimate(walk, nullptr, set, EstimateOptions{}), *walk.plates, ValidationOptions{});
   for (const auto& r : s.per_trial[1]) {
     ASSERT_EQ(r.stances.size(), direct.stances.size()) << r.name;

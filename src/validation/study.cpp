@@ -7,6 +7,8 @@
 #include <limits>
 #include <random>
 #include <sstream>
+#include <tuple>
+#include <vector>
 
 #include "kin2grf/error.hpp"
 
@@ -18,7 +20,19 @@ struct Setting {
   double value;
   std::function<void(EstimateOptions&)> apply;
   double marker_noise_m = 0.0;  ///< the `noise` study: Gaussian noise added to every marker coordinate
+  bool is_default = false;      ///< leaves kin2grf's default options as they are
 };
+
+/// Marks the settings that leave the fields `get` reads at kin2grf's defaults.
+template <class Get>
+void mark_default(std::vector<Setting>& settings, Get get) {
+  const EstimateOptions defaults;
+  for (Setting& s : settings) {
+    EstimateOptions o;
+    s.apply(o);
+    s.is_default = s.marker_noise_m == 0 && get(o) == get(defaults);
+  }
+}
 
 /// The `noise` study's realizations per level (seeds 1..8), pooled: one realization of 2 mm noise
 /// moved subject01's vertical rRMSE by anything from +0.1 to +2.5 points with the seed, so a
@@ -34,26 +48,31 @@ std::vector<Setting> settings_for(const std::string& kind) {
       std::snprintf(b, sizeof b, "%.3g", r);
       s.push_back({b, r, [r](EstimateOptions& o) { o.solver.r_N_per_m = r; }});
     }
+    mark_default(s, [](const EstimateOptions& o) { return o.solver.r_N_per_m; });
   } else if (kind == "ground-shift") {
     for (double d : {-0.01, 0.0, 0.01}) {
       std::snprintf(b, sizeof b, "%+.0f mm", 1000 * d);
       s.push_back({b, d, [d](EstimateOptions& o) { o.contact.ground_shift_m = d; }});
     }
+    mark_default(s, [](const EstimateOptions& o) { return o.contact.ground_shift_m; });
   } else if (kind == "cutoff") {
     for (double f : {4.0, 6.0, 8.0, 10.0, 12.0, 15.0, 20.0}) {
       std::snprintf(b, sizeof b, "%.0f Hz", f);
       s.push_back({b, f, [f](EstimateOptions& o) { o.post_cutoff_hz = f; }});
     }
+    mark_default(s, [](const EstimateOptions& o) { return o.post_cutoff_hz; });
   } else if (kind == "kinematic-cutoff") {
     for (double f : {4.0, 5.0, 6.0, 8.0, 10.0, 12.0}) {
       std::snprintf(b, sizeof b, "%.0f Hz", f);
       s.push_back({b, f, [f](EstimateOptions& o) { o.kinematic_cutoff_hz = f; }});
     }
+    mark_default(s, [](const EstimateOptions& o) { return o.kinematic_cutoff_hz; });
   } else if (kind == "speed-gate") {
     for (double v : {0.0, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0}) {
       std::snprintf(b, sizeof b, v > 0 ? "%.2f m/s" : "off", v);
       s.push_back({b, v, [v](EstimateOptions& o) { o.solver.speed_gate_ratio = 0, o.solver.speed_gate_mps = v; }});
     }
+    mark_default(s, [](const EstimateOptions& o) { return std::tuple(o.solver.speed_gate_ratio, o.solver.speed_gate_mps); });
   } else if (kind == "speed-gate-ratio") {
     s.push_back({"fixed 1.50 m/s", 0, [](EstimateOptions& o) { o.solver.speed_gate_ratio = 0, o.solver.speed_gate_mps = 1.5; }});
     for (double floor : {0.5, 0.75})
@@ -61,6 +80,9 @@ std::vector<Setting> settings_for(const std::string& kind) {
         std::snprintf(b, sizeof b, "%.1f x speed, >= %.2f", k, floor);
         s.push_back({b, k, [k, floor](EstimateOptions& o) { o.solver.speed_gate_ratio = k, o.solver.speed_gate_floor_mps = floor; }});
       }
+    mark_default(s, [](const EstimateOptions& o) {
+      return std::tuple(o.solver.speed_gate_ratio, o.solver.speed_gate_mps, o.solver.speed_gate_floor_mps);
+    });
   } else if (kind == "noise") {
     // Robustness to what real capture does (issue 10): 0, 1, 2, 3 mm of Gaussian noise on every
     // marker coordinate, kNoiseRealizations seeded draws per level (the same draws for every run),
@@ -74,17 +96,21 @@ std::vector<Setting> settings_for(const std::string& kind) {
       std::snprintf(b, sizeof b, d > 0 ? "%.2f m" : "off", d);
       s.push_back({b, d, [d](EstimateOptions& o) { o.solver.min_split_distance_m = d; }});
     }
+    mark_default(s, [](const EstimateOptions& o) { return o.solver.min_split_distance_m; });
   } else if (kind == "torso-length") {
     s.push_back({"fixed (the paper)", 0, [](EstimateOptions& o) { o.torso_length = TorsoLength::Fixed; }});
     s.push_back({"measured", 1, [](EstimateOptions& o) { o.torso_length = TorsoLength::Measured; }});
+    mark_default(s, [](const EstimateOptions& o) { return o.torso_length; });
   } else if (kind == "torso-lag") {
     for (double t : {0.0, 0.01, 0.02, 0.03, 0.04}) {
       std::snprintf(b, sizeof b, t > 0 ? "%.0f ms" : "off", 1000 * t);
       s.push_back({b, t, [t](EstimateOptions& o) { o.torso_lag_s = t; }});
     }
+    mark_default(s, [](const EstimateOptions& o) { return o.torso_lag_s; });
   } else if (kind == "foot-model") {
     s.push_back({"three-point (model 1)", 1, [](EstimateOptions& o) { o.contact.foot_model = FootModel::ThreePoint; }});
     s.push_back({"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }});
+    mark_default(s, [](const EstimateOptions& o) { return o.contact.foot_model; });
   } else {
     throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, speed-gate, speed-gate-ratio, noise, split-distance, torso-length, torso-lag, foot-model)");
   }
@@ -121,6 +147,7 @@ StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& tr
     StudyRow row;
     row.label = s.label;
     row.value = s.value;
+    row.is_default = s.is_default;
     std::vector<StudyTrialResult> per_trial;
     for (const auto& t : trials) {
       StudyTrialResult tr{t.name, t.activity, t.lab_or_name(), {}, std::numeric_limits<double>::quiet_NaN(), false};
@@ -188,13 +215,19 @@ CrossValidation cross_validate(const StudyResult& s) {
     }
     return nlabs ? score / nlabs : std::numeric_limits<double>::quiet_NaN();
   };
+  // The lowest criterion; a tie keeps kin2grf's default (a default changes only when the figure
+  // improves: labs on which the setting changes nothing, e.g. the split distance on trials where
+  // the feet are never side by side, carry no evidence against it), else the first (lowest) setting.
   auto choose = [&](const std::function<bool(const StudyTrialResult&)>& use) {
     std::size_t best = 0;
     double best_score = std::numeric_limits<double>::infinity();
+    std::vector<double> score(s.per_trial.size());
     for (std::size_t r = 0; r < s.per_trial.size(); ++r) {
-      const double score = criterion(r, use);
-      if (score < best_score - 1e-9) best_score = score, best = r;  // NaN never wins
+      score[r] = criterion(r, use);
+      if (score[r] < best_score - 1e-9) best_score = score[r], best = r;  // NaN never wins
     }
+    for (std::size_t r = 0; r < s.per_trial.size(); ++r)
+      if (s.rows[r].is_default && score[r] <= best_score + 1e-9) return r;
     return best;
   };
   CrossValidation cv;
@@ -236,7 +269,8 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
   for (const auto& [lab, choice] : cv.lab_choice) os << "  without " << lab << ": " << choice << "\n";
   os << "criterion on all trials (mean over labs of (vertical + anterior + COP) / 3, %):";
   for (const auto& [label, c] : cv.criterion) {
-    std::snprintf(b, sizeof b, " %s %.2f;", label.c_str(), c);
+    const auto row = std::find_if(s.rows.begin(), s.rows.end(), [&](const StudyRow& r) { return r.label == label; });
+    std::snprintf(b, sizeof b, " %s%s %.2f;", label.c_str(), row != s.rows.end() && row->is_default ? " (default)" : "", c);
     os << b;
   }
   os << "\n";
@@ -283,7 +317,7 @@ nlohmann::json study_json(const StudyResult& s) {
   j["study"] = s.kind;
   j["rows"] = nlohmann::json::array();
   for (const auto& r : s.rows) {
-    nlohmann::json row = {{"setting", r.label}, {"value", r.value}};
+    nlohmann::json row = {{"setting", r.label}, {"value", r.value}, {"default", r.is_default}};
     for (const auto& c : r.cells)
       row["activities"][c.activity] = {{"trials", c.trials},
                                        {"stances", c.per_foot.n},

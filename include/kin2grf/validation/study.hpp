@@ -53,6 +53,7 @@ struct StudyCell {
 struct StudyRow {
   std::string label;  ///< the setting's value as text
   double value = 0.0;
+  bool is_default = false;       ///< the setting leaves kin2grf's default options as they are
   std::vector<StudyCell> cells;  ///< per activity, then "all"
 };
 
@@ -67,7 +68,8 @@ struct StudyTrialResult {
 /// Leave-one-lab-out choice of the setting (cross_validate()). The criterion a setting is chosen
 /// by: per lab, the mean over its stances of (vertical + anterior + COP) / 3 rRMSE; then the mean
 /// over the labs, so that each lab weighs the same and all activities are pooled (one default
-/// serves every activity, as kin2grf's defaults do). Ties keep the first (lowest) setting.
+/// serves every activity, as kin2grf's defaults do). A tie keeps kin2grf's default setting (a
+/// default changes only when the figure improves), else the first (lowest) setting.
 struct CrossValidation {
   std::string in_sample_choice;                   ///< the setting chosen on every trial
   std::vector<std::pair<std::string, double>> criterion;  ///< per setting, on every trial
