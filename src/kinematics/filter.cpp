@@ -37,38 +37,27 @@ void filtfilt_interleaved(const Biquad& q, std::vector<double>& e) {
   const std::size_t m = e.size() / L;
   if (m == 0) return;
   double z1[L], z2[L];
-  // Forward pass, from the steady state for the first sample (unit DC gain: output = input).
-  for (int l = 0; l < L; ++l) {
-    const double x0 = e[static_cast<std::size_t>(l)];
-    z2[l] = (q.b2 - q.a2) * x0;
-    z1[l] = (q.b1 - q.a1) * x0 + z2[l];
-  }
-  for (std::size_t i = 0; i < m; ++i) {
-    double* v = &e[i * L];
+  // Direct form II transposed, started from the steady state for the sample at `first` (unit DC
+  // gain: output = input, so no start-up transient), run over the samples from there.
+  auto pass = [&](std::size_t first, auto next) {
     for (int l = 0; l < L; ++l) {
-      const double in = v[l];
-      const double y = q.b0 * in + z1[l];
-      z1[l] = q.b1 * in - q.a1 * y + z2[l];
-      z2[l] = q.b2 * in - q.a2 * y;
-      v[l] = y;
+      const double x0 = e[first * L + static_cast<std::size_t>(l)];
+      z2[l] = (q.b2 - q.a2) * x0;
+      z1[l] = (q.b1 - q.a1) * x0 + z2[l];
     }
-  }
-  // Backward pass, from the steady state for the last sample.
-  for (int l = 0; l < L; ++l) {
-    const double x0 = e[(m - 1) * L + static_cast<std::size_t>(l)];
-    z2[l] = (q.b2 - q.a2) * x0;
-    z1[l] = (q.b1 - q.a1) * x0 + z2[l];
-  }
-  for (std::size_t i = m; i-- > 0;) {
-    double* v = &e[i * L];
-    for (int l = 0; l < L; ++l) {
-      const double in = v[l];
-      const double y = q.b0 * in + z1[l];
-      z1[l] = q.b1 * in - q.a1 * y + z2[l];
-      z2[l] = q.b2 * in - q.a2 * y;
-      v[l] = y;
+    for (std::size_t k = 0, i = first; k < m; ++k, i = next(i)) {
+      double* v = &e[i * L];
+      for (int l = 0; l < L; ++l) {
+        const double in = v[l];
+        const double y = q.b0 * in + z1[l];
+        z1[l] = q.b1 * in - q.a1 * y + z2[l];
+        z2[l] = q.b2 * in - q.a2 * y;
+        v[l] = y;
+      }
     }
-  }
+  };
+  pass(0, [](std::size_t i) { return i + 1; });      // forward
+  pass(m - 1, [](std::size_t i) { return i - 1; });  // backward (i wraps after the last sample, unused)
 }
 
 /// The single-pass section and the edge padding of a zero-lag filter at cutoff_hz (see the header).
