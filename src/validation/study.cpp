@@ -269,7 +269,9 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
   for (const auto& [lab, choice] : cv.lab_choice) os << "  without " << lab << ": " << choice << "\n";
   os << "criterion on all trials (mean over labs of (vertical + anterior + COP) / 3, %):";
   for (const auto& [label, c] : cv.criterion) {
-    const auto row = std::find_if(s.rows.begin(), s.rows.end(), [&](const StudyRow& r) { return r.label == label; });
+    // (A structured binding captured by a lambda is C++20 that some clang versions refuse.)
+    auto row = s.rows.begin();
+    while (row != s.rows.end() && row->label != label) ++row;
     std::snprintf(b, sizeof b, " %s%s %.2f;", label.c_str(), row != s.rows.end() && row->is_default ? " (default)" : "", c);
     os << b;
   }
