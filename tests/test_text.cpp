@@ -120,7 +120,8 @@ TEST(Text, ParsePlainFieldsReadsARowAsSplittingAndParsingWould) {
   const std::vector<std::string> plain = {"0", "-0", "12", "-463.902787", "  0.230000", " 95.849552 ", "1082.20154",
                                           "0.0000001", "9007199254740992", "123456.7890123"};
   const std::vector<std::string> odd = {"", " ", "1e-3", "nan", "+1.5", "1.", ".5", "1 2", "12a", "-", "1.2.3",
-                                        "12345678901234567890", "\r"};
+                                        "12345678901234567890", "\r", "-.5", "1..2", "1.5.", "12-3", "1.2 3",
+                                        "1234567890.123456789", "0.12345678901234567890"};
   std::vector<double> fast, slow;
   int accepted = 0;
   for (int rep = 0; rep < 20000; ++rep) {
