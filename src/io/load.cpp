@@ -30,7 +30,7 @@ std::optional<Axis> up_axis_from_data(const Trial& t, std::string* why) {
   std::array<std::vector<double>, 3> spread;
   std::array<long, 3> positive{0, 0, 0};
   long valid = 0;
-  const Eigen::Index step = std::max<Eigen::Index>(1, n / 200);  // 200 frames are plenty
+  const Eigen::Index step = std::max<Eigen::Index>(1, (n + 199) / 200);  // at most 200 frames: plenty
   std::array<std::vector<double>, 3> c;
   for (Eigen::Index i = 0; i < n; i += step) {
     for (auto& v : c) v.clear();
