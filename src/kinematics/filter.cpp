@@ -201,7 +201,7 @@ double residual_analysis_cutoff(const Eigen::MatrixXd& x, double rate_hz, double
   const double f_lo = 0.5 * nyq, f_hi = 0.8 * nyq;  // where the residual is mostly noise
   if (n < 20 || x.cols() == 0 || !(upper_hz > 0.5 && upper_hz < f_lo)) return upper_hz;
   constexpr int m = 8;  // points on the noise line
-  const Eigen::MatrixXd head = x.topRows(n);
+  const auto head = x.topRows(n);  // a view: its columns are copied where a residual is summed
   std::vector<double> choice(static_cast<std::size_t>(x.cols()));  // per column; +inf: above upper_hz
   // Nine filtfilt passes a column (the noise line and upper_hz), four columns at a time; the
   // bisection, when a column needs it, one column at a time.

@@ -268,11 +268,9 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
   os << "\nleave-one-lab-out (" << s.kind << "): chosen on all trials: " << cv.in_sample_choice << "\n";
   for (const auto& [lab, choice] : cv.lab_choice) os << "  without " << lab << ": " << choice << "\n";
   os << "criterion on all trials (mean over labs of (vertical + anterior + COP) / 3, %):";
-  for (const auto& [label, c] : cv.criterion) {
-    // (A structured binding captured by a lambda is C++20 that some clang versions refuse.)
-    auto row = s.rows.begin();
-    while (row != s.rows.end() && row->label != label) ++row;
-    std::snprintf(b, sizeof b, " %s%s %.2f;", label.c_str(), row != s.rows.end() && row->is_default ? " (default)" : "", c);
+  for (std::size_t r = 0; r < cv.criterion.size(); ++r) {  // one entry per row of the study, in its order
+    const auto& [label, c] = cv.criterion[r];
+    std::snprintf(b, sizeof b, " %s%s %.2f;", label.c_str(), r < s.rows.size() && s.rows[r].is_default ? " (default)" : "", c);
     os << b;
   }
   os << "\n";
