@@ -25,6 +25,34 @@ double progression_speed(const SagittalLandmarks& lm) {
   return v.empty() ? 0.0 : median(v);
 }
 
+std::optional<double> median_stance_s(const std::array<std::vector<bool>, 2>& contact, double rate_hz) {
+  if (!(rate_hz > 0)) return std::nullopt;
+  const auto bridge = static_cast<std::size_t>(0.02 * rate_hz);       // a flicker inside a stance
+  const double shortest = 0.05 * rate_hz;                              // frames
+  std::vector<double> durations;
+  for (const auto& c : contact) {
+    const std::size_t n = c.size();
+    std::size_t i = 0;
+    while (i < n) {
+      if (!c[i]) { ++i; continue; }
+      const std::size_t begin = i;
+      std::size_t end = i;  // one past the run's last contact frame
+      while (i < n) {
+        if (c[i]) { end = ++i; continue; }
+        std::size_t j = i;
+        while (j < n && !c[j]) ++j;
+        if (j < n && j - i <= bridge) { i = j; continue; }
+        break;
+      }
+      if (begin > 0 && end < n && static_cast<double>(end - begin) >= shortest)
+        durations.push_back(static_cast<double>(end - begin) / rate_hz);
+      i = end;
+    }
+  }
+  if (durations.empty()) return std::nullopt;
+  return median(durations);
+}
+
 namespace {
 
 void require(bool ok, const std::string& setting, double value, const std::string& allowed) {
@@ -42,6 +70,8 @@ void check_options(const EstimateOptions& o) {
           "a number above 0 (paper: 6)");
   require(finite(o.post_cutoff_hz) && o.post_cutoff_hz >= 0, "post-filter cut-off (Hz)", o.post_cutoff_hz,
           "0 (no post-filter) or a number above 0 (paper: 12)");
+  require(finite(o.post_cutoff_cycles) && o.post_cutoff_cycles >= 0 && o.post_cutoff_cycles <= 50, "post-filter cycles per stance",
+          o.post_cutoff_cycles, "between 0 (the fixed post-filter cut-off) and 50 (kin2grf: 4)");
   require(finite(o.solver.r_N_per_m) && o.solver.r_N_per_m > 0, "activation parameter r (N/m)", o.solver.r_N_per_m,
           "a number above 0 (kin2grf: 1000, paper: 10000)");
   require(finite(o.contact.ground_shift_m) && std::abs(o.contact.ground_shift_m) <= 1.0, "ground shift (m)", o.contact.ground_shift_m,
@@ -261,9 +291,30 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, con
   const int np = static_cast<int>(contacts.front().points.size());
   const Eigen::MatrixXd& lam = raw.lambda;
   const auto& act = raw.active;
-  // Final filtering (Sect. 2.6): all multipliers at post_cutoff, then inactive ones back to zero.
-  Eigen::MatrixXd lamf = o.post_cutoff_hz > 0 ? butterworth_filtfilt(lam, rate_hz, o.post_cutoff_hz) : lam;
-  r.joint_torque_Nm = o.post_cutoff_hz > 0 ? butterworth_filtfilt(raw.torque, rate_hz, o.post_cutoff_hz) : raw.torque;
+  // Each foot's contact state: any of its points active.
+  std::array<std::vector<bool>, 2> contact{std::vector<bool>(static_cast<std::size_t>(n)), std::vector<bool>(static_cast<std::size_t>(n))};
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int j = 0; j < np; ++j)
+      if (act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)])
+        contact[static_cast<std::size_t>(contacts[static_cast<std::size_t>(i)].points[static_cast<std::size_t>(j)].side)][static_cast<std::size_t>(i)] = true;
+  // Final filtering (Sect. 2.6): all multipliers at the post-filter cut-off, then inactive ones
+  // back to zero. The cut-off follows the trial's stance duration (post_cutoff_cycles), within
+  // what the marker rate allows.
+  r.post_cutoff_hz = o.post_cutoff_hz;
+  if (o.post_cutoff_cycles > 0) {
+    char b[200];
+    if (const auto stance = median_stance_s(contact, rate_hz)) {
+      r.post_cutoff_hz = std::min(o.post_cutoff_cycles / *stance, 0.4 * rate_hz);
+      std::snprintf(b, sizeof b, "post-filter cut-off %.1f Hz: %g cycles over the median stance of %.3f s", r.post_cutoff_hz,
+                    o.post_cutoff_cycles, *stance);
+    } else {
+      std::snprintf(b, sizeof b, "post-filter cut-off %g Hz (fixed): no complete stance to scale it to", o.post_cutoff_hz);
+    }
+    r.messages.emplace_back(b);
+  }
+  const double post = r.post_cutoff_hz;
+  Eigen::MatrixXd lamf = post > 0 ? butterworth_filtfilt(lam, rate_hz, post) : lam;
+  r.joint_torque_Nm = post > 0 ? butterworth_filtfilt(raw.torque, rate_hz, post) : raw.torque;
   for (Eigen::Index i = 0; i < n; ++i)
     for (int j = 0; j < np; ++j)
       if (!act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;
@@ -274,7 +325,7 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, con
     f.force_N = Eigen::MatrixX2d::Zero(n, 2);
     f.raw_force_N = Eigen::MatrixX2d::Zero(n, 2);
     f.cop_x_m = Eigen::VectorXd::Constant(n, nan);
-    f.contact.assign(static_cast<std::size_t>(n), false);
+    f.contact = contact[static_cast<std::size_t>(side)];
     f.inclination_rad.resize(n);
     f.gap_m = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
     f.sole_m.resize(n, 6);
@@ -289,7 +340,6 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, con
         f.raw_force_N(i, 0) += lam(i, 2 * j + 1);
         f.raw_force_N(i, 1) += lam(i, 2 * j);
         mx += lamf(i, 2 * j) * p.position.x();
-        if (act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) f.contact[static_cast<std::size_t>(i)] = true;
       }
       f.inclination_rad[i] = contacts[static_cast<std::size_t>(i)].foot_inclination_rad[static_cast<std::size_t>(side)];
       const auto& sole = contacts[static_cast<std::size_t>(i)].sole[static_cast<std::size_t>(side)];

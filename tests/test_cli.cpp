@@ -82,6 +82,8 @@ TEST(CliInput, EveryBadNumericOptionIsRefusedNamingTheSetting) {
       {"--max-gap -5", "longest gap"},                 {"--mass -70", "body mass"},
       {"--mass 0.5", "body mass"},                     {"--mass nan", "body mass"},
       {"--torso-lag -0.01", "torso-lag"},              {"--torso-lag 1", "torso-lag"},
+      {"--post-cutoff-cycles -1", "post-filter cycles"}, {"--post-cutoff-cycles nan", "post-filter cycles"},
+      {"--post-cutoff-cycles 60", "post-filter cycles"}, {"--post-cutoff 8 --post-cutoff-cycles 4", "give one of them"},
   };
   for (const auto& c : cases) {
     const CliRun r = run("estimate " + trc + " --mass 70 " + c.option);

@@ -295,3 +295,85 @@ TEST(Estimate, ATorsoLagOutsideItsRangeIsRefusedNamingTheSetting) {
     }
   }
 }
+
+TEST(Pipeline, MedianStanceBridgesFlickersAndLeavesOutRunsCutByTheWindow) {
+  // 100 Hz: a flicker of 2 frames (20 ms) is bridged, 3 frames are not; runs under 5 frames and
+  // runs touching either end of the window do not count.
+  const auto runs = [](std::initializer_list<std::pair<int, int>> on, int n) {
+    std::vector<bool> c(static_cast<std::size_t>(n), false);
+    for (const auto& [a, b] : on)
+      for (int i = a; i < b; ++i) c[static_cast<std::size_t>(i)] = true;
+    return c;
+  };
+  // Right: 0-30 (cut by the start), 50-110 with a 2-frame flicker at 70: one stance of 0.60 s.
+  // Left: 120-180 (0.60 s), 200-203 (too short), 250-300 (cut by the end).
+  std::array<std::vector<bool>, 2> c{runs({{0, 30}, {50, 70}, {72, 110}}, 300), runs({{120, 180}, {200, 203}, {250, 300}}, 300)};
+  auto s = median_stance_s(c, 100.0);
+  ASSERT_TRUE(s);
+  EXPECT_DOUBLE_EQ(*s, 0.6);
+  // A gap of 3 frames splits the right stance in two (0.20 and 0.37 s): median of 0.2, 0.37, 0.6.
+  c[0] = runs({{0, 30}, {50, 70}, {73, 110}}, 300);
+  s = median_stance_s(c, 100.0);
+  ASSERT_TRUE(s);
+  EXPECT_DOUBLE_EQ(*s, 0.37);
+  // Standing throughout, or only runs cut by the window: no stance to measure.
+  EXPECT_FALSE(median_stance_s({std::vector<bool>(300, true), std::vector<bool>(300, true)}, 100.0));
+  EXPECT_FALSE(median_stance_s({runs({{0, 100}}, 300), runs({{200, 300}}, 300)}, 100.0));
+  EXPECT_FALSE(median_stance_s({std::vector<bool>{}, std::vector<bool>{}}, 100.0));
+}
+
+TEST(Estimate, ThePostFilterFollowsTheStanceDuration) {
+  // A slow and a brisk synthetic walk: each post-filter cut-off is 4 cycles over its own median
+  // stance, close to the walk's stance by construction, so the brisk walk's is higher in
+  // proportion.
+  double cutoff[2], stance[2];
+  const double stride[2] = {1.4, 0.9};
+  for (int k = 0; k < 2; ++k) {
+    SyntheticWalkOptions wo;
+    wo.stride_time_s = stride[k];
+    wo.speed_mps = 1.3 * 1.1 / stride[k] * 0.8;
+    wo.duration_s = 4 * stride[k];
+    const SyntheticWalk w = make_synthetic_walk(wo);
+    const auto r = estimate(w.trial, nullptr, *find_marker_set("kin2grf-example"), {});
+    const auto measured = median_stance_s({r.feet[0].contact, r.feet[1].contact}, 100.0);
+    const auto built = median_stance_s(w.stance, 100.0);
+    ASSERT_TRUE(measured && built);
+    // The estimate's stances run a little long (0.96 against 0.84 s on the slow walk, 0.60 against
+    // 0.55 s on the brisk one: the landing foot is taken up early), not by a fixed amount.
+    EXPECT_NEAR(*measured, *built, 0.15 * *built) << stride[k];
+    EXPECT_DOUBLE_EQ(r.post_cutoff_hz, 4.0 / *measured);
+    bool said = false;
+    for (const auto& m : r.messages) said = said || m.find("post-filter cut-off") != std::string::npos;
+    EXPECT_TRUE(said);
+    cutoff[k] = r.post_cutoff_hz, stance[k] = *built;
+    // The paper's fixed cut-off when asked for.
+    EstimateOptions fixed;
+    fixed.post_cutoff_cycles = 0;
+    EXPECT_EQ(estimate(w.trial, nullptr, *find_marker_set("kin2grf-example"), fixed).post_cutoff_hz, 12.0);
+  }
+  EXPECT_GT(cutoff[1], cutoff[0]);
+  EXPECT_NEAR(cutoff[1] / cutoff[0], stance[0] / stance[1], 0.1 * stance[0] / stance[1]);
+}
+
+TEST(Estimate, AStandingTrialKeepsTheFixedPostFilterAndSaysWhy) {
+  SyntheticOptions so;
+  so.squat_depth = 0.0;
+  const auto r = run(so);
+  EXPECT_EQ(r.post_cutoff_hz, 12.0);
+  bool said = false;
+  for (const auto& m : r.messages) said = said || m.find("no complete stance") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
+TEST(Estimate, PostFilterCyclesOutsideTheirRangeAreRefusedNamingTheSetting) {
+  for (const double bad : {-1.0, 60.0, std::nan("")}) {
+    EstimateOptions o;
+    o.post_cutoff_cycles = bad;
+    try {
+      run({}, o);
+      ADD_FAILURE() << "no error for post-filter cycles " << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("post-filter cycles per stance"), std::string::npos) << e.what();
+    }
+  }
+}

@@ -24,7 +24,15 @@ struct EstimateOptions {
   bool allow_unusual_mass = false;
   std::string anthropometry = "de-leva";  ///< kin2grf's default; the paper cites Winter (--paper)
   double kinematic_cutoff_hz = 6.0;        ///< paper: 6 Hz
-  double post_cutoff_hz = 12.0;            ///< paper: 12 Hz
+  double post_cutoff_hz = 12.0;            ///< paper: 12 Hz; see post_cutoff_cycles
+  /// The post-filter follows the motion (kin2grf): its cut-off is this many cycles per stance,
+  /// post_cutoff_cycles / the trial's median stance duration (median_stance_s), from a slow walk
+  /// to a sprint. A stance's force curve is a pulse of its own duration (two humps in walking, one
+  /// in running), so its content scales with 1 / stance time; 4 cycles is 6-7 Hz for a 0.6 s
+  /// walking stance and 16-20 Hz for a 0.2-0.25 s running one (chosen leave-one-lab-out, `kin2grf
+  /// study post-cutoff-cycles`). 0: the fixed post_cutoff_hz (the paper's 12 Hz), which also
+  /// serves a trial with no complete stance.
+  double post_cutoff_cycles = 4.0;
   /// Lower the kinematic cut-off to what the markers' noise allows (noise_limited_cutoff; kin2grf)
   /// or keep it fixed (the paper).
   bool cutoff_from_noise = true;
@@ -60,6 +68,7 @@ struct EstimateResult {
   double mass_kg = 0.0;
   SagittalFrame frame;
   double kinematic_cutoff_hz = 0.0;  ///< the kinematic cut-off used (EstimateOptions::cutoff_from_noise)
+  double post_cutoff_hz = 0.0;       ///< the post-filter cut-off used (EstimateOptions::post_cutoff_cycles)
   Model model;
   /// The floor, the soles, the belt velocity, the progression speed and the speed gate the trial
   /// was solved with (measured once, model_stage and contact_stage).
@@ -90,6 +99,12 @@ inline constexpr double kMassRangeKg[2] = {20.0, 300.0};
 /// Every numeric setting checked before any work: InputError naming the setting, its value and
 /// the allowed range (NaN, infinities, zero or negative cut-offs, r, gaps...). estimate() calls it.
 void check_options(const EstimateOptions& options);
+
+/// The median duration (s) of the trial's complete stances: each foot's runs of contact frames
+/// (gaps shorter than 20 ms bridged, runs shorter than 50 ms left out, as no stance is that short),
+/// except a run that starts at the first frame or ends at the last, whose length is not known.
+/// None when there is no complete stance (a standing trial, a single stance cut by the window).
+std::optional<double> median_stance_s(const std::array<std::vector<bool>, 2>& contact, double rate_hz);
 
 /// The hip's horizontal speed (m/s), median over the window of its displacement over +-0.25 s.
 double progression_speed(const SagittalLandmarks& lm);

@@ -111,6 +111,7 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
                       {"how", r.frame.how}};
   j["contact_speed_gate_mps"] = r.calibration.speed_gate_mps;
   j["kinematic_cutoff_hz"] = r.kinematic_cutoff_hz;  // the one used (lowered for noisy markers)
+  j["post_cutoff_hz"] = r.post_cutoff_hz;            // the one used (per stance, or fixed)
   const auto n = r.time_s.size();
   j["frames"] = {{"first", r.first_frame_number}, {"last", r.first_frame_number + n - 1}, {"count", n}};
   json contacts = json::object();

@@ -58,9 +58,17 @@ std::vector<Setting> settings_for(const std::string& kind) {
   } else if (kind == "cutoff") {
     for (double f : {4.0, 6.0, 8.0, 10.0, 12.0, 15.0, 20.0}) {
       std::snprintf(b, sizeof b, "%.0f Hz", f);
-      s.push_back({b, f, [f](EstimateOptions& o) { o.post_cutoff_hz = f; }});
+      s.push_back({b, f, [f](EstimateOptions& o) { o.post_cutoff_cycles = 0, o.post_cutoff_hz = f; }});
     }
-    mark_default(s, [](const EstimateOptions& o) { return o.post_cutoff_hz; });
+    mark_default(s, [](const EstimateOptions& o) { return std::tuple(o.post_cutoff_cycles, o.post_cutoff_hz); });
+  } else if (kind == "post-cutoff-cycles") {
+    // The post-filter per stance (EstimateOptions::post_cutoff_cycles) against the paper's fixed 12 Hz.
+    s.push_back({"fixed 12 Hz", 0, [](EstimateOptions& o) { o.post_cutoff_cycles = 0, o.post_cutoff_hz = 12; }});
+    for (double c : {3.0, 3.5, 4.0, 5.0, 6.0, 8.0}) {
+      std::snprintf(b, sizeof b, "%.1f cycles", c);
+      s.push_back({b, c, [c](EstimateOptions& o) { o.post_cutoff_cycles = c; }});
+    }
+    mark_default(s, [](const EstimateOptions& o) { return std::tuple(o.post_cutoff_cycles, o.post_cutoff_hz); });
   } else if (kind == "kinematic-cutoff") {
     for (double f : {4.0, 5.0, 6.0, 8.0, 10.0, 12.0}) {
       std::snprintf(b, sizeof b, "%.0f Hz", f);
@@ -112,7 +120,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
     s.push_back({"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }});
     mark_default(s, [](const EstimateOptions& o) { return o.contact.foot_model; });
   } else {
-    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, kinematic-cutoff, speed-gate, speed-gate-ratio, noise, split-distance, torso-length, torso-lag, foot-model)");
+    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, post-cutoff-cycles, kinematic-cutoff, speed-gate, speed-gate-ratio, noise, split-distance, torso-length, torso-lag, foot-model)");
   }
   return s;
 }

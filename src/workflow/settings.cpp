@@ -33,7 +33,12 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("--kinematic-cutoff-rule", a.kinematic_cutoff_rule,
                 "noise: --kinematic-cutoff lowered where the markers' noise needs it (residual analysis); fixed: as given (--paper)")
       ->check(CLI::IsMember({"noise", "fixed"}))->capture_default_str();
-  c->add_option("--post-cutoff", a.post_cutoff, "Multiplier post-filter cut-off, Hz")->capture_default_str();
+  c->add_option("--post-cutoff", a.post_cutoff,
+                "Multiplier post-filter at this fixed cut-off, Hz (the paper: 12; 0: none); replaces --post-cutoff-cycles");
+  c->add_option_function<double>(
+       "--post-cutoff-cycles", [&a](double v) { a.post_cutoff_cycles = v, a.post_cutoff_cycles_given = true; },
+       "Multiplier post-filter cut-off as cycles per stance: this over the trial's median stance duration (default 4; "
+       "0, --paper or a trial with no complete stance: 12 Hz)");
   c->add_option("--ground-level", a.ground_level, "Floor height in the lab's up axis, m (default: estimated)");
   c->add_option("--grm-reference", a.grm_reference,
                  "GRM reference point in the sagittal frame: along progression and up from the lab origin, m (default 0 0)")
@@ -107,7 +112,10 @@ EstimateOptions to_options(const Settings& a) {
   o.allow_unusual_mass = a.force_mass;
   o.anthropometry = (a.paper && !a.anthropometry_given) ? "winter" : a.anthropometry;
   o.kinematic_cutoff_hz = a.kinematic_cutoff;
-  o.post_cutoff_hz = a.post_cutoff;
+  if (a.post_cutoff && a.post_cutoff_cycles_given)
+    throw InputError("--post-cutoff and --post-cutoff-cycles: give one of them (a fixed cut-off or one per stance)");
+  if (a.post_cutoff) o.post_cutoff_hz = *a.post_cutoff;
+  o.post_cutoff_cycles = a.post_cutoff ? 0.0 : (a.paper && !a.post_cutoff_cycles_given) ? 0.0 : a.post_cutoff_cycles;
   o.cutoff_from_noise = !a.paper && a.kinematic_cutoff_rule == "noise";
   o.ground_level_m = a.ground_level;
   o.contact.foot_model = a.foot_model == "cop" ? FootModel::Cop : FootModel::ThreePoint;
@@ -158,6 +166,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"kinematic_cutoff_rule", o.cutoff_from_noise ? "noise" : "fixed"},
           {"post_cutoff_hz", o.post_cutoff_hz},
+          {"post_cutoff_cycles", o.post_cutoff_cycles},
           {"anthropometry", o.anthropometry},
           {"ground_level_m", o.ground_level_m ? nlohmann::json(*o.ground_level_m) : nlohmann::json("auto")},
           {"ground_shift_m", o.contact.ground_shift_m},
