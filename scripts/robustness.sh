@@ -15,8 +15,9 @@ K=build/release/kin2grf
 OUT=out/robustness
 mkdir -p "$OUT"
 grep -v '^#' scripts/trials.txt | grep '^walking' | sed "s#DATA#$DATA#g" >"$OUT/walking.txt"
-# One study line: "SETTING vertical anterior COP" for the rows of a one-trial study.
-rows() { "$K" study "$1" --trial-list "$2" 2>/dev/null | awk '/ mm / {print $1, $(NF-4), $(NF-3), $(NF-2)}'; }
+# A study's rows as JSON (unrounded: the targets are tenths of a point, so differences of the
+# printed, rounded figures could be off by 0.1).
+study_json() { "$K" study "$1" --trial-list "$2" --json "$3" >/dev/null 2>&1; }
 {
   echo "# Robustness to marker noise and ground level (walking)"
   echo
@@ -24,7 +25,8 @@ rows() { "$K" study "$1" --trial-list "$2" 2>/dev/null | awk '/ mm / {print $1, 
   echo "Per-foot rRMSE % (mean over the trial's plate stances) with the defaults, and the change in"
   echo "points with 2 mm of Gaussian noise on every marker coordinate (8 seeded draws, the same for every"
   echo "trial, their stances pooled: one draw alone moved subject01's vertical by +0.1 to +2.5 points with"
-  echo "the seed) and with the ground shifted by -1 cm and +1 cm after calibration (the larger change)."
+  echo "the seed) and with the ground shifted by -1 cm and +1 cm after calibration (the change of larger size,"
+  echo "with its sign: + is worse). Differences of the unrounded figures (the study JSON)."
   echo "Targets (issue 10): noise < 1 point, ground shift < 0.2 points, on every trial."
   echo
   echo "| trial | vertical | anterior | COP | 2 mm noise: vertical | anterior | COP | +-1 cm ground: vertical | anterior | COP |"
@@ -32,20 +34,30 @@ rows() { "$K" study "$1" --trial-list "$2" 2>/dev/null | awk '/ mm / {print $1, 
   while IFS= read -r line; do
     name=$(echo "$line" | cut -d'|' -f3)
     echo "$line ${*:-}" >"$OUT/one.txt"
-    noise=$(rows noise "$OUT/one.txt")
-    shift_rows=$(rows ground-shift "$OUT/one.txt" | tr "\n" " ")
-    base=$(echo "$noise" | awk '$1 == "0" {print $2, $3, $4}')
-    two=$(echo "$noise" | awk '$1 == "2" {print $2, $3, $4}')
-    echo "$name $base $two $shift_rows" | awk '
-      function d(a, b) { return (a == "nan" || b == "nan") ? "-" : sprintf("%+.1f", b - a) }
-      function ad(a, b) { return (a == "nan" || b == "nan") ? 0 : (b - a < 0 ? a - b : b - a) }
-      { n = $1; v = $2; a = $3; c = $4
-        if (v == "nan") { printf "| %s | no complete stance | | | | | | | | |\n", n; next }
-        # ground-shift rows: -10 v a c, +0 v a c, +10 v a c from field 8 on
-        gv = ad(v, $9); if (ad(v, $17) > gv) gv = ad(v, $17)
-        ga = ad(a, $10); if (ad(a, $18) > ga) ga = ad(a, $18)
-        gc = ad(c, $11); if (ad(c, $19) > gc) gc = ad(c, $19)
-        printf "| %s | %.1f | %.1f | %.1f | %s | %s | %s | %.1f | %.1f | %.1f |\n", n, v, a, c, d(v, $5), d(a, $6), d(c, $7), gv, ga, gc }'
+    study_json noise "$OUT/one.txt" "$OUT/noise.json"
+    study_json ground-shift "$OUT/one.txt" "$OUT/shift.json"
+    /usr/bin/python3 - "$name" "$OUT/noise.json" "$OUT/shift.json" <<'PY'
+import json, math, sys
+name = sys.argv[1]
+def rows(path):
+    out = {}
+    for r in json.load(open(path))["rows"]:
+        acts = r["activities"]
+        m = next(iter(acts.values()))["rrmse_percent"] if acts else {}
+        out[r["setting"]] = [float("nan") if m.get(k) is None else m[k] for k in ("vertical", "anterior", "cop")]  # NaN is null
+    return out
+noise, shift = rows(sys.argv[2]), rows(sys.argv[3])
+base, two = noise.get("0 mm noise"), noise.get("2 mm noise")
+if not base or any(math.isnan(x) for x in base):
+    print(f"| {name} | no complete stance | | | | | | | | |")
+    sys.exit()
+cells = [f"{x:.1f}" for x in base] + [f"{t - b:+.1f}" for b, t in zip(base, two)]
+# The ground: the change of larger size of -1 cm and +1 cm, with its sign (+: worse).
+for k in range(3):
+    changes = [shift[s][k] - shift["+0 mm"][k] for s in ("-10 mm", "+10 mm")]
+    cells.append(f"{max(changes, key=abs):+.1f}")
+print("| " + name + " | " + " | ".join(cells) + " |")
+PY
   done <"$OUT/walking.txt"
 } >docs/ROBUSTNESS.md
 cat docs/ROBUSTNESS.md

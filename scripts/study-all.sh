@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Run the paper's studies (kin2grf study) on every development trial with plates and write their
 # tables, JSON and HTML reports to out/study/.
-#   bash scripts/study-all.sh [DATA_DIR] [KIND...]     (default kinds: all six)
+#   bash scripts/study-all.sh [DATA_DIR] [KIND...]     (default kinds: all of them)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA=${1:-../shared/data}
 shift || true
 KINDS=("$@")
-[ ${#KINDS[@]} -gt 0 ] || KINDS=(r ground-shift cutoff kinematic-cutoff speed-gate speed-gate-ratio noise split-distance torso-length foot-model)
+[ ${#KINDS[@]} -gt 0 ] || KINDS=(r ground-shift cutoff post-cutoff-cycles kinematic-cutoff speed-gate speed-gate-ratio noise split-distance torso-length torso-lag foot-model)
 [ -d "$DATA" ] || { echo "study-all: no data folder $DATA" >&2; exit 1; }
 cmake --preset release >/dev/null
 cmake --build --preset release >/dev/null

@@ -157,11 +157,20 @@ ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, doub
 void lag_torso_fore_aft(ModelMotion& m, double tau_s) {
   if (!(tau_s > 0) || m.frames() == 0) return;
   const int c = coord::com_x(kTorso);
-  const double dt = 1.0 / m.rate_hz, k = dt / (tau_s + dt);
-  double a = m.qdd(0, c);
-  for (Eigen::Index i = 0; i < m.frames(); ++i) {
-    a += k * (m.qdd(i, c) - a);
-    m.qdd(i, c) = a;
+  const Eigen::Index n = m.frames();
+  // Frame i takes the acceleration of (fractional) frame i - d, linearly interpolated; frames
+  // before the trial's first take its first. Backwards, so that each frame reads only the
+  // earlier ones, not yet overwritten.
+  const double d = tau_s * m.rate_hz;
+  for (Eigen::Index i = n - 1; i >= 0; --i) {
+    const double t = static_cast<double>(i) - d;
+    if (t <= 0) {
+      m.qdd(i, c) = m.qdd(0, c);
+      continue;
+    }
+    const auto i0 = static_cast<Eigen::Index>(t);  // t < i: i0 + 1 <= i
+    const double f = t - static_cast<double>(i0);
+    m.qdd(i, c) = (1 - f) * m.qdd(i0, c) + f * m.qdd(i0 + 1, c);
   }
 }
 

@@ -110,7 +110,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
     s.push_back({"measured", 1, [](EstimateOptions& o) { o.torso_length = TorsoLength::Measured; }});
     mark_default(s, [](const EstimateOptions& o) { return o.torso_length; });
   } else if (kind == "torso-lag") {
-    for (double t : {0.0, 0.01, 0.02, 0.03, 0.04}) {
+    for (double t : {0.0, 0.01, 0.02, 0.025, 0.03, 0.035, 0.04, 0.05}) {
       std::snprintf(b, sizeof b, t > 0 ? "%.0f ms" : "off", 1000 * t);
       s.push_back({b, t, [t](EstimateOptions& o) { o.torso_lag_s = t; }});
     }

@@ -61,8 +61,8 @@ void add_settings_options(CLI::App* c, Settings& a) {
                 "measured (the hip-shoulder distance of each frame, filtered) or fixed (its median, the paper's rigid HAT)")
       ->check(CLI::IsMember({"measured", "fixed"}))->capture_default_str();
   c->add_option("--torso-lag", a.torso_lag,
-                "The upper body's fore-aft lag behind the pelvis, s: the HAT's fore-aft inertial force lags by this time "
-                "constant, less what the trunk markers already lag the hip by (0 = none, the paper)")
+                "The upper body's fore-aft lag behind the pelvis, s: the HAT's fore-aft inertial force is delayed by this "
+                "time, less what the trunk markers already lag the hip by (0 = none, the paper)")
       ->check(CLI::Range(0.0, 0.2))->capture_default_str();
   c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
       ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();

@@ -73,14 +73,16 @@ ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, doub
 /// The upper body's fore-aft lag (kin2grf, not in the paper). The HAT is one rigid segment whose
 /// COM follows the hip and shoulder landmarks, but most of its mass (viscera, arms, head, soft
 /// tissue) hangs on a compliant spine and follows the pelvis's fore-aft oscillation late: upper-
-/// body accelerations lag and are attenuated against the pelvis's in walking. With the skeleton's
-/// timing the model's braking force and ground moment lead the plates in double support and load
-/// moves to the leading foot early (docs/METHOD-NOTES.md). The HAT COM's fore-aft acceleration
-/// (its inertial force m a_x, paper Eq. 5's M qdd) is replaced by its first-order causal lag with
-/// time constant tau (backward Euler of tau a' + a = a_x, started at a_x(0)):
-///   a[i] = a[i-1] + dt / (tau + dt) (a_x[i] - a[i-1]).
-/// Its position and velocity, its vertical and angular accelerations and every other segment are
-/// unchanged. tau_s = 0 leaves the motion as it is (the paper).
+/// body accelerations lag the pelvis's in walking. With the skeleton's timing the model's braking
+/// force and ground moment lead the plates in double support and load moves to the leading foot
+/// early (docs/METHOD-NOTES.md). The HAT COM's fore-aft acceleration (its inertial force m a_x,
+/// paper Eq. 5's M qdd) is replaced by itself delayed by tau:
+///   a(t) = a_x(t - tau), linearly interpolated between frames; a_x(0) before the first frame.
+/// A delay, as what the trunk markers already lag the hip by is measured (measured_torso_lag_s,
+/// a cross-correlation peak); until session 11 this was a first-order lag of time constant tau,
+/// which also attenuated (docs/METHOD-NOTES.md compares them). Its position and velocity, its
+/// vertical and angular accelerations and every other segment are unchanged. tau_s = 0 leaves
+/// the motion as it is (the paper).
 void lag_torso_fore_aft(ModelMotion& m, double tau_s);
 
 /// How late the HAT COM's fore-aft acceleration already follows the hip's in `m`, s: the lag of
