@@ -41,7 +41,7 @@ struct EstimateOptions {
   /// The upper body's fore-aft lag behind the pelvis, s (kin2grf): the HAT COM's fore-aft
   /// acceleration is delayed (lag_torso_fore_aft) by this time less what the trunk
   /// markers already lag the hip by (measured_torso_lag_s), never below 0. 0: none (the paper).
-  double torso_lag_s = 0.025;
+  double torso_lag_s = 0.03;
   std::optional<double> ground_level_m;    ///< else estimate_ground_level
   ContactModelOptions contact;
   SolverOptions solver;
