@@ -27,26 +27,14 @@ double progression_speed(const SagittalLandmarks& lm) {
 
 std::optional<double> median_stance_s(const std::array<std::vector<bool>, 2>& contact, double rate_hz) {
   if (!(rate_hz > 0)) return std::nullopt;
-  const auto bridge = static_cast<std::size_t>(0.02 * rate_hz);       // a flicker inside a stance
-  const double shortest = 0.05 * rate_hz;                              // frames
+  const auto bridge = static_cast<Eigen::Index>(0.02 * rate_hz);  // a flicker inside a stance
   std::vector<double> durations;
   for (const auto& c : contact) {
-    const std::size_t n = c.size();
-    std::size_t i = 0;
-    while (i < n) {
-      if (!c[i]) { ++i; continue; }
-      const std::size_t begin = i;
-      std::size_t end = i;  // one past the run's last contact frame
-      while (i < n) {
-        if (c[i]) { end = ++i; continue; }
-        std::size_t j = i;
-        while (j < n && !c[j]) ++j;
-        if (j < n && j - i <= bridge) { i = j; continue; }
-        break;
-      }
-      if (begin > 0 && end < n && static_cast<double>(end - begin) >= shortest)
-        durations.push_back(static_cast<double>(end - begin) / rate_hz);
-      i = end;
+    const auto n = static_cast<Eigen::Index>(c.size());
+    const auto runs = runs_where(n, [&](Eigen::Index i) { return c[static_cast<std::size_t>(i)]; });
+    for (const IndexRun& run : merge_close_runs(runs, bridge)) {
+      const auto frames = static_cast<double>(run.last - run.first + 1);
+      if (run.first > 0 && run.last < n - 1 && frames >= 0.05 * rate_hz) durations.push_back(frames / rate_hz);
     }
   }
   if (durations.empty()) return std::nullopt;

@@ -283,17 +283,23 @@ TEST(Estimate, AMarkerSampleNoBodyCanProduceIsAGap) {
   }
 }
 
-TEST(Estimate, ATorsoLagOutsideItsRangeIsRefusedNamingTheSetting) {
-  for (const double bad : {-0.01, 0.5, std::nan("")}) {
+/// estimate() refuses each bad value of one setting with an InputError that names the setting.
+template <class Set>
+void expect_refused_naming(Set set, std::initializer_list<double> bad, const std::string& named) {
+  for (const double v : bad) {
     EstimateOptions o;
-    o.torso_lag_s = bad;
+    set(o, v);
     try {
       run({}, o);
-      ADD_FAILURE() << "no error for torso lag " << bad;
+      ADD_FAILURE() << "no error for " << named << " " << v;
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("torso lag"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
     }
   }
+}
+
+TEST(Estimate, ATorsoLagOutsideItsRangeIsRefusedNamingTheSetting) {
+  expect_refused_naming([](EstimateOptions& o, double v) { o.torso_lag_s = v; }, {-0.01, 0.5, std::nan("")}, "torso lag");
 }
 
 TEST(Pipeline, MedianStanceBridgesFlickersAndLeavesOutRunsCutByTheWindow) {
@@ -366,14 +372,6 @@ TEST(Estimate, AStandingTrialKeepsTheFixedPostFilterAndSaysWhy) {
 }
 
 TEST(Estimate, PostFilterCyclesOutsideTheirRangeAreRefusedNamingTheSetting) {
-  for (const double bad : {-1.0, 60.0, std::nan("")}) {
-    EstimateOptions o;
-    o.post_cutoff_cycles = bad;
-    try {
-      run({}, o);
-      ADD_FAILURE() << "no error for post-filter cycles " << bad;
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("post-filter cycles per stance"), std::string::npos) << e.what();
-    }
-  }
+  expect_refused_naming([](EstimateOptions& o, double v) { o.post_cutoff_cycles = v; }, {-1.0, 60.0, std::nan("")},
+                        "post-filter cycles per stance");
 }

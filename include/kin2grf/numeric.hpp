@@ -61,6 +61,16 @@ std::vector<IndexRun> runs_where(Eigen::Index n, Holds holds) {
   return out;
 }
 
+/// `runs` (in order) with those separated by at most max_gap indices joined into one.
+inline std::vector<IndexRun> merge_close_runs(const std::vector<IndexRun>& runs, Eigen::Index max_gap) {
+  std::vector<IndexRun> out;
+  for (const IndexRun& r : runs) {
+    if (!out.empty() && r.first - out.back().last - 1 <= max_gap) out.back().last = r.last;
+    else out.push_back(r);
+  }
+  return out;
+}
+
 /// The runs where v is above thr (NaN is not).
 inline std::vector<IndexRun> runs_above(const Eigen::Ref<const Eigen::VectorXd>& v, double thr) {
   return runs_where(v.size(), [&](Eigen::Index i) { return std::isfinite(v[i]) && v[i] > thr; });

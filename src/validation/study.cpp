@@ -34,6 +34,9 @@ void mark_default(std::vector<Setting>& settings, Get get) {
   }
 }
 
+/// The post-filter's settings (the `cutoff` and `post-cutoff-cycles` studies' defaults).
+std::tuple<double, double> post_filter_setting(const EstimateOptions& o) { return {o.post_cutoff_cycles, o.post_cutoff_hz}; }
+
 /// The `noise` study's realizations per level (seeds 1..8), pooled: one realization of 2 mm noise
 /// moved subject01's vertical rRMSE by anything from +0.1 to +2.5 points with the seed, so a
 /// single draw measures the seed as much as the method.
@@ -60,7 +63,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
       std::snprintf(b, sizeof b, "%.0f Hz", f);
       s.push_back({b, f, [f](EstimateOptions& o) { o.post_cutoff_cycles = 0, o.post_cutoff_hz = f; }});
     }
-    mark_default(s, [](const EstimateOptions& o) { return std::tuple(o.post_cutoff_cycles, o.post_cutoff_hz); });
+    mark_default(s, post_filter_setting);
   } else if (kind == "post-cutoff-cycles") {
     // The post-filter per stance (EstimateOptions::post_cutoff_cycles) against the paper's fixed 12 Hz.
     s.push_back({"fixed 12 Hz", 0, [](EstimateOptions& o) { o.post_cutoff_cycles = 0, o.post_cutoff_hz = 12; }});
@@ -68,7 +71,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
       std::snprintf(b, sizeof b, "%.1f cycles", c);
       s.push_back({b, c, [c](EstimateOptions& o) { o.post_cutoff_cycles = c; }});
     }
-    mark_default(s, [](const EstimateOptions& o) { return std::tuple(o.post_cutoff_cycles, o.post_cutoff_hz); });
+    mark_default(s, post_filter_setting);
   } else if (kind == "kinematic-cutoff") {
     for (double f : {4.0, 5.0, 6.0, 8.0, 10.0, 12.0}) {
       std::snprintf(b, sizeof b, "%.0f Hz", f);

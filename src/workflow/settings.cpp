@@ -115,7 +115,8 @@ EstimateOptions to_options(const Settings& a) {
   if (a.post_cutoff && a.post_cutoff_cycles_given)
     throw InputError("--post-cutoff and --post-cutoff-cycles: give one of them (a fixed cut-off or one per stance)");
   if (a.post_cutoff) o.post_cutoff_hz = *a.post_cutoff;
-  o.post_cutoff_cycles = a.post_cutoff ? 0.0 : (a.paper && !a.post_cutoff_cycles_given) ? 0.0 : a.post_cutoff_cycles;
+  const bool fixed_post_cutoff = a.post_cutoff || (a.paper && !a.post_cutoff_cycles_given);
+  o.post_cutoff_cycles = fixed_post_cutoff ? 0.0 : a.post_cutoff_cycles;
   o.cutoff_from_noise = !a.paper && a.kinematic_cutoff_rule == "noise";
   o.ground_level_m = a.ground_level;
   o.contact.foot_model = a.foot_model == "cop" ? FootModel::Cop : FootModel::ThreePoint;
