@@ -245,12 +245,14 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
   // the progress.
   for_chunks(static_cast<std::size_t>(n), min_chunk_for(10e-6), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
     ContactSolver solver(r.model, r.calibration, o.solver);
+    MotionFrame f;
     const auto step = std::max<std::size_t>(1, (end - begin) / 100);
     for (std::size_t k = begin; k < end; ++k) {
       const auto i = static_cast<Eigen::Index>(k);
       if (chunk == 0 && o.progress && (k - begin) % step == 0)
         o.progress(static_cast<long>(static_cast<double>(k) / static_cast<double>(end) * static_cast<double>(n)), static_cast<long>(n));
-      const FrameSolution s = solver.solve(motion.q.row(i).transpose(), motion.qdd.row(i).transpose(), contacts[k]);
+      motion.frame(i, f);
+      const FrameSolution s = solver.solve(f.q, f.qdd, contacts[k]);
       raw.lambda.row(i) = s.contact_lambda.transpose();
       raw.torque.row(i) = s.joint_torque_Nm.transpose();
       raw.active[k] = s.contact_active;
@@ -360,15 +362,17 @@ void totals_stage(const EstimateOptions& o, EstimateResult& r, const ModelMotion
   r.kinematic_total = Eigen::MatrixX3d::Zero(n, 3);
   r.joint_force_N = Eigen::MatrixXd::Zero(n, 2 * kJointCount);
   const double g = r.model.gravity_mps2;
+  MotionFrame m;
   for (Eigen::Index i = 0; i < n; ++i) {
+    motion.frame(i, m);
     Eigen::Vector3d kin = Eigen::Vector3d::Zero();  // sum m(a+g), sum of moments about the origin
     std::array<Eigen::Vector2d, kSegmentCount> seg_force;
     for (int s = 0; s < kSegmentCount; ++s) {
       const Body& b = r.model.bodies[s];
-      const Eigen::Vector2d pos(motion.q(i, coord::com_x(s)), motion.q(i, coord::com_x(s) + 1));
-      const Eigen::Vector2d F = b.mass_kg * Eigen::Vector2d(motion.qdd(i, coord::com_x(s)), motion.qdd(i, coord::com_x(s) + 1) + g);
+      const Eigen::Vector2d pos = m.q.segment<2>(coord::com_x(s));
+      const Eigen::Vector2d F = b.mass_kg * Eigen::Vector2d(m.qdd(coord::com_x(s)), m.qdd(coord::com_x(s) + 1) + g);
       seg_force[static_cast<std::size_t>(s)] = F;
-      kin += Eigen::Vector3d(F.x(), F.y(), sagittal_moment(pos.x(), pos.y(), F.x(), F.y()) + b.inertia_kgm2 * motion.qdd(i, coord::theta(s)));
+      kin += Eigen::Vector3d(F.x(), F.y(), sagittal_moment(pos.x(), pos.y(), F.x(), F.y()) + b.inertia_kgm2 * m.qdd(coord::theta(s)));
     }
     Eigen::Vector3d ext = Eigen::Vector3d::Zero();
     for (int side = 0; side < 2; ++side) {
@@ -409,11 +413,15 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   auto [contacts, calibration] = contact_stage(o, r.model, std::move(soles), r, motion);
   r.calibration = std::move(calibration);
   const auto t1 = clock::now();
-  const RawSolve raw = solve_stage(trial, o, r, motion, contacts);
+  RawSolve raw = solve_stage(trial, o, r, motion, contacts);
   const auto t2 = clock::now();
   r.seconds_kinematics = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_dynamics = std::chrono::duration<double>(t2 - t1).count();
   feet_stage(o, r, motion.rate_hz, contacts, raw);
+  // What only the per-foot results needed is freed before the totals take their arrays: a long
+  // trial's peak memory (issue 10).
+  contacts = std::vector<FrameContacts>();
+  raw = RawSolve();
   totals_stage(o, r, motion);
   return r;
 }

@@ -30,10 +30,11 @@ TEST(Kinematics, ReconstructionSatisfiesTheBilateralConstraints) {
   (void)prepare_contacts(r.model, r.calibration.contact, ContactModelOptions{}, mm);
   ContactSolver solver(r.model, r.calibration, {});
   for (Eigen::Index i = 5; i < mm.frames(); i += 37) {
-    const Eigen::MatrixXd Phi = solver.bilateral_jacobian(mm.q.row(i).transpose());
+    const MotionFrame f = mm.frame(i);
+    const Eigen::MatrixXd Phi = solver.bilateral_jacobian(f.q);
     // Velocity level: Phi_q qd = 0 except the rheonomic rows (their time derivative is phi_dot).
-    Eigen::VectorXd v = Phi * mm.qd.row(i).transpose();
-    v.segment(row::kDriving, kJointCount) -= mm.qd.row(i).segment(coord::kPhi, 8).transpose();
+    Eigen::VectorXd v = Phi * f.qd;
+    v.segment(row::kDriving, kJointCount) -= f.qd.segment(coord::kPhi, 8);
     EXPECT_LT(v.cwiseAbs().maxCoeff(), 1e-9) << "frame " << i;
   }
 }
@@ -52,8 +53,9 @@ TEST(Kinematics, ReconstructedPositionsKeepTheSegmentLengths) {
       if (b.points[k] < 0) continue;
       const double L = b.points_local[k].norm();
       for (Eigen::Index i = 0; i < mm.frames(); i += 13) {
-        const Eigen::Vector2d p(mm.q(i, coord::point_x(b.points[k])), mm.q(i, coord::point_x(b.points[k]) + 1));
-        const Eigen::Vector2d o(mm.q(i, coord::point_x(b.proximal)), mm.q(i, coord::point_x(b.proximal) + 1));
+        const MotionFrame f = mm.frame(i);
+        const Eigen::Vector2d p = f.q.segment<2>(coord::point_x(b.points[k]));
+        const Eigen::Vector2d o = f.q.segment<2>(coord::point_x(b.proximal));
         EXPECT_NEAR((p - o).norm(), L, 1e-12) << "segment " << s << " frame " << i;
       }
     }
@@ -72,20 +74,17 @@ TEST(Kinematics, MeasuredTorsoLengthIsFollowedAndDifferentiated) {
   const ModelMotion measured = compute_motion(r.model, lm, 6.0, TorsoLength::Measured);
   const ModelMotion fixed = compute_motion(r.model, lm, 6.0, TorsoLength::Fixed);
   const double dt = 1.0 / lm.rate_hz, L0 = r.model.bodies[kTorso].length_m;
-  auto point = [](const Eigen::MatrixXd& q, int col, Eigen::Index i) {
-    return Eigen::Vector2d(q(i, col), q(i, col + 1));
-  };
+  auto point = [](const ModelMotion& m, int col, Eigen::Index i) { return Eigen::Vector2d(m.frame(i).q.segment<2>(col)); };
   double worst_len = 0, worst_acc = 0, fixed_spread = 0, acc_scale = 0;
   const int sh = coord::point_x(kShoulder), hip = coord::point_x(kHip), com = coord::com_x(kTorso);
   for (Eigen::Index i = 20; i < measured.frames() - 20; ++i) {
-    const double len = (point(measured.q, sh, i) - point(measured.q, hip, i)).norm();
+    const double len = (point(measured, sh, i) - point(measured, hip, i)).norm();
     const double truth = (lm.p[kShoulder].row(i) - lm.p[kHip].row(i)).norm();
     worst_len = std::max(worst_len, std::abs(len - truth));
-    fixed_spread = std::max(fixed_spread, std::abs((point(fixed.q, sh, i) - point(fixed.q, hip, i)).norm() - L0));
+    fixed_spread = std::max(fixed_spread, std::abs((point(fixed, sh, i) - point(fixed, hip, i)).norm() - L0));
     // Second central difference of the torso COM position against its reconstructed acceleration.
-    const Eigen::Vector2d fd = (point(measured.q, com, i + 1) - 2 * point(measured.q, com, i) +
-                                point(measured.q, com, i - 1)) / (dt * dt);
-    const Eigen::Vector2d a(measured.qdd(i, com), measured.qdd(i, com + 1));
+    const Eigen::Vector2d fd = (point(measured, com, i + 1) - 2 * point(measured, com, i) + point(measured, com, i - 1)) / (dt * dt);
+    const Eigen::Vector2d a = measured.frame(i).qdd.segment<2>(com);
     worst_acc = std::max(worst_acc, (fd - a).norm());
     acc_scale = std::max(acc_scale, a.norm());
   }
@@ -96,8 +95,8 @@ TEST(Kinematics, MeasuredTorsoLengthIsFollowedAndDifferentiated) {
 }
 
 // The upper body's fore-aft lag (lag_torso_fore_aft): only the HAT COM's fore-aft acceleration
-// changes, causally (nothing before a step moves), with a first-order step response that reaches
-// about 1 - 1/e after one time constant; tau = 0 changes nothing. In the whole estimate the vertical
+// changes, causally (nothing before a step moves), delayed whole (a delay, not a filter); tau = 0
+// changes nothing. In the whole estimate the vertical
 // force sum is untouched and the fore-aft one is not.
 TEST(Kinematics, TorsoLagDelaysOnlyTheTorsosForeAftAcceleration) {
   const Trial t = make_synthetic_trial({});
@@ -106,34 +105,37 @@ TEST(Kinematics, TorsoLagDelaysOnlyTheTorsosForeAftAcceleration) {
   const int c = coord::com_x(kTorso);
   ModelMotion step = base;
   const Eigen::Index i0 = 100;
-  for (Eigen::Index i = 0; i < step.frames(); ++i) step.qdd(i, c) = i < i0 ? 0.0 : 1.0;
+  for (Eigen::Index i = 0; i < step.frames(); ++i) step.torso_ax_mps2[i] = i < i0 ? 0.0 : 1.0;
   const ModelMotion before = step;
   const double tau = 0.03;
   ASSERT_EQ(step.rate_hz, 100.0);
   // A delay of 3 frames: the step arrives whole at frame i0 + 3, nothing before (causal), no
   // overshoot, no attenuation.
   lag_torso_fore_aft(step, tau);
-  for (Eigen::Index i = 0; i < step.frames(); ++i) ASSERT_EQ(step.qdd(i, c), i < i0 + 3 ? 0.0 : 1.0) << i;
+  for (Eigen::Index i = 0; i < step.frames(); ++i) ASSERT_EQ(step.frame(i).qdd(c), i < i0 + 3 ? 0.0 : 1.0) << i;
   // 25 ms, between frames: half the step at frame i0 + 2 (linear interpolation).
   ModelMotion half = before;
   lag_torso_fore_aft(half, 0.025);
-  EXPECT_EQ(half.qdd(i0 + 1, c), 0.0);
-  EXPECT_NEAR(half.qdd(i0 + 2, c), 0.5, 1e-12);
-  EXPECT_EQ(half.qdd(i0 + 3, c), 1.0);
+  EXPECT_EQ(half.torso_ax_mps2[i0 + 1], 0.0);
+  EXPECT_NEAR(half.torso_ax_mps2[i0 + 2], 0.5, 1e-12);
+  EXPECT_EQ(half.torso_ax_mps2[i0 + 3], 1.0);
   // A sine comes out as itself, later: a delay, not a filter.
   ModelMotion sine = before;
-  for (Eigen::Index i = 0; i < sine.frames(); ++i) sine.qdd(i, c) = std::sin(2 * M_PI * 1.5 * static_cast<double>(i) / 100.0);
+  for (Eigen::Index i = 0; i < sine.frames(); ++i) sine.torso_ax_mps2[i] = std::sin(2 * M_PI * 1.5 * static_cast<double>(i) / 100.0);
   lag_torso_fore_aft(sine, tau);
   for (Eigen::Index i = 3; i < sine.frames(); ++i)
-    ASSERT_NEAR(sine.qdd(i, c), std::sin(2 * M_PI * 1.5 * (static_cast<double>(i) / 100.0 - tau)), 1e-12) << i;
-  Eigen::MatrixXd others = step.qdd - before.qdd;
-  others.col(c).setZero();
-  EXPECT_EQ(others.cwiseAbs().maxCoeff(), 0.0);  // vertical, angles, every other segment
-  EXPECT_EQ(step.q, before.q);
-  EXPECT_EQ(step.qd, before.qd);
+    ASSERT_NEAR(sine.torso_ax_mps2[i], std::sin(2 * M_PI * 1.5 * (static_cast<double>(i) / 100.0 - tau)), 1e-12) << i;
+  for (Eigen::Index i = 0; i < step.frames(); ++i) {
+    const MotionFrame a = step.frame(i), b = before.frame(i);
+    Eigen::VectorXd others = a.qdd - b.qdd;
+    others(c) = 0.0;
+    ASSERT_EQ(others.cwiseAbs().maxCoeff(), 0.0) << i;  // vertical, angles, every other segment
+    ASSERT_EQ(a.q, b.q) << i;
+    ASSERT_EQ(a.qd, b.qd) << i;
+  }
   ModelMotion same = base;
   lag_torso_fore_aft(same, 0.0);
-  EXPECT_EQ(same.qdd, base.qdd);
+  EXPECT_EQ(same.torso_ax_mps2, base.torso_ax_mps2);
 
   EstimateOptions none, lagged;
   none.torso_lag_s = 0.0;
@@ -150,13 +152,12 @@ TEST(Kinematics, TorsoLagDelaysOnlyTheTorsosForeAftAcceleration) {
 TEST(Kinematics, TheTrunksOwnLagBehindTheHipIsMeasured) {
   const auto r = run({});
   ModelMotion m = compute_motion(r.model, synthetic_landmarks(make_synthetic_trial({})), 6.0);
-  const int c = coord::com_x(kTorso), h = coord::point_x(kHip);
   auto with_delay = [&](double delay_s) {
     ModelMotion d = m;
     for (Eigen::Index i = 0; i < d.frames(); ++i) {
       const double t = static_cast<double>(i) / d.rate_hz;
-      d.qdd(i, h) = std::sin(2 * M_PI * 1.8 * t) + 0.4 * std::sin(2 * M_PI * 3.6 * t + 0.7);
-      d.qdd(i, c) = std::sin(2 * M_PI * 1.8 * (t - delay_s)) + 0.4 * std::sin(2 * M_PI * 3.6 * (t - delay_s) + 0.7);
+      d.xdd(i, 0) = std::sin(2 * M_PI * 1.8 * t) + 0.4 * std::sin(2 * M_PI * 3.6 * t + 0.7);  // the hip's fore-aft
+      d.torso_ax_mps2[i] = std::sin(2 * M_PI * 1.8 * (t - delay_s)) + 0.4 * std::sin(2 * M_PI * 3.6 * (t - delay_s) + 0.7);
     }
     return measured_torso_lag_s(d);
   };
@@ -167,8 +168,26 @@ TEST(Kinematics, TheTrunksOwnLagBehindTheHipIsMeasured) {
   EXPECT_NEAR(with_delay(-0.015), -0.015, 2e-3);
   ModelMotion short_trial = m;
   short_trial.time_s = short_trial.time_s.head(10).eval();
-  short_trial.q = short_trial.q.topRows(10).eval();
-  short_trial.qd = short_trial.qd.topRows(10).eval();
-  short_trial.qdd = short_trial.qdd.topRows(10).eval();
+  short_trial.xdd = short_trial.xdd.topRows(10).eval();
+  short_trial.torso_ax_mps2 = short_trial.torso_ax_mps2.head(10).eval();
   EXPECT_EQ(measured_torso_lag_s(short_trial), 0.0);
+}
+
+// A trial's motion is held as what determines it (independent coordinates, the torso's fore-aft
+// acceleration, D*): at most 50 numbers a frame, not the 3 x 63 of q, qd, qdd (issue 10's
+// memory). Every frame() is rebuilt the same, bit for bit, however often it is asked for.
+TEST(Kinematics, TheMotionHoldsFewNumbersAFrameAndRebuildsEachFrameAlike) {
+  const auto r = run({});
+  const ModelMotion m = compute_motion(r.model, synthetic_landmarks(make_synthetic_trial({})), 6.0);
+  const Eigen::Index n = m.frames();
+  ASSERT_GT(n, 100);
+  const auto held = m.x.size() + m.xd.size() + m.xdd.size() + m.torso_ax_mps2.size() + m.dstar.size() + m.dstar_d.size() +
+                    m.dstar_dd.size() + m.time_s.size();
+  EXPECT_LE(held, 50 * n);
+  EXPECT_GT(held, 36 * n);  // x, xd, xdd of the 12 independent coordinates at least
+  const MotionFrame a = m.frame(n / 2), b = m.frame(n / 2);
+  EXPECT_EQ(a.q, b.q);
+  EXPECT_EQ(a.qdd, b.qdd);
+  EXPECT_EQ(a.qdd(coord::com_x(kTorso)), m.torso_ax_mps2[n / 2]);
+  EXPECT_EQ(a.qdd.segment<2>(coord::point_x(kHip)), Eigen::Vector2d(m.xdd(n / 2, 0), m.xdd(n / 2, 1)));
 }

@@ -151,7 +151,7 @@ TEST(Estimate, PrescribedSingleSupportRecoversTheExactContactForce) {
   const FrameContacts& fc = contacts[static_cast<std::size_t>(i)];
   ASSERT_EQ(fc.points.size(), 2u);
   ASSERT_GT(fc.points[1].gap_m, 0.05) << "the left foot is lifted";
-  const Eigen::VectorXd q = mm.q.row(i).transpose();
+  const Eigen::VectorXd q = mm.frame(i).q;
   SolverOptions sopt;
   sopt.r_N_per_m = 1e5;
   ContactSolver solver(r.model, r.calibration, sopt);  // no speed gate (eo's)

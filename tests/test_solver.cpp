@@ -35,7 +35,8 @@ TEST(Solver, StructuredAndDenseFactorisationsAgree) {
     dense_opt.dense_factorisation = true;
     ContactSolver structured(r.model, r.calibration, structured_opt), dense(r.model, r.calibration, dense_opt);
     for (Eigen::Index i = 0; i < mm.frames(); i += 11) {
-      const Eigen::VectorXd q = mm.q.row(i).transpose(), qdd = mm.qdd.row(i).transpose();
+      const MotionFrame f = mm.frame(i);
+      const Eigen::VectorXd q = f.q, qdd = f.qdd;
       const auto a = structured.solve(q, qdd, contacts[static_cast<std::size_t>(i)]);
       const auto b = dense.solve(q, qdd, contacts[static_cast<std::size_t>(i)]);
       ASSERT_EQ(a.contact_active, b.contact_active) << "frame " << i;
@@ -64,8 +65,9 @@ TEST(Solver, SlowWalkSwingFootCarriesNothing) {
   fc.points[0].velocity.setZero();                 // the stance foot's D* is still
   fc.points[1].gap_m = 0.008;                      // low swing clearance
   fc.points[1].velocity = Eigen::Vector2d(1.0, 0);  // a slow walker's swing foot
-  const Eigen::VectorXd q = mm.q.row(i).transpose();
-  Eigen::VectorXd qdd = mm.qdd.row(i).transpose();
+  const MotionFrame f = mm.frame(i);
+  const Eigen::VectorXd q = f.q;
+  Eigen::VectorXd qdd = f.qdd;
   qdd[coord::theta(kTorso)] += 20.0;  // rad/s^2: about 30 N m that no single contact point balances
 
   TrialCalibration fixed = r.calibration;  // the old fixed gate

@@ -19,12 +19,12 @@ struct MaterialPoint {
   ContactJacobian jx, jy;
 };
 
-MaterialPoint material_point(const Model& model, const ModelMotion& m, Eigen::Index i, int s, const Eigen::Vector2d& X) {
+MaterialPoint material_point(const Model& model, const MotionFrame& m, int s, const Eigen::Vector2d& X) {
   const int P = model.bodies[s].proximal;
-  const Eigen::Vector2d rP(m.q(i, coord::point_x(P)), m.q(i, coord::point_x(P) + 1));
-  const Eigen::Vector2d vP(m.qd(i, coord::point_x(P)), m.qd(i, coord::point_x(P) + 1));
-  const Eigen::Vector2d aP(m.qdd(i, coord::point_x(P)), m.qdd(i, coord::point_x(P) + 1));
-  const double w = m.qd(i, coord::theta(s)), al = m.qdd(i, coord::theta(s));
+  const Eigen::Vector2d rP = m.q.segment<2>(coord::point_x(P));
+  const Eigen::Vector2d vP = m.qd.segment<2>(coord::point_x(P));
+  const Eigen::Vector2d aP = m.qdd.segment<2>(coord::point_x(P));
+  const double w = m.qd(coord::theta(s)), al = m.qdd(coord::theta(s));
   const Eigen::Vector2d d = X - rP;
   MaterialPoint mp;
   mp.v = vP + w * perp(d);
@@ -46,13 +46,13 @@ double CopFunction::fraction(double th) const {
   return s_to;
 }
 
-std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, const ModelMotion& m, Eigen::Index i, int side) {
+std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, const MotionFrame& m, int side) {
   const int foot = segment(side, kFoot), toes = segment(side, kToes);
   const int ankle = landmark(side, kAnkle), mt = landmark(side, kMt);
-  const Eigen::Vector2d rA(m.q(i, coord::point_x(ankle)), m.q(i, coord::point_x(ankle) + 1));
-  const Eigen::Vector2d rM(m.q(i, coord::point_x(mt)), m.q(i, coord::point_x(mt) + 1));
-  const Eigen::Matrix2d Rf = rotation(m.q(i, coord::theta(foot)));
-  const Eigen::Matrix2d Rt = rotation(m.q(i, coord::theta(toes)));
+  const Eigen::Vector2d rA = m.q.segment<2>(coord::point_x(ankle));
+  const Eigen::Vector2d rM = m.q.segment<2>(coord::point_x(mt));
+  const Eigen::Matrix2d Rf = rotation(m.q(coord::theta(foot)));
+  const Eigen::Matrix2d Rt = rotation(m.q(coord::theta(toes)));
   const auto& fg = soles.feet[static_cast<std::size_t>(side)];
   return {rA + Rf * fg.heel_local, rA + Rf * fg.mt_local, rM + Rt * fg.hallux_local};
 }
@@ -64,14 +64,16 @@ std::vector<bool> flight_frames(const Model& model, const ModelMotion& m, const 
   for (const Body& b : model.bodies) mass += b.mass_kg;
   const double limit = flight_fraction * mass * model.gravity_mps2;
   std::vector<bool> flight(static_cast<std::size_t>(n), false), out(static_cast<std::size_t>(n), false);
+  MotionFrame f;
   for (Eigen::Index i = 0; i < n; ++i) {
+    m.frame(i, f);
     double fy = 0;
     for (int s = 0; s < kSegmentCount; ++s)
-      fy += model.bodies[static_cast<std::size_t>(s)].mass_kg * (m.qdd(i, coord::com_x(s) + 1) + model.gravity_mps2);
+      fy += model.bodies[static_cast<std::size_t>(s)].mass_kg * (f.qdd(coord::com_x(s) + 1) + model.gravity_mps2);
     if (!(fy < limit)) continue;
     bool airborne = true;
     for (int side = 0; side < 2 && airborne; ++side)
-      for (const Eigen::Vector2d& p : sole_points(soles, m, i, side)) airborne = airborne && p.y() - soles.ground_level_m > clearance_m;
+      for (const Eigen::Vector2d& p : sole_points(soles, f, side)) airborne = airborne && p.y() - soles.ground_level_m > clearance_m;
     flight[static_cast<std::size_t>(i)] = airborne;
   }
   const Eigen::Index w = static_cast<Eigen::Index>(std::lround(window_s * m.rate_hz));
@@ -93,16 +95,18 @@ std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCal
   const Eigen::Index n = m.frames();
   std::vector<FrameContacts> out(static_cast<std::size_t>(n));
   const double ground = soles.ground_level_m + o.ground_shift_m;
+  MotionFrame f;
   for (Eigen::Index i = 0; i < n; ++i) {
     FrameContacts& fc = out[static_cast<std::size_t>(i)];
+    m.frame(i, f);
     for (int side = 0; side < 2; ++side) {
       const int foot = segment(side, kFoot), toes = segment(side, kToes);
-      const auto sp = sole_points(soles, m, i, side);
+      const auto sp = sole_points(soles, f, side);
       fc.sole[static_cast<std::size_t>(side)] = sp;
-      fc.foot_inclination_rad[side] = -(m.q(i, coord::theta(foot)) - soles.feet[static_cast<std::size_t>(side)].flat_angle_rad);
+      fc.foot_inclination_rad[side] = -(f.q(coord::theta(foot)) - soles.feet[static_cast<std::size_t>(side)].flat_angle_rad);
       if (o.foot_model == FootModel::ThreePoint) {
         for (int k = 0; k < 3; ++k) {
-          const MaterialPoint mp = material_point(model, m, i, k < 2 ? foot : toes, sp[k]);
+          const MaterialPoint mp = material_point(model, f, k < 2 ? foot : toes, sp[k]);
           ContactPoint cp;
           cp.side = side;
           cp.position = sp[k];
@@ -125,14 +129,11 @@ std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCal
       const double yD = std::min({sp[0].y(), sp[1].y(), sp[2].y()});
       const Eigen::Vector2d D(on.x(), yD);
       // D* is the foot's material point at D.
-      const MaterialPoint mp = material_point(model, m, i, foot, D);
+      const MaterialPoint mp = material_point(model, f, foot, D);
       const int c = coord::dstar_x(side);
-      m.q(i, c) = D.x();
-      m.q(i, c + 1) = D.y();
-      m.qd(i, c) = mp.v.x();
-      m.qd(i, c + 1) = mp.v.y();
-      m.qdd(i, c) = mp.a.x();
-      m.qdd(i, c + 1) = mp.a.y();
+      m.dstar.block<1, 2>(i, 2 * side) = D.transpose();
+      m.dstar_d.block<1, 2>(i, 2 * side) = mp.v.transpose();
+      m.dstar_dd.block<1, 2>(i, 2 * side) = mp.a.transpose();
       ContactPoint cp;
       cp.side = side;
       cp.position = D;

@@ -14,6 +14,25 @@ namespace {
 
 double angle_of(const Eigen::Vector2d& d) { return std::atan2(d.y(), d.x()); }
 
+/// Position, velocity and acceleration of a point fixed in a body (Sect. 2.2's forward
+/// kinematics, with the torso's length scale k, k', k''; k = 1, k' = k'' = 0 for the others).
+struct PointKinematics {
+  Eigen::Vector2d r, v, a;
+};
+PointKinematics place(const PointKinematics& proximal, double th, double w, double al, const Eigen::Vector2d& local, double k0,
+                      double k1, double k2) {
+  const Eigen::Vector2d e = rotation(th) * local;
+  const Eigen::Vector2d ed = w * perp(e), edd = al * perp(e) - w * w * e;
+  return {proximal.r + k0 * e, proximal.v + k1 * e + k0 * ed, proximal.a + k2 * e + 2 * k1 * ed + k0 * edd};
+}
+
+/// The torso's length scale k = L(t) / L0 and its derivatives at frame i (1, 0, 0 without column 11).
+std::array<double, 3> torso_scale(const ModelMotion& m, Eigen::Index i) {
+  if (m.x.cols() <= 11) return {1.0, 0.0, 0.0};
+  const double L0 = m.model.bodies[kTorso].length_m;
+  return {m.x(i, 11) / L0, m.xd(i, 11) / L0, m.xdd(i, 11) / L0};
+}
+
 }  // namespace
 
 BodyGeometry measure_geometry(const SagittalLandmarks& lm) {
@@ -74,90 +93,99 @@ Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm) {
   return x;
 }
 
-ModelMotion reconstruct_motion(const Model& model, const Eigen::MatrixXd& x, const Eigen::MatrixXd& xd,
-                               const Eigen::MatrixXd& xdd, double rate_hz, const Eigen::VectorXd& time_s) {
+void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
+  f.q.setZero();
+  f.qd.setZero();
+  f.qdd.setZero();
+  // Bodies in an order where the parent comes first (the torso, then each leg down).
+  static constexpr int order[] = {kTorso, kThighR, kShankR, kFootR, kToesR, kThighL, kShankL, kFootL, kToesL};
+  std::array<double, kSegmentCount> th{}, w{}, al{};
+  th[kTorso] = x(i, 2); w[kTorso] = xd(i, 2); al[kTorso] = xdd(i, 2);
+  for (int j = 0; j < kJointCount; ++j) {
+    const int c = joint_child(j), p = joint_parent(j);
+    th[c] = th[p] + x(i, 3 + j);
+    w[c] = w[p] + xd(i, 3 + j);
+    al[c] = al[p] + xdd(i, 3 + j);
+  }
+  std::array<PointKinematics, kLandmarkCount> pk;
+  pk[kHip] = {Eigen::Vector2d(x(i, 0), x(i, 1)), Eigen::Vector2d(xd(i, 0), xd(i, 1)), Eigen::Vector2d(xdd(i, 0), xdd(i, 1))};
+  // The torso's points scale with its measured length (column 11, when given): d = k e with
+  // e = R(theta) rho, so d' = k' e + k e' and d'' = k'' e + 2 k' e' + k e''.
+  const auto [ks, ksd, ksdd] = torso_scale(*this, i);
+  for (int s : order) {
+    const Body& b = model.bodies[s];
+    const bool scaled = s == kTorso;
+    const double k0 = scaled ? ks : 1.0, k1 = scaled ? ksd : 0.0, k2 = scaled ? ksdd : 0.0;
+    for (int k = 0; k < 2; ++k)
+      if (b.points[k] >= 0) pk[b.points[k]] = place(pk[b.proximal], th[s], w[s], al[s], b.points_local[k], k0, k1, k2);
+    const PointKinematics g = place(pk[b.proximal], th[s], w[s], al[s], b.com_local, k0, k1, k2);
+    f.q.segment<2>(coord::com_x(s)) = g.r;
+    f.qd.segment<2>(coord::com_x(s)) = g.v;
+    f.qdd.segment<2>(coord::com_x(s)) = g.a;
+    f.q(coord::theta(s)) = th[s];
+    f.qd(coord::theta(s)) = w[s];
+    f.qdd(coord::theta(s)) = al[s];
+  }
+  for (int k = 0; k < kLandmarkCount; ++k) {
+    f.q.segment<2>(coord::point_x(k)) = pk[k].r;
+    f.qd.segment<2>(coord::point_x(k)) = pk[k].v;
+    f.qdd.segment<2>(coord::point_x(k)) = pk[k].a;
+  }
+  for (int j = 0; j < kJointCount; ++j) {
+    f.q(coord::phi(j)) = x(i, 3 + j);
+    f.qd(coord::phi(j)) = xd(i, 3 + j);
+    f.qdd(coord::phi(j)) = xdd(i, 3 + j);
+  }
+  if (torso_ax_mps2.size() > i) f.qdd(coord::com_x(kTorso)) = torso_ax_mps2[i];
+  if (dstar.rows() > i) {
+    f.q.segment<4>(coord::dstar_x(0)) = dstar.row(i).transpose();
+    f.qd.segment<4>(coord::dstar_x(0)) = dstar_d.row(i).transpose();
+    f.qdd.segment<4>(coord::dstar_x(0)) = dstar_dd.row(i).transpose();
+  }
+}
+
+ModelMotion reconstruct_motion(const Model& model, Eigen::MatrixXd x, Eigen::MatrixXd xd, Eigen::MatrixXd xdd, double rate_hz,
+                               Eigen::VectorXd time_s) {
   const Eigen::Index n = x.rows();
   ModelMotion mm;
   mm.rate_hz = rate_hz;
-  mm.time_s = time_s;
-  mm.q = Eigen::MatrixXd::Zero(n, coord::kCount);
-  mm.qd = Eigen::MatrixXd::Zero(n, coord::kCount);
-  mm.qdd = Eigen::MatrixXd::Zero(n, coord::kCount);
-  // Bodies in an order where the parent comes first (the torso, then each leg down).
-  static constexpr int order[] = {kTorso, kThighR, kShankR, kFootR, kToesR, kThighL, kShankL, kFootL, kToesL};
+  mm.time_s = std::move(time_s);
+  mm.model = model;
+  mm.x = std::move(x);
+  mm.xd = std::move(xd);
+  mm.xdd = std::move(xdd);
+  mm.dstar = Eigen::MatrixX4d::Zero(n, 4);
+  mm.dstar_d = Eigen::MatrixX4d::Zero(n, 4);
+  mm.dstar_dd = Eigen::MatrixX4d::Zero(n, 4);
+  // The HAT COM's fore-aft acceleration as the chain gives it (as frame() places it), the series
+  // the torso lag delays.
+  Eigen::VectorXd ax(n);
+  const Eigen::Vector2d& rho = model.bodies[kTorso].com_local;
   for (Eigen::Index i = 0; i < n; ++i) {
-    std::array<double, kSegmentCount> th{}, w{}, al{};
-    th[kTorso] = x(i, 2); w[kTorso] = xd(i, 2); al[kTorso] = xdd(i, 2);
-    for (int j = 0; j < kJointCount; ++j) {
-      const int c = joint_child(j), p = joint_parent(j);
-      th[c] = th[p] + x(i, 3 + j);
-      w[c] = w[p] + xd(i, 3 + j);
-      al[c] = al[p] + xdd(i, 3 + j);
-    }
-    std::array<Eigen::Vector2d, kLandmarkCount> r, v, a;
-    r[kHip] = Eigen::Vector2d(x(i, 0), x(i, 1));
-    v[kHip] = Eigen::Vector2d(xd(i, 0), xd(i, 1));
-    a[kHip] = Eigen::Vector2d(xdd(i, 0), xdd(i, 1));
-    // The torso's points scale with its measured length (column 11, when given): d = k e with
-    // e = R(theta) rho, so d' = k' e + k e' and d'' = k'' e + 2 k' e' + k e''.
-    double ks = 1, ksd = 0, ksdd = 0;  // k, k', k''
-    if (x.cols() > 11) {
-      const double L0 = model.bodies[kTorso].length_m;
-      ks = x(i, 11) / L0, ksd = xd(i, 11) / L0, ksdd = xdd(i, 11) / L0;
-    }
-    auto place = [&](const Body& b, int s, const Eigen::Vector2d& local, Eigen::Vector2d& rr, Eigen::Vector2d& vv,
-                     Eigen::Vector2d& aa) {
-      const Eigen::Vector2d e = rotation(th[s]) * local;
-      const Eigen::Vector2d ed = w[s] * perp(e), edd = al[s] * perp(e) - w[s] * w[s] * e;
-      // Other bodies: k = 1, k' = k'' = 0 (exactly the fixed-length forward kinematics).
-      const bool scaled = s == kTorso;
-      const double k0 = scaled ? ks : 1.0, k1 = scaled ? ksd : 0.0, k2 = scaled ? ksdd : 0.0;
-      rr = r[b.proximal] + k0 * e;
-      vv = v[b.proximal] + k1 * e + k0 * ed;
-      aa = a[b.proximal] + k2 * e + 2 * k1 * ed + k0 * edd;
-    };
-    for (int s : order) {
-      const Body& b = model.bodies[s];
-      for (int k = 0; k < 2; ++k)
-        if (b.points[k] >= 0) place(b, s, b.points_local[k], r[b.points[k]], v[b.points[k]], a[b.points[k]]);
-      Eigen::Vector2d rg, vg, ag;
-      place(b, s, b.com_local, rg, vg, ag);
-      mm.q.block<1, 2>(i, coord::com_x(s)) = rg.transpose();
-      mm.qd.block<1, 2>(i, coord::com_x(s)) = vg.transpose();
-      mm.qdd.block<1, 2>(i, coord::com_x(s)) = ag.transpose();
-      mm.q(i, coord::theta(s)) = th[s];
-      mm.qd(i, coord::theta(s)) = w[s];
-      mm.qdd(i, coord::theta(s)) = al[s];
-    }
-    for (int k = 0; k < kLandmarkCount; ++k) {
-      mm.q.block<1, 2>(i, coord::point_x(k)) = r[k].transpose();
-      mm.qd.block<1, 2>(i, coord::point_x(k)) = v[k].transpose();
-      mm.qdd.block<1, 2>(i, coord::point_x(k)) = a[k].transpose();
-    }
-    for (int j = 0; j < kJointCount; ++j) {
-      mm.q(i, coord::phi(j)) = x(i, 3 + j);
-      mm.qd(i, coord::phi(j)) = xd(i, 3 + j);
-      mm.qdd(i, coord::phi(j)) = xdd(i, 3 + j);
-    }
+    const PointKinematics hip{Eigen::Vector2d(mm.x(i, 0), mm.x(i, 1)), Eigen::Vector2d(mm.xd(i, 0), mm.xd(i, 1)),
+                              Eigen::Vector2d(mm.xdd(i, 0), mm.xdd(i, 1))};
+    const auto [k0, k1, k2] = torso_scale(mm, i);
+    ax[i] = place(hip, mm.x(i, 2), mm.xd(i, 2), mm.xdd(i, 2), rho, k0, k1, k2).a.x();
   }
+  mm.torso_ax_mps2 = std::move(ax);
   return mm;
 }
 
 ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz, TorsoLength torso) {
   if (lm.frames() < 8) throw InputError("too few frames (" + std::to_string(lm.frames()) + ") for the kinematics");
   const double dt = 1.0 / lm.rate_hz;
-  Eigen::MatrixXd raw = independent_coordinates(lm);
-  if (torso == TorsoLength::Fixed) raw.conservativeResize(Eigen::NoChange, 11);
-  const Eigen::MatrixXd x = cutoff_hz > 0 ? butterworth_filtfilt(raw, lm.rate_hz, cutoff_hz) : raw;
-  const Eigen::MatrixXd xd = central_difference(x, dt);
-  const Eigen::MatrixXd xdd = second_difference(x, dt);
-  return reconstruct_motion(model, x, xd, xdd, lm.rate_hz, lm.time_s);
+  Eigen::MatrixXd x = independent_coordinates(lm);
+  if (torso == TorsoLength::Fixed) x.conservativeResize(Eigen::NoChange, 11);
+  if (cutoff_hz > 0) x = butterworth_filtfilt(x, lm.rate_hz, cutoff_hz);
+  Eigen::MatrixXd xd = central_difference(x, dt);
+  Eigen::MatrixXd xdd = second_difference(x, dt);
+  return reconstruct_motion(model, std::move(x), std::move(xd), std::move(xdd), lm.rate_hz, lm.time_s);
 }
 
 void lag_torso_fore_aft(ModelMotion& m, double tau_s) {
   if (!(tau_s > 0) || m.frames() == 0) return;
-  const int c = coord::com_x(kTorso);
-  const Eigen::Index n = m.frames();
+  Eigen::VectorXd& ax = m.torso_ax_mps2;
+  const Eigen::Index n = ax.size();
   // Frame i takes the acceleration of (fractional) frame i - d, linearly interpolated; frames
   // before the trial's first take its first. Backwards, so that each frame reads only the
   // earlier ones, not yet overwritten.
@@ -165,12 +193,12 @@ void lag_torso_fore_aft(ModelMotion& m, double tau_s) {
   for (Eigen::Index i = n - 1; i >= 0; --i) {
     const double t = static_cast<double>(i) - d;
     if (t <= 0) {
-      m.qdd(i, c) = m.qdd(0, c);
+      ax[i] = ax[0];
       continue;
     }
     const auto i0 = static_cast<Eigen::Index>(t);  // t < i: i0 + 1 <= i
     const double f = t - static_cast<double>(i0);
-    m.qdd(i, c) = (1 - f) * m.qdd(i0, c) + f * m.qdd(i0 + 1, c);
+    ax[i] = (1 - f) * ax[i0] + f * ax[i0 + 1];
   }
 }
 
@@ -180,15 +208,17 @@ double measured_torso_lag_s(const ModelMotion& m) {
   // and a 10-minute trial at 2 kHz would otherwise take 0.5 s here.
   const Eigen::Index n = m.frames(), m0 = n / 10;
   const Eigen::Index m1 = std::min(n - n / 10, m0 + static_cast<Eigen::Index>(std::min(60.0 * m.rate_hz, static_cast<double>(n))));
-  const int c = coord::com_x(kTorso), h = coord::point_x(kHip);
+  // The hip's fore-aft acceleration is its independent coordinate's (column 0).
+  const Eigen::VectorXd& hip = m.xdd.col(0);
+  const Eigen::VectorXd& hat = m.torso_ax_mps2;
   const int reach = std::max(1, static_cast<int>(0.08 * m.rate_hz));
   // The peak lag of y behind x, in frames (parabola through the peak); NaN without a positive peak.
-  auto peak_lag = [&](int x, int y) {
+  auto peak_lag = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
     std::vector<double> r(static_cast<std::size_t>(2 * reach + 1));
     for (int lag = -reach; lag <= reach; ++lag) {
       double sum = 0;
       for (Eigen::Index i = m0; i < m1; ++i)
-        if (const Eigen::Index j = i + lag; j >= 0 && j < n) sum += m.qdd(i, x) * m.qdd(j, y);
+        if (const Eigen::Index j = i + lag; j >= 0 && j < n) sum += x[i] * y[j];
       r[static_cast<std::size_t>(lag + reach)] = sum;
     }
     const auto k = static_cast<int>(std::max_element(r.begin(), r.end()) - r.begin());
@@ -199,7 +229,7 @@ double measured_torso_lag_s(const ModelMotion& m) {
   };
   // Both ways round and halved: a finite window biases each estimate by the same amount (a
   // quarter of a frame for a stride's harmonics), and the difference cancels it.
-  const double lag = 0.5 * (peak_lag(h, c) - peak_lag(c, h));
+  const double lag = 0.5 * (peak_lag(hip, hat) - peak_lag(hat, hip));
   return std::isfinite(lag) ? lag / m.rate_hz : 0.0;
 }
 

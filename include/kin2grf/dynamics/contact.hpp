@@ -136,10 +136,10 @@ struct ContactModelOptions {
   double ground_shift_m = 0.0;  ///< added to the measured ground (the paper's robustness study)
 };
 
-/// World positions of the sole points A, B, C of a foot at frame i.
-std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, const ModelMotion& motion, Eigen::Index i, int side);
+/// World positions of the sole points A, B, C of a foot in one frame (ModelMotion::frame).
+std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, const MotionFrame& frame, int side);
 
-/// Fill the D* columns of q/qd/qdd (model 2) and return each frame's contact points. `running`
+/// Fill D* (motion.dstar and its derivatives, model 2) and return each frame's contact points. `running`
 /// (empty, or one flag per frame): frames that take options.running_cop.
 std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCalibration& soles, const ContactModelOptions& options,
                                             ModelMotion& motion,

@@ -48,17 +48,39 @@ BodyGeometry measure_geometry(const SagittalLandmarks& lm);
 /// hip-shoulder distance (m), N x 12.
 Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm);
 
+/// q, qd, qdd of one frame (63 each, on the stack: the per-frame solve allocates nothing).
+struct MotionFrame {
+  Eigen::Matrix<double, coord::kCount, 1> q, qd, qdd;
+};
+
+/// The model's motion over a trial, held as what determines it: the independent coordinates and
+/// their derivatives (N x 11 or 12 each), the HAT COM's fore-aft acceleration as used (N: the
+/// torso lag replaces it) and D* (N x 4: x, y per side; zero until prepare_contacts fills it).
+/// q, qd, qdd of a frame are rebuilt by frame(i), the same forward kinematics for every caller,
+/// bit for bit. Why not N x 63 matrices: three of them were 1.5 KB a frame, 44 % of a long
+/// trial's peak memory (issue 10), and rebuilding a frame costs less than streaming its 1.5 KB
+/// through the cache four times.
 struct ModelMotion {
   double rate_hz = 0.0;
   Eigen::VectorXd time_s;
-  Eigen::MatrixXd q, qd, qdd;  ///< N x 63; the D* columns are filled by the contact model
+  Model model;                         ///< the bodies frame() places (a copy: the motion stands alone)
+  Eigen::MatrixXd x, xd, xdd;          ///< independent coordinates (independent_coordinates' columns)
+  Eigen::VectorXd torso_ax_mps2;       ///< N: the HAT COM's fore-aft acceleration (lag_torso_fore_aft)
+  Eigen::MatrixX4d dstar, dstar_d, dstar_dd;  ///< N x 4: D* and its derivatives (coord::dstar_x)
   [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
+  /// q, qd, qdd of frame i into f.
+  void frame(Eigen::Index i, MotionFrame& f) const;
+  [[nodiscard]] MotionFrame frame(Eigen::Index i) const {
+    MotionFrame f;
+    frame(i, f);
+    return f;
+  }
 };
 
 /// Forward kinematics of the chain from the independent coordinates and their first and second
 /// time derivatives (N x 11: fixed lengths; N x 12: the torso takes column 11's length).
-ModelMotion reconstruct_motion(const Model& model, const Eigen::MatrixXd& x, const Eigen::MatrixXd& xd,
-                               const Eigen::MatrixXd& xdd, double rate_hz, const Eigen::VectorXd& time_s);
+ModelMotion reconstruct_motion(const Model& model, Eigen::MatrixXd x, Eigen::MatrixXd xd, Eigen::MatrixXd xdd, double rate_hz,
+                               Eigen::VectorXd time_s);
 
 enum class TorsoLength {
   Measured,  ///< the filtered hip-shoulder distance of each frame (kin2grf's default)
@@ -81,8 +103,8 @@ ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, doub
 /// A delay, as what the trunk markers already lag the hip by is measured (measured_torso_lag_s,
 /// a cross-correlation peak); until session 11 this was a first-order lag of time constant tau,
 /// which also attenuated (docs/METHOD-NOTES.md compares them). Its position and velocity, its
-/// vertical and angular accelerations and every other segment are unchanged. tau_s = 0 leaves
-/// the motion as it is (the paper).
+/// vertical and angular accelerations and every other segment are unchanged (torso_ax_mps2 is
+/// the one series it writes). tau_s = 0 leaves the motion as it is (the paper).
 void lag_torso_fore_aft(ModelMotion& m, double tau_s);
 
 /// How late the HAT COM's fore-aft acceleration already follows the hip's in `m`, s: the lag of
