@@ -49,7 +49,7 @@ py::dict estimate(const std::string& trial, const std::vector<std::string>& word
   kin2grf::EstimateOptions o;
   {
     py::gil_scoped_release nogil;
-    const auto files = kin2grf::load_trial_and_static(s);
+    const auto files = kin2grf::load_trial_and_static(s, kin2grf::estimate_load_options());
     o = kin2grf::to_options(s);
     r = kin2grf::estimate_trial(s, o, files.trial, files.static_trial);
   }

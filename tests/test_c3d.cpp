@@ -389,6 +389,39 @@ TEST(C3dQuirks, ForcePlatformGroupWithoutAnalogDataGivesNoPlatesAndANote) {
   EXPECT_NE(back.warnings.back().find("FORCE_PLATFORM:USED = 2"), std::string::npos) << back.warnings.back();
 }
 
+// `estimate` reads the plates without their samples (C3dReadOptions::plate_samples = false):
+// the same markers, the same plates with their geometry, type and rate, no samples, and no note
+// that the file holds no analog data (it does). With samples, the plates are read as always.
+TEST(C3dQuirks, PlatesWithoutSamplesKeepTheirGeometryAndTheMarkers) {
+  C3dWriteOptions o;
+  o.analog_samples_per_frame = 4;  // small_trial's plates: 400 Hz under 100 Hz markers
+  const auto bytes = write_c3d_bytes(small_trial(), o);
+  const Trial full = read_c3d_bytes(bytes, "fp.c3d");
+  C3dReadOptions lean;
+  lean.plate_samples = false;
+  const Trial geometry = read_c3d_bytes(bytes, "fp.c3d", lean);
+  ASSERT_TRUE(full.plates && geometry.plates);
+  ASSERT_GT(full.plates->samples(), 0);
+  EXPECT_EQ(geometry.plates->samples(), 0);
+  EXPECT_EQ(geometry.plates->rate_hz, full.plates->rate_hz);
+  ASSERT_EQ(geometry.plates->plates.size(), full.plates->plates.size());
+  for (std::size_t p = 0; p < full.plates->plates.size(); ++p) {
+    const ForcePlate &a = full.plates->plates[p], &b = geometry.plates->plates[p];
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.type, b.type);
+    EXPECT_TRUE(b.has_geometry);
+    EXPECT_EQ(a.lab_R_plate, b.lab_R_plate);
+    EXPECT_EQ(a.centre_m, b.centre_m);
+    EXPECT_EQ(b.force_N.rows(), 0);
+  }
+  EXPECT_EQ(geometry.markers.names, full.markers.names);
+  for (std::size_t k = 0; k < full.markers.positions_m.size(); ++k) {
+    const auto &a = full.markers.positions_m[k].array(), &b = geometry.markers.positions_m[k].array();
+    EXPECT_TRUE((a == b || (a.isNaN() && b.isNaN())).all()) << full.markers.names[k];
+  }
+  EXPECT_EQ(geometry.warnings, full.warnings);
+}
+
 namespace {
 /// small_trial() in a Y-up lab: (x, y, z) -> (x, z, -y), plates included.
 Trial small_trial_y_up() {

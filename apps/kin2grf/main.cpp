@@ -74,7 +74,7 @@ int run_estimate(const EstimateArgs& a) {
     const auto f = kin2grf::opensim_export_paths(a.opensim_dir, std::filesystem::path(a.trial).stem().string());
     check_outputs({f.grf_mot, f.markers_trc, f.external_loads_xml}, kin2grf::input_files(a));
   }
-  const auto files = kin2grf::load_trial_and_static(a);
+  const auto files = kin2grf::load_trial_and_static(a, kin2grf::estimate_load_options());
   const kin2grf::Trial& trial = files.trial;
   auto options = kin2grf::to_options(a);
   options.progress = kin2grf::solve_progress(stderr);

@@ -470,8 +470,9 @@ double read_c3d_points(const C3dFile& f, const Bytes& b, const C3dLayout& l, con
   return to_m;
 }
 
-/// The analog channels, scaled (ANALOG:SCALE, OFFSET, GEN_SCALE, FORMAT), one row per sample.
-AnalogData read_c3d_analog(const C3dFile& f, const Bytes& b, const C3dLayout& l, const std::string& path) {
+/// The analog channels, scaled (ANALOG:SCALE, OFFSET, GEN_SCALE, FORMAT), one row per sample;
+/// without `samples`, their labels, units and rate only (no rows).
+AnalogData read_c3d_analog(const C3dFile& f, const Bytes& b, const C3dLayout& l, const std::string& path, bool samples) {
   const long nframes = l.nframes;
   const int npoints = l.npoints, nchannels = l.nchannels, spf = l.spf, analog_slots = l.analog_slots;
   const double analog_rate = l.analog_rate;
@@ -479,7 +480,8 @@ AnalogData read_c3d_analog(const C3dFile& f, const Bytes& b, const C3dLayout& l,
   // ---- Analog ---------------------------------------------------------------------------
   AnalogData analog;
   if (nchannels > 0) {
-    const long nsamples = nframes * spf;
+    const long frames_read = samples ? nframes : 0;
+    const long nsamples = frames_read * spf;
     analog.rate_hz = analog_rate;
     analog.first_time_s = (f.first_frame - 1) / f.point_rate_hz;
     analog.values.resize(nsamples, nchannels);
@@ -506,7 +508,7 @@ AnalogData read_c3d_analog(const C3dFile& f, const Bytes& b, const C3dLayout& l,
         throw InputError(path + ": ANALOG:SCALE[" + std::to_string(c + 1) + "] is not finite");
     }
     const std::size_t analog_off = static_cast<std::size_t>(npoints) * 4 * word;
-    for (long i = 0; i < nframes; ++i) {
+    for (long i = 0; i < frames_read; ++i) {
       for (int s = 0; s < spf; ++s) {
         const long row = i * spf + s;
         for (int c = 0; c < nchannels; ++c) {
@@ -532,7 +534,9 @@ void read_c3d_plates(const C3dFile& f, const C3dLayout& l, const AnalogData& ana
   // ---- Force plates -----------------------------------------------------------------------
   const int nplates = count_value(number(f, "FORCE_PLATFORM:USED", 0));
   if (nplates < 0) throw InputError(path + ": FORCE_PLATFORM:USED is not a count");
-  if (nplates > 0 && analog.values.size() == 0) {
+  // From the layout, not from `analog`, which has no rows when the samples are not read.
+  const bool no_analog_data = nchannels <= 0 || spf <= 0 || l.nframes <= 0;
+  if (nplates > 0 && no_analog_data) {
     // A static or marker-only export often keeps the lab's FORCE_PLATFORM description with no
     // analog data (e.g. RBDS001static.c3d). The markers are still good: no plates, and a note.
     t.warnings.push_back(path + ": FORCE_PLATFORM:USED = " + std::to_string(nplates) +
@@ -662,7 +666,7 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
   t.encoding = f.processor + (f.float_data ? ", float" : ", integer");
   const C3dLayout layout = c3d_layout(f, bytes.size(), path, t.warnings);
   const double to_m = read_c3d_points(f, b, layout, path, t);
-  const AnalogData analog = read_c3d_analog(f, b, layout, path);
+  const AnalogData analog = read_c3d_analog(f, b, layout, path, options.plate_samples);
   read_c3d_plates(f, layout, analog, to_m, options, path, t);
   read_c3d_events_and_subject(f, t);
   return t;

@@ -221,6 +221,12 @@ TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load)
   return out;
 }
 
+LoadOptions estimate_load_options() {
+  LoadOptions load;
+  load.c3d.plate_samples = false;
+  return load;
+}
+
 EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial, const std::optional<Trial>& st) {
   MarkerSet custom;
   std::string why;

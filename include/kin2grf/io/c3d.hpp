@@ -32,6 +32,11 @@ struct C3dReadOptions {
   /// Type-4 CAL_MATRIX storage: true = element (row i, col j) at i + 6 j (C3D arrays are stored
   /// first-index-fastest); the c3d.org TYPE-2/TYPE-4 samples agree with this order.
   bool cal_matrix_first_index_fastest = true;
+  /// false: the plates keep their geometry, type and rate but no samples (ForcePlateRecording::
+  /// samples() is 0), and the analog samples are not read. For `estimate`, which needs the plates
+  /// only to tell the lab's up axis: at 1-2 kHz their force, moment and COP in doubles are
+  /// 4-6 x the analog data's size in the file (issue 10's memory).
+  bool plate_samples = true;
 };
 
 /// One parameter as stored: numbers (int8/int16/float as double) or strings (char arrays).

@@ -77,6 +77,10 @@ struct TrialAndStatic {
 /// threads when thread_count() allows; an error is the trial's first, as when read in turn.
 TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load = {});
 
+/// How `estimate` reads its trial: C3D plates without their samples (C3dReadOptions::
+/// plate_samples), since the estimate takes nothing of the plates but the lab's up axis.
+LoadOptions estimate_load_options();
+
 /// Resolves the marker set and runs estimate() on `trial` (with its static trial `st`) with
 /// `options` (to_options(s), resolved once by the caller, who also records them); the marker
 /// set's recognition goes into the result's messages.
