@@ -144,6 +144,11 @@ std::pair<Model, ContactCalibration> model_stage(const EstimateOptions& o, Estim
   return {build_model(measure_geometry(lm), r.mass_kg, anthropometric_table(o.anthropometry)), std::move(soles)};
 }
 
+/// Whether frame i takes the running COP function (`running` empty: none does).
+bool is_running(const std::vector<bool>& running, Eigen::Index i) {
+  return static_cast<Eigen::Index>(running.size()) > i && running[static_cast<std::size_t>(i)];
+}
+
 /// Model coordinates and their derivatives, filtered at the kinematic cut-off.
 ModelMotion kinematics_stage(const EstimateOptions& o, const Model& model, EstimateResult& r) {
   const SagittalLandmarks& lm = r.landmarks;
@@ -178,12 +183,11 @@ void lag_torso_stage(const EstimateOptions& o, ModelMotion& motion, EstimateResu
   lag_torso_fore_aft(motion, added);
 }
 
-/// The contact points of every frame (D* filled into the motion), and from them the rest of the
-/// trial's calibration: the belt velocity (always, on a treadmill), the progression speed and the
-/// speed gate.
-std::pair<std::vector<FrameContacts>, TrialCalibration> contact_stage(const EstimateOptions& o, const Model& model,
-                                                                      ContactCalibration soles, EstimateResult& r,
-                                                                      ModelMotion& motion) {
+/// Which frames take the running COP function, and the rest of the trial's calibration: the belt
+/// velocity (always, on a treadmill, from every frame's contact points), the progression speed
+/// and the speed gate.
+std::pair<std::vector<bool>, TrialCalibration> contact_stage(const EstimateOptions& o, const Model& model, ContactCalibration soles,
+                                                             EstimateResult& r, const ModelMotion& motion) {
   const SagittalLandmarks& lm = r.landmarks;
   const ContactModelOptions& co = o.contact;
   std::vector<bool> running;
@@ -197,13 +201,20 @@ std::pair<std::vector<FrameContacts>, TrialCalibration> contact_stage(const Esti
       r.messages.push_back(b);
     }
   }
-  auto contacts = prepare_contacts(model, soles, co, motion, running);
   TrialCalibration cal;
   cal.contact = std::move(soles);
   if (r.frame.treadmill) {
     // Measured on every treadmill trial, whatever the solver's settings: validation's still-foot
     // rule takes it too.
-    if (const auto belt = measure_belt_velocity(contacts)) {
+    BeltVelocitySamples samples;
+    MotionFrame f;
+    FrameContacts fc;
+    for (Eigen::Index i = 0; i < motion.frames(); ++i) {
+      motion.frame(i, f);
+      contact_frame(model, cal.contact, co, is_running(running, i), f, fc);
+      samples.add(fc);
+    }
+    if (const auto belt = samples.median_mps()) {
       cal.belt_velocity_mps = *belt;
       char b[128];
       std::snprintf(b, sizeof b, std::abs(*belt) < 0.05 ? "no progression (stationary trial): ground velocity %.2f m/s"
@@ -220,24 +231,43 @@ std::pair<std::vector<FrameContacts>, TrialCalibration> contact_stage(const Esti
                   o.solver.speed_gate_ratio, cal.progression_speed_mps, o.solver.speed_gate_floor_mps);
     r.messages.push_back(b);
   }
-  return {std::move(contacts), std::move(cal)};
+  return {std::move(running), std::move(cal)};
 }
 
 /// The per-frame solve's raw results (before the post-filter).
 struct RawSolve {
   Eigen::MatrixXd lambda, torque;  ///< N x 2 np contact multipliers (n, t); N x 8 joint torques
   std::vector<std::array<bool, kMaxContactPoints>> active;
+  // What the per-foot results take of each frame's contact points (contact_frame), kept as the
+  // frames are solved instead of the points themselves.
+  std::vector<int> point_side;                     ///< each contact point's foot (fixed over the frames)
+  Eigen::MatrixXd point_x_m, point_gap_m;          ///< N x np: along progression; normal gap
+  std::array<Eigen::VectorXd, 2> inclination_rad;  ///< per side: theta_A
+  std::array<Eigen::MatrixXd, 2> sole_m;           ///< per side, N x 6: A, B, C (x, y)
 };
 
 /// Eqs. 5-10 on every frame (least squares, activation, semi-smooth iterations).
 RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResult& r, const ModelMotion& motion,
-                     const std::vector<FrameContacts>& contacts) {
+                     const std::vector<bool>& running) {
   const Eigen::Index n = motion.frames();
-  const int np = static_cast<int>(contacts.front().points.size());
   RawSolve raw;
+  {
+    MotionFrame f;
+    FrameContacts fc;
+    motion.frame(0, f);
+    contact_frame(r.model, r.calibration.contact, o.contact, is_running(running, 0), f, fc);
+    for (const auto& p : fc.points) raw.point_side.push_back(p.side);
+  }
+  const auto np = static_cast<Eigen::Index>(raw.point_side.size());
   raw.lambda.resize(n, 2 * np);
   raw.torque.resize(n, kJointCount);
   raw.active.resize(static_cast<std::size_t>(n));
+  raw.point_x_m.resize(n, np);
+  raw.point_gap_m.resize(n, np);
+  for (int side = 0; side < 2; ++side) {
+    raw.inclination_rad[side].resize(n);
+    raw.sole_m[side].resize(n, 6);
+  }
   r.iterations.resize(static_cast<std::size_t>(n));
   std::vector<char> cycled(static_cast<std::size_t>(n)), capped(static_cast<std::size_t>(n));
   // Frames are independent: each chunk of frames (about 10 us each) has its own solver
@@ -246,13 +276,24 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
   for_chunks(static_cast<std::size_t>(n), min_chunk_for(10e-6), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
     ContactSolver solver(r.model, r.calibration, o.solver);
     MotionFrame f;
+    FrameContacts fc;
     const auto step = std::max<std::size_t>(1, (end - begin) / 100);
     for (std::size_t k = begin; k < end; ++k) {
       const auto i = static_cast<Eigen::Index>(k);
       if (chunk == 0 && o.progress && (k - begin) % step == 0)
         o.progress(static_cast<long>(static_cast<double>(k) / static_cast<double>(end) * static_cast<double>(n)), static_cast<long>(n));
       motion.frame(i, f);
-      const FrameSolution s = solver.solve(f.q, f.qdd, contacts[k]);
+      contact_frame(r.model, r.calibration.contact, o.contact, is_running(running, i), f, fc);
+      const FrameSolution s = solver.solve(f.q, f.qdd, fc);
+      for (Eigen::Index j = 0; j < np; ++j) {
+        const ContactPoint& p = fc.points[static_cast<std::size_t>(j)];
+        raw.point_x_m(i, j) = p.position.x();
+        raw.point_gap_m(i, j) = p.gap_m;
+      }
+      for (int side = 0; side < 2; ++side) {
+        raw.inclination_rad[side][i] = fc.foot_inclination_rad[static_cast<std::size_t>(side)];
+        for (int c = 0; c < 3; ++c) raw.sole_m[side].block<1, 2>(i, 2 * c) = fc.sole[static_cast<std::size_t>(side)][static_cast<std::size_t>(c)].transpose();
+      }
       raw.lambda.row(i) = s.contact_lambda.transpose();
       raw.torque.row(i) = s.joint_torque_Nm.transpose();
       raw.active[k] = s.contact_active;
@@ -275,10 +316,9 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
 }
 
 /// The post-filter (Sect. 2.6) and each foot's force, COP, contact state, gap and sole.
-void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, const std::vector<FrameContacts>& contacts,
-                const RawSolve& raw) {
+void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, RawSolve& raw) {
   const Eigen::Index n = raw.lambda.rows();
-  const int np = static_cast<int>(contacts.front().points.size());
+  const int np = static_cast<int>(raw.point_side.size());
   const Eigen::MatrixXd& lam = raw.lambda;
   const auto& act = raw.active;
   // Each foot's contact state: any of its points active.
@@ -286,7 +326,7 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, con
   for (Eigen::Index i = 0; i < n; ++i)
     for (int j = 0; j < np; ++j)
       if (act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)])
-        contact[static_cast<std::size_t>(contacts[static_cast<std::size_t>(i)].points[static_cast<std::size_t>(j)].side)][static_cast<std::size_t>(i)] = true;
+        contact[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])][static_cast<std::size_t>(i)] = true;
   // Final filtering (Sect. 2.6): all multipliers at the post-filter cut-off, then inactive ones
   // back to zero. The cut-off follows the trial's stance duration (post_cutoff_cycles), within
   // what the marker rate allows.
@@ -316,26 +356,22 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, con
     f.raw_force_N = Eigen::MatrixX2d::Zero(n, 2);
     f.cop_x_m = Eigen::VectorXd::Constant(n, nan);
     f.contact = contact[static_cast<std::size_t>(side)];
-    f.inclination_rad.resize(n);
+    f.inclination_rad = std::move(raw.inclination_rad[side]);
     f.gap_m = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
-    f.sole_m.resize(n, 6);
+    f.sole_m = std::move(raw.sole_m[side]);
     for (Eigen::Index i = 0; i < n; ++i) {
       double mx = 0;
       for (int j = 0; j < np; ++j) {
-        const auto& p = contacts[static_cast<std::size_t>(i)].points[static_cast<std::size_t>(j)];
-        if (p.side != side) continue;
-        f.gap_m[i] = std::min(f.gap_m[i], p.gap_m);
+        if (raw.point_side[static_cast<std::size_t>(j)] != side) continue;
+        f.gap_m[i] = std::min(f.gap_m[i], raw.point_gap_m(i, j));
         f.force_N(i, 0) += lamf(i, 2 * j + 1);
         f.force_N(i, 1) += lamf(i, 2 * j);
         f.raw_force_N(i, 0) += lam(i, 2 * j + 1);
         f.raw_force_N(i, 1) += lam(i, 2 * j);
-        mx += lamf(i, 2 * j) * p.position.x();
+        mx += lamf(i, 2 * j) * raw.point_x_m(i, j);
       }
-      f.inclination_rad[i] = contacts[static_cast<std::size_t>(i)].foot_inclination_rad[static_cast<std::size_t>(side)];
-      const auto& sole = contacts[static_cast<std::size_t>(i)].sole[static_cast<std::size_t>(side)];
-      for (int k = 0; k < 3; ++k) f.sole_m.block<1, 2>(i, 2 * k) = sole[static_cast<std::size_t>(k)].transpose();
       if (f.contact[static_cast<std::size_t>(i)]) {
-        if (np == 2) f.cop_x_m[i] = contacts[static_cast<std::size_t>(i)].points[static_cast<std::size_t>(side)].position.x();
+        if (np == 2) f.cop_x_m[i] = raw.point_x_m(i, side);
         else if (std::abs(f.force_N(i, 1)) > 1e-6) f.cop_x_m[i] = mx / f.force_N(i, 1);
       }
     }
@@ -410,17 +446,16 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   r.model = std::move(model);
   ModelMotion motion = kinematics_stage(o, r.model, r);
   lag_torso_stage(o, motion, r);
-  auto [contacts, calibration] = contact_stage(o, r.model, std::move(soles), r, motion);
+  auto [running, calibration] = contact_stage(o, r.model, std::move(soles), r, motion);
   r.calibration = std::move(calibration);
   const auto t1 = clock::now();
-  RawSolve raw = solve_stage(trial, o, r, motion, contacts);
+  RawSolve raw = solve_stage(trial, o, r, motion, running);
   const auto t2 = clock::now();
   r.seconds_kinematics = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_dynamics = std::chrono::duration<double>(t2 - t1).count();
-  feet_stage(o, r, motion.rate_hz, contacts, raw);
+  feet_stage(o, r, motion.rate_hz, raw);
   // What only the per-foot results needed is freed before the totals take their arrays: a long
   // trial's peak memory (issue 10).
-  contacts = std::vector<FrameContacts>();
   raw = RawSolve();
   totals_stage(o, r, motion);
   return r;

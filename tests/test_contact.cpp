@@ -138,3 +138,37 @@ TEST(Contact, GroundLevelIsTheLabFloorUnlessTheFeetSayOtherwise) {
   EXPECT_NE(raised.message.find("lowest of them"), std::string::npos) << raised.message;
   EXPECT_NEAR(estimate_ground_level(lifted(-0.30)).level_m, -0.30 + lowest, 0.01) << "the origin above the floor";
 }
+
+// The pipeline makes each frame's contacts as it solves the frame (contact_frame, issue 10's
+// memory): they are the whole-trial prepare_contacts' to the bit, the reused FrameContacts keeps
+// no point of the frame before, and D* goes into the frame as prepare_contacts keeps it.
+TEST(Contact, EachFramesContactsAreTheWholeTrialsBitForBit) {
+  const Trial t = make_synthetic_trial({});
+  const auto r = run({});
+  for (FootModel model : {FootModel::Cop, FootModel::ThreePoint}) {
+    ContactModelOptions co;
+    co.foot_model = model;
+    ModelMotion whole = compute_motion(r.model, synthetic_landmarks(t), 6.0);
+    const ModelMotion bare = whole;
+    const auto all = prepare_contacts(r.model, r.calibration.contact, co, whole);
+    FrameContacts fc;
+    MotionFrame f;
+    for (Eigen::Index i = 0; i < bare.frames(); i += 7) {
+      bare.frame(i, f);
+      contact_frame(r.model, r.calibration.contact, co, false, f, fc);
+      const FrameContacts& ref = all[static_cast<std::size_t>(i)];
+      ASSERT_EQ(fc.points.size(), ref.points.size()) << i;
+      ASSERT_EQ(fc.points.size(), model == FootModel::Cop ? 2u : 6u);
+      for (std::size_t j = 0; j < fc.points.size(); ++j) {
+        EXPECT_EQ(fc.points[j].side, ref.points[j].side);
+        EXPECT_EQ(fc.points[j].position, ref.points[j].position);
+        EXPECT_EQ(fc.points[j].velocity, ref.points[j].velocity);
+        EXPECT_EQ(fc.points[j].gap_m, ref.points[j].gap_m);
+      }
+      EXPECT_EQ(fc.foot_inclination_rad, ref.foot_inclination_rad);
+      const MotionFrame kept = whole.frame(i);
+      EXPECT_EQ(f.q, kept.q) << i;
+      EXPECT_EQ(f.qdd, kept.qdd) << i;
+    }
+  }
+}

@@ -90,70 +90,86 @@ std::vector<bool> flight_frames(const Model& model, const ModelMotion& m, const 
   return out;
 }
 
+void contact_frame(const Model& model, const ContactCalibration& soles, const ContactModelOptions& o, bool running, MotionFrame& f,
+                   FrameContacts& fc) {
+  const double ground = soles.ground_level_m + o.ground_shift_m;
+  fc.points.clear();
+  for (int side = 0; side < 2; ++side) {
+    const int foot = segment(side, kFoot), toes = segment(side, kToes);
+    const auto sp = sole_points(soles, f, side);
+    fc.sole[static_cast<std::size_t>(side)] = sp;
+    fc.foot_inclination_rad[side] = -(f.q(coord::theta(foot)) - soles.feet[static_cast<std::size_t>(side)].flat_angle_rad);
+    if (o.foot_model == FootModel::ThreePoint) {
+      for (int k = 0; k < 3; ++k) {
+        const MaterialPoint mp = material_point(model, f, k < 2 ? foot : toes, sp[k]);
+        ContactPoint cp;
+        cp.side = side;
+        cp.position = sp[k];
+        cp.velocity = mp.v;
+        cp.gap_m = sp[k].y() - ground;
+        cp.jac_normal = mp.jy;
+        cp.jac_tangent = mp.jx;
+        fc.points.push_back(std::move(cp));
+      }
+      continue;
+    }
+    // Model 2: D at arc fraction s of A -> B -> C, at the lowest sole point's height (Eq. 2).
+    const double s = (running && o.running_cop ? *o.running_cop : o.cop).fraction(fc.foot_inclination_rad[side]);
+    fc.cop_fraction[side] = s;
+    const double l1 = (sp[1] - sp[0]).norm(), l2 = (sp[2] - sp[1]).norm();
+    const double along = s * (l1 + l2);
+    const Eigen::Vector2d on = along <= l1 ? sp[0] + (sp[1] - sp[0]) * (l1 > 0 ? along / l1 : 0.0)
+                                           : sp[1] + (sp[2] - sp[1]) * (l2 > 0 ? (along - l1) / l2 : 0.0);
+    const double yD = std::min({sp[0].y(), sp[1].y(), sp[2].y()});
+    const Eigen::Vector2d D(on.x(), yD);
+    // D* is the foot's material point at D.
+    const MaterialPoint mp = material_point(model, f, foot, D);
+    const int c = coord::dstar_x(side);
+    f.q.segment<2>(c) = D;
+    f.qd.segment<2>(c) = mp.v;
+    f.qdd.segment<2>(c) = mp.a;
+    ContactPoint cp;
+    cp.side = side;
+    cp.position = D;
+    cp.velocity = mp.v;
+    cp.gap_m = D.y() - ground;
+    cp.jac_normal.add(c + 1, 1.0);
+    cp.jac_tangent.add(c, 1.0);
+    fc.points.push_back(std::move(cp));
+  }
+}
+
 std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCalibration& soles, const ContactModelOptions& o,
                                             ModelMotion& m, const std::vector<bool>& running) {
   const Eigen::Index n = m.frames();
   std::vector<FrameContacts> out(static_cast<std::size_t>(n));
-  const double ground = soles.ground_level_m + o.ground_shift_m;
+  m.dstar = m.dstar_d = m.dstar_dd = Eigen::MatrixX4d::Zero(n, 4);
   MotionFrame f;
   for (Eigen::Index i = 0; i < n; ++i) {
-    FrameContacts& fc = out[static_cast<std::size_t>(i)];
     m.frame(i, f);
-    for (int side = 0; side < 2; ++side) {
-      const int foot = segment(side, kFoot), toes = segment(side, kToes);
-      const auto sp = sole_points(soles, f, side);
-      fc.sole[static_cast<std::size_t>(side)] = sp;
-      fc.foot_inclination_rad[side] = -(f.q(coord::theta(foot)) - soles.feet[static_cast<std::size_t>(side)].flat_angle_rad);
-      if (o.foot_model == FootModel::ThreePoint) {
-        for (int k = 0; k < 3; ++k) {
-          const MaterialPoint mp = material_point(model, f, k < 2 ? foot : toes, sp[k]);
-          ContactPoint cp;
-          cp.side = side;
-          cp.position = sp[k];
-          cp.velocity = mp.v;
-          cp.gap_m = sp[k].y() - ground;
-          cp.jac_normal = mp.jy;
-          cp.jac_tangent = mp.jx;
-          fc.points.push_back(std::move(cp));
-        }
-        continue;
-      }
-      // Model 2: D at arc fraction s of A -> B -> C, at the lowest sole point's height (Eq. 2).
-      const bool run = o.running_cop && static_cast<Eigen::Index>(running.size()) == n && running[static_cast<std::size_t>(i)];
-      const double s = (run ? *o.running_cop : o.cop).fraction(fc.foot_inclination_rad[side]);
-      fc.cop_fraction[side] = s;
-      const double l1 = (sp[1] - sp[0]).norm(), l2 = (sp[2] - sp[1]).norm();
-      const double along = s * (l1 + l2);
-      const Eigen::Vector2d on = along <= l1 ? sp[0] + (sp[1] - sp[0]) * (l1 > 0 ? along / l1 : 0.0)
-                                             : sp[1] + (sp[2] - sp[1]) * (l2 > 0 ? (along - l1) / l2 : 0.0);
-      const double yD = std::min({sp[0].y(), sp[1].y(), sp[2].y()});
-      const Eigen::Vector2d D(on.x(), yD);
-      // D* is the foot's material point at D.
-      const MaterialPoint mp = material_point(model, f, foot, D);
-      const int c = coord::dstar_x(side);
-      m.dstar.block<1, 2>(i, 2 * side) = D.transpose();
-      m.dstar_d.block<1, 2>(i, 2 * side) = mp.v.transpose();
-      m.dstar_dd.block<1, 2>(i, 2 * side) = mp.a.transpose();
-      ContactPoint cp;
-      cp.side = side;
-      cp.position = D;
-      cp.velocity = mp.v;
-      cp.gap_m = D.y() - ground;
-      cp.jac_normal.add(c + 1, 1.0);
-      cp.jac_tangent.add(c, 1.0);
-      fc.points.push_back(std::move(cp));
-    }
+    const bool run = static_cast<Eigen::Index>(running.size()) == n && running[static_cast<std::size_t>(i)];
+    contact_frame(model, soles, o, run, f, out[static_cast<std::size_t>(i)]);
+    m.dstar.row(i) = f.q.segment<4>(coord::dstar_x(0)).transpose();
+    m.dstar_d.row(i) = f.qd.segment<4>(coord::dstar_x(0)).transpose();
+    m.dstar_dd.row(i) = f.qdd.segment<4>(coord::dstar_x(0)).transpose();
   }
   return out;
 }
 
+void BeltVelocitySamples::add(const FrameContacts& fc) {
+  for (const auto& p : fc.points)
+    if (p.gap_m < 0.01) v_mps.push_back(p.velocity.x());
+}
+
+std::optional<double> BeltVelocitySamples::median_mps() const {
+  if (v_mps.empty()) return std::nullopt;
+  return median(v_mps);
+}
+
 std::optional<double> measure_belt_velocity(const std::vector<FrameContacts>& contacts) {
-  std::vector<double> v;
-  for (const auto& fc : contacts)
-    for (const auto& p : fc.points)
-      if (p.gap_m < 0.01) v.push_back(p.velocity.x());
-  if (v.empty()) return std::nullopt;
-  return median(std::move(v));
+  BeltVelocitySamples s;
+  for (const auto& fc : contacts) s.add(fc);
+  return s.median_mps();
 }
 
 }  // namespace kin2grf

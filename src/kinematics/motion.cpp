@@ -154,9 +154,6 @@ ModelMotion reconstruct_motion(const Model& model, Eigen::MatrixXd x, Eigen::Mat
   mm.x = std::move(x);
   mm.xd = std::move(xd);
   mm.xdd = std::move(xdd);
-  mm.dstar = Eigen::MatrixX4d::Zero(n, 4);
-  mm.dstar_d = Eigen::MatrixX4d::Zero(n, 4);
-  mm.dstar_dd = Eigen::MatrixX4d::Zero(n, 4);
   // The HAT COM's fore-aft acceleration as the chain gives it (as frame() places it), the series
   // the torso lag delays.
   Eigen::VectorXd ax(n);

@@ -139,7 +139,15 @@ struct ContactModelOptions {
 /// World positions of the sole points A, B, C of a foot in one frame (ModelMotion::frame).
 std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, const MotionFrame& frame, int side);
 
-/// Fill D* (motion.dstar and its derivatives, model 2) and return each frame's contact points. `running`
+/// One frame's contact points into `fc` (its vector is reused: no allocation once it has held a
+/// frame) and, for model 2, D*'s q, qd, qdd into `frame` (Sect. 2.3: D* is a coordinate of q).
+/// `running`: the frame takes options.running_cop. The pipeline makes each frame's contacts when
+/// it solves that frame, so no stage holds them for the whole trial (416 bytes a frame).
+void contact_frame(const Model& model, const ContactCalibration& soles, const ContactModelOptions& options, bool running,
+                   MotionFrame& frame, FrameContacts& fc);
+
+/// contact_frame over the whole trial, D* kept in motion.dstar and its derivatives (for tests
+/// and benchmarks that look at every frame's contacts). `running`
 /// (empty, or one flag per frame): frames that take options.running_cop.
 std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCalibration& soles, const ContactModelOptions& options,
                                             ModelMotion& motion,
@@ -171,6 +179,11 @@ ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_
 
 /// The belt velocity of a treadmill trial (m/s): the median horizontal velocity of the contact
 /// points within 10 mm of the floor; none when no point comes that close.
+struct BeltVelocitySamples {
+  std::vector<double> v_mps;
+  void add(const FrameContacts& fc);  ///< one frame's points, in frame order
+  [[nodiscard]] std::optional<double> median_mps() const;
+};
 std::optional<double> measure_belt_velocity(const std::vector<FrameContacts>& contacts);
 
 /// Automatic ground level: 0 (the lab floor, where capture systems put it) when the feet's

@@ -54,8 +54,9 @@ struct MotionFrame {
 };
 
 /// The model's motion over a trial, held as what determines it: the independent coordinates and
-/// their derivatives (N x 11 or 12 each), the HAT COM's fore-aft acceleration as used (N: the
-/// torso lag replaces it) and D* (N x 4: x, y per side; zero until prepare_contacts fills it).
+/// their derivatives (N x 11 or 12 each) and the HAT COM's fore-aft acceleration as used (N: the
+/// torso lag replaces it). D* (zero here) is the contact model's: contact_frame puts it into a
+/// frame, prepare_contacts keeps it for every frame.
 /// q, qd, qdd of a frame are rebuilt by frame(i), the same forward kinematics for every caller,
 /// bit for bit. Why not N x 63 matrices: three of them were 1.5 KB a frame, 44 % of a long
 /// trial's peak memory (issue 10), and rebuilding a frame costs less than streaming its 1.5 KB
@@ -66,7 +67,7 @@ struct ModelMotion {
   Model model;                         ///< the bodies frame() places (a copy: the motion stands alone)
   Eigen::MatrixXd x, xd, xdd;          ///< independent coordinates (independent_coordinates' columns)
   Eigen::VectorXd torso_ax_mps2;       ///< N: the HAT COM's fore-aft acceleration (lag_torso_fore_aft)
-  Eigen::MatrixX4d dstar, dstar_d, dstar_dd;  ///< N x 4: D* and its derivatives (coord::dstar_x)
+  Eigen::MatrixX4d dstar, dstar_d, dstar_dd;  ///< N x 4: D* and its derivatives (coord::dstar_x); empty (zero) unless prepare_contacts kept them
   [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
   /// q, qd, qdd of frame i into f.
   void frame(Eigen::Index i, MotionFrame& f) const;
