@@ -291,8 +291,9 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
         raw.point_gap_m(i, j) = p.gap_m;
       }
       for (int side = 0; side < 2; ++side) {
-        raw.inclination_rad[side][i] = fc.foot_inclination_rad[static_cast<std::size_t>(side)];
-        for (int c = 0; c < 3; ++c) raw.sole_m[side].block<1, 2>(i, 2 * c) = fc.sole[static_cast<std::size_t>(side)][static_cast<std::size_t>(c)].transpose();
+        const auto s_ = static_cast<std::size_t>(side);
+        raw.inclination_rad[s_][i] = fc.foot_inclination_rad[s_];
+        for (int c = 0; c < 3; ++c) raw.sole_m[s_].block<1, 2>(i, 2 * c) = fc.sole[s_][static_cast<std::size_t>(c)].transpose();
       }
       raw.lambda.row(i) = s.contact_lambda.transpose();
       raw.torque.row(i) = s.joint_torque_Nm.transpose();

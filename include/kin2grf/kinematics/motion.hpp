@@ -59,15 +59,17 @@ struct MotionFrame {
 /// frame, prepare_contacts keeps it for every frame.
 /// q, qd, qdd of a frame are rebuilt by frame(i), the same forward kinematics for every caller,
 /// bit for bit. Why not N x 63 matrices: three of them were 1.5 KB a frame, 44 % of a long
-/// trial's peak memory (issue 10), and rebuilding a frame costs less than streaming its 1.5 KB
-/// through the cache four times.
+/// trial's peak memory (issue 10); rebuilding each frame where it is used (the contact stage,
+/// the solve, the totals) costs the pipeline about 5 % (scripts/speed-compare.sh).
 struct ModelMotion {
   double rate_hz = 0.0;
   Eigen::VectorXd time_s;
   Model model;                         ///< the bodies frame() places (a copy: the motion stands alone)
   Eigen::MatrixXd x, xd, xdd;          ///< independent coordinates (independent_coordinates' columns)
   Eigen::VectorXd torso_ax_mps2;       ///< N: the HAT COM's fore-aft acceleration (lag_torso_fore_aft)
-  Eigen::MatrixX4d dstar, dstar_d, dstar_dd;  ///< N x 4: D* and its derivatives (coord::dstar_x); empty (zero) unless prepare_contacts kept them
+  /// N x 4: D* and its derivatives (coord::dstar_x); empty (zero in a frame) unless
+  /// prepare_contacts kept them.
+  Eigen::MatrixX4d dstar, dstar_d, dstar_dd;
   [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
   /// q, qd, qdd of frame i into f.
   void frame(Eigen::Index i, MotionFrame& f) const;
