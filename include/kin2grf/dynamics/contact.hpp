@@ -177,13 +177,14 @@ namespace kin2grf {
 /// the soles go 40 mm below the heel landmarks (no stance is invented). Its `message` says which.
 ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_level_m);
 
-/// The belt velocity of a treadmill trial (m/s): the median horizontal velocity of the contact
-/// points within 10 mm of the floor; none when no point comes that close.
+/// The belt velocity of a treadmill trial (m/s), gathered frame by frame: the median horizontal
+/// velocity of the contact points within 10 mm of the floor; none when no point comes that close.
 struct BeltVelocitySamples {
   std::vector<double> v_mps;
   void add(const FrameContacts& fc);  ///< one frame's points, in frame order
   [[nodiscard]] std::optional<double> median_mps() const;
 };
+/// BeltVelocitySamples over every frame's contacts.
 std::optional<double> measure_belt_velocity(const std::vector<FrameContacts>& contacts);
 
 /// Automatic ground level: 0 (the lab floor, where capture systems put it) when the feet's

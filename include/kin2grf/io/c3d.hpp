@@ -34,8 +34,8 @@ struct C3dReadOptions {
   bool cal_matrix_first_index_fastest = true;
   /// false: the plates keep their geometry, type and rate but no samples (ForcePlateRecording::
   /// samples() is 0), and the analog samples are not read. For `estimate`, which needs the plates
-  /// only to tell the lab's up axis: at 1-2 kHz their force, moment and COP in doubles are
-  /// 4-6 x the analog data's size in the file (issue 10's memory).
+  /// only to tell the lab's up axis: their force, moment and COP in doubles take 4 (float) to 8
+  /// (integer) times the plates' analog data in the file, at 1-2 kHz (issue 10's memory).
   bool plate_samples = true;
 };
 
