@@ -96,8 +96,8 @@ TEST(Kinematics, MeasuredTorsoLengthIsFollowedAndDifferentiated) {
 
 // The upper body's fore-aft lag (lag_torso_fore_aft): only the HAT COM's fore-aft acceleration
 // changes, causally (nothing before a step moves), delayed whole (a delay, not a filter); tau = 0
-// changes nothing. In the whole estimate the vertical
-// force sum is untouched and the fore-aft one is not.
+// changes nothing. In the whole estimate the vertical force sum is untouched and the fore-aft one
+// is not.
 TEST(Kinematics, TorsoLagDelaysOnlyTheTorsosForeAftAcceleration) {
   const Trial t = make_synthetic_trial({});
   const auto r = run({});
