@@ -144,11 +144,6 @@ std::pair<Model, ContactCalibration> model_stage(const EstimateOptions& o, Estim
   return {build_model(measure_geometry(lm), r.mass_kg, anthropometric_table(o.anthropometry)), std::move(soles)};
 }
 
-/// Whether frame i takes the running COP function (`running` empty: none does).
-bool is_running(const std::vector<bool>& running, Eigen::Index i) {
-  return static_cast<Eigen::Index>(running.size()) > i && running[static_cast<std::size_t>(i)];
-}
-
 /// Model coordinates and their derivatives, filtered at the kinematic cut-off.
 ModelMotion kinematics_stage(const EstimateOptions& o, const Model& model, EstimateResult& r) {
   const SagittalLandmarks& lm = r.landmarks;
@@ -211,7 +206,7 @@ std::pair<std::vector<bool>, TrialCalibration> contact_stage(const EstimateOptio
     FrameContacts fc;
     for (Eigen::Index i = 0; i < motion.frames(); ++i) {
       motion.frame(i, f);
-      contact_frame(model, cal.contact, co, is_running(running, i), f, fc);
+      contact_frame(model, cal.contact, co, is_running_frame(running, i), f, fc);
       samples.add(fc);
     }
     if (const auto belt = samples.median_mps()) {
@@ -255,7 +250,7 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
     MotionFrame f;
     FrameContacts fc;
     motion.frame(0, f);
-    contact_frame(r.model, r.calibration.contact, o.contact, is_running(running, 0), f, fc);
+    contact_frame(r.model, r.calibration.contact, o.contact, is_running_frame(running, 0), f, fc);
     for (const auto& p : fc.points) raw.point_side.push_back(p.side);
   }
   const auto np = static_cast<Eigen::Index>(raw.point_side.size());
@@ -283,7 +278,7 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
       if (chunk == 0 && o.progress && (k - begin) % step == 0)
         o.progress(static_cast<long>(static_cast<double>(k) / static_cast<double>(end) * static_cast<double>(n)), static_cast<long>(n));
       motion.frame(i, f);
-      contact_frame(r.model, r.calibration.contact, o.contact, is_running(running, i), f, fc);
+      contact_frame(r.model, r.calibration.contact, o.contact, is_running_frame(running, i), f, fc);
       const FrameSolution s = solver.solve(f.q, f.qdd, fc);
       for (Eigen::Index j = 0; j < np; ++j) {
         const ContactPoint& p = fc.points[static_cast<std::size_t>(j)];

@@ -147,8 +147,7 @@ std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCal
   MotionFrame f;
   for (Eigen::Index i = 0; i < n; ++i) {
     m.frame(i, f);
-    const bool run = static_cast<Eigen::Index>(running.size()) == n && running[static_cast<std::size_t>(i)];
-    contact_frame(model, soles, o, run, f, out[static_cast<std::size_t>(i)]);
+    contact_frame(model, soles, o, is_running_frame(running, i), f, out[static_cast<std::size_t>(i)]);
     m.dstar.row(i) = f.q.segment<4>(coord::dstar_x(0)).transpose();
     m.dstar_d.row(i) = f.qd.segment<4>(coord::dstar_x(0)).transpose();
     m.dstar_dd.row(i) = f.qdd.segment<4>(coord::dstar_x(0)).transpose();
@@ -164,12 +163,6 @@ void BeltVelocitySamples::add(const FrameContacts& fc) {
 std::optional<double> BeltVelocitySamples::median_mps() const {
   if (v_mps.empty()) return std::nullopt;
   return median(v_mps);
-}
-
-std::optional<double> measure_belt_velocity(const std::vector<FrameContacts>& contacts) {
-  BeltVelocitySamples s;
-  for (const auto& fc : contacts) s.add(fc);
-  return s.median_mps();
 }
 
 }  // namespace kin2grf

@@ -94,9 +94,8 @@ Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm) {
 }
 
 void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
-  f.q.setZero();
-  f.qd.setZero();
-  f.qdd.setZero();
+  // Every coordinate is written below (each landmark is a body's proximal or attached point);
+  // D* is zero where the motion keeps none.
   // Bodies in an order where the parent comes first (the torso, then each leg down).
   static constexpr int order[] = {kTorso, kThighR, kShankR, kFootR, kToesR, kThighL, kShankL, kFootL, kToesL};
   std::array<double, kSegmentCount> th{}, w{}, al{};
@@ -141,6 +140,10 @@ void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
     f.q.segment<4>(coord::dstar_x(0)) = dstar.row(i).transpose();
     f.qd.segment<4>(coord::dstar_x(0)) = dstar_d.row(i).transpose();
     f.qdd.segment<4>(coord::dstar_x(0)) = dstar_dd.row(i).transpose();
+  } else {
+    f.q.segment<4>(coord::dstar_x(0)).setZero();
+    f.qd.segment<4>(coord::dstar_x(0)).setZero();
+    f.qdd.segment<4>(coord::dstar_x(0)).setZero();
   }
 }
 
@@ -206,11 +209,11 @@ double measured_torso_lag_s(const ModelMotion& m) {
   const Eigen::Index n = m.frames(), m0 = n / 10;
   const Eigen::Index m1 = std::min(n - n / 10, m0 + static_cast<Eigen::Index>(std::min(60.0 * m.rate_hz, static_cast<double>(n))));
   // The hip's fore-aft acceleration is its independent coordinate's (column 0).
-  const Eigen::VectorXd& hip = m.xdd.col(0);
-  const Eigen::VectorXd& hat = m.torso_ax_mps2;
+  using Series = Eigen::Ref<const Eigen::VectorXd>;  // views, no copies
+  const Series hip = m.xdd.col(0), hat = m.torso_ax_mps2;
   const int reach = std::max(1, static_cast<int>(0.08 * m.rate_hz));
   // The peak lag of y behind x, in frames (parabola through the peak); NaN without a positive peak.
-  auto peak_lag = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
+  auto peak_lag = [&](const Series& x, const Series& y) {
     std::vector<double> r(static_cast<std::size_t>(2 * reach + 1));
     for (int lag = -reach; lag <= reach; ++lag) {
       double sum = 0;

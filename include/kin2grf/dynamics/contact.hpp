@@ -146,6 +146,11 @@ std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, cons
 void contact_frame(const Model& model, const ContactCalibration& soles, const ContactModelOptions& options, bool running,
                    MotionFrame& frame, FrameContacts& fc);
 
+/// Whether frame i takes the running COP function (`running`: flight_frames' flags; empty, none).
+inline bool is_running_frame(const std::vector<bool>& running, Eigen::Index i) {
+  return static_cast<Eigen::Index>(running.size()) > i && running[static_cast<std::size_t>(i)];
+}
+
 /// contact_frame over the whole trial, D* kept in motion.dstar and its derivatives (for tests
 /// and benchmarks that look at every frame's contacts). `running`
 /// (empty, or one flag per frame): frames that take options.running_cop.
@@ -184,8 +189,6 @@ struct BeltVelocitySamples {
   void add(const FrameContacts& fc);  ///< one frame's points, in frame order
   [[nodiscard]] std::optional<double> median_mps() const;
 };
-/// BeltVelocitySamples over every frame's contacts.
-std::optional<double> measure_belt_velocity(const std::vector<FrameContacts>& contacts);
 
 /// Automatic ground level: 0 (the lab floor, where capture systems put it) when the feet's
 /// flat-stance landmarks stand 0-150 mm above it; otherwise the lowest of them (a raised or
