@@ -3,19 +3,24 @@
 # (issue 10's target: at most twice the file's size plus a constant). Uses the release build.
 #   bash scripts/memory.sh [SECONDS] [DATA_DIR]   (default 600: 60,000 frames of the synthetic walk;
 #   then, where DATA_DIR (../shared/data) is, four lab C3D files with their scripts/trials.txt options)
+# Each run writes the outputs a user asks for (-o GRF.mot, --csv, --json), as their writing is part
+# of the peak. KIN2GRF=path/to/kin2grf measures another build (the release build by default).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_LONG=${1:-600}
 DATA=${2:-../shared/data}
-cmake --preset release >/dev/null
-cmake --build --preset release >/dev/null
+if [ -z "${KIN2GRF:-}" ]; then
+  cmake --preset release >/dev/null
+  cmake --build --preset release >/dev/null
+fi
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
-K=build/release/kin2grf
+K=${KIN2GRF:-build/release/kin2grf}
+OUTS=(-o "$WORK/out.mot" --csv "$WORK/out.csv" --json "$WORK/out.json")
 "$K" make-example --out-dir "$WORK" --seconds "$SECONDS_LONG" >/dev/null
 for f in example_walk.c3d example_walk.trc; do
   size=$(stat -c %s "$WORK/$f")
-  /usr/bin/time -o "$WORK/peak" -f "%M" "$K" estimate "$WORK/$f" --mass 70 >/dev/null 2>&1
+  /usr/bin/time -o "$WORK/peak" -f "%M" "$K" estimate "$WORK/$f" --mass 70 "${OUTS[@]}" >/dev/null 2>&1
   /usr/bin/time -o "$WORK/base" -f "%M" "$K" --version >/dev/null
   peak_kb=$(tail -1 "$WORK/peak")
   base_kb=$(tail -1 "$WORK/base")
@@ -31,7 +36,7 @@ for f in opensim_c3d_overground_walk/walking2.c3d btk_plugingait_walk/PiG_Motion
   [ -n "$args" ] || args="$DATA/$f"
   size=$(stat -c %s "$DATA/$f")
   # shellcheck disable=SC2086
-  /usr/bin/time -o "$WORK/peak" -f "%M" "$K" estimate $args >/dev/null 2>&1
+  /usr/bin/time -o "$WORK/peak" -f "%M" "$K" estimate $args "${OUTS[@]}" >/dev/null 2>&1
   peak_kb=$(tail -1 "$WORK/peak")
   awk -v f="$(basename "$f")" -v s="$size" -v p="$peak_kb" 'BEGIN {
     printf "%-28s file %5.2f MB  peak %6.1f MB  peak / file %5.1f\n", f, s / 1e6, p * 1024 / 1e6, p * 1024 / s }'

@@ -457,28 +457,33 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   return r;
 }
 
+LabFootFrame lab_foot_frame(const EstimateResult& r, int side, Eigen::Index i) {
+  const auto& f = r.feet[static_cast<std::size_t>(side)];
+  const Eigen::Index k = r.first_index + i;  // the trial frame (a turning frame's heading)
+  LabFootFrame out;
+  out.force_N = f.force_N(i, 0) * r.frame.forward_at(k) + f.force_N(i, 1) * r.frame.up;
+  if (std::isfinite(f.cop_x_m[i]))
+    out.cop_m = r.frame.to_lab(f.cop_x_m[i], r.ground_level_m(), r.foot_lateral_m[static_cast<std::size_t>(side)][i], k);
+  else
+    out.cop_m.setConstant(std::numeric_limits<double>::quiet_NaN());
+  return out;
+}
+
 std::array<ForcePlate, 2> as_lab_plates(const EstimateResult& r) {
   std::array<ForcePlate, 2> out;
   const Eigen::Index n = r.time_s.size();
-  const double nan = std::numeric_limits<double>::quiet_NaN();
   for (int side = 0; side < 2; ++side) {
-    ForcePlate& p = out[side];
+    ForcePlate& p = out[static_cast<std::size_t>(side)];
     p.name = side ? "left" : "right";
     p.side_hint = side ? Side::Left : Side::Right;
     p.force_N.resize(n, 3);
     p.cop_m.resize(n, 3);
     p.free_moment_Nm = Eigen::MatrixX3d::Zero(n, 3);
-    p.moment_centre_Nm = Eigen::MatrixX3d::Constant(n, 3, nan);
+    p.moment_centre_Nm = Eigen::MatrixX3d::Constant(n, 3, std::numeric_limits<double>::quiet_NaN());
     for (Eigen::Index i = 0; i < n; ++i) {
-      const auto& f = r.feet[side];
-      const Eigen::Index k = r.first_index + i;  // the trial frame (a turning frame's heading)
-      const Eigen::Vector3d F = f.force_N(i, 0) * r.frame.forward_at(k) + f.force_N(i, 1) * r.frame.up;
-      p.force_N.row(i) = F.transpose();
-      if (std::isfinite(f.cop_x_m[i])) {
-        p.cop_m.row(i) = r.frame.to_lab(f.cop_x_m[i], r.ground_level_m(), r.foot_lateral_m[side][i], k).transpose();
-      } else {
-        p.cop_m.row(i).setConstant(nan);
-      }
+      const LabFootFrame f = lab_foot_frame(r, side, i);
+      p.force_N.row(i) = f.force_N.transpose();
+      p.cop_m.row(i) = f.cop_m.transpose();
     }
   }
   return out;

@@ -6,6 +6,9 @@
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/opensim.hpp"
+#include "kin2grf/io/text.hpp"
+#include "kin2grf/output/results.hpp"
+#include "kin2grf/synth/example.hpp"
 #include "test_support.hpp"
 
 using namespace kin2grf;
@@ -197,4 +200,36 @@ TEST(Trc, AHeaderOfManyMarkersOverManyShortRowsIsRefusedBeforeAllocating) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("markers over 20000 rows"), std::string::npos) << e.what();
   }
+}
+
+// The GRF .mot and the CSV are written row by row as they are made (never held whole: issue 10's
+// memory): byte for byte what the whole-table writers (grf_table + format_sto, results_table)
+// give, over more than one of the writers' 64 KB buffers.
+TEST(Outputs, StreamedWritersWriteWhatTheWholeTablesWould) {
+  SyntheticOptions so;
+  so.duration_s = 12.0;
+  const EstimateResult r = test::run(so);
+  const auto dir = test::temp_dir("streamed_outputs");
+  const std::string mot = (dir / "e.mot").string(), csv = (dir / "e.csv").string();
+  write_grf_mot(mot, r, "{\"a\":1}");
+  write_results_csv(csv, r);
+  const auto plates = as_lab_plates(r);
+  Table t = grf_table(r.time_s, plates[0], plates[1]);
+  t.name = "kin2grf_estimated_grf";
+  t.header["DataType"] = "double";
+  t.header["kin2grf_version"] = KIN2GRF_VERSION;
+  t.header["kin2grf_settings"] = "{\"a\":1}";
+  const std::string mot_text = read_file_text(mot);
+  EXPECT_GT(mot_text.size(), std::size_t{1} << 16);
+  EXPECT_EQ(mot_text, format_sto(t));
+  const std::string csv_text = read_file_text(csv);
+  EXPECT_GT(csv_text.size(), std::size_t{1} << 17);
+  EXPECT_EQ(csv_text, format_results_csv(r));
+  // The CSV's rows are results_table's (6 significant digits).
+  const ResultsTable table = results_table(r);
+  const Table back = parse_sto(mot_text, "e.mot");
+  ASSERT_EQ(back.data.rows(), r.time_s.size());
+  EXPECT_NEAR(back.data(r.time_s.size() / 2, 2), plates[0].force_N(r.time_s.size() / 2, 1), 1e-4 * 1000);
+  EXPECT_EQ(table.values.rows(), r.time_s.size());
+  EXPECT_EQ(static_cast<std::size_t>(table.values.cols()), results_columns().size());
 }

@@ -82,7 +82,7 @@ int run_estimate(const EstimateArgs& a) {
   print_messages(r);
   const std::string settings_line = kin2grf::settings_json(a, options).dump();
   if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r, settings_line);
-  if (!a.out_csv.empty()) kin2grf::write_file_text(a.out_csv, kin2grf::format_results_csv(r));
+  if (!a.out_csv.empty()) kin2grf::write_results_csv(a.out_csv, r);
   if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(kin2grf::results_summary(r, kin2grf::settings_json(a, options))));
   std::cout << kin2grf::format_results_text(r);
   for (const auto& [file, what] : {std::pair{a.out_mot, "OpenSim GRF"}, {a.out_csv, "per-frame CSV"}, {a.out_json, "JSON summary"}})

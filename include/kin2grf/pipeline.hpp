@@ -112,7 +112,14 @@ double progression_speed(const SagittalLandmarks& lm);
 EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set,
                         const EstimateOptions& options);
 
-/// The per-foot results as lab-frame force plates (force, COP, free moment), for the .mot writer.
+/// One foot's result at one processed frame in the lab frame of the input: force on the body (N)
+/// and COP (m; NaN without contact). A turning trial's frame takes that frame's heading.
+struct LabFootFrame {
+  Eigen::Vector3d force_N, cop_m;
+};
+LabFootFrame lab_foot_frame(const EstimateResult& r, int side, Eigen::Index i);
+/// The per-foot results as lab-frame force plates (force, COP, free moment), lab_foot_frame for
+/// every frame.
 std::array<ForcePlate, 2> as_lab_plates(const EstimateResult& r);
 
 }  // namespace kin2grf

@@ -361,9 +361,9 @@ Table parse_sto(std::string_view text, const std::string& path) {
   return t;
 }
 
-std::string format_sto(const Table& t) {
+std::string sto_header(const Table& t, Eigen::Index rows) {
   std::ostringstream os;
-  os << (t.name.empty() ? "kin2grf" : t.name) << "\nversion=1\nnRows=" << t.data.rows()
+  os << (t.name.empty() ? "kin2grf" : t.name) << "\nversion=1\nnRows=" << rows
      << "\nnColumns=" << t.labels.size() << "\ninDegrees=" << (t.in_degrees ? "yes" : "no");
   for (const auto& [k, v] : t.header) {
     if (k == "version" || k == "nRows" || k == "nColumns" || k == "inDegrees") continue;
@@ -372,21 +372,31 @@ std::string format_sto(const Table& t) {
   os << "\nendheader\n";
   for (std::size_t c = 0; c < t.labels.size(); ++c) os << (c ? "\t" : "") << t.labels[c];
   os << "\n";
-  // The numbers straight into the text (as fmt() writes them), not through the stream.
-  std::string out = os.str();
-  out.reserve(out.size() + static_cast<std::size_t>(t.data.size()) * 14);
+  return os.str();
+}
+
+void append_sto_row(std::string& out, std::span<const double> values) {
+  // The numbers straight into the text (as fmt() writes them), not through a stream.
   char buf[64];
-  for (Eigen::Index r = 0; r < t.data.rows(); ++r) {
-    for (Eigen::Index c = 0; c < t.data.cols(); ++c) {
-      if (c) out += '\t';
-      const double v = t.data(r, c);
-      if (!std::isfinite(v)) {
-        out += "NaN";
-        continue;
-      }
-      out.append(buf, std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 8).ptr);
+  for (std::size_t c = 0; c < values.size(); ++c) {
+    if (c) out += '\t';
+    const double v = values[c];
+    if (!std::isfinite(v)) {
+      out += "NaN";
+      continue;
     }
-    out += '\n';
+    out.append(buf, std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 8).ptr);
+  }
+  out += '\n';
+}
+
+std::string format_sto(const Table& t) {
+  std::string out = sto_header(t, t.data.rows());
+  out.reserve(out.size() + static_cast<std::size_t>(t.data.size()) * 14);
+  std::vector<double> row(static_cast<std::size_t>(t.data.cols()));
+  for (Eigen::Index r = 0; r < t.data.rows(); ++r) {
+    for (Eigen::Index c = 0; c < t.data.cols(); ++c) row[static_cast<std::size_t>(c)] = t.data(r, c);
+    append_sto_row(out, row);
   }
   return out;
 }
@@ -469,17 +479,22 @@ std::optional<ForcePlateRecording> grf_from_table(const Table& t, const std::str
   return rec;
 }
 
+std::vector<std::string> grf_labels() {
+  std::vector<std::string> labels = {"time"};
+  const char* ax = "xyz";
+  for (const std::string prefix : {"", "1_"}) {
+    for (int a = 0; a < 3; ++a) labels.push_back(prefix + "ground_force_v" + ax[a]);
+    for (int a = 0; a < 3; ++a) labels.push_back(prefix + "ground_force_p" + ax[a]);
+  }
+  for (const std::string prefix : {"", "1_"})
+    for (int a = 0; a < 3; ++a) labels.push_back(prefix + "ground_torque_" + ax[a]);
+  return labels;
+}
+
 Table grf_table(const Eigen::VectorXd& time_s, const ForcePlate& right, const ForcePlate& left) {
   Table t;
   t.name = "kin2grf_grf";
-  t.labels = {"time"};
-  const char* ax = "xyz";
-  for (const std::string prefix : {"", "1_"}) {
-    for (int a = 0; a < 3; ++a) t.labels.push_back(prefix + "ground_force_v" + ax[a]);
-    for (int a = 0; a < 3; ++a) t.labels.push_back(prefix + "ground_force_p" + ax[a]);
-  }
-  for (const std::string prefix : {"", "1_"})
-    for (int a = 0; a < 3; ++a) t.labels.push_back(prefix + "ground_torque_" + ax[a]);
+  t.labels = grf_labels();
   const Eigen::Index n = time_s.size();
   t.data.resize(n, static_cast<Eigen::Index>(t.labels.size()));
   for (Eigen::Index i = 0; i < n; ++i) {

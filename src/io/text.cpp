@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -105,29 +106,39 @@ MappedFile::~MappedFile() {
   if (mapped_) ::munmap(const_cast<char*>(mapped_), size_);
 }
 
-void write_file_text(const std::string& path, std::string_view text) {
-  // Through a temporary file in the same folder, renamed at the end: a failed or interrupted run
-  // leaves the old file (or none), never half a file.
+AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path tmp = target.parent_path() / (target.filename().string() + ".kin2grf-tmp");
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw InputError(path + ": cannot open for writing (" + std::strerror(errno) + ")");
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw InputError(path + ": write failed (" + std::strerror(errno) + ")");
-    }
-  }
+  const fs::path target(path_);
+  tmp_ = (target.parent_path() / (target.filename().string() + ".kin2grf-tmp")).string();
+  out_ = std::make_unique<std::ofstream>(tmp_, std::ios::binary);
+  if (!*out_) throw InputError(path_ + ": cannot open for writing (" + std::strerror(errno) + ")");
+}
+
+AtomicFile::~AtomicFile() {
+  if (committed_) return;
+  out_.reset();
   std::error_code ec;
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw InputError(path + ": cannot replace the file (" + ec.message() + ")");
-  }
+  std::filesystem::remove(tmp_, ec);
+}
+
+std::ostream& AtomicFile::stream() { return *out_; }
+
+void AtomicFile::commit() {
+  out_->flush();
+  const bool ok = static_cast<bool>(*out_);
+  const int err = errno;
+  out_->close();
+  if (!ok || !*out_) throw InputError(path_ + ": write failed (" + std::strerror(err) + ")");
+  std::error_code ec;
+  std::filesystem::rename(tmp_, path_, ec);
+  if (ec) throw InputError(path_ + ": cannot replace the file (" + ec.message() + ")");
+  committed_ = true;
+}
+
+void write_file_text(const std::string& path, std::string_view text) {
+  AtomicFile f(path);
+  f.stream() << text;
+  f.commit();
 }
 
 void ensure_not_an_input(const std::string& output, const std::vector<std::string>& inputs) {

@@ -4,26 +4,57 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <string>
 
 #include "kin2grf/io/opensim.hpp"
+#include "kin2grf/io/text.hpp"
 #include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
 
+namespace {
+
+/// Rows are gathered into a buffer and written out every so often: the file is written as it is
+/// made, never held whole (issue 10).
+constexpr std::size_t kFlushBytes = std::size_t{1} << 16;
+
+void flush_if_full(std::string& buf, std::ostream& os, bool force = false) {
+  if (force || buf.size() >= kFlushBytes) {
+    os.write(buf.data(), static_cast<std::streamsize>(buf.size()));
+    buf.clear();
+  }
+}
+
+}  // namespace
+
 void write_grf_mot(const std::string& path, const EstimateResult& r, const std::string& settings) {
-  const auto plates = as_lab_plates(r);
-  Table t = grf_table(r.time_s, plates[0], plates[1]);
+  Table t;
   t.name = "kin2grf_estimated_grf";
+  t.labels = grf_labels();
   t.header["DataType"] = "double";
   t.header["kin2grf_version"] = KIN2GRF_VERSION;
   if (!settings.empty()) t.header["kin2grf_settings"] = settings;
-  write_sto(path, t);
+  const Eigen::Index n = r.time_s.size();
+  AtomicFile file(path);
+  std::string buf = sto_header(t, n);
+  std::array<double, 19> row{};  // time, per foot force and COP (NaN -> 0), per foot free moment (0)
+  for (Eigen::Index i = 0; i < n; ++i) {
+    std::size_t c = 0;
+    row[c++] = r.time_s[i];
+    for (int side = 0; side < 2; ++side) {
+      const LabFootFrame f = lab_foot_frame(r, side, i);
+      for (int a = 0; a < 3; ++a) row[c++] = f.force_N[a];
+      for (int a = 0; a < 3; ++a) row[c++] = std::isfinite(f.cop_m[a]) ? f.cop_m[a] : 0.0;
+    }
+    append_sto_row(buf, row);
+    flush_if_full(buf, file.stream());
+  }
+  flush_if_full(buf, file.stream(), true);
+  file.commit();
 }
 
-ResultsTable results_table(const EstimateResult& r) {
-  ResultsTable t;
-  auto& c = t.columns;
-  c = {"frame", "time_s"};
+std::vector<std::string> results_columns() {
+  std::vector<std::string> c = {"frame", "time_s"};
   for (const char* s : {"r", "l"})
     for (const char* name : {"grf_anterior_%s_N", "grf_vertical_%s_N", "cop_x_%s_m", "contact_%s", "gap_%s_m",
                              "foot_inclination_%s_rad", "grf_vertical_unfiltered_%s_N"}) {
@@ -38,50 +69,74 @@ ResultsTable results_table(const EstimateResult& r) {
     c.push_back(std::string("force_") + joint_name(j) + "_y_N");
   }
   for (const char* name : {"residual_x_N", "residual_y_N", "residual_moment_Nm", "iterations"}) c.emplace_back(name);
+  return c;
+}
+
+void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> v) {
+  std::size_t k = 0;
+  v[k++] = static_cast<double>(r.first_frame_number + i);
+  v[k++] = r.time_s[i];
+  for (int s = 0; s < 2; ++s) {
+    const auto& f = r.feet[static_cast<std::size_t>(s)];
+    v[k++] = f.force_N(i, 0), v[k++] = f.force_N(i, 1), v[k++] = f.cop_x_m[i];
+    v[k++] = f.contact[static_cast<std::size_t>(i)] ? 1.0 : 0.0;
+    v[k++] = f.gap_m[i], v[k++] = f.inclination_rad[i], v[k++] = f.raw_force_N(i, 1);
+  }
+  v[k++] = r.grm_Nm[i];
+  for (int j = 0; j < kJointCount; ++j) v[k++] = r.joint_torque_Nm(i, j);
+  for (int j = 0; j < 2 * kJointCount; ++j) v[k++] = r.joint_force_N(i, j);
+  for (int j = 0; j < 3; ++j) v[k++] = r.residual(i, j);
+  v[k++] = r.iterations[static_cast<std::size_t>(i)];
+}
+
+ResultsTable results_table(const EstimateResult& r) {
+  ResultsTable t;
+  t.columns = results_columns();
   const Eigen::Index n = r.time_s.size();
-  auto& v = t.values;
-  v.resize(n, static_cast<Eigen::Index>(c.size()));
+  const auto nc = static_cast<Eigen::Index>(t.columns.size());
+  t.values.resize(n, nc);
+  std::vector<double> row(static_cast<std::size_t>(nc));
   for (Eigen::Index i = 0; i < n; ++i) {
-    Eigen::Index k = 0;
-    v(i, k++) = static_cast<double>(r.first_frame_number + i);
-    v(i, k++) = r.time_s[i];
-    for (int s = 0; s < 2; ++s) {
-      const auto& f = r.feet[s];
-      v(i, k++) = f.force_N(i, 0), v(i, k++) = f.force_N(i, 1), v(i, k++) = f.cop_x_m[i];
-      v(i, k++) = f.contact[static_cast<std::size_t>(i)] ? 1.0 : 0.0;
-      v(i, k++) = f.gap_m[i], v(i, k++) = f.inclination_rad[i], v(i, k++) = f.raw_force_N(i, 1);
-    }
-    v(i, k++) = r.grm_Nm[i];
-    for (int j = 0; j < kJointCount; ++j) v(i, k++) = r.joint_torque_Nm(i, j);
-    for (int j = 0; j < 2 * kJointCount; ++j) v(i, k++) = r.joint_force_N(i, j);
-    for (int j = 0; j < 3; ++j) v(i, k++) = r.residual(i, j);
-    v(i, k++) = r.iterations[static_cast<std::size_t>(i)];
+    results_row(r, i, row);
+    t.values.row(i) = Eigen::Map<const Eigen::RowVectorXd>(row.data(), nc);
   }
   return t;
 }
 
-std::string format_results_csv(const EstimateResult& r) {
-  const ResultsTable t = results_table(r);
-  std::ostringstream os;
-  for (std::size_t k = 0; k < t.columns.size(); ++k) os << (k ? "," : "") << t.columns[k];
-  os << "\n";
+void write_results_csv(std::ostream& os, const EstimateResult& r) {
+  const std::vector<std::string> columns = results_columns();
+  std::string buf;
+  for (std::size_t k = 0; k < columns.size(); ++k) (buf += k ? "," : "") += columns[k];
+  buf += '\n';
   // Counts (frame, contact, iterations) as integers; the rest to 6 significant digits; NaN empty.
-  std::vector<bool> integer(t.columns.size());
-  for (std::size_t k = 0; k < t.columns.size(); ++k)
-    integer[k] = t.columns[k] == "frame" || t.columns[k].rfind("contact_", 0) == 0 || t.columns[k] == "iterations";
-  char buf[64];
-  for (Eigen::Index i = 0; i < t.values.rows(); ++i) {
-    for (Eigen::Index k = 0; k < t.values.cols(); ++k) {
-      const double x = t.values(i, k);
-      if (k) os << ',';
-      if (integer[static_cast<std::size_t>(k)]) os << static_cast<long long>(x);
-      else if (std::isfinite(x)) {
-        const auto end = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::general, 6).ptr;  // = %.6g
-        os.write(buf, end - buf);
-      }
+  std::vector<bool> integer(columns.size());
+  for (std::size_t k = 0; k < columns.size(); ++k)
+    integer[k] = columns[k] == "frame" || columns[k].rfind("contact_", 0) == 0 || columns[k] == "iterations";
+  std::vector<double> row(columns.size());
+  char num[64];
+  for (Eigen::Index i = 0; i < r.time_s.size(); ++i) {
+    results_row(r, i, row);
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      const double x = row[k];
+      if (k) buf += ',';
+      if (integer[k]) buf += std::to_string(static_cast<long long>(x));
+      else if (std::isfinite(x)) buf.append(num, std::to_chars(num, num + sizeof num, x, std::chars_format::general, 6).ptr);  // = %.6g
     }
-    os << "\n";
+    buf += '\n';
+    flush_if_full(buf, os);
   }
+  flush_if_full(buf, os, true);
+}
+
+void write_results_csv(const std::string& path, const EstimateResult& r) {
+  AtomicFile file(path);
+  write_results_csv(file.stream(), r);
+  file.commit();
+}
+
+std::string format_results_csv(const EstimateResult& r) {
+  std::ostringstream os;
+  write_results_csv(os, r);
   return os.str();
 }
 

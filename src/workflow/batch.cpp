@@ -101,7 +101,7 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
       }();
       const std::string csv = base.string() + ".csv", mot = base.string() + "_grf.mot", json = base.string() + ".json";
       for (const auto& o : {csv, mot, json}) ensure_not_an_input(o, inputs);
-      write_file_text(csv, format_results_csv(r));
+      write_results_csv(csv, r);
       auto settings = settings_json(s, estimate_options);
       write_grf_mot(mot, r, settings.dump());
       write_file_text(json, json_text(v ? validation_json(entry.name, r, *v, settings) : results_summary(r, settings)));

@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -42,6 +43,11 @@ Table read_sto(const std::string& path);
 Table parse_sto(std::string_view text, const std::string& path);
 /// OpenSim 4 header (version=1, nRows, nColumns, inDegrees, endheader).
 std::string format_sto(const Table& t);
+/// format_sto's header and column labels for a table of `rows` rows (t.data is not read), and
+/// one row of numbers as format_sto writes them (8 significant digits, NaN): for writers that
+/// stream their rows instead of holding the table.
+std::string sto_header(const Table& t, Eigen::Index rows);
+void append_sto_row(std::string& out, std::span<const double> values);
 void write_sto(const std::string& path, const Table& t);
 
 /// The GRF channel sets of a table (empty when it has none). Time regularised to a uniform grid
@@ -50,6 +56,9 @@ std::optional<ForcePlateRecording> grf_from_table(const Table& t, const std::str
                                                   double cop_threshold_N,
                                                   std::vector<std::string>& warnings);
 
+/// grf_table's column labels: time, then each foot's ground_force_v and _p (right unprefixed,
+/// left `1_`-prefixed), then each foot's ground_torque_.
+std::vector<std::string> grf_labels();
 /// OpenSim ExternalLoads-ready table: right foot unprefixed, left foot `1_`-prefixed.
 Table grf_table(const Eigen::VectorXd& time_s, const ForcePlate& right, const ForcePlate& left);
 

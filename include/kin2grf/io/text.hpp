@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cstdint>
+#include <fstream>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -37,6 +39,25 @@ class MappedFile {
   const char* mapped_ = nullptr;
   std::size_t size_ = 0;
   std::string copy_;
+};
+/// A file written through a temporary file in the same folder (PATH.kin2grf-tmp), renamed over
+/// `path` by commit(): a failed or interrupted run leaves the old file (or none), never half a
+/// file. Written as it is made, so a long trial's output is never held whole in memory (issue 10).
+/// Destroyed uncommitted (an exception on the way), the temporary file is removed.
+class AtomicFile {
+ public:
+  explicit AtomicFile(std::string path);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  std::ostream& stream();
+  /// Flushes, checks every write succeeded, renames: InputError naming the file otherwise.
+  void commit();
+
+ private:
+  std::string path_, tmp_;
+  std::unique_ptr<std::ofstream> out_;
+  bool committed_ = false;
 };
 /// Write through a temporary file renamed at the end (no half file on failure).
 void write_file_text(const std::string& path, std::string_view text);

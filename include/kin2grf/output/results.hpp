@@ -3,6 +3,8 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <ostream>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -13,7 +15,7 @@ namespace kin2grf {
 /// OpenSim ExternalLoads-ready: ground_force_v/p, ground_torque_ (right), 1_-prefixed (left),
 /// lab frame of the input, metres, force on the body.
 /// `settings`: the run's settings as one line (compact JSON), written to the header with the
-/// version (kin2grf_version=, kin2grf_settings=).
+/// version (kin2grf_version=, kin2grf_settings=). Written row by row as it is made (AtomicFile).
 void write_grf_mot(const std::string& path, const EstimateResult& r, const std::string& settings = "");
 /// The per-frame results as one table (sagittal frame; units in the column names): what the CSV
 /// writes and the Python module returns. NaN where a value does not exist (COP without contact).
@@ -22,8 +24,14 @@ struct ResultsTable {
   Eigen::MatrixXd values;  ///< frames x columns
 };
 ResultsTable results_table(const EstimateResult& r);
+/// results_table's columns, and its row `i` into `out` (out.size() == the columns' count).
+std::vector<std::string> results_columns();
+void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> out);
 /// results_table as CSV: counts (frame, contact, iterations) as integers, the rest to 6
-/// significant digits, NaN as an empty cell.
+/// significant digits, NaN as an empty cell. Written row by row as made, never held whole; the
+/// file through AtomicFile.
+void write_results_csv(std::ostream& os, const EstimateResult& r);
+void write_results_csv(const std::string& path, const EstimateResult& r);
 std::string format_results_csv(const EstimateResult& r);
 nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings);
 /// A few lines for a person: frames, mass, progression, each foot's contact intervals and peak
