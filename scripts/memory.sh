@@ -1,32 +1,46 @@
 #!/usr/bin/env bash
 # Peak memory of `kin2grf estimate` against the input file's size, on a generated long trial
 # (issue 10's target: at most twice the file's size plus a constant). Uses the release build.
-#   bash scripts/memory.sh [SECONDS] [DATA_DIR]   (default 600: 60,000 frames of the synthetic walk;
-#   then, where DATA_DIR (../shared/data) is, four lab C3D files with their scripts/trials.txt options)
+#   bash scripts/memory.sh [SECONDS] [DATA_DIR] [CAPTURE_SECONDS]
+# Three kinds of input:
+#  - the synthetic walk at 100 Hz, C3D (14 markers, 12 analog channels at the marker rate) and TRC,
+#    SECONDS long (default 600: 60,000 frames): as small a file per frame as a trial can be;
+#  - the same walk as a long capture is recorded, 2 kHz markers and 10 kHz analog (issue 10's
+#    example), CAPTURE_SECONDS long (default 120; 600 s is a 557 MB file, and make-example takes
+#    4 GB and 40 s to write it);
+#  - where DATA_DIR (../shared/data) is, four lab C3D files with their scripts/trials.txt options.
 # Each run writes the outputs a user asks for (-o GRF.mot, --csv, --json), as their writing is part
 # of the peak. KIN2GRF=path/to/kin2grf measures another build (the release build by default).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_LONG=${1:-600}
 DATA=${2:-../shared/data}
-if [ -z "${KIN2GRF:-}" ]; then
-  cmake --preset release >/dev/null
-  cmake --build --preset release >/dev/null
-fi
+CAPTURE_SECONDS=${3:-120}
+# The release build writes the inputs (make-example); KIN2GRF, if given, is the build measured.
+cmake --preset release >/dev/null
+cmake --build --preset release >/dev/null
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 K=${KIN2GRF:-build/release/kin2grf}
 OUTS=(-o "$WORK/out.mot" --csv "$WORK/out.csv" --json "$WORK/out.json")
-"$K" make-example --out-dir "$WORK" --seconds "$SECONDS_LONG" >/dev/null
-for f in example_walk.c3d example_walk.trc; do
-  size=$(stat -c %s "$WORK/$f")
-  /usr/bin/time -o "$WORK/peak" -f "%M" "$K" estimate "$WORK/$f" --mass 70 "${OUTS[@]}" >/dev/null 2>&1
+GEN=build/release/kin2grf
+measure() {  # FILE LABEL: estimate's peak against the file's size
+  local size peak_kb base_kb
+  size=$(stat -c %s "$1")
+  /usr/bin/time -o "$WORK/peak" -f "%M" "$K" estimate "$1" --mass 70 "${OUTS[@]}" >/dev/null 2>&1
   /usr/bin/time -o "$WORK/base" -f "%M" "$K" --version >/dev/null
   peak_kb=$(tail -1 "$WORK/peak")
   base_kb=$(tail -1 "$WORK/base")
-  awk -v f="$f" -v s="$size" -v p="$peak_kb" -v b="$base_kb" 'BEGIN {
-    printf "%-18s file %7.1f MB  peak %7.1f MB (process alone %4.1f MB)  peak / file %5.1f\n", f, s / 1e6, p * 1024 / 1e6, b * 1024 / 1e6, p * 1024 / s }'
-done
+  awk -v f="$2" -v s="$size" -v p="$peak_kb" -v b="$base_kb" 'BEGIN {
+    printf "%-34s file %7.1f MB  peak %7.1f MB (process alone %4.1f MB)  peak / file %5.2f\n", f, s / 1e6, p * 1024 / 1e6, b * 1024 / 1e6, p * 1024 / s }'
+}
+"$GEN" make-example --out-dir "$WORK/lean" --seconds "$SECONDS_LONG" >/dev/null
+measure "$WORK/lean/example_walk.c3d" "walk ${SECONDS_LONG} s, 100 Hz, C3D"
+measure "$WORK/lean/example_walk.trc" "walk ${SECONDS_LONG} s, 100 Hz, TRC"
+rm -rf "$WORK/lean"
+"$GEN" make-example --out-dir "$WORK/capture" --seconds "$CAPTURE_SECONDS" --rate 2000 --analog-rate 10000 >/dev/null
+measure "$WORK/capture/example_walk.c3d" "walk ${CAPTURE_SECONDS} s, 2 kHz + 10 kHz analog"
+rm -rf "$WORK/capture"
 # Lab files: markers with 1-2 kHz plates, as `estimate` reads them (the plates without samples).
 [ -d "$DATA" ] || exit 0
 for f in opensim_c3d_overground_walk/walking2.c3d btk_plugingait_walk/PiG_Motion-FlatFoot-Full.c3d \

@@ -101,14 +101,21 @@ double resolve_mass(const Trial& trial, const EstimateOptions& o) {
 }
 
 /// markers -> landmarks -> the sagittal frame and window (r.frame, r.landmarks, r.time_s...).
-void sagittal_stage(const Trial& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o,
-                    EstimateResult& r) {
+/// `release` (the trial, when the caller gave it up): its marker samples are released once the
+/// landmarks are made, the last use of them.
+void sagittal_stage(const Trial& trial, Trial* release, const Trial* static_trial, const MarkerSet& set,
+                    const EstimateOptions& o, EstimateResult& r) {
   if (trial.markers.frames() == 0) throw InputError(trial.path + ": the trial has no marker frames");
   std::vector<std::string> cleaning;
-  const std::optional<MarkerTrajectories> cleaned = without_marker_outliers(trial.markers, set.motion_markers(), cleaning);
-  const MarkerTrajectories& markers = cleaned ? *cleaned : trial.markers;
-  const Landmarks3D lm3 = compute_landmarks(set, markers, static_trial ? &static_trial->markers : nullptr,
-                                            o.landmarks, trial.path);
+  std::optional<MarkerTrajectories> cleaned = without_marker_outliers(trial.markers, set.motion_markers(), cleaning);
+  Landmarks3D lm3 = compute_landmarks(set, cleaned ? *cleaned : trial.markers, static_trial ? &static_trial->markers : nullptr,
+                                      o.landmarks, trial.path);
+  // From here on, only the markers' frame count, numbers, times, rate and up axis are read (the
+  // trial's, which the cleaned copy shares).
+  cleaned.reset();
+  if (release)
+    for (auto& p : release->markers.positions_m) p.resize(0, 3);
+  const MarkerTrajectories& markers = trial.markers;
   // What the readers noticed (duplicate labels, rows cut short, an up axis corrected...) goes with
   // the results, so that estimate's and validate's outputs say it too.
   for (const auto& w : trial.warnings) r.messages.push_back("input: " + w);
@@ -117,12 +124,12 @@ void sagittal_stage(const Trial& trial, const Trial* static_trial, const MarkerS
   r.messages.insert(r.messages.end(), cleaning.begin(), cleaning.end());
   r.messages.insert(r.messages.end(), lm3.messages.begin(), lm3.messages.end());
   r.frame = detect_sagittal_frame(lm3, markers, o.landmarks);
-  SagittalWindow win = sagittal_landmarks(lm3, set, r.frame, markers, o.landmarks, trial.path);
+  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, r.frame, markers, o.landmarks, trial.path);
   r.messages.insert(r.messages.end(), win.messages.begin(), win.messages.end());
   r.first_index = win.first;
   r.first_frame_number = trial.markers.first_frame + static_cast<int>(win.first);
-  r.foot_lateral_m = win.foot_lateral_m;
-  r.landmarks = win.landmarks;
+  r.foot_lateral_m = std::move(win.foot_lateral_m);
+  r.landmarks = std::move(win.landmarks);
   const SagittalLandmarks& lm = r.landmarks;
   if (2.0 * o.kinematic_cutoff_hz >= lm.rate_hz || 2.0 * o.post_cutoff_hz >= lm.rate_hz)
     throw InputError(trial.path + ": cut-off frequencies must be below half the marker rate (" + std::to_string(lm.rate_hz) + " Hz)");
@@ -261,7 +268,7 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
   raw.point_gap_m.resize(n, np);
   for (int side = 0; side < 2; ++side) {
     raw.inclination_rad[side].resize(n);
-    raw.sole_m[side].resize(n, 6);
+    if (o.keep_validation_series) raw.sole_m[side].resize(n, 6);
   }
   r.iterations.resize(static_cast<std::size_t>(n));
   std::vector<char> cycled(static_cast<std::size_t>(n)), capped(static_cast<std::size_t>(n));
@@ -288,7 +295,8 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
       for (int side = 0; side < 2; ++side) {
         const auto s_ = static_cast<std::size_t>(side);
         raw.inclination_rad[s_][i] = fc.foot_inclination_rad[s_];
-        for (int c = 0; c < 3; ++c) raw.sole_m[s_].block<1, 2>(i, 2 * c) = fc.sole[s_][static_cast<std::size_t>(c)].transpose();
+        if (o.keep_validation_series)
+          for (int c = 0; c < 3; ++c) raw.sole_m[s_].block<1, 2>(i, 2 * c) = fc.sole[s_][static_cast<std::size_t>(c)].transpose();
       }
       raw.lambda.row(i) = s.contact_lambda.transpose();
       raw.torque.row(i) = s.joint_torque_Nm.transpose();
@@ -391,7 +399,7 @@ void totals_stage(const EstimateOptions& o, EstimateResult& r, const ModelMotion
   // GRM about the reference point, residual and joint forces.
   r.grm_Nm = Eigen::VectorXd::Zero(n);
   r.residual = Eigen::MatrixX3d::Zero(n, 3);
-  r.kinematic_total = Eigen::MatrixX3d::Zero(n, 3);
+  if (o.keep_validation_series) r.kinematic_total = Eigen::MatrixX3d::Zero(n, 3);
   r.joint_force_N = Eigen::MatrixXd::Zero(n, 2 * kJointCount);
   const double g = r.model.gravity_mps2;
   MotionFrame m;
@@ -416,7 +424,7 @@ void totals_stage(const EstimateOptions& o, EstimateResult& r, const ModelMotion
       ext += Eigen::Vector3d(fx, fy, sagittal_moment(x, y, fx, fy));
     }
     r.residual.row(i) = (kin - ext).transpose();
-    r.kinematic_total.row(i) = kin.transpose();
+    if (o.keep_validation_series) r.kinematic_total.row(i) = kin.transpose();
     for (int j = 0; j < kJointCount; ++j) {
       const int side = j / 4, depth = j % 4;
       Eigen::Vector2d F = Eigen::Vector2d::Zero();
@@ -430,20 +438,26 @@ void totals_stage(const EstimateOptions& o, EstimateResult& r, const ModelMotion
 
 }  // namespace
 
-EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o) {
+namespace {
+
+/// estimate(); `release` (the trial itself, when the caller gave it up) loses its marker samples
+/// once the landmarks are made.
+EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* static_trial, const MarkerSet& set,
+                             const EstimateOptions& o) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   check_options(o);
   EstimateResult r;
   r.marker_set = set.name;
   r.mass_kg = resolve_mass(trial, o);
-  sagittal_stage(trial, static_trial, set, o, r);
+  sagittal_stage(trial, release, static_trial, set, o, r);
   auto [model, soles] = model_stage(o, r);
   r.model = std::move(model);
   ModelMotion motion = kinematics_stage(o, r.model, r);
   lag_torso_stage(o, motion, r);
   auto [running, calibration] = contact_stage(o, r.model, std::move(soles), r, motion);
   r.calibration = std::move(calibration);
+  if (!o.keep_validation_series) r.landmarks.p = {};  // the last to read them is contact_stage (the hip's speed)
   const auto t1 = clock::now();
   RawSolve raw = solve_stage(trial, o, r, motion, running);
   const auto t2 = clock::now();
@@ -455,6 +469,16 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
   raw = RawSolve();
   totals_stage(o, r, motion);
   return r;
+}
+
+}  // namespace
+
+EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o) {
+  return estimate_impl(trial, nullptr, static_trial, set, o);
+}
+
+EstimateResult estimate(Trial&& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o) {
+  return estimate_impl(trial, &trial, static_trial, set, o);
 }
 
 LabFootFrame lab_foot_frame(const EstimateResult& r, int side, Eigen::Index i) {

@@ -14,6 +14,8 @@
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/c3d.hpp"
+#include "kin2grf/io/text.hpp"
+#include "kin2grf/synth/example.hpp"
 #include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/opensim.hpp"
@@ -542,4 +544,49 @@ TEST(CorruptCorpus, EachFileIsReadWithAWarningOrRefusedByName) {
     }
   }
   EXPECT_GE(files, 13);
+}
+
+// A long capture (10 minutes at 2 kHz: 1.2 million frames) has more frames than the header's
+// 16-bit frame numbers hold: the writer stores them in TRIAL:ACTUAL_START/END_FIELD (two 16-bit
+// words each), as Vicon does, and every frame reads back, the numbers past 65535 too.
+TEST(C3dRoundTrip, MoreThan65535FramesKeepEveryFrameAndTheirNumbers) {
+  Trial t;
+  t.path = "long.c3d";
+  auto& m = t.markers;
+  const Eigen::Index n = 70000;
+  m.rate_hz = 1000.0;
+  m.first_frame = 1;
+  m.names = {"A"};
+  m.descriptions = {""};
+  m.time_s = Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1) / m.rate_hz);
+  m.positions_m.emplace_back(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) m.positions_m[0].row(i) << 0.001 * static_cast<double>(i % 1000), 0.5, 0.9;
+  for (const int first : {1, 65000}) {
+    C3dWriteOptions o;
+    o.first_frame = first;
+    const Trial r = read_c3d_bytes(write_c3d_bytes(t, o), "long.c3d");
+    ASSERT_EQ(r.markers.frames(), n) << first;
+    EXPECT_EQ(r.markers.first_frame, first);
+    EXPECT_TRUE(test::matrices_near(r.markers.positions_m[0], m.positions_m[0], 1e-6));
+  }
+}
+
+// read_c3d maps the file and releases each block of frames once read (issue 10's memory); the
+// plates' samples are read after the markers, from pages released already. Over several blocks,
+// the trial must be the very one read_c3d_bytes makes of the file read into memory. The example
+// walk at 1 kHz markers and 5 kHz analog: 20,000 frames, 9 MB.
+TEST(C3dRoundTrip, AMappedFileReleasedAsItIsReadGivesTheSameTrial) {
+  const auto dir = test::temp_dir("mapped_c3d");
+  write_examples(dir.string(), 20.0, 1000.0, 5000.0);
+  const std::string path = (dir / "example_walk.c3d").string();
+  const Trial mapped = read_c3d(path);
+  const Trial whole = read_c3d_bytes(read_file_bytes(path), path);
+  ASSERT_GT(read_file_bytes(path).size(), std::size_t{8} << 20);
+  ASSERT_EQ(mapped.markers.names, whole.markers.names);
+  for (std::size_t k = 0; k < whole.markers.positions_m.size(); ++k)
+    EXPECT_TRUE(mapped.markers.positions_m[k].cwiseEqual(whole.markers.positions_m[k]).all()) << whole.markers.names[k];
+  ASSERT_TRUE(mapped.plates && whole.plates);
+  EXPECT_EQ(mapped.plates->rate_hz, 5000.0);
+  for (std::size_t p = 0; p < whole.plates->plates.size(); ++p)
+    EXPECT_TRUE(mapped.plates->plates[p].force_N.cwiseEqual(whole.plates->plates[p].force_N).all()) << p;
 }

@@ -12,6 +12,7 @@
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/markers/presets.hpp"
+#include "kin2grf/output/results.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
 #include "test_support.hpp"
@@ -374,4 +375,36 @@ TEST(Estimate, AStandingTrialKeepsTheFixedPostFilterAndSaysWhy) {
 TEST(Estimate, PostFilterCyclesOutsideTheirRangeAreRefusedNamingTheSetting) {
   expect_refused_naming([](EstimateOptions& o, double v) { o.post_cutoff_cycles = v; }, {-1.0, 60.0, std::nan("")},
                         "post-filter cycles per stance");
+}
+
+// A long trial's memory (issue 10): estimate(Trial&&) releases the markers once the landmarks are
+// made, and keep_validation_series = false leaves out what only validation reads. Neither may
+// change an output. The walk has a one-frame marker spike, so the cleaned copy's path is taken.
+TEST(Estimate, ReleasingTheMarkersAndTheValidationSeriesChangesNoOutput) {
+  SyntheticWalkOptions wo;
+  wo.duration_s = 6.0;
+  Trial walk = make_synthetic_walk(wo).trial;
+  walk.markers.positions_m[static_cast<std::size_t>(walk.markers.find("RKJC"))].row(300).array() += 0.5;
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  const EstimateResult full = estimate(walk, nullptr, set, EstimateOptions{});
+  EstimateOptions lean;
+  lean.keep_validation_series = false;
+  Trial given = walk;
+  const EstimateResult r = estimate(std::move(given), nullptr, set, lean);
+  EXPECT_EQ(format_results_csv(r), format_results_csv(full));
+  EXPECT_EQ(r.messages, full.messages);
+  EXPECT_TRUE(std::any_of(r.messages.begin(), r.messages.end(),
+                          [](const std::string& m) { return m.rfind("RKJC: 1 sample(s) no body can produce", 0) == 0; }));
+  EXPECT_EQ(r.post_cutoff_hz, full.post_cutoff_hz);
+  // What was released or left out.
+  for (const auto& p : given.markers.positions_m) EXPECT_EQ(p.rows(), 0);
+  EXPECT_EQ(given.markers.frames(), walk.markers.frames());
+  EXPECT_EQ(given.markers.names, walk.markers.names);
+  EXPECT_EQ(r.landmarks.p[kHip].rows(), 0);
+  EXPECT_EQ(r.landmarks.frames(), full.landmarks.frames());
+  EXPECT_EQ(r.feet[0].sole_m.rows(), 0);
+  EXPECT_EQ(r.kinematic_total.rows(), 0);
+  EXPECT_EQ(full.feet[0].sole_m.rows(), full.time_s.size());
+  // A trial given up keeps what an error message names.
+  EXPECT_EQ(given.path, walk.path);
 }

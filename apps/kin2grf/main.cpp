@@ -74,11 +74,15 @@ int run_estimate(const EstimateArgs& a) {
     const auto f = kin2grf::opensim_export_paths(a.opensim_dir, std::filesystem::path(a.trial).stem().string());
     check_outputs({f.grf_mot, f.markers_trc, f.external_loads_xml}, kin2grf::input_files(a));
   }
-  const auto files = kin2grf::load_trial_and_static(a, kin2grf::estimate_load_options());
+  auto files = kin2grf::load_trial_and_static(a, kin2grf::estimate_load_options());
   const kin2grf::Trial& trial = files.trial;
   auto options = kin2grf::to_options(a);
   options.progress = kin2grf::solve_progress(stderr);
-  const auto r = kin2grf::estimate_trial(a, options, trial, files.static_trial);
+  // The outputs need neither what validation reads nor, unless the OpenSim export writes them,
+  // the markers: a long trial's memory (issue 10).
+  options.keep_validation_series = false;
+  const auto r = a.opensim_dir.empty() ? kin2grf::estimate_trial(a, options, std::move(files.trial), files.static_trial)
+                                       : kin2grf::estimate_trial(a, options, trial, files.static_trial);
   print_messages(r);
   const std::string settings_line = kin2grf::settings_json(a, options).dump();
   if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r, settings_line);
@@ -210,8 +214,8 @@ int run_batch(const BatchArgs& a) {
 }
 
 /// The bundled examples (write_examples): a walk over two plates and a squat.
-int run_make_example(const std::string& dir, double seconds) {
-  for (const auto& line : kin2grf::write_examples(dir, seconds)) std::cout << "wrote " << line << "\n";
+int run_make_example(const std::string& dir, double seconds, double rate_hz, double analog_rate_hz) {
+  for (const auto& line : kin2grf::write_examples(dir, seconds, rate_hz, analog_rate_hz)) std::cout << "wrote " << line << "\n";
   return 0;
 }
 
@@ -311,11 +315,14 @@ int main(int argc, char** argv) {
   }
 
   std::string example_dir = "example";
-  double example_seconds = 3.0;
+  double example_seconds = 3.0, example_rate = 100.0, example_analog_rate = 0.0;
   if (wanted("make-example")) {
     make_example = app.add_subcommand("make-example", "Write the synthetic example trial (C3D with plates, TRC, GRF .mot)");
     make_example->add_option("--out-dir", example_dir, "Output folder")->capture_default_str();
     make_example->add_option("--seconds", example_seconds, "Duration, s")->capture_default_str();
+    make_example->add_option("--rate", example_rate, "Marker rate, Hz (50-2000)")->capture_default_str();
+    make_example->add_option("--analog-rate", example_analog_rate,
+                             "The walk's plates' rate, Hz: a whole multiple of the marker rate (default: the marker rate)");
   }
 
   try {
@@ -332,7 +339,7 @@ int main(int argc, char** argv) {
     else if (chosen(study)) rc = run_study(study_args);
     else if (chosen(fit_cop)) rc = run_fit_cop(fit_args);
     else if (chosen(batch)) rc = run_batch(batch_args);
-    else if (chosen(make_example)) rc = run_make_example(example_dir, example_seconds);
+    else if (chosen(make_example)) rc = run_make_example(example_dir, example_seconds, example_rate, example_analog_rate);
     // Standard output closed or full: the output is lost, so the run failed.
     std::cout.flush();
     if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout))

@@ -46,6 +46,12 @@ struct EstimateOptions {
   ContactModelOptions contact;
   SolverOptions solver;
   LandmarkOptions landmarks;
+  /// Whether the result keeps what only validation and COP fitting read: the processed window's
+  /// landmarks (EstimateResult::landmarks), each foot's sole points (FootResult::sole_m) and the
+  /// kinematic totals (EstimateResult::kinematic_total). false: the landmarks are released once
+  /// the motion is made (r.landmarks keeps its rate and times), the other two are left empty: a
+  /// long trial's memory when only the outputs are wanted (issue 10). The outputs are the same.
+  bool keep_validation_series = true;
   /// GRM reference point in the sagittal frame (x along progression, y up), m.
   Eigen::Vector2d grm_reference_m = Eigen::Vector2d::Zero();
   /// Called with (frames solved, frames in all) every 1 % of the contact solve; empty: none.
@@ -60,7 +66,7 @@ struct FootResult {
   std::vector<bool> contact;
   Eigen::VectorXd inclination_rad;  ///< theta_A, the paper's foot inclination (contact.hpp)
   Eigen::VectorXd gap_m;            ///< normal gap g_n of the foot's lowest contact point
-  Eigen::MatrixXd sole_m;           ///< N x 6: sole points A, B, C (x, y) in the sagittal frame
+  Eigen::MatrixXd sole_m;           ///< N x 6: sole points A, B, C (x, y) in the sagittal frame (keep_validation_series)
 };
 
 struct EstimateResult {
@@ -88,6 +94,7 @@ struct EstimateResult {
   SagittalLandmarks landmarks;     ///< the processed window's landmarks (sagittal frame)
   /// Rigid-body totals from the kinematics alone, N x 3: sum m (a + g) (x, y, N) and the sum of
   /// moments about the origin (N m). What all external forces together must equal.
+  /// (keep_validation_series)
   Eigen::MatrixX3d kinematic_total;
   std::vector<std::string> messages;
   double seconds_kinematics = 0, seconds_dynamics = 0;
@@ -111,6 +118,10 @@ double progression_speed(const SagittalLandmarks& lm);
 
 EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set,
                         const EstimateOptions& options);
+/// The same, taking the trial: its marker samples are released as soon as the landmarks are made
+/// (its path, warnings and everything else are kept), so that a long trial's markers and its
+/// results are never held together (issue 10's memory). The results are the same.
+EstimateResult estimate(Trial&& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& options);
 
 /// One foot's result at one processed frame in the lab frame of the input: force on the body (N)
 /// and COP (m; NaN without contact). A turning trial's frame takes that frame's heading.

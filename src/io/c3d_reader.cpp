@@ -1,6 +1,8 @@
 // C3D reader, written from the C3D specification because no C3D library is packaged in Debian.
 // See include/kin2grf/io/c3d.hpp for what is supported and the conventions.
 #include <algorithm>
+#include <functional>
+#include <span>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -22,7 +24,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// Bounds-checked decoding of the file's bytes in the file's processor encoding.
 class Bytes {
  public:
-  Bytes(const std::vector<std::uint8_t>& data, std::string path)
+  Bytes(std::span<const std::uint8_t> data, std::string path)
       : data_(data), path_(std::move(path)) {}
 
   void set_processor(int p) { processor_ = p; }
@@ -79,7 +81,7 @@ class Bytes {
   }
 
  private:
-  const std::vector<std::uint8_t>& data_;
+  std::span<const std::uint8_t> data_;
   std::string path_;
   int processor_ = 84;
 };
@@ -242,6 +244,10 @@ const C3dParameter* C3dFile::find(const std::string& key) const {
 }
 
 C3dFile read_c3d_header(const std::vector<std::uint8_t>& bytes, const std::string& path) {
+  return read_c3d_header(std::span<const std::uint8_t>(bytes), path);
+}
+
+C3dFile read_c3d_header(std::span<const std::uint8_t> bytes, const std::string& path) {
   Bytes b(bytes, path);
   if (bytes.size() < 512) {
     throw InputError(path + ": not a C3D file: " + std::to_string(bytes.size()) +
@@ -315,9 +321,6 @@ C3dFile read_c3d_header(const std::vector<std::uint8_t>& bytes, const std::strin
   return f;
 }
 
-Trial read_c3d(const std::string& path, const C3dReadOptions& options) {
-  return read_c3d_bytes(read_file_bytes(path), path, options);
-}
 
 namespace {
 
@@ -397,7 +400,17 @@ C3dLayout c3d_layout(const C3dFile& f, std::size_t file_size, const std::string&
 
 /// The markers (model outputs stored as points set aside by name): a negative residual or a point
 /// at exactly (0, 0, 0) is missing. Returns POINT:UNITS's scale to metres.
-double read_c3d_points(const C3dFile& f, const Bytes& b, const C3dLayout& l, const std::string& path, Trial& t) {
+/// Called with byte ranges of the data section that have been read (a mapped file releases them).
+using ReleaseRead = std::function<void(std::size_t, std::size_t)>;
+
+/// Frames read at a time: the markers are taken frame block by frame block, so that the bytes
+/// behind can be released as the reading goes (about 4 MB of the file at a time).
+long frames_per_block(std::size_t frame_bytes) {
+  return std::max<long>(1, static_cast<long>((std::size_t{4} << 20) / std::max<std::size_t>(1, frame_bytes)));
+}
+
+double read_c3d_points(const C3dFile& f, const Bytes& b, const C3dLayout& l, const std::string& path, Trial& t,
+                       const ReleaseRead& release) {
   const long nframes = l.nframes;
   const int npoints = l.npoints;
   const std::size_t word = l.word, frame_bytes = l.frame_bytes, data_start = l.data_start;
@@ -443,36 +456,42 @@ double read_c3d_points(const C3dFile& f, const Bytes& b, const C3dLayout& l, con
     point_slot.push_back(k);
   }
   const double scale = std::abs(f.point_scale);
-  for (std::size_t mk = 0; mk < point_slot.size(); ++mk) {
-    const std::size_t slot = static_cast<std::size_t>(point_slot[mk]);
-    auto& P = m.positions_m[mk];
-    for (long i = 0; i < nframes; ++i) {
-      const std::size_t o = data_start + static_cast<std::size_t>(i) * frame_bytes + slot * 4 * word;
-      double x, y, z, res;
-      if (f.float_data) {
-        x = b.f32_unchecked(o); y = b.f32_unchecked(o + 4); z = b.f32_unchecked(o + 8);
-        res = b.f32_unchecked(o + 12);
-      } else {
-        x = static_cast<std::int16_t>(b.u16_unchecked(o)) * scale;
-        y = static_cast<std::int16_t>(b.u16_unchecked(o + 2)) * scale;
-        z = static_cast<std::int16_t>(b.u16_unchecked(o + 4)) * scale;
-        res = static_cast<std::int16_t>(b.u16_unchecked(o + 6));
-      }
-      // Missing: a negative residual (the specification), and a point at exactly (0, 0, 0),
-      // which several exporters write for a gap whatever the residual (65535 included).
-      if (res < 0 || !finite_all({x, y, z}) || (x == 0 && y == 0 && z == 0)) {
-        P.row(i).setConstant(kNaN);
-      } else {
-        P(i, 0) = x * to_m; P(i, 1) = y * to_m; P(i, 2) = z * to_m;
+  const long block = frames_per_block(frame_bytes);
+  for (long i0 = 0; i0 < nframes; i0 += block) {
+    const long i1 = std::min(nframes, i0 + block);
+    for (std::size_t mk = 0; mk < point_slot.size(); ++mk) {
+      const std::size_t slot = static_cast<std::size_t>(point_slot[mk]);
+      auto& P = m.positions_m[mk];
+      for (long i = i0; i < i1; ++i) {
+        const std::size_t o = data_start + static_cast<std::size_t>(i) * frame_bytes + slot * 4 * word;
+        double x, y, z, res;
+        if (f.float_data) {
+          x = b.f32_unchecked(o); y = b.f32_unchecked(o + 4); z = b.f32_unchecked(o + 8);
+          res = b.f32_unchecked(o + 12);
+        } else {
+          x = static_cast<std::int16_t>(b.u16_unchecked(o)) * scale;
+          y = static_cast<std::int16_t>(b.u16_unchecked(o + 2)) * scale;
+          z = static_cast<std::int16_t>(b.u16_unchecked(o + 4)) * scale;
+          res = static_cast<std::int16_t>(b.u16_unchecked(o + 6));
+        }
+        // Missing: a negative residual (the specification), and a point at exactly (0, 0, 0),
+        // which several exporters write for a gap whatever the residual (65535 included).
+        if (res < 0 || !finite_all({x, y, z}) || (x == 0 && y == 0 && z == 0)) {
+          P.row(i).setConstant(kNaN);
+        } else {
+          P(i, 0) = x * to_m; P(i, 1) = y * to_m; P(i, 2) = z * to_m;
+        }
       }
     }
+    if (release) release(data_start + static_cast<std::size_t>(i0) * frame_bytes, data_start + static_cast<std::size_t>(i1) * frame_bytes);
   }
   return to_m;
 }
 
 /// The analog channels, scaled (ANALOG:SCALE, OFFSET, GEN_SCALE, FORMAT), one row per sample;
 /// without `samples`, their labels, units and rate only (no rows).
-AnalogData read_c3d_analog(const C3dFile& f, const Bytes& b, const C3dLayout& l, const std::string& path, bool samples) {
+AnalogData read_c3d_analog(const C3dFile& f, const Bytes& b, const C3dLayout& l, const std::string& path, bool samples,
+                           const ReleaseRead& release) {
   const long nframes = l.nframes;
   const int npoints = l.npoints, nchannels = l.nchannels, spf = l.spf, analog_slots = l.analog_slots;
   const double analog_rate = l.analog_rate;
@@ -508,7 +527,10 @@ AnalogData read_c3d_analog(const C3dFile& f, const Bytes& b, const C3dLayout& l,
         throw InputError(path + ": ANALOG:SCALE[" + std::to_string(c + 1) + "] is not finite");
     }
     const std::size_t analog_off = static_cast<std::size_t>(npoints) * 4 * word;
+    const long block = frames_per_block(frame_bytes);
     for (long i = 0; i < frames_read; ++i) {
+      if (release && i > 0 && i % block == 0)
+        release(data_start + static_cast<std::size_t>(i - block) * frame_bytes, data_start + static_cast<std::size_t>(i) * frame_bytes);
       for (int s = 0; s < spf; ++s) {
         const long row = i * spf + s;
         for (int c = 0; c < nchannels; ++c) {
@@ -655,8 +677,10 @@ void read_c3d_events_and_subject(const C3dFile& f, Trial& t) {
 
 }  // namespace
 
-Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& path,
-                     const C3dReadOptions& options) {
+namespace {
+
+Trial read_c3d_span(std::span<const std::uint8_t> bytes, const std::string& path, const C3dReadOptions& options,
+                    const ReleaseRead& release) {
   const C3dFile f = read_c3d_header(bytes, path);
   Bytes b(bytes, path);
   b.set_processor(f.processor == "Intel" ? 84 : f.processor == "DEC" ? 85 : 86);
@@ -665,11 +689,24 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
   t.format = "C3D";
   t.encoding = f.processor + (f.float_data ? ", float" : ", integer");
   const C3dLayout layout = c3d_layout(f, bytes.size(), path, t.warnings);
-  const double to_m = read_c3d_points(f, b, layout, path, t);
-  const AnalogData analog = read_c3d_analog(f, b, layout, path, options.plate_samples);
+  const double to_m = read_c3d_points(f, b, layout, path, t, release);
+  const AnalogData analog = read_c3d_analog(f, b, layout, path, options.plate_samples, release);
   read_c3d_plates(f, layout, analog, to_m, options, path, t);
   read_c3d_events_and_subject(f, t);
   return t;
+}
+
+}  // namespace
+
+Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& path, const C3dReadOptions& options) {
+  return read_c3d_span(bytes, path, options, nullptr);
+}
+
+Trial read_c3d(const std::string& path, const C3dReadOptions& options) {
+  // Mapped, not read into memory: the frames are read front to back and each block's bytes are
+  // released behind (issue 10's memory: a 10-minute capture is 0.5 GB, mostly analog samples).
+  const MappedFile file(path, /*populate=*/false);
+  return read_c3d_span(file.bytes(), path, options, [&](std::size_t begin, std::size_t end) { file.release(begin, end); });
 }
 
 }  // namespace kin2grf

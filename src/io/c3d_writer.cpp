@@ -130,7 +130,7 @@ std::vector<Param> c3d_parameters(const Trial& trial, const C3dWriteOptions& o, 
   const int nchan = 6 * nplates;
   std::vector<Param> params;
   params.push_back(ints("POINT", "USED", {static_cast<double>(m.names.size())}));
-  params.push_back(ints("POINT", "FRAMES", {static_cast<double>(nframes)}));
+  params.push_back(ints("POINT", "FRAMES", {static_cast<double>(std::min(nframes, 65535L))}));
   params.push_back(floats("POINT", "SCALE", {pscale}));
   params.push_back(floats("POINT", "RATE", {m.rate_hz}));
   params.push_back(strs("POINT", "UNITS", {"mm"}, false));
@@ -189,8 +189,12 @@ std::vector<Param> c3d_parameters(const Trial& trial, const C3dWriteOptions& o, 
   }
   if (trial.body_mass_kg) params.push_back(floats("PROCESSING", "Bodymass", {*trial.body_mass_kg}));
   if (trial.height_m) params.push_back(floats("PROCESSING", "Height", {*trial.height_m * 1000.0}));
-  params.push_back(ints("TRIAL", "ACTUAL_START_FIELD", {static_cast<double>(o.first_frame), 0}));
-  params.push_back(ints("TRIAL", "ACTUAL_END_FIELD", {static_cast<double>(o.first_frame + nframes - 1), 0}));
+  // Frame numbers as two 16-bit words (low, high): the header's 16-bit frame numbers stop at 65535,
+  // and a long capture (10 minutes at 2 kHz) has more. Readers (Vicon's, ezc3d, kin2grf's) take
+  // these where present.
+  const long last = o.first_frame + nframes - 1;
+  params.push_back(ints("TRIAL", "ACTUAL_START_FIELD", {static_cast<double>(o.first_frame % 65536), static_cast<double>(o.first_frame / 65536)}));
+  params.push_back(ints("TRIAL", "ACTUAL_END_FIELD", {static_cast<double>(last % 65536), static_cast<double>(last / 65536)}));
   params.push_back(ints("POINT", "DATA_START", {0}));  // patched below
 
   return params;
@@ -246,7 +250,8 @@ std::vector<std::uint8_t> write_c3d_bytes(const Trial& trial, const C3dWriteOpti
   const MarkerTrajectories& m = trial.markers;
   const auto nframes = static_cast<long>(m.frames());
   if (nframes < 1) throw InputError("write_c3d: the trial has no frames");
-  if (nframes > 65535) throw InputError("write_c3d: more than 65535 frames are not supported by the writer");
+  if (nframes + o.first_frame > (1L << 30)) throw InputError("write_c3d: more than 2^30 frames");
+  if (o.first_frame < 1 || o.first_frame > 65535) throw InputError("write_c3d: the first frame must be 1-65535");
   if (m.names.size() > 255 * 255) throw InputError("write_c3d: too many markers");
   const int spf = o.analog_samples_per_frame;
   const ForcePlateRecording* fpr = trial.plates ? &*trial.plates : nullptr;
@@ -279,7 +284,7 @@ std::vector<std::uint8_t> write_c3d_bytes(const Trial& trial, const C3dWriteOpti
   h.i16(static_cast<int>(m.names.size()));
   h.i16(nchan * spf);
   h.i16(o.first_frame);
-  h.i16(static_cast<int>(o.first_frame + nframes - 1));
+  h.i16(static_cast<int>(std::min(o.first_frame + nframes - 1, 65535L)));  // TRIAL:ACTUAL_END_FIELD beyond
   h.i16(0);
   h.f32(pscale);
   h.i16(data_block);

@@ -1,5 +1,6 @@
 #include "kin2grf/io/text.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <charconv>
@@ -89,10 +90,10 @@ std::vector<std::uint8_t> read_file_bytes(const std::string& path) { return read
 
 std::string read_file_text(const std::string& path) { return read_whole_file<std::string>(path); }
 
-MappedFile::MappedFile(const std::string& path) {
+MappedFile::MappedFile(const std::string& path, bool populate) {
   const std::size_t size = checked_input_size(path);
   const int fd = size > 0 ? ::open(path.c_str(), O_RDONLY | O_CLOEXEC) : -1;
-  void* p = fd >= 0 ? ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0) : MAP_FAILED;
+  void* p = fd >= 0 ? ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | (populate ? MAP_POPULATE : 0), fd, 0) : MAP_FAILED;
   if (fd >= 0) ::close(fd);  // the mapping keeps the file
   if (p == MAP_FAILED) {
     copy_ = read_file_text(path);
@@ -100,6 +101,13 @@ MappedFile::MappedFile(const std::string& path) {
   }
   mapped_ = static_cast<const char*>(p);
   size_ = size;
+}
+
+void MappedFile::release(std::size_t begin, std::size_t end) const {
+  if (!mapped_) return;
+  const auto page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  const std::size_t first = (begin + page - 1) / page * page, last = std::min(end, size_) / page * page;
+  if (last > first) ::madvise(const_cast<char*>(mapped_) + first, last - first, MADV_DONTNEED);
 }
 
 MappedFile::~MappedFile() {

@@ -431,11 +431,11 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
   return f;
 }
 
-SagittalWindow sagittal_landmarks(const Landmarks3D& lm3, const MarkerSet& set, const SagittalFrame& fr,
+SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const SagittalFrame& fr,
                                   const MarkerTrajectories& m, const LandmarkOptions& o, const std::string& path) {
   SagittalWindow w;
   const Eigen::Index n = m.frames();
-  std::array<Eigen::MatrixX3d, kLandmarkCount> p = lm3.p;
+  std::array<Eigen::MatrixX3d, kLandmarkCount>& p = lm3.p;
   // Fill short gaps (cubic Catmull-Rom between the valid neighbours; linear with one neighbour pair).
   std::vector<bool> ok(static_cast<std::size_t>(n), true);
   for (int id = 0; id < kLandmarkCount; ++id) {

@@ -104,8 +104,8 @@ FootPose foot_pose(double cycles, double first_heel_x, const SyntheticWalkOption
 
 SyntheticWalk make_synthetic_walk(const SyntheticWalkOptions& o) {
   if (!(o.speed_mps > 0.2 && o.speed_mps < 2.5 && o.stride_time_s > 0.6 && o.stride_time_s < 2.5 && o.duration_s >= 2 * o.stride_time_s &&
-        o.duration_s <= 600 && o.rate_hz >= 50 && o.rate_hz <= 1000))
-    throw InputError("synthetic walk: speed 0.2-2.5 m/s, stride time 0.6-2.5 s, at least two strides, 50-1000 Hz");
+        o.duration_s <= 600 && o.rate_hz >= 50 && o.rate_hz <= 2000))
+    throw InputError("synthetic walk: speed 0.2-2.5 m/s, stride time 0.6-2.5 s, at least two strides, 50-2000 Hz");
   SyntheticWalk w;
   w.trial = example_trial_frame("synthetic walk", o.duration_s, o.rate_hz, o.mass_kg);
   auto& m = w.trial.markers;
@@ -258,11 +258,55 @@ Trial make_example_walk(const SyntheticWalkOptions& o) {
   return w.trial;
 }
 
-std::vector<std::string> write_examples(const std::string& dir, double seconds) {
+namespace {
+
+/// The plates at `factor` samples per frame, each channel linear between frames (held after the
+/// last): the analog rate of a real capture.
+ForcePlateRecording upsampled(const ForcePlateRecording& rec, int factor) {
+  if (factor == 1) return rec;
+  ForcePlateRecording out = rec;
+  const Eigen::Index n = rec.time_s.size(), m = n * factor;
+  out.rate_hz = rec.rate_hz * factor;
+  out.time_s.resize(m);
+  for (Eigen::Index k = 0; k < m; ++k) out.time_s[k] = rec.time_s[0] + static_cast<double>(k) / out.rate_hz;
+  auto up = [&](const Eigen::MatrixX3d& x) {
+    Eigen::MatrixX3d y(m, 3);
+    for (Eigen::Index k = 0; k < m; ++k) {
+      const Eigen::Index i = k / factor, j = std::min(i + 1, n - 1);
+      const double t = static_cast<double>(k % factor) / factor;
+      y.row(k) = (1 - t) * x.row(i) + t * x.row(j);
+    }
+    return y;
+  };
+  for (std::size_t p = 0; p < rec.plates.size(); ++p) {
+    out.plates[p].force_N = up(rec.plates[p].force_N);
+    out.plates[p].cop_m = up(rec.plates[p].cop_m);
+    out.plates[p].free_moment_Nm = up(rec.plates[p].free_moment_Nm);
+    out.plates[p].moment_centre_Nm = up(rec.plates[p].moment_centre_Nm);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> write_examples(const std::string& dir, double seconds, double rate_hz, double analog_rate_hz) {
   if (!(std::isfinite(seconds) && seconds >= 1.0 && seconds <= 600.0))
   {
     char b[128];
     std::snprintf(b, sizeof b, "example duration (--seconds) %g s: must be between 1 and 600", seconds);
+    throw InputError(b);
+  }
+  if (!(std::isfinite(rate_hz) && rate_hz >= 50 && rate_hz <= 2000)) {
+    char b[128];
+    std::snprintf(b, sizeof b, "example marker rate (--rate) %g Hz: must be between 50 and 2000", rate_hz);
+    throw InputError(b);
+  }
+  if (analog_rate_hz == 0) analog_rate_hz = rate_hz;
+  const double ratio = analog_rate_hz / rate_hz;
+  if (!(std::isfinite(ratio) && ratio >= 1 && ratio <= 100 && ratio == std::round(ratio))) {
+    char b[160];
+    std::snprintf(b, sizeof b, "example analog rate (--analog-rate) %g Hz: must be 1 to 100 times the marker rate (%g Hz)",
+                  analog_rate_hz, rate_hz);
     throw InputError(b);
   }
   std::filesystem::create_directories(dir);
@@ -270,9 +314,16 @@ std::vector<std::string> write_examples(const std::string& dir, double seconds) 
   {
     SyntheticWalkOptions wo;
     wo.duration_s = std::max(seconds, 2.5 * wo.stride_time_s);
-    const Trial walk = make_example_walk(wo);
+    wo.rate_hz = rate_hz;
+    Trial walk = make_example_walk(wo);
     const std::string base = (std::filesystem::path(dir) / "example_walk").string();
-    write_c3d(base + ".c3d", walk);
+    {
+      Trial at_analog_rate = walk;
+      at_analog_rate.plates = upsampled(*walk.plates, static_cast<int>(ratio));
+      C3dWriteOptions co;
+      co.analog_samples_per_frame = static_cast<int>(ratio);
+      write_c3d(base + ".c3d", at_analog_rate, co);
+    }
     write_trc(base + ".trc", walk.markers);
     const auto& p = walk.plates->plates;
     auto t = grf_table(walk.plates->time_s, p[0], p[1]);
@@ -282,6 +333,7 @@ std::vector<std::string> write_examples(const std::string& dir, double seconds) 
   }
   SyntheticOptions so;
   so.duration_s = seconds;
+  so.rate_hz = rate_hz;
   Trial t = make_synthetic_trial(so);
   const EstimateResult r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
   t.plates = example_plates(r, t, 0);

@@ -227,12 +227,16 @@ LoadOptions estimate_load_options() {
   return load;
 }
 
-EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial, const std::optional<Trial>& st) {
+namespace {
+
+EstimateResult estimate_trial_impl(const Settings& s, const EstimateOptions& options, const Trial& trial, Trial* release,
+                                   const std::optional<Trial>& st) {
   MarkerSet custom;
   std::string why;
   const MarkerSet& set = resolve_marker_set(s, trial, custom, &why);
   try {
-    auto r = estimate(trial, st ? &*st : nullptr, set, options);
+    auto r = release ? estimate(std::move(*release), st ? &*st : nullptr, set, options)
+                     : estimate(trial, st ? &*st : nullptr, set, options);
     if (!why.empty()) r.messages.insert(r.messages.begin(), "marker set recognised: " + why);
     return r;
   } catch (const InputError& e) {
@@ -244,6 +248,16 @@ EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const 
     if (warnings.empty()) throw;
     throw InputError(std::string(e.what()) + warnings);
   }
+}
+
+}  // namespace
+
+EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial, const std::optional<Trial>& st) {
+  return estimate_trial_impl(s, options, trial, nullptr, st);
+}
+
+EstimateResult estimate_trial(const Settings& s, EstimateOptions options, Trial&& trial, const std::optional<Trial>& st) {
+  return estimate_trial_impl(s, options, trial, &trial, st);
 }
 
 }  // namespace kin2grf

@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,7 @@ struct C3dFile {
 
 /// Parse header and parameter section only.
 C3dFile read_c3d_header(const std::vector<std::uint8_t>& bytes, const std::string& path);
+C3dFile read_c3d_header(std::span<const std::uint8_t> bytes, const std::string& path);
 
 /// Read a whole trial (markers, plates, events, mass) from a C3D file.
 Trial read_c3d(const std::string& path, const C3dReadOptions& options = {});

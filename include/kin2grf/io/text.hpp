@@ -29,11 +29,21 @@ std::string read_file_text(const std::string& path);
 /// that maps: a file cut short by another program while it is being read stops the process.)
 class MappedFile {
  public:
-  explicit MappedFile(const std::string& path);
+  /// `populate`: read every page at once (a text parsed whole); false: pages are read as touched
+  /// (a binary file read front to back, released behind the reading).
+  explicit MappedFile(const std::string& path, bool populate = true);
   ~MappedFile();
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;
   std::string_view text() const { return mapped_ ? std::string_view(mapped_, size_) : std::string_view(copy_); }
+  std::span<const std::uint8_t> bytes() const {
+    const std::string_view t = text();
+    return {reinterpret_cast<const std::uint8_t*>(t.data()), t.size()};
+  }
+  /// The pages wholly inside bytes [begin, end) leave the process's memory (they are read again
+  /// from the page cache if touched): a long capture read front to back is never resident whole
+  /// (issue 10's memory). Nothing for a file read into memory.
+  void release(std::size_t begin, std::size_t end) const;
 
  private:
   const char* mapped_ = nullptr;

@@ -148,8 +148,9 @@ struct SagittalWindow {
 };
 
 /// Gap filling, the longest fully defined window, projection on the sagittal plane, and the
-/// virtual hallux when the set has none.
-SagittalWindow sagittal_landmarks(const Landmarks3D& lm, const MarkerSet& set, const SagittalFrame& frame,
+/// virtual hallux when the set has none. `lm` is taken (gaps are filled in it): moved in, it is
+/// not copied. Of `m` only the frame count, numbers, times and rate are read.
+SagittalWindow sagittal_landmarks(Landmarks3D lm, const MarkerSet& set, const SagittalFrame& frame,
                                   const MarkerTrajectories& motion, const LandmarkOptions& options,
                                   const std::string& path);
 

@@ -79,7 +79,11 @@ Trial make_example_walk(const SyntheticWalkOptions& options = {});
 /// The bundled examples in `dir` (`kin2grf make-example`): example_walk.c3d/.trc/_grf.mot (the
 /// walk, at least 2.5 strides long) and example_squat.c3d/.trc/_grf.mot (a squat on two plates
 /// whose signals are the method's own estimate), `seconds` long (1-600). Returns what was written,
-/// a line per example.
-std::vector<std::string> write_examples(const std::string& dir, double seconds);
+/// a line per example. `rate_hz`: the markers' rate (50-2000 Hz); `analog_rate_hz`: the walk's
+/// plates' rate, an integer multiple of it (0: the marker rate), their signals interpolated
+/// linearly between frames: a capture's size and shape for the memory benchmark (issue 10: 2 kHz
+/// markers, 10 kHz analog). The squat's plates are at the marker rate.
+std::vector<std::string> write_examples(const std::string& dir, double seconds, double rate_hz = 100.0,
+                                        double analog_rate_hz = 0.0);
 
 }  // namespace kin2grf

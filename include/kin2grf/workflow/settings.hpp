@@ -85,5 +85,8 @@ LoadOptions estimate_load_options();
 /// `options` (to_options(s), resolved once by the caller, who also records them); the marker
 /// set's recognition goes into the result's messages.
 EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial, const std::optional<Trial>& st);
+/// The same, giving up the trial: its marker samples are released once the landmarks are made
+/// (estimate(Trial&&), issue 10's memory).
+EstimateResult estimate_trial(const Settings& s, EstimateOptions options, Trial&& trial, const std::optional<Trial>& st);
 
 }  // namespace kin2grf
