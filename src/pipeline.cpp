@@ -108,8 +108,13 @@ void sagittal_stage(const Trial& trial, Trial* release, const Trial* static_tria
   if (trial.markers.frames() == 0) throw InputError(trial.path + ": the trial has no marker frames");
   std::vector<std::string> cleaning;
   std::optional<MarkerTrajectories> cleaned = without_marker_outliers(trial.markers, set.motion_markers(), cleaning);
+  // The samples the landmarks are made of are released as they are used (the cleaned copy's, or
+  // the trial's when the caller gave it up): with the cleaned copy, the trial's at once.
+  if (cleaned && release)
+    for (auto& p : release->markers.positions_m) p.resize(0, 3);
+  MarkerTrajectories* releasable = cleaned ? &*cleaned : release ? &release->markers : nullptr;
   Landmarks3D lm3 = compute_landmarks(set, cleaned ? *cleaned : trial.markers, static_trial ? &static_trial->markers : nullptr,
-                                      o.landmarks, trial.path);
+                                      o.landmarks, trial.path, releasable);
   // From here on, only the markers' frame count, numbers, times, rate and up axis are read (the
   // trial's, which the cleaned copy shares).
   cleaned.reset();
@@ -348,7 +353,8 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, Raw
   }
   const double post = r.post_cutoff_hz;
   Eigen::MatrixXd lamf = post > 0 ? butterworth_filtfilt(lam, rate_hz, post) : lam;
-  r.joint_torque_Nm = post > 0 ? butterworth_filtfilt(raw.torque, rate_hz, post) : raw.torque;
+  r.joint_torque_Nm = post > 0 ? butterworth_filtfilt(raw.torque, rate_hz, post) : std::move(raw.torque);
+  raw.torque = Eigen::MatrixXd();  // a long trial's memory: nothing below reads it
   for (Eigen::Index i = 0; i < n; ++i)
     for (int j = 0; j < np; ++j)
       if (!act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;

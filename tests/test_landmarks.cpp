@@ -151,3 +151,34 @@ TEST(Landmarks, PresetRecognitionLooksAtWhichMarkersHoldData) {
   for (std::size_t k = 0; k < m.names.size(); ++k) m.positions_m[k].setConstant(0.5);
   EXPECT_EQ(recognise_marker_set(m)->name, "plug-in-gait");
 }
+
+// compute_landmarks given its markers to release (a long trial's memory, issue 10): each marker's
+// samples go after the last landmark that reads it (RHJC is read by the hip and, last, by the
+// left hallux here), a marker no landmark reads at once, and the landmarks are the very ones made
+// without releasing. Reading a released marker would throw, not read an empty series.
+TEST(Landmarks, MarkersAreReleasedAfterTheirLastLandmarkAndTheLandmarksAreTheSame) {
+  MarkerTrajectories m = make_synthetic_trial({}).markers;
+  m.names.push_back("EXTRA");
+  m.descriptions.push_back("");
+  m.positions_m.push_back(m.positions_m[0]);
+  nlohmann::json j = {{"name", "t"}, {"landmarks", nlohmann::json::object()}};
+  j["landmarks"]["shoulder"] = {{"mean", {"RSHO", "LSHO"}}};
+  j["landmarks"]["hip"] = {{"mean", {"RHJC", "LHJC"}}};
+  for (const char* side : {"r", "l"}) {
+    const std::string S = side[0] == 'r' ? "R" : "L";
+    j["landmarks"][std::string("knee_") + side] = {{"marker", S + "KJC"}};
+    j["landmarks"][std::string("ankle_") + side] = {{"marker", S + "AJC"}};
+    j["landmarks"][std::string("heel_") + side] = {{"marker", S + "HEE"}};
+    j["landmarks"][std::string("mt_") + side] = {{"marker", S + "MT1"}};
+    j["landmarks"][std::string("hallux_") + side] = {{"marker", S + "HLX"}};
+  }
+  j["landmarks"]["hallux_l"] = {{"mean", {"LHLX", "RHJC"}}};
+  const MarkerSet set = parse_marker_set(j, "test");
+  const Landmarks3D kept = compute_landmarks(set, m, nullptr, {}, "synthetic");
+  MarkerTrajectories given = m;
+  const Landmarks3D released = compute_landmarks(set, given, nullptr, {}, "synthetic", &given);
+  for (int id = 0; id < kLandmarkCount; ++id)
+    EXPECT_TRUE(released.p[static_cast<std::size_t>(id)].cwiseEqual(kept.p[static_cast<std::size_t>(id)]).all()) << id;
+  for (std::size_t k = 0; k < given.names.size(); ++k) EXPECT_EQ(given.positions_m[k].rows(), 0) << given.names[k];
+  EXPECT_EQ(given.frames(), m.frames());
+}

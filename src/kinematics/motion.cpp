@@ -27,11 +27,14 @@ PointKinematics place(const PointKinematics& proximal, double th, double w, doub
 }
 
 /// The torso's length scale k = L(t) / L0 and its derivatives at frame i (1, 0, 0 without column 11).
-std::array<double, 3> torso_scale(const ModelMotion& m, Eigen::Index i) {
+std::array<double, 3> torso_scale(const ModelMotion& m, Eigen::Index i, const double* xd_i, const double* xdd_i) {
   if (m.x.cols() <= 11) return {1.0, 0.0, 0.0};
   const double L0 = m.model.bodies[kTorso].length_m;
-  return {m.x(i, 11) / L0, m.xd(i, 11) / L0, m.xdd(i, 11) / L0};
+  return {m.x(i, 11) / L0, xd_i[11] / L0, xdd_i[11] / L0};
 }
+
+/// The most independent coordinates a motion has (the torso's length as the 12th).
+constexpr Eigen::Index kMaxIndependent = 12;
 
 }  // namespace
 
@@ -93,24 +96,61 @@ Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm) {
   return x;
 }
 
+void ModelMotion::derivatives_at(Eigen::Index i, double* d1, double* d2) const {
+  const Eigen::Index n = x.rows(), cols = x.cols();
+  if (xd.rows() == n && xdd.rows() == n && xd.cols() == cols && xdd.cols() == cols) {
+    for (Eigen::Index k = 0; k < cols; ++k) d1[k] = xd(i, k), d2[k] = xdd(i, k);
+    return;
+  }
+  // central_difference and second_difference of x, row i, with their very operations (the same
+  // doubles as the whole-trial matrices).
+  const double dt = 1.0 / rate_hz;
+  for (Eigen::Index k = 0; k < cols; ++k) {
+    if (n < 2) d1[k] = 0.0;
+    else if (i == 0) d1[k] = (x(1, k) - x(0, k)) / dt;
+    else if (i == n - 1) d1[k] = (x(n - 1, k) - x(n - 2, k)) / dt;
+    else d1[k] = (x(i + 1, k) - x(i - 1, k)) / (2 * dt);
+    if (n < 3) {
+      d2[k] = 0.0;
+    } else {
+      const Eigen::Index j = std::clamp<Eigen::Index>(i, 1, n - 2);  // the ends take their neighbour's
+      d2[k] = (x(j + 1, k) - 2 * x(j, k) + x(j - 1, k)) / (dt * dt);
+    }
+  }
+}
+
+Eigen::VectorXd ModelMotion::xdd_column(int c) const {
+  const Eigen::Index n = x.rows();
+  if (xdd.rows() == n && xdd.cols() == x.cols()) return xdd.col(c);
+  Eigen::VectorXd out(n);
+  std::array<double, kMaxIndependent> d1{}, d2{};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    derivatives_at(i, d1.data(), d2.data());
+    out[i] = d2[static_cast<std::size_t>(c)];
+  }
+  return out;
+}
+
 void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
   // Every coordinate is written below (each landmark is a body's proximal or attached point);
   // D* is zero where the motion keeps none.
   // Bodies in an order where the parent comes first (the torso, then each leg down).
   static constexpr int order[] = {kTorso, kThighR, kShankR, kFootR, kToesR, kThighL, kShankL, kFootL, kToesL};
+  std::array<double, kMaxIndependent> d1{}, d2{};
+  derivatives_at(i, d1.data(), d2.data());
   std::array<double, kSegmentCount> th{}, w{}, al{};
-  th[kTorso] = x(i, 2); w[kTorso] = xd(i, 2); al[kTorso] = xdd(i, 2);
+  th[kTorso] = x(i, 2); w[kTorso] = d1[2]; al[kTorso] = d2[2];
   for (int j = 0; j < kJointCount; ++j) {
     const int c = joint_child(j), p = joint_parent(j);
     th[c] = th[p] + x(i, 3 + j);
-    w[c] = w[p] + xd(i, 3 + j);
-    al[c] = al[p] + xdd(i, 3 + j);
+    w[c] = w[p] + d1[static_cast<std::size_t>(3 + j)];
+    al[c] = al[p] + d2[static_cast<std::size_t>(3 + j)];
   }
   std::array<PointKinematics, kLandmarkCount> pk;
-  pk[kHip] = {Eigen::Vector2d(x(i, 0), x(i, 1)), Eigen::Vector2d(xd(i, 0), xd(i, 1)), Eigen::Vector2d(xdd(i, 0), xdd(i, 1))};
+  pk[kHip] = {Eigen::Vector2d(x(i, 0), x(i, 1)), Eigen::Vector2d(d1[0], d1[1]), Eigen::Vector2d(d2[0], d2[1])};
   // The torso's points scale with its measured length (column 11, when given): d = k e with
   // e = R(theta) rho, so d' = k' e + k e' and d'' = k'' e + 2 k' e' + k e''.
-  const auto [ks, ksd, ksdd] = torso_scale(*this, i);
+  const auto [ks, ksd, ksdd] = torso_scale(*this, i, d1.data(), d2.data());
   for (int s : order) {
     const Body& b = model.bodies[s];
     const bool scaled = s == kTorso;
@@ -132,8 +172,8 @@ void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
   }
   for (int j = 0; j < kJointCount; ++j) {
     f.q(coord::phi(j)) = x(i, 3 + j);
-    f.qd(coord::phi(j)) = xd(i, 3 + j);
-    f.qdd(coord::phi(j)) = xdd(i, 3 + j);
+    f.qd(coord::phi(j)) = d1[static_cast<std::size_t>(3 + j)];
+    f.qdd(coord::phi(j)) = d2[static_cast<std::size_t>(3 + j)];
   }
   if (torso_ax_mps2.size() > i) f.qdd(coord::com_x(kTorso)) = torso_ax_mps2[i];
   if (dstar.rows() > i) {
@@ -161,11 +201,12 @@ ModelMotion reconstruct_motion(const Model& model, Eigen::MatrixXd x, Eigen::Mat
   // the torso lag delays.
   Eigen::VectorXd ax(n);
   const Eigen::Vector2d& rho = model.bodies[kTorso].com_local;
+  std::array<double, kMaxIndependent> d1{}, d2{};
   for (Eigen::Index i = 0; i < n; ++i) {
-    const PointKinematics hip{Eigen::Vector2d(mm.x(i, 0), mm.x(i, 1)), Eigen::Vector2d(mm.xd(i, 0), mm.xd(i, 1)),
-                              Eigen::Vector2d(mm.xdd(i, 0), mm.xdd(i, 1))};
-    const auto [k0, k1, k2] = torso_scale(mm, i);
-    ax[i] = place(hip, mm.x(i, 2), mm.xd(i, 2), mm.xdd(i, 2), rho, k0, k1, k2).a.x();
+    mm.derivatives_at(i, d1.data(), d2.data());
+    const PointKinematics hip{Eigen::Vector2d(mm.x(i, 0), mm.x(i, 1)), Eigen::Vector2d(d1[0], d1[1]), Eigen::Vector2d(d2[0], d2[1])};
+    const auto [k0, k1, k2] = torso_scale(mm, i, d1.data(), d2.data());
+    ax[i] = place(hip, mm.x(i, 2), d1[2], d2[2], rho, k0, k1, k2).a.x();
   }
   mm.torso_ax_mps2 = std::move(ax);
   return mm;
@@ -173,13 +214,11 @@ ModelMotion reconstruct_motion(const Model& model, Eigen::MatrixXd x, Eigen::Mat
 
 ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz, TorsoLength torso) {
   if (lm.frames() < 8) throw InputError("too few frames (" + std::to_string(lm.frames()) + ") for the kinematics");
-  const double dt = 1.0 / lm.rate_hz;
   Eigen::MatrixXd x = independent_coordinates(lm);
   if (torso == TorsoLength::Fixed) x.conservativeResize(Eigen::NoChange, 11);
   if (cutoff_hz > 0) x = butterworth_filtfilt(x, lm.rate_hz, cutoff_hz);
-  Eigen::MatrixXd xd = central_difference(x, dt);
-  Eigen::MatrixXd xdd = second_difference(x, dt);
-  return reconstruct_motion(model, std::move(x), std::move(xd), std::move(xdd), lm.rate_hz, lm.time_s);
+  // Empty derivatives: each frame takes x's central differences (ModelMotion::derivatives_at).
+  return reconstruct_motion(model, std::move(x), Eigen::MatrixXd(), Eigen::MatrixXd(), lm.rate_hz, lm.time_s);
 }
 
 void lag_torso_fore_aft(ModelMotion& m, double tau_s) {
@@ -210,7 +249,8 @@ double measured_torso_lag_s(const ModelMotion& m) {
   const Eigen::Index m1 = std::min(n - n / 10, m0 + static_cast<Eigen::Index>(std::min(60.0 * m.rate_hz, static_cast<double>(n))));
   // The hip's fore-aft acceleration is its independent coordinate's (column 0).
   using Series = Eigen::Ref<const Eigen::VectorXd>;  // views, no copies
-  const Series hip = m.xdd.col(0), hat = m.torso_ax_mps2;
+  const Eigen::VectorXd hip_ax = m.xdd_column(0);
+  const Series hip = hip_ax, hat = m.torso_ax_mps2;
   const int reach = std::max(1, static_cast<int>(0.08 * m.rate_hz));
   // The peak lag of y behind x, in frames (parabola through the peak); NaN without a positive peak.
   auto peak_lag = [&](const Series& x, const Series& y) {

@@ -1,6 +1,7 @@
 #include "kin2grf/markers/landmarks.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -31,7 +32,11 @@ Eigen::MatrixX3d marker(const MarkerTrajectories& m, const std::string& name, co
     if (other.size() > name.size() + 1 && other.compare(0, name.size() + 1, name + "#") == 0)
       throw InputError(path + ": marker '" + name + "' (needed for " + what + ") appears more than once in the file (" +
                        name + ", " + other + "): rename one, or map the landmark to the one meant");
-  return m.positions_m[static_cast<std::size_t>(k)];
+  const Eigen::MatrixX3d& p = m.positions_m[static_cast<std::size_t>(k)];
+  // compute_landmarks releases a marker after the last landmark that reads it: reading it later is
+  // a bug of that bookkeeping, never silently an empty series.
+  if (p.rows() != m.frames()) throw std::logic_error("marker '" + name + "' read after its samples were released (" + what + ")");
+  return p;
 }
 
 Eigen::MatrixX3d mean_of(const MarkerTrajectories& m, const std::vector<std::string>& names, const std::string& path,
@@ -223,9 +228,26 @@ std::optional<MarkerTrajectories> without_marker_outliers(const MarkerTrajectori
 }
 
 Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m, const MarkerTrajectories* st,
-                              const LandmarkOptions& options, const std::string& path) {
+                              const LandmarkOptions& options, const std::string& path, MarkerTrajectories* release) {
   Landmarks3D out;
   const Eigen::Index n = m.frames();
+  // The last landmark that reads each marker of the trial (-1: none).
+  std::vector<int> last_use(m.names.size(), -1);
+  for (int id = 0; id < kLandmarkCount; ++id) {
+    const LandmarkRule& r = set.rules[static_cast<std::size_t>(id)];
+    auto use = [&](const std::string& name) {
+      if (const int k = m.find(name); k >= 0) last_use[static_cast<std::size_t>(k)] = id;
+    };
+    for (const auto& name : r.markers) use(name);
+    for (const auto& name : r.cluster) use(name);
+    for (const auto& [key, name] : r.pelvis) use(name);
+  }
+  auto release_after = [&](int id) {
+    if (!release) return;
+    for (std::size_t k = 0; k < last_use.size(); ++k)
+      if (last_use[k] == id) release->positions_m[k].resize(0, 3);
+  };
+  release_after(-1);
   for (int id = 0; id < kLandmarkCount; ++id) {
     const LandmarkRule& r = set.rules[static_cast<std::size_t>(id)];
     const std::string what = std::string("landmark ") + kNames[id];
@@ -292,7 +314,8 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
         if (cluster_frame(cm, i, R, o)) P.row(i) = (o + R * local).transpose();
       }
     }
-    out.p[static_cast<std::size_t>(id)] = P;  // virtual_hallux stays NaN: built in the sagittal step
+    out.p[static_cast<std::size_t>(id)] = std::move(P);  // virtual_hallux stays NaN: built in the sagittal step
+    release_after(id);
   }
   return out;
 }

@@ -65,12 +65,22 @@ struct ModelMotion {
   double rate_hz = 0.0;
   Eigen::VectorXd time_s;
   Model model;                         ///< the bodies frame() places (a copy: the motion stands alone)
-  Eigen::MatrixXd x, xd, xdd;          ///< independent coordinates (independent_coordinates' columns)
+  Eigen::MatrixXd x;                   ///< independent coordinates (independent_coordinates' columns)
+  /// x's first and second time derivatives: stored (reconstruct_motion), or, when empty, x's
+  /// central differences (central_difference, second_difference) taken per frame by
+  /// derivatives_at(). compute_motion keeps x only: the derivatives were two thirds of a long
+  /// trial's motion (issue 10's memory), and a frame's differences cost a few operations. The
+  /// same numbers either way, bit for bit.
+  Eigen::MatrixXd xd, xdd;
   Eigen::VectorXd torso_ax_mps2;       ///< N: the HAT COM's fore-aft acceleration (lag_torso_fore_aft)
   /// N x 4: D* and its derivatives (coord::dstar_x); empty (zero in a frame) unless
   /// prepare_contacts kept them.
   Eigen::MatrixX4d dstar, dstar_d, dstar_dd;
   [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
+  /// Row i of xd and xdd into xd_i and xdd_i (x.cols() numbers each).
+  void derivatives_at(Eigen::Index i, double* xd_i, double* xdd_i) const;
+  /// Column c of xdd, the whole trial.
+  [[nodiscard]] Eigen::VectorXd xdd_column(int c) const;
   /// q, qd, qdd of frame i into f.
   void frame(Eigen::Index i, MotionFrame& f) const;
   [[nodiscard]] MotionFrame frame(Eigen::Index i) const {
@@ -81,7 +91,8 @@ struct ModelMotion {
 };
 
 /// Forward kinematics of the chain from the independent coordinates and their first and second
-/// time derivatives (N x 11: fixed lengths; N x 12: the torso takes column 11's length).
+/// time derivatives (N x 11: fixed lengths; N x 12: the torso takes column 11's length). xd and
+/// xdd empty: x's central differences, per frame (ModelMotion::derivatives_at).
 ModelMotion reconstruct_motion(const Model& model, Eigen::MatrixXd x, Eigen::MatrixXd xd, Eigen::MatrixXd xdd, double rate_hz,
                                Eigen::VectorXd time_s);
 

@@ -133,9 +133,14 @@ inline constexpr double kMaxLabCoordinateM = 1e4, kMaxMarkerSpeedMps = 30.0;
 std::optional<MarkerTrajectories> without_marker_outliers(const MarkerTrajectories& markers, const std::vector<std::string>& only,
                                                           std::vector<std::string>& messages);
 
+/// `release`: `motion` itself, when the caller has no further use for its samples: each
+/// marker's samples are released (left 0 x 3) after the last landmark that reads them, and those
+/// of markers no landmark reads at once, so that a long trial's markers and landmarks are not
+/// held whole together (issue 10's memory). The names, times and rate stay.
 Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& motion,
                               const MarkerTrajectories* static_trial, const LandmarkOptions& options,
-                              const std::string& path);
+                              const std::string& path,
+                              MarkerTrajectories* release = nullptr);
 
 SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajectories& motion,
                                     const LandmarkOptions& options);
