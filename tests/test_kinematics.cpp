@@ -205,3 +205,21 @@ TEST(Kinematics, TheMotionHoldsFewNumbersAFrameAndRebuildsEachFrameAlike) {
   }
   EXPECT_EQ(m.xdd_column(0), xdd.col(0));
 }
+
+// The noise-limited cut-off reads at most a minute of frames (the noise of a recording does not
+// change along it), and gathers only those (a long trial's memory, issue 10): on a 70 s trial
+// with noisy markers it is the residual analysis of all the landmarks' columns.
+TEST(Kinematics, TheNoiseLimitedCutOffOfALongTrialIsTheResidualAnalysisOfItsFirstMinute) {
+  SyntheticOptions so;
+  so.duration_s = 70.0;
+  SagittalLandmarks lm = synthetic_landmarks(make_synthetic_trial(so));
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.004);
+  for (auto& P : lm.p)
+    for (Eigen::Index i = 0; i < P.rows(); ++i) P(i, 0) += noise(rng), P(i, 1) += noise(rng);
+  Eigen::MatrixXd all(lm.frames(), 2 * kLandmarkCount);
+  for (int k = 0; k < kLandmarkCount; ++k) all.middleCols(2 * k, 2) = lm.p[static_cast<std::size_t>(k)];
+  const double fc = noise_limited_cutoff(lm, 6.0);
+  EXPECT_LT(fc, 6.0);  // the noise lowers it
+  EXPECT_EQ(fc, residual_analysis_cutoff(all, lm.rate_hz, 6.0));
+}

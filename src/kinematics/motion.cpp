@@ -274,8 +274,11 @@ double measured_torso_lag_s(const ModelMotion& m) {
 }
 
 double noise_limited_cutoff(const SagittalLandmarks& lm, double upper_hz) {
-  Eigen::MatrixXd xy(lm.frames(), 2 * kLandmarkCount);
-  for (int k = 0; k < kLandmarkCount; ++k) xy.middleCols(2 * k, 2) = lm.p[static_cast<std::size_t>(k)];
+  // residual_analysis_cutoff reads at most a minute of frames: only those are gathered (a long
+  // trial's memory, issue 10).
+  const Eigen::Index n = std::min<Eigen::Index>(lm.frames(), static_cast<Eigen::Index>(60 * lm.rate_hz));
+  Eigen::MatrixXd xy(n, 2 * kLandmarkCount);
+  for (int k = 0; k < kLandmarkCount; ++k) xy.middleCols(2 * k, 2) = lm.p[static_cast<std::size_t>(k)].topRows(n);
   return residual_analysis_cutoff(xy, lm.rate_hz, upper_hz);
 }
 

@@ -521,17 +521,27 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
   SagittalLandmarks& s = w.landmarks;
   s.rate_hz = m.rate_hz;
   s.time_s = m.time_s.segment(best_a, best_len);
+  // Each 3D landmark is released once projected (the heels and MT heads once the feet's lateral
+  // places are taken too): a long trial's memory (issue 10).
+  const auto lateral_needs = [](int id) {
+    for (int side = 0; side < 2; ++side)
+      if (id == landmark(side, kHeel) || id == landmark(side, kMt)) return true;
+    return false;
+  };
   for (int id = 0; id < kLandmarkCount; ++id) {
     s.p[static_cast<std::size_t>(id)].resize(best_len, 2);
     for (Eigen::Index i = 0; i < best_len; ++i)
       s.p[static_cast<std::size_t>(id)].row(i) =
           fr.to_sagittal(p[static_cast<std::size_t>(id)].row(best_a + i).transpose(), best_a + i).transpose();
+    if (!lateral_needs(id)) p[static_cast<std::size_t>(id)].resize(0, 3);
   }
   for (int side = 0; side < 2; ++side) {
     w.foot_lateral_m[side].resize(best_len);
     for (Eigen::Index i = 0; i < best_len; ++i)
       w.foot_lateral_m[side][i] =
           0.5 * (p[landmark(side, kHeel)].row(best_a + i) + p[landmark(side, kMt)].row(best_a + i)).dot(fr.lateral_at(best_a + i).transpose());
+    p[landmark(side, kHeel)].resize(0, 3);
+    p[landmark(side, kMt)].resize(0, 3);
     // Virtual hallux: toes straight along the foot, held at the MT head's foot-flat height.
     const LandmarkRule& r = set.rules[static_cast<std::size_t>(landmark(side, kHallux))];
     if (r.kind != "virtual_hallux") continue;

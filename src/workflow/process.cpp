@@ -14,7 +14,7 @@ void* g_heap_below_huge_pages = nullptr;  // kept, never freed (reachable, for l
 }
 
 void tune_allocator_for_a_short_run() {
-  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
   mallopt(M_TRIM_THRESHOLD, 512 << 20);
   mallopt(M_TOP_PAD, 32 << 20);
   mallopt(M_ARENA_MAX, 1);
