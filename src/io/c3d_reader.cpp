@@ -1,14 +1,14 @@
 // C3D reader, written from the C3D specification because no C3D library is packaged in Debian.
 // See include/kin2grf/io/c3d.hpp for what is supported and the conventions.
 #include <algorithm>
-#include <functional>
-#include <span>
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <numeric>
+#include <span>
 #include <sstream>
 
 #include "kin2grf/error.hpp"
@@ -321,7 +321,6 @@ C3dFile read_c3d_header(std::span<const std::uint8_t> bytes, const std::string& 
   return f;
 }
 
-
 namespace {
 
 /// Where a C3D's frames are and how they are laid out: checked against the header, the
@@ -398,8 +397,6 @@ C3dLayout c3d_layout(const C3dFile& f, std::size_t file_size, const std::string&
   return l;
 }
 
-/// The markers (model outputs stored as points set aside by name): a negative residual or a point
-/// at exactly (0, 0, 0) is missing. Returns POINT:UNITS's scale to metres.
 /// Called with byte ranges of the data section that have been read (a mapped file releases them).
 using ReleaseRead = std::function<void(std::size_t, std::size_t)>;
 
@@ -409,6 +406,8 @@ long frames_per_block(std::size_t frame_bytes) {
   return std::max<long>(1, static_cast<long>((std::size_t{4} << 20) / std::max<std::size_t>(1, frame_bytes)));
 }
 
+/// The markers (model outputs stored as points set aside by name): a negative residual or a point
+/// at exactly (0, 0, 0) is missing. Returns POINT:UNITS's scale to metres.
 double read_c3d_points(const C3dFile& f, const Bytes& b, const C3dLayout& l, const std::string& path, Trial& t,
                        const ReleaseRead& release) {
   const long nframes = l.nframes;

@@ -1,13 +1,13 @@
 #include "kin2grf/markers/landmarks.hpp"
 
 #include <algorithm>
-#include <stdexcept>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <functional>
 #include <limits>
 #include <set>
+#include <stdexcept>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/numeric.hpp"

@@ -1,5 +1,6 @@
 #include "kin2grf/output/results.hpp"
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdio>

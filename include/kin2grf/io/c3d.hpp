@@ -70,7 +70,10 @@ struct C3dFile {
 C3dFile read_c3d_header(const std::vector<std::uint8_t>& bytes, const std::string& path);
 C3dFile read_c3d_header(std::span<const std::uint8_t> bytes, const std::string& path);
 
-/// Read a whole trial (markers, plates, events, mass) from a C3D file.
+/// Read a whole trial (markers, plates, events, mass) from a C3D file. The file is mapped, not
+/// read into memory, and each block of frames is released once read (a long capture is never
+/// resident whole); as with every reader that maps, a file cut short by another program while it
+/// is being read stops the process.
 Trial read_c3d(const std::string& path, const C3dReadOptions& options = {});
 Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& path,
                      const C3dReadOptions& options = {});
