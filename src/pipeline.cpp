@@ -273,7 +273,7 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
   raw.point_gap_m.resize(n, np);
   for (int side = 0; side < 2; ++side) {
     raw.inclination_rad[side].resize(n);
-    if (o.keep_validation_series) raw.sole_m[side].resize(n, 6);
+    if (o.keep_all_series) raw.sole_m[side].resize(n, 6);
   }
   r.iterations.resize(static_cast<std::size_t>(n));
   std::vector<char> cycled(static_cast<std::size_t>(n)), capped(static_cast<std::size_t>(n));
@@ -300,7 +300,7 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
       for (int side = 0; side < 2; ++side) {
         const auto s_ = static_cast<std::size_t>(side);
         raw.inclination_rad[s_][i] = fc.foot_inclination_rad[s_];
-        if (o.keep_validation_series)
+        if (o.keep_all_series)
           for (int c = 0; c < 3; ++c) raw.sole_m[s_].block<1, 2>(i, 2 * c) = fc.sole[s_][static_cast<std::size_t>(c)].transpose();
       }
       raw.lambda.row(i) = s.contact_lambda.transpose();
@@ -399,50 +399,62 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, Raw
   }
 }
 
-/// Whole-body totals from the kinematics alone, the GRM, the dynamic residual and joint forces.
-void totals_stage(const EstimateOptions& o, EstimateResult& r, const ModelMotion& motion) {
-  const Eigen::Index n = motion.frames();
-  // GRM about the reference point, residual and joint forces.
+/// Whole-body totals from the kinematics alone, the GRM, the dynamic residual and joint forces,
+/// for every frame (frame_totals), unless the result is not to hold them (keep_all_series).
+void totals_stage(const EstimateOptions& o, EstimateResult& r) {
+  if (!o.keep_all_series) return;
+  const Eigen::Index n = r.motion.frames();
   r.grm_Nm = Eigen::VectorXd::Zero(n);
   r.residual = Eigen::MatrixX3d::Zero(n, 3);
-  if (o.keep_validation_series) r.kinematic_total = Eigen::MatrixX3d::Zero(n, 3);
+  r.kinematic_total = Eigen::MatrixX3d::Zero(n, 3);
   r.joint_force_N = Eigen::MatrixXd::Zero(n, 2 * kJointCount);
-  const double g = r.model.gravity_mps2;
-  MotionFrame m;
   for (Eigen::Index i = 0; i < n; ++i) {
-    motion.frame(i, m);
-    Eigen::Vector3d kin = Eigen::Vector3d::Zero();  // sum m(a+g), sum of moments about the origin
-    std::array<Eigen::Vector2d, kSegmentCount> seg_force;
-    for (int s = 0; s < kSegmentCount; ++s) {
-      const Body& b = r.model.bodies[s];
-      const Eigen::Vector2d pos = m.q.segment<2>(coord::com_x(s));
-      const Eigen::Vector2d F = b.mass_kg * Eigen::Vector2d(m.qdd(coord::com_x(s)), m.qdd(coord::com_x(s) + 1) + g);
-      seg_force[static_cast<std::size_t>(s)] = F;
-      kin += Eigen::Vector3d(F.x(), F.y(), sagittal_moment(pos.x(), pos.y(), F.x(), F.y()) + b.inertia_kgm2 * m.qdd(coord::theta(s)));
-    }
-    Eigen::Vector3d ext = Eigen::Vector3d::Zero();
-    for (int side = 0; side < 2; ++side) {
-      const auto& f = r.feet[side];
-      if (!f.contact[static_cast<std::size_t>(i)]) continue;
-      const double x = f.cop_x_m[i], y = r.ground_level_m();
-      const double fx = f.force_N(i, 0), fy = f.force_N(i, 1);
-      r.grm_Nm[i] += sagittal_moment(x - o.grm_reference_m.x(), y - o.grm_reference_m.y(), fx, fy);
-      ext += Eigen::Vector3d(fx, fy, sagittal_moment(x, y, fx, fy));
-    }
-    r.residual.row(i) = (kin - ext).transpose();
-    if (o.keep_validation_series) r.kinematic_total.row(i) = kin.transpose();
-    for (int j = 0; j < kJointCount; ++j) {
-      const int side = j / 4, depth = j % 4;
-      Eigen::Vector2d F = Eigen::Vector2d::Zero();
-      for (int k = depth; k < 4; ++k) F += seg_force[static_cast<std::size_t>(segment(side, static_cast<LegSegment>(k)))];
-      if (depth <= 2 && r.feet[side].contact[static_cast<std::size_t>(i)]) F -= r.feet[side].force_N.row(i).transpose();
-      r.joint_force_N(i, 2 * j) = F.x();
-      r.joint_force_N(i, 2 * j + 1) = F.y();
-    }
+    const FrameTotals t = frame_totals(r, i);
+    r.grm_Nm[i] = t.grm_Nm;
+    r.residual.row(i) = t.residual.transpose();
+    r.kinematic_total.row(i) = t.kinematic_total.transpose();
+    for (int j = 0; j < 2 * kJointCount; ++j) r.joint_force_N(i, j) = t.joint_force_N[static_cast<std::size_t>(j)];
   }
 }
 
 }  // namespace
+
+FrameTotals frame_totals(const EstimateResult& r, Eigen::Index i) {
+  FrameTotals t;
+  const double g = r.model.gravity_mps2;
+  MotionFrame m;
+  r.motion.frame(i, m);
+  Eigen::Vector3d kin = Eigen::Vector3d::Zero();  // sum m(a+g), sum of moments about the origin
+  std::array<Eigen::Vector2d, kSegmentCount> seg_force;
+  for (int s = 0; s < kSegmentCount; ++s) {
+    const Body& b = r.model.bodies[s];
+    const Eigen::Vector2d pos = m.q.segment<2>(coord::com_x(s));
+    const Eigen::Vector2d F = b.mass_kg * Eigen::Vector2d(m.qdd(coord::com_x(s)), m.qdd(coord::com_x(s) + 1) + g);
+    seg_force[static_cast<std::size_t>(s)] = F;
+    kin += Eigen::Vector3d(F.x(), F.y(), sagittal_moment(pos.x(), pos.y(), F.x(), F.y()) + b.inertia_kgm2 * m.qdd(coord::theta(s)));
+  }
+  Eigen::Vector3d ext = Eigen::Vector3d::Zero();
+  for (int side = 0; side < 2; ++side) {
+    const auto& f = r.feet[static_cast<std::size_t>(side)];
+    if (!f.contact[static_cast<std::size_t>(i)]) continue;
+    const double x = f.cop_x_m[i], y = r.ground_level_m();
+    const double fx = f.force_N(i, 0), fy = f.force_N(i, 1);
+    t.grm_Nm += sagittal_moment(x - r.grm_reference_m.x(), y - r.grm_reference_m.y(), fx, fy);
+    ext += Eigen::Vector3d(fx, fy, sagittal_moment(x, y, fx, fy));
+  }
+  t.residual = kin - ext;
+  t.kinematic_total = kin;
+  for (int j = 0; j < kJointCount; ++j) {
+    const int side = j / 4, depth = j % 4;
+    Eigen::Vector2d F = Eigen::Vector2d::Zero();
+    for (int k = depth; k < 4; ++k) F += seg_force[static_cast<std::size_t>(segment(side, static_cast<LegSegment>(k)))];
+    if (depth <= 2 && r.feet[static_cast<std::size_t>(side)].contact[static_cast<std::size_t>(i)])
+      F -= r.feet[static_cast<std::size_t>(side)].force_N.row(i).transpose();
+    t.joint_force_N[static_cast<std::size_t>(2 * j)] = F.x();
+    t.joint_force_N[static_cast<std::size_t>(2 * j + 1)] = F.y();
+  }
+  return t;
+}
 
 namespace {
 
@@ -463,7 +475,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   lag_torso_stage(o, motion, r);
   auto [running, calibration] = contact_stage(o, r.model, std::move(soles), r, motion);
   r.calibration = std::move(calibration);
-  if (!o.keep_validation_series) r.landmarks.p = {};  // the last to read them is contact_stage (the hip's speed)
+  if (!o.keep_all_series) r.landmarks.p = {};  // the last to read them is contact_stage (the hip's speed)
   const auto t1 = clock::now();
   RawSolve raw = solve_stage(trial, o, r, motion, running);
   const auto t2 = clock::now();
@@ -473,7 +485,9 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   // What only the per-foot results needed is freed before the totals take their arrays: a long
   // trial's peak memory (issue 10).
   raw = RawSolve();
-  totals_stage(o, r, motion);
+  r.motion = std::move(motion);
+  r.grm_reference_m = o.grm_reference_m;
+  totals_stage(o, r);
   return r;
 }
 

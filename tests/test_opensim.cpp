@@ -1,7 +1,9 @@
 // OpenSim TRC and MOT/STO tests: shared files, round trips, and malformed headers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <mutex>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/load.hpp"
@@ -232,4 +234,36 @@ TEST(Outputs, StreamedWritersWriteWhatTheWholeTablesWould) {
   EXPECT_NEAR(back.data(r.time_s.size() / 2, 2), plates[0].force_N(r.time_s.size() / 2, 1), 1e-4 * 1000);
   EXPECT_EQ(table.values.rows(), r.time_s.size());
   EXPECT_EQ(static_cast<std::size_t>(table.values.cols()), results_columns().size());
+}
+
+// read_trc maps the file and lets the rows' text go as they are parsed (issue 10's memory):
+// parse_trc tells which byte ranges it is done with. They lie past the header, inside the text,
+// never overlap, and the markers are those of a parse that releases nothing.
+TEST(Trc, TheRowsTextIsReleasedOnlyOnceParsedAndTheMarkersAreTheSame) {
+  SyntheticWalkOptions wo;
+  wo.duration_s = 60.0;
+  wo.rate_hz = 500.0;
+  const std::string text = format_trc(make_synthetic_walk(wo).trial.markers, "walk.trc");
+  ASSERT_GT(text.size(), std::size_t{8} << 20);
+  std::vector<std::pair<std::size_t, std::size_t>> ranges;
+  std::mutex lock;
+  const MarkerTrajectories released = parse_trc(text, "walk.trc", nullptr, [&](std::size_t b, std::size_t e) {
+    const std::lock_guard<std::mutex> g(lock);
+    ranges.emplace_back(b, e);
+  });
+  const MarkerTrajectories kept = parse_trc(text, "walk.trc");
+  ASSERT_FALSE(ranges.empty());
+  std::sort(ranges.begin(), ranges.end());
+  const std::size_t header_end = text.find("\n\n") + 2;  // the header's 5 lines and the blank one
+  for (std::size_t k = 0; k < ranges.size(); ++k) {
+    EXPECT_GE(ranges[k].first, header_end);
+    EXPECT_LE(ranges[k].first, ranges[k].second);
+    EXPECT_LE(ranges[k].second, text.size());
+    if (k) {
+      EXPECT_LE(ranges[k - 1].second, ranges[k].first);
+    }
+  }
+  ASSERT_EQ(released.names, kept.names);
+  for (std::size_t k = 0; k < kept.positions_m.size(); ++k)
+    EXPECT_TRUE(released.positions_m[k].cwiseEqual(kept.positions_m[k]).all()) << kept.names[k];
 }

@@ -378,8 +378,8 @@ TEST(Estimate, PostFilterCyclesOutsideTheirRangeAreRefusedNamingTheSetting) {
 }
 
 // A long trial's memory (issue 10): estimate(Trial&&) releases the markers once the landmarks are
-// made, and keep_validation_series = false leaves out what only validation reads. Neither may
-// change an output. The walk has a one-frame marker spike, so the cleaned copy's path is taken.
+// made, and keep_all_series = false leaves out what only validation reads and the per-frame
+// totals, remade as the writers go. Neither may change an output. The walk has a one-frame marker spike, so the cleaned copy's path is taken.
 TEST(Estimate, ReleasingTheMarkersAndTheValidationSeriesChangesNoOutput) {
   SyntheticWalkOptions wo;
   wo.duration_s = 6.0;
@@ -388,7 +388,7 @@ TEST(Estimate, ReleasingTheMarkersAndTheValidationSeriesChangesNoOutput) {
   const MarkerSet& set = *find_marker_set("kin2grf-example");
   const EstimateResult full = estimate(walk, nullptr, set, EstimateOptions{});
   EstimateOptions lean;
-  lean.keep_validation_series = false;
+  lean.keep_all_series = false;
   Trial given = walk;
   const EstimateResult r = estimate(std::move(given), nullptr, set, lean);
   EXPECT_EQ(format_results_csv(r), format_results_csv(full));
@@ -404,6 +404,15 @@ TEST(Estimate, ReleasingTheMarkersAndTheValidationSeriesChangesNoOutput) {
   EXPECT_EQ(r.landmarks.frames(), full.landmarks.frames());
   EXPECT_EQ(r.feet[0].sole_m.rows(), 0);
   EXPECT_EQ(r.kinematic_total.rows(), 0);
+  // The totals are remade frame by frame (frame_totals), the very numbers held otherwise.
+  EXPECT_EQ(r.grm_Nm.size(), 0);
+  EXPECT_EQ(r.joint_force_N.rows(), 0);
+  EXPECT_EQ(results_summary(r, {})["residual_rms"], results_summary(full, {})["residual_rms"]);
+  for (const Eigen::Index i : {Eigen::Index{0}, full.time_s.size() / 2}) {
+    const FrameTotals t = frame_totals(r, i);
+    EXPECT_EQ(t.grm_Nm, full.grm_Nm[i]);
+    EXPECT_EQ(t.kinematic_total, full.kinematic_total.row(i).transpose());
+  }
   EXPECT_EQ(full.feet[0].sole_m.rows(), full.time_s.size());
   // A trial given up keeps what an error message names.
   EXPECT_EQ(given.path, walk.path);

@@ -80,7 +80,7 @@ int run_estimate(const EstimateArgs& a) {
   options.progress = kin2grf::solve_progress(stderr);
   // The outputs need neither what validation reads nor, unless the OpenSim export writes them,
   // the markers: a long trial's memory (issue 10).
-  options.keep_validation_series = false;
+  options.keep_all_series = false;
   const auto r = a.opensim_dir.empty() ? kin2grf::estimate_trial(a, options, std::move(files.trial), files.static_trial)
                                        : kin2grf::estimate_trial(a, options, trial, files.static_trial);
   print_messages(r);

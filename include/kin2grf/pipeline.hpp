@@ -46,12 +46,13 @@ struct EstimateOptions {
   ContactModelOptions contact;
   SolverOptions solver;
   LandmarkOptions landmarks;
-  /// Whether the result keeps what only validation and COP fitting read: the processed window's
-  /// landmarks (EstimateResult::landmarks), each foot's sole points (FootResult::sole_m) and the
-  /// kinematic totals (EstimateResult::kinematic_total). false: the landmarks are released once
-  /// the motion is made (r.landmarks keeps its rate and times), the other two are left empty: a
-  /// long trial's memory when only the outputs are wanted (issue 10). The outputs are the same.
-  bool keep_validation_series = true;
+  /// Whether the result holds every per-frame series. false (a long trial's memory when only the
+  /// outputs are wanted, issue 10): what only validation and COP fitting read is left out (the
+  /// window's landmarks are released once the motion is made, r.landmarks keeping its rate and
+  /// times; FootResult::sole_m and kinematic_total stay empty), and so are the per-frame totals
+  /// (grm_Nm, residual, joint_force_N), which frame_totals() remakes from the motion as the
+  /// writers go. The outputs are the same.
+  bool keep_all_series = true;
   /// GRM reference point in the sagittal frame (x along progression, y up), m.
   Eigen::Vector2d grm_reference_m = Eigen::Vector2d::Zero();
   /// Called with (frames solved, frames in all) every 1 % of the contact solve; empty: none.
@@ -66,7 +67,7 @@ struct FootResult {
   std::vector<bool> contact;
   Eigen::VectorXd inclination_rad;  ///< theta_A, the paper's foot inclination (contact.hpp)
   Eigen::VectorXd gap_m;            ///< normal gap g_n of the foot's lowest contact point
-  Eigen::MatrixXd sole_m;           ///< N x 6: sole points A, B, C (x, y) in the sagittal frame (keep_validation_series)
+  Eigen::MatrixXd sole_m;           ///< N x 6: sole points A, B, C (x, y) in the sagittal frame (keep_all_series)
 };
 
 struct EstimateResult {
@@ -84,21 +85,37 @@ struct EstimateResult {
   Eigen::Index first_index = 0;    ///< first processed frame's index in the trial
   int first_frame_number = 1;      ///< its frame number in the file
   std::array<FootResult, 2> feet;
-  Eigen::VectorXd grm_Nm;          ///< sagittal ground reaction moment about grm_reference_m
+  Eigen::VectorXd grm_Nm;          ///< sagittal ground reaction moment about grm_reference_m (keep_all_series)
   Eigen::MatrixXd joint_torque_Nm; ///< N x 8, moment on the child body, counter-clockwise +
-  Eigen::MatrixXd joint_force_N;   ///< N x 16, force on the child body's subtree (x, y) per joint
-  Eigen::MatrixX3d residual;       ///< N x 3: dynamic inconsistency (Fx N, Fy N, M N m)
+  Eigen::MatrixXd joint_force_N;   ///< N x 16, force on the child body's subtree (x, y) per joint (keep_all_series)
+  Eigen::MatrixX3d residual;       ///< N x 3: dynamic inconsistency (Fx N, Fy N, M N m) (keep_all_series)
   std::vector<int> iterations;
   int cycled_frames = 0, capped_frames = 0;
   std::array<Eigen::VectorXd, 2> foot_lateral_m;
+  /// The motion the contact forces were solved with (independent coordinates, about 100 bytes a
+  /// frame) and the GRM's reference point: what frame_totals() remakes a frame's totals from.
+  ModelMotion motion;
+  Eigen::Vector2d grm_reference_m = Eigen::Vector2d::Zero();
   SagittalLandmarks landmarks;     ///< the processed window's landmarks (sagittal frame)
   /// Rigid-body totals from the kinematics alone, N x 3: sum m (a + g) (x, y, N) and the sum of
   /// moments about the origin (N m). What all external forces together must equal.
-  /// (keep_validation_series)
+  /// (keep_all_series)
   Eigen::MatrixX3d kinematic_total;
   std::vector<std::string> messages;
   double seconds_kinematics = 0, seconds_dynamics = 0;
 };
+
+/// One processed frame's totals: the GRM about r.grm_reference_m, the dynamic residual (the
+/// kinematic total less the feet's forces and moments), the kinematic total (sum m (a + g) and
+/// the moments about the origin) and each joint's force on its child's subtree (x, y). What
+/// estimate() puts into grm_Nm, residual, kinematic_total and joint_force_N, frame by frame from
+/// r.motion and the feet's results, for a result that does not hold them (keep_all_series).
+struct FrameTotals {
+  double grm_Nm = 0.0;
+  Eigen::Vector3d residual = Eigen::Vector3d::Zero(), kinematic_total = Eigen::Vector3d::Zero();
+  std::array<double, 2 * kJointCount> joint_force_N{};
+};
+FrameTotals frame_totals(const EstimateResult& r, Eigen::Index i);
 
 /// Plausible adult and child body masses (kg): outside, estimate() refuses unless allowed.
 inline constexpr double kMassRangeKg[2] = {20.0, 300.0};

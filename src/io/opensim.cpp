@@ -4,6 +4,7 @@
 #include <atomic>
 #include <charconv>
 #include <cmath>
+#include <functional>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -48,8 +49,10 @@ int Table::column(const std::string& label) const {
 }
 
 MarkerTrajectories read_trc(const std::string& path, std::vector<std::string>* warnings) {
-  const MappedFile file(path);
-  return parse_trc(file.text(), path, warnings);
+  // The rows' text is released as they are parsed (issue 10's memory: a long trial's text and its
+  // markers are not held whole together).
+  const MappedFile file(path, /*populate=*/false);
+  return parse_trc(file.text(), path, warnings, [&](std::size_t begin, std::size_t end) { file.release(begin, end); });
 }
 
 namespace {
@@ -163,8 +166,10 @@ bool read_trc_row(std::string_view line, std::size_t li, const TrcHeader& th, co
 /// Every data row (line 6 on, blank lines skipped) straight into `m` and `frames`; returns the
 /// number of rows that end early. Rows are independent: chunks of them are read on the
 /// machine's cores, each into its own rows (no second copy of the data).
-std::size_t parse_trc_rows(const std::vector<std::string_view>& lines, std::size_t text_bytes, const TrcHeader& th,
-                           const std::string& path, MarkerTrajectories& m, std::vector<int>& frames) {
+std::size_t parse_trc_rows(const std::vector<std::string_view>& lines, std::string_view text, const TrcHeader& th,
+                           const std::string& path, MarkerTrajectories& m, std::vector<int>& frames,
+                           const std::function<void(std::size_t, std::size_t)>& release) {
+  const std::size_t text_bytes = text.size();
   std::vector<std::size_t> data_lines;
   data_lines.reserve(lines.size());
   for (std::size_t li = std::min<std::size_t>(5, lines.size()); li < lines.size(); ++li)
@@ -189,9 +194,18 @@ std::size_t parse_trc_rows(const std::vector<std::string_view>& lines, std::size
     std::vector<std::string_view> cells;
     std::vector<double> row_values;
     std::size_t short_here = 0;
-    for (std::size_t r = begin; r < end; ++r)
+    // Each chunk of rows is one thread's: it releases its own rows' text every 4 MB or so.
+    const auto offset = [&](std::size_t r) { return static_cast<std::size_t>(lines[data_lines[r]].data() - text.data()); };
+    std::size_t released = offset(begin);
+    for (std::size_t r = begin; r < end; ++r) {
       short_here += read_trc_row(lines[data_lines[r]], data_lines[r], th, path, cells, row_values, m, static_cast<Eigen::Index>(r),
                                  frames[r]);
+      if (release && r + 1 < end && offset(r + 1) - released >= (std::size_t{4} << 20)) {
+        release(released, offset(r + 1));
+        released = offset(r + 1);
+      }
+    }
+    if (release) release(released, end < data_lines.size() ? offset(end) : text.size());
     short_rows += short_here;
   });
   return short_rows;
@@ -199,13 +213,13 @@ std::size_t parse_trc_rows(const std::vector<std::string_view>& lines, std::size
 
 }  // namespace
 
-MarkerTrajectories parse_trc(std::string_view text, const std::string& path,
-                             std::vector<std::string>* warnings) {
+MarkerTrajectories parse_trc(std::string_view text, const std::string& path, std::vector<std::string>* warnings,
+                             const std::function<void(std::size_t, std::size_t)>& release) {
   const auto lines = lines_of(text);
   const TrcHeader th = parse_trc_header(lines, path, warnings);
   MarkerTrajectories m;
   std::vector<int> frames;
-  const std::size_t short_rows = parse_trc_rows(lines, text.size(), th, path, m, frames);
+  const std::size_t short_rows = parse_trc_rows(lines, text, th, path, m, frames, release);
   const auto n = m.frames();
   m.rate_hz = th.rate_hz;
   m.up_axis = Axis::Y;

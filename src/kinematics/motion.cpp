@@ -70,29 +70,35 @@ BodyGeometry measure_geometry(const SagittalLandmarks& lm) {
 Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm) {
   const Eigen::Index n = lm.frames();
   Eigen::MatrixXd x(n, 12);
-  Eigen::MatrixXd theta(n, kSegmentCount);
+  // The absolute angles first, in x itself (a long trial's memory, issue 10): the torso's in
+  // column 2, each joint's child segment's in column 3 + j.
   for (Eigen::Index i = 0; i < n; ++i) {
     auto P = [&](int k) { return Eigen::Vector2d(lm.p[k].row(i).transpose()); };
-    theta(i, kTorso) = angle_of(P(kShoulder) - P(kHip));
+    x(i, 2) = angle_of(P(kShoulder) - P(kHip));
     for (int s = 0; s < 2; ++s) {
-      theta(i, segment(s, kThigh)) = angle_of(P(landmark(s, kKnee)) - P(kHip));
-      theta(i, segment(s, kShank)) = angle_of(P(landmark(s, kAnkle)) - P(landmark(s, kKnee)));
-      theta(i, segment(s, kFoot)) = angle_of(P(landmark(s, kMt)) - P(landmark(s, kAnkle)));
-      theta(i, segment(s, kToes)) = angle_of(P(landmark(s, kHallux)) - P(landmark(s, kMt)));
+      x(i, 3 + 4 * s + kThigh) = angle_of(P(landmark(s, kKnee)) - P(kHip));
+      x(i, 3 + 4 * s + kShank) = angle_of(P(landmark(s, kAnkle)) - P(landmark(s, kKnee)));
+      x(i, 3 + 4 * s + kFoot) = angle_of(P(landmark(s, kMt)) - P(landmark(s, kAnkle)));
+      x(i, 3 + 4 * s + kToes) = angle_of(P(landmark(s, kHallux)) - P(landmark(s, kMt)));
     }
     x(i, 0) = lm.p[kHip](i, 0);
     x(i, 1) = lm.p[kHip](i, 1);
     x(i, 11) = (P(kShoulder) - P(kHip)).norm();
   }
-  // Unwrap each absolute angle over time, then form the joint angles.
-  for (int s = 0; s < kSegmentCount; ++s)
+  // Unwrap each absolute angle over time, then form the joint angles, child less parent: the
+  // distal joints first, so that a parent's absolute angle is still there for its child.
+  for (int c = 2; c < 3 + kJointCount; ++c)
     for (Eigen::Index i = 1; i < n; ++i) {
-      double d = theta(i, s) - theta(i - 1, s);
-      while (d > M_PI) { theta(i, s) -= 2 * M_PI; d -= 2 * M_PI; }
-      while (d < -M_PI) { theta(i, s) += 2 * M_PI; d += 2 * M_PI; }
+      double d = x(i, c) - x(i - 1, c);
+      while (d > M_PI) { x(i, c) -= 2 * M_PI; d -= 2 * M_PI; }
+      while (d < -M_PI) { x(i, c) += 2 * M_PI; d += 2 * M_PI; }
     }
-  x.col(2) = theta.col(kTorso);
-  for (int j = 0; j < kJointCount; ++j) x.col(3 + j) = theta.col(joint_child(j)) - theta.col(joint_parent(j));
+  for (int depth = 3; depth >= 0; --depth)
+    for (int s = 0; s < 2; ++s) {
+      const int j = 4 * s + depth;
+      static_assert(kThigh == 0 && kShank == 1 && kFoot == 2 && kToes == 3, "joint j's child is segment(j / 4, j % 4)");
+      x.col(3 + j) -= x.col(depth == 0 ? 2 : 3 + j - 1);  // joint_parent(j)'s absolute angle
+    }
   return x;
 }
 

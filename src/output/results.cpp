@@ -83,10 +83,13 @@ void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> v) {
     v[k++] = f.contact[static_cast<std::size_t>(i)] ? 1.0 : 0.0;
     v[k++] = f.gap_m[i], v[k++] = f.inclination_rad[i], v[k++] = f.raw_force_N(i, 1);
   }
-  v[k++] = r.grm_Nm[i];
+  // The totals: held, or remade from the motion (a result that holds no series of them).
+  const bool held = r.grm_Nm.size() == r.time_s.size();
+  const FrameTotals t = held ? FrameTotals{} : frame_totals(r, i);
+  v[k++] = held ? r.grm_Nm[i] : t.grm_Nm;
   for (int j = 0; j < kJointCount; ++j) v[k++] = r.joint_torque_Nm(i, j);
-  for (int j = 0; j < 2 * kJointCount; ++j) v[k++] = r.joint_force_N(i, j);
-  for (int j = 0; j < 3; ++j) v[k++] = r.residual(i, j);
+  for (int j = 0; j < 2 * kJointCount; ++j) v[k++] = held ? r.joint_force_N(i, j) : t.joint_force_N[static_cast<std::size_t>(j)];
+  for (int j = 0; j < 3; ++j) v[k++] = held ? r.residual(i, j) : t.residual[j];
   v[k++] = r.iterations[static_cast<std::size_t>(i)];
 }
 
@@ -182,9 +185,15 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
   for (int it : r.iterations) { mean_it += it; max_it = std::max(max_it, it); }
   j["iterations"] = {{"mean", n ? mean_it / static_cast<double>(n) : 0.0}, {"max", max_it},
                      {"cycled_frames", r.cycled_frames}, {"capped_frames", r.capped_frames}};
-  j["residual_rms"] = {{"x_N", std::sqrt(r.residual.col(0).squaredNorm() / std::max<double>(1, static_cast<double>(n)))},
-                       {"y_N", std::sqrt(r.residual.col(1).squaredNorm() / std::max<double>(1, static_cast<double>(n)))},
-                       {"moment_Nm", std::sqrt(r.residual.col(2).squaredNorm() / std::max<double>(1, static_cast<double>(n)))}};
+  Eigen::MatrixX3d remade;  // the residual of a result that does not hold it, for these three numbers
+  if (r.residual.rows() != n) {
+    remade.resize(n, 3);
+    for (Eigen::Index i = 0; i < n; ++i) remade.row(i) = frame_totals(r, i).residual.transpose();
+  }
+  const Eigen::MatrixX3d& residual = r.residual.rows() == n ? r.residual : remade;
+  j["residual_rms"] = {{"x_N", std::sqrt(residual.col(0).squaredNorm() / std::max<double>(1, static_cast<double>(n)))},
+                       {"y_N", std::sqrt(residual.col(1).squaredNorm() / std::max<double>(1, static_cast<double>(n)))},
+                       {"moment_Nm", std::sqrt(residual.col(2).squaredNorm() / std::max<double>(1, static_cast<double>(n)))}};
   j["timing"] = {{"kinematics_s", r.seconds_kinematics}, {"dynamics_s", r.seconds_dynamics},
                  {"frames_per_s", static_cast<double>(n) / std::max(1e-9, r.seconds_kinematics + r.seconds_dynamics)}};
   j["messages"] = r.messages;

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <functional>
 #include <map>
 #include <optional>
 #include <span>
@@ -33,8 +34,10 @@ struct Table {
 };
 
 MarkerTrajectories read_trc(const std::string& path, std::vector<std::string>* warnings = nullptr);
-MarkerTrajectories parse_trc(std::string_view text, const std::string& path,
-                             std::vector<std::string>* warnings = nullptr);
+/// `release(begin, end)`, if given, is told the byte ranges of `text` whose rows are parsed (a
+/// mapped file lets them go: read_trc).
+MarkerTrajectories parse_trc(std::string_view text, const std::string& path, std::vector<std::string>* warnings = nullptr,
+                             const std::function<void(std::size_t, std::size_t)>& release = {});
 /// Writes millimetres (the TRC norm), `up_axis` kept as in memory.
 std::string format_trc(const MarkerTrajectories& m, const std::string& file_name);
 void write_trc(const std::string& path, const MarkerTrajectories& m);
