@@ -4,9 +4,9 @@
 #include <atomic>
 #include <charconv>
 #include <cmath>
-#include <functional>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <span>
 #include <sstream>
