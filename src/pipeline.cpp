@@ -115,11 +115,10 @@ void sagittal_stage(const Trial& trial, Trial* release, const Trial* static_tria
   MarkerTrajectories* releasable = cleaned ? &*cleaned : release ? &release->markers : nullptr;
   Landmarks3D lm3 = compute_landmarks(set, cleaned ? *cleaned : trial.markers, static_trial ? &static_trial->markers : nullptr,
                                       o.landmarks, trial.path, releasable);
-  // From here on, only the markers' frame count, numbers, times, rate and up axis are read (the
-  // trial's, which the cleaned copy shares).
+  // Every sample is released now (compute_landmarks lets go of unread markers too). From here on,
+  // only the markers' frame count, numbers, times, rate and up axis are read (the trial's, which
+  // the cleaned copy shares).
   cleaned.reset();
-  if (release)
-    for (auto& p : release->markers.positions_m) p.resize(0, 3);
   const MarkerTrajectories& markers = trial.markers;
   // What the readers noticed (duplicate labels, rows cut short, an up axis corrected...) goes with
   // the results, so that estimate's and validate's outputs say it too.

@@ -317,18 +317,17 @@ std::vector<std::string> write_examples(const std::string& dir, double seconds, 
     wo.rate_hz = rate_hz;
     Trial walk = make_example_walk(wo);
     const std::string base = (std::filesystem::path(dir) / "example_walk").string();
-    {
-      Trial at_analog_rate = walk;
-      at_analog_rate.plates = upsampled(*walk.plates, static_cast<int>(ratio));
-      C3dWriteOptions co;
-      co.analog_samples_per_frame = static_cast<int>(ratio);
-      write_c3d(base + ".c3d", at_analog_rate, co);
-    }
     write_trc(base + ".trc", walk.markers);
     const auto& p = walk.plates->plates;
     auto t = grf_table(walk.plates->time_s, p[0], p[1]);
     t.name = "kin2grf_example_walk_plates";
     write_sto(base + "_grf.mot", t);
+    // The C3D last, its plates at the analog rate in place of the marker-rate ones (no copy of the
+    // markers).
+    walk.plates = upsampled(*walk.plates, static_cast<int>(ratio));
+    C3dWriteOptions co;
+    co.analog_samples_per_frame = static_cast<int>(ratio);
+    write_c3d(base + ".c3d", walk, co);
     written.push_back(base + ".c3d, .trc and _grf.mot (a walk over plates FP1 and FP2)");
   }
   SyntheticOptions so;
