@@ -4,7 +4,8 @@
 #   bash scripts/memory.sh [SECONDS] [DATA_DIR] [CAPTURE_SECONDS]
 # Three kinds of input:
 #  - the synthetic walk at 100 Hz, C3D (14 markers, 12 analog channels at the marker rate) and TRC,
-#    SECONDS long (default 600: 60,000 frames): as small a file per frame as a trial can be;
+#    SECONDS long (default 600: 60,000 frames) and half as long: as small a file per frame as a
+#    trial can be; the two lengths give the peak's growth per byte of file;
 #  - the same walk as a long capture is recorded, 2 kHz markers and 10 kHz analog (issue 10's
 #    example), CAPTURE_SECONDS long (default 120; 600 s is a 557 MB file, and make-example takes
 #    4 GB and 40 s to write it);
@@ -24,19 +25,30 @@ trap 'rm -rf "$WORK"' EXIT
 K=${KIN2GRF:-build/release/kin2grf}
 OUTS=(-o "$WORK/out.mot" --csv "$WORK/out.csv" --json "$WORK/out.json")
 GEN=build/release/kin2grf
-measure() {  # FILE LABEL: estimate's peak against the file's size
-  local size peak_kb base_kb
-  size=$(stat -c %s "$1")
+measure() {  # FILE LABEL: estimate's peak against the file's size; sets SIZE and PEAK (bytes)
+  local base_kb
+  SIZE=$(stat -c %s "$1")
   /usr/bin/time -o "$WORK/peak" -f "%M" "$K" estimate "$1" --mass 70 "${OUTS[@]}" >/dev/null 2>&1
   /usr/bin/time -o "$WORK/base" -f "%M" "$K" --version >/dev/null
-  peak_kb=$(tail -1 "$WORK/peak")
+  PEAK=$(( $(tail -1 "$WORK/peak") * 1024 ))
   base_kb=$(tail -1 "$WORK/base")
-  awk -v f="$2" -v s="$size" -v p="$peak_kb" -v b="$base_kb" 'BEGIN {
-    printf "%-34s file %7.1f MB  peak %7.1f MB (process alone %4.1f MB)  peak / file %5.2f\n", f, s / 1e6, p * 1024 / 1e6, b * 1024 / 1e6, p * 1024 / s }'
+  awk -v f="$2" -v s="$SIZE" -v p="$PEAK" -v b="$base_kb" 'BEGIN {
+    printf "%-34s file %7.1f MB  peak %7.1f MB (process alone %4.1f MB)  peak / file %5.2f\n", f, s / 1e6, p / 1e6, b * 1024 / 1e6, p / s }'
 }
+# The walk at half the length too: what a second of trial adds to the peak against what it adds to
+# the file (the target's "twice the file" is this slope; the constant is the rest).
+HALF=$(( SECONDS_LONG / 2 ))
+"$GEN" make-example --out-dir "$WORK/half" --seconds "$HALF" >/dev/null
 "$GEN" make-example --out-dir "$WORK/lean" --seconds "$SECONDS_LONG" >/dev/null
-measure "$WORK/lean/example_walk.c3d" "walk ${SECONDS_LONG} s, 100 Hz, C3D"
-measure "$WORK/lean/example_walk.trc" "walk ${SECONDS_LONG} s, 100 Hz, TRC"
+for ext in c3d trc; do
+  measure "$WORK/half/example_walk.$ext" "walk ${HALF} s, 100 Hz, ${ext^^}"
+  s0=$SIZE p0=$PEAK
+  measure "$WORK/lean/example_walk.$ext" "walk ${SECONDS_LONG} s, 100 Hz, ${ext^^}"
+  awk -v s0="$s0" -v p0="$p0" -v s1="$SIZE" -v p1="$PEAK" -v e="${ext^^}" 'BEGIN {
+    printf "  %s from %.1f to %.1f MB of file: %.2f bytes of peak per byte of file; peak - 2 x file %.1f MB\n", e, s0 / 1e6, s1 / 1e6,
+      (p1 - p0) / (s1 - s0), (p1 - 2 * s1) / 1e6 }'
+done
+rm -rf "$WORK/half"
 rm -rf "$WORK/lean"
 "$GEN" make-example --out-dir "$WORK/capture" --seconds "$CAPTURE_SECONDS" --rate 2000 --analog-rate 10000 >/dev/null
 measure "$WORK/capture/example_walk.c3d" "walk ${CAPTURE_SECONDS} s, 2 kHz + 10 kHz analog"

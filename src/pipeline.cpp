@@ -352,8 +352,8 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, Raw
   }
   const double post = r.post_cutoff_hz;
   Eigen::MatrixXd lamf = post > 0 ? butterworth_filtfilt(lam, rate_hz, post) : lam;
-  r.joint_torque_Nm = post > 0 ? butterworth_filtfilt(raw.torque, rate_hz, post) : std::move(raw.torque);
-  raw.torque = Eigen::MatrixXd();  // a long trial's memory: nothing below reads it
+  // In place (nothing below reads the raw torques): a long trial holds them once.
+  r.joint_torque_Nm = post > 0 ? butterworth_filtfilt(std::move(raw.torque), rate_hz, post) : std::move(raw.torque);
   for (Eigen::Index i = 0; i < n; ++i)
     for (int j = 0; j < np; ++j)
       if (!act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;

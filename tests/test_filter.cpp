@@ -10,6 +10,7 @@
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
+#include "kin2grf/parallel.hpp"
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/markers/presets.hpp"
 #include "kin2grf/pipeline.hpp"
@@ -51,6 +52,24 @@ TEST(Filter, ColumnsSideBySideGiveEachColumnsOwnFilterBitForBit) {
       const Eigen::VectorXd one = butterworth_filtfilt(Eigen::VectorXd(x.col(c)), 100.0, 6.0);
       for (Eigen::Index i = 0; i < rows; ++i) ASSERT_EQ(y(i, c), one[i]) << "row " << i << " column " << c << " of " << rows;
     }
+  }
+}
+
+// A long trial's coordinates are filtered where they lie (issue 10's memory): a matrix given up
+// with std::move comes back in the same storage, with the numbers a copy gets, on any thread count.
+TEST(Filter, AMovedMatrixIsFilteredInPlaceWithTheSameNumbers) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Eigen::MatrixXd x(40000, 13);  // long enough for the columns to go to several threads
+  for (Eigen::Index i = 0; i < x.size(); ++i) x.data()[i] = g(rng);
+  const Eigen::MatrixXd copied = butterworth_filtfilt(x, 100.0, 6.0);
+  for (const int threads : {1, 4}) {
+    const ThreadCountScope scope(threads);
+    Eigen::MatrixXd m = x;
+    const double* storage = m.data();
+    const Eigen::MatrixXd y = butterworth_filtfilt(std::move(m), 100.0, 6.0);
+    EXPECT_EQ(y.data(), storage) << threads << " threads";
+    EXPECT_TRUE(y == copied) << threads << " threads";
   }
 }
 

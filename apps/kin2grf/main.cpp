@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -73,6 +74,11 @@ int run_estimate(const EstimateArgs& a) {
   if (!a.opensim_dir.empty()) {
     const auto f = kin2grf::opensim_export_paths(a.opensim_dir, std::filesystem::path(a.trial).stem().string());
     check_outputs({f.grf_mot, f.markers_trc, f.external_loads_xml}, kin2grf::input_files(a));
+  }
+  {
+    // From 8 MB of file on, the trial's series alone outgrow the heap's 32 MB of huge pages.
+    std::error_code ec;
+    if (std::filesystem::file_size(a.trial, ec) >= (std::uintmax_t{8} << 20) && !ec) kin2grf::tune_allocator_for_a_long_run();
   }
   auto files = kin2grf::load_trial_and_static(a, kin2grf::estimate_load_options());
   const kin2grf::Trial& trial = files.trial;

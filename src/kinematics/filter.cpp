@@ -122,19 +122,20 @@ Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, d
   return y.col(0);
 }
 
-Eigen::MatrixXd butterworth_filtfilt(const Eigen::MatrixXd& x, double rate_hz, double cutoff_hz) {
+Eigen::MatrixXd butterworth_filtfilt(Eigen::MatrixXd x, double rate_hz, double cutoff_hz) {
   const Eigen::Index n = x.rows();
   if (n < 2 || x.cols() == 0) return x;
   const ZeroLagDesign d = design_zero_lag(n, rate_hz, cutoff_hz);
-  Eigen::MatrixXd y(n, x.cols());
+  // In place: filtfilt_columns copies its columns into the workspace before it writes them back,
+  // and no two chunks share a column, so a long trial's series is never held twice.
   // Columns are independent: on the machine's cores when long enough to pay for a thread (two
   // passes of a biquad, about 3 ns a sample four columns at a time).
   const std::size_t min_columns = min_chunk_for(3e-9 * static_cast<double>(n));
   for_chunks(static_cast<std::size_t>(x.cols()), min_columns, [&](std::size_t, std::size_t begin, std::size_t end) {
     std::vector<double> e;
-    filtfilt_range(d, x, static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(end), y, e);
+    filtfilt_range(d, x, static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(end), x, e);
   });
-  return y;
+  return x;
 }
 
 Eigen::MatrixXd central_difference(const Eigen::MatrixXd& x, double dt) {

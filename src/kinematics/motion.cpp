@@ -222,7 +222,7 @@ ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, doub
   if (lm.frames() < 8) throw InputError("too few frames (" + std::to_string(lm.frames()) + ") for the kinematics");
   Eigen::MatrixXd x = independent_coordinates(lm);
   if (torso == TorsoLength::Fixed) x.conservativeResize(Eigen::NoChange, 11);
-  if (cutoff_hz > 0) x = butterworth_filtfilt(x, lm.rate_hz, cutoff_hz);
+  if (cutoff_hz > 0) x = butterworth_filtfilt(std::move(x), lm.rate_hz, cutoff_hz);
   // Empty derivatives: each frame takes x's central differences (ModelMotion::derivatives_at).
   return reconstruct_motion(model, std::move(x), Eigen::MatrixXd(), Eigen::MatrixXd(), lm.rate_hz, lm.time_s);
 }

@@ -11,6 +11,7 @@ namespace kin2grf {
 
 namespace {
 void* g_heap_below_huge_pages = nullptr;  // kept, never freed (reachable, for leak checkers)
+std::uintptr_t g_huge_begin = 0, g_huge_end = 0;  // the heap's range advised for huge pages
 }
 
 void tune_allocator_for_a_short_run() {
@@ -27,7 +28,15 @@ void tune_allocator_for_a_short_run() {
   const auto start = (before + (64 << 10) + huge - 1) & ~(huge - 1);
   g_heap_below_huge_pages = std::malloc(start - before - (32 << 10));  // the heap grows by it and the pad
   const auto after = reinterpret_cast<std::uintptr_t>(sbrk(0));
-  if (g_heap_below_huge_pages && after > start) madvise(reinterpret_cast<void*>(start), after - start, MADV_HUGEPAGE);
+  if (g_heap_below_huge_pages && after > start && madvise(reinterpret_cast<void*>(start), after - start, MADV_HUGEPAGE) == 0)
+    g_huge_begin = start, g_huge_end = after;
+}
+
+void tune_allocator_for_a_long_run() {
+  // Pages already huge stay so (the first few MB); later faults in the range are 4 KB.
+  if (g_huge_end > g_huge_begin)
+    madvise(reinterpret_cast<void*>(g_huge_begin), g_huge_end - g_huge_begin, MADV_NOHUGEPAGE);
+  g_huge_begin = g_huge_end = 0;
 }
 
 void allow_allocator_arenas(int threads) {

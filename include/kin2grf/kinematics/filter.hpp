@@ -19,8 +19,9 @@ namespace kin2grf {
 /// Requires finite samples; cutoff must be below the Nyquist frequency.
 Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, double cutoff_hz);
 
-/// Column-wise butterworth_filtfilt.
-Eigen::MatrixXd butterworth_filtfilt(const Eigen::MatrixXd& x, double rate_hz, double cutoff_hz);
+/// Column-wise butterworth_filtfilt. Filters x in place: pass it with std::move where the
+/// unfiltered series is not needed again.
+Eigen::MatrixXd butterworth_filtfilt(Eigen::MatrixXd x, double rate_hz, double cutoff_hz);
 
 /// First derivative by central differences (one-sided at the ends), per column.
 Eigen::MatrixXd central_difference(const Eigen::MatrixXd& x, double dt_s);
