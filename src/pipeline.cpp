@@ -107,12 +107,14 @@ void sagittal_stage(const Trial& trial, Trial* release, const Trial* static_tria
                     const EstimateOptions& o, EstimateResult& r) {
   if (trial.markers.frames() == 0) throw InputError(trial.path + ": the trial has no marker frames");
   std::vector<std::string> cleaning;
-  std::optional<MarkerTrajectories> cleaned = without_marker_outliers(trial.markers, set.motion_markers(), cleaning);
-  // The samples the landmarks are made of are released as they are used (the cleaned copy's, or
-  // the trial's when the caller gave it up): with the cleaned copy, the trial's at once.
-  if (cleaned && release)
-    for (auto& p : release->markers.positions_m) p.resize(0, 3);
-  MarkerTrajectories* releasable = cleaned ? &*cleaned : release ? &release->markers : nullptr;
+  // A trial the caller gave up is cleaned in place (`release` is `trial` then); otherwise the
+  // cleaned copy is made only when there is an outlier.
+  std::optional<MarkerTrajectories> cleaned;
+  if (release) remove_marker_outliers(release->markers, set.motion_markers(), cleaning);
+  else cleaned = without_marker_outliers(trial.markers, set.motion_markers(), cleaning);
+  // The samples the landmarks are made of are released as they are used (the trial's, when the
+  // caller gave it up).
+  MarkerTrajectories* releasable = release ? &release->markers : nullptr;
   Landmarks3D lm3 = compute_landmarks(set, cleaned ? *cleaned : trial.markers, static_trial ? &static_trial->markers : nullptr,
                                       o.landmarks, trial.path, releasable);
   // Every sample is released now (compute_landmarks lets go of unread markers too). From here on,

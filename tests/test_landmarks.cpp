@@ -182,3 +182,34 @@ TEST(Landmarks, MarkersAreReleasedAfterTheirLastLandmarkAndTheLandmarksAreTheSam
   for (std::size_t k = 0; k < given.names.size(); ++k) EXPECT_EQ(given.positions_m[k].rows(), 0) << given.names[k];
   EXPECT_EQ(given.frames(), m.frames());
 }
+
+// A trial given up is cleaned of impossible samples where it lies (no copy of every marker for
+// one bad sample: a long trial's memory): the same gaps and messages as the cleaned copy.
+TEST(Landmarks, OutliersRemovedInPlaceAreThoseOfTheCleanedCopy) {
+  MarkerTrajectories m = make_synthetic_trial({}).markers;
+  const int k = m.find("RKJC"), far = m.find("LHEE");
+  m.positions_m[static_cast<std::size_t>(k)].row(40).array() += 1.0;  // a one-frame jump
+  m.positions_m[static_cast<std::size_t>(far)](7, 2) = 1e300;          // outside any lab
+  std::vector<std::string> copy_messages, place_messages;
+  const auto cleaned = without_marker_outliers(m, {}, copy_messages);
+  ASSERT_TRUE(cleaned.has_value());
+  std::vector<const double*> storage;
+  for (const auto& P : m.positions_m) storage.push_back(P.data());
+  EXPECT_EQ(remove_marker_outliers(m, {}, place_messages), 2U);
+  EXPECT_EQ(place_messages, copy_messages);
+  ASSERT_EQ(place_messages.size(), 2U);
+  for (std::size_t j = 0; j < m.positions_m.size(); ++j) {
+    EXPECT_EQ(m.positions_m[j].data(), storage[j]) << m.names[j];
+    const Eigen::ArrayX3d a = m.positions_m[j].array(), b = cleaned->positions_m[j].array();
+    EXPECT_TRUE(((a == b) || (a.isNaN() && b.isNaN())).all()) << m.names[j];
+  }
+  EXPECT_TRUE(std::isnan(m.positions_m[static_cast<std::size_t>(k)](40, 0)));
+  EXPECT_TRUE(std::isnan(m.positions_m[static_cast<std::size_t>(far)](7, 0)));
+  // Only the markers asked about are checked.
+  std::vector<std::string> none;
+  MarkerTrajectories again = make_synthetic_trial({}).markers;
+  again.positions_m[static_cast<std::size_t>(k)].row(40).array() += 1.0;
+  EXPECT_EQ(remove_marker_outliers(again, {"LHEE"}, none), 0U);
+  EXPECT_TRUE(none.empty());
+  EXPECT_FALSE(std::isnan(again.positions_m[static_cast<std::size_t>(k)](40, 0)));
+}

@@ -190,41 +190,74 @@ constexpr double kTrunkTrendCutoffHz = 0.5;
 }  // namespace
 
 
-std::optional<MarkerTrajectories> without_marker_outliers(const MarkerTrajectories& m, const std::vector<std::string>& only,
-                                                          std::vector<std::string>& messages) {
+namespace {
+
+/// The samples of marker k that no body can produce (see without_marker_outliers), in frame order.
+std::vector<Eigen::Index> outlier_samples(const MarkerTrajectories& m, std::size_t k) {
   const Eigen::Index n = m.frames();
   const double limit = kMaxMarkerSpeedMps / std::max(m.rate_hz, 1e-9) + 0.02;
+  const auto& P = m.positions_m[k];
+  // Usable samples: finite and inside any capture volume.
+  std::vector<bool> ok(static_cast<std::size_t>(n));
+  std::vector<Eigen::Index> where;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    ok[static_cast<std::size_t>(i)] = P.row(i).allFinite() && P.row(i).cwiseAbs().maxCoeff() <= kMaxLabCoordinateM;
+    if (P.row(i).allFinite() && !ok[static_cast<std::size_t>(i)]) where.push_back(i);
+  }
+  for (Eigen::Index i = 1; i + 1 < n; ++i) {
+    if (!ok[static_cast<std::size_t>(i - 1)] || !ok[static_cast<std::size_t>(i)] || !ok[static_cast<std::size_t>(i + 1)]) continue;
+    if ((P.row(i) - P.row(i - 1)).norm() > limit && (P.row(i + 1) - P.row(i)).norm() > limit &&
+        (P.row(i + 1) - P.row(i - 1)).norm() < limit) {
+      ok[static_cast<std::size_t>(i)] = false;
+      where.push_back(i);
+    }
+  }
+  std::sort(where.begin(), where.end());
+  return where;
+}
+
+std::string outlier_message(const MarkerTrajectories& m, std::size_t k, const std::vector<Eigen::Index>& where) {
+  std::string frames;
+  for (std::size_t w = 0; w < where.size() && w < 5; ++w) frames += (w ? ", " : "") + std::to_string(m.first_frame + where[w]);
+  if (where.size() > 5) frames += ", ...";
+  return m.names[k] + ": " + std::to_string(where.size()) + " sample(s) no body can produce (frame " + frames +
+         ": outside the lab or a one-frame jump faster than " + std::to_string(static_cast<int>(kMaxMarkerSpeedMps)) +
+         " m/s) treated as gaps";
+}
+
+bool checked(const MarkerTrajectories& m, std::size_t k, const std::vector<std::string>& only) {
+  return only.empty() || std::find(only.begin(), only.end(), m.names[k]) != only.end();
+}
+
+}  // namespace
+
+std::optional<MarkerTrajectories> without_marker_outliers(const MarkerTrajectories& m, const std::vector<std::string>& only,
+                                                          std::vector<std::string>& messages) {
   std::optional<MarkerTrajectories> out;  // copied only when there is something to remove
   for (std::size_t k = 0; k < m.positions_m.size(); ++k) {
-    if (!only.empty() && std::find(only.begin(), only.end(), m.names[k]) == only.end()) continue;
-    const auto& P = m.positions_m[k];
-    // Usable samples: finite and inside any capture volume.
-    std::vector<bool> ok(static_cast<std::size_t>(n));
-    std::vector<Eigen::Index> where;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      ok[static_cast<std::size_t>(i)] = P.row(i).allFinite() && P.row(i).cwiseAbs().maxCoeff() <= kMaxLabCoordinateM;
-      if (P.row(i).allFinite() && !ok[static_cast<std::size_t>(i)]) where.push_back(i);
-    }
-    for (Eigen::Index i = 1; i + 1 < n; ++i) {
-      if (!ok[static_cast<std::size_t>(i - 1)] || !ok[static_cast<std::size_t>(i)] || !ok[static_cast<std::size_t>(i + 1)]) continue;
-      if ((P.row(i) - P.row(i - 1)).norm() > limit && (P.row(i + 1) - P.row(i)).norm() > limit &&
-          (P.row(i + 1) - P.row(i - 1)).norm() < limit) {
-        ok[static_cast<std::size_t>(i)] = false;
-        where.push_back(i);
-      }
-    }
+    if (!checked(m, k, only)) continue;
+    const std::vector<Eigen::Index> where = outlier_samples(m, k);
     if (where.empty()) continue;
     if (!out) out = m;
     for (const Eigen::Index i : where) out->positions_m[k].row(i).setConstant(kNaN);
-    std::sort(where.begin(), where.end());
-    std::string frames;
-    for (std::size_t w = 0; w < where.size() && w < 5; ++w) frames += (w ? ", " : "") + std::to_string(m.first_frame + where[w]);
-    if (where.size() > 5) frames += ", ...";
-    messages.push_back(m.names[k] + ": " + std::to_string(where.size()) + " sample(s) no body can produce (frame " + frames +
-                       ": outside the lab or a one-frame jump faster than " + std::to_string(static_cast<int>(kMaxMarkerSpeedMps)) +
-                       " m/s) treated as gaps");
+    messages.push_back(outlier_message(m, k, where));
   }
   return out;
+}
+
+std::size_t remove_marker_outliers(MarkerTrajectories& m, const std::vector<std::string>& only, std::vector<std::string>& messages) {
+  std::size_t removed = 0;
+  for (std::size_t k = 0; k < m.positions_m.size(); ++k) {
+    if (!checked(m, k, only)) continue;
+    // Each marker's outliers are found on its own samples before any of them is changed, so the
+    // result is without_marker_outliers' (markers do not read each other).
+    const std::vector<Eigen::Index> where = outlier_samples(m, k);
+    if (where.empty()) continue;
+    for (const Eigen::Index i : where) m.positions_m[k].row(i).setConstant(kNaN);
+    messages.push_back(outlier_message(m, k, where));
+    removed += where.size();
+  }
+  return removed;
 }
 
 Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m, const MarkerTrajectories* st,

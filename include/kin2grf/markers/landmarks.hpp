@@ -132,6 +132,10 @@ struct SagittalFrame {
 inline constexpr double kMaxLabCoordinateM = 1e4, kMaxMarkerSpeedMps = 30.0;
 std::optional<MarkerTrajectories> without_marker_outliers(const MarkerTrajectories& markers, const std::vector<std::string>& only,
                                                           std::vector<std::string>& messages);
+/// The same, in place (no copy: for a caller that has given the trial up). Returns the number of
+/// samples turned into gaps.
+std::size_t remove_marker_outliers(MarkerTrajectories& markers, const std::vector<std::string>& only,
+                                   std::vector<std::string>& messages);
 
 /// `release`: `motion` itself, when the caller has no further use for its samples: each
 /// marker's samples are released (left 0 x 3) after the last landmark that reads them, and those
