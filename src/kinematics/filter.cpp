@@ -139,22 +139,16 @@ Eigen::MatrixXd butterworth_filtfilt(Eigen::MatrixXd x, double rate_hz, double c
 }
 
 Eigen::MatrixXd central_difference(const Eigen::MatrixXd& x, double dt) {
-  const Eigen::Index n = x.rows();
-  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(n, x.cols());
-  if (n < 2) return d;
-  for (Eigen::Index i = 1; i + 1 < n; ++i) d.row(i) = (x.row(i + 1) - x.row(i - 1)) / (2 * dt);
-  d.row(0) = (x.row(1) - x.row(0)) / dt;
-  d.row(n - 1) = (x.row(n - 1) - x.row(n - 2)) / dt;
+  Eigen::MatrixXd d(x.rows(), x.cols());
+  for (Eigen::Index k = 0; k < x.cols(); ++k)
+    for (Eigen::Index i = 0; i < x.rows(); ++i) d(i, k) = central_difference_at(x, i, k, dt);
   return d;
 }
 
 Eigen::MatrixXd second_difference(const Eigen::MatrixXd& x, double dt) {
-  const Eigen::Index n = x.rows();
-  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(n, x.cols());
-  if (n < 3) return d;
-  for (Eigen::Index i = 1; i + 1 < n; ++i) d.row(i) = (x.row(i + 1) - 2 * x.row(i) + x.row(i - 1)) / (dt * dt);
-  d.row(0) = d.row(1);
-  d.row(n - 1) = d.row(n - 2);
+  Eigen::MatrixXd d(x.rows(), x.cols());
+  for (Eigen::Index k = 0; k < x.cols(); ++k)
+    for (Eigen::Index i = 0; i < x.rows(); ++i) d(i, k) = second_difference_at(x, i, k, dt);
   return d;
 }
 

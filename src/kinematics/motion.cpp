@@ -108,32 +108,16 @@ void ModelMotion::derivatives_at(Eigen::Index i, double* d1, double* d2) const {
     for (Eigen::Index k = 0; k < cols; ++k) d1[k] = xd(i, k), d2[k] = xdd(i, k);
     return;
   }
-  // central_difference and second_difference of x, row i, with their very operations (the same
-  // doubles as the whole-trial matrices).
+  // x's central differences, row i (the doubles of the whole-trial matrices).
   const double dt = 1.0 / rate_hz;
-  for (Eigen::Index k = 0; k < cols; ++k) {
-    if (n < 2) d1[k] = 0.0;
-    else if (i == 0) d1[k] = (x(1, k) - x(0, k)) / dt;
-    else if (i == n - 1) d1[k] = (x(n - 1, k) - x(n - 2, k)) / dt;
-    else d1[k] = (x(i + 1, k) - x(i - 1, k)) / (2 * dt);
-    if (n < 3) {
-      d2[k] = 0.0;
-    } else {
-      const Eigen::Index j = std::clamp<Eigen::Index>(i, 1, n - 2);  // the ends take their neighbour's
-      d2[k] = (x(j + 1, k) - 2 * x(j, k) + x(j - 1, k)) / (dt * dt);
-    }
-  }
+  for (Eigen::Index k = 0; k < cols; ++k) d1[k] = central_difference_at(x, i, k, dt), d2[k] = second_difference_at(x, i, k, dt);
 }
 
 Eigen::VectorXd ModelMotion::xdd_column(int c) const {
   const Eigen::Index n = x.rows();
   if (xdd.rows() == n && xdd.cols() == x.cols()) return xdd.col(c);
   Eigen::VectorXd out(n);
-  std::array<double, kMaxIndependent> d1{}, d2{};
-  for (Eigen::Index i = 0; i < n; ++i) {
-    derivatives_at(i, d1.data(), d2.data());
-    out[i] = d2[static_cast<std::size_t>(c)];
-  }
+  for (Eigen::Index i = 0; i < n; ++i) out[i] = second_difference_at(x, i, c, 1.0 / rate_hz);
   return out;
 }
 

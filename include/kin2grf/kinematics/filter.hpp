@@ -27,6 +27,22 @@ Eigen::MatrixXd butterworth_filtfilt(Eigen::MatrixXd x, double rate_hz, double c
 Eigen::MatrixXd central_difference(const Eigen::MatrixXd& x, double dt_s);
 /// Second derivative (x[i+1] - 2 x[i] + x[i-1]) / dt^2 (ends copied from their neighbours).
 Eigen::MatrixXd second_difference(const Eigen::MatrixXd& x, double dt_s);
+/// Element (i, k) of central_difference(x, dt_s) and second_difference(x, dt_s), the same
+/// doubles, without the whole matrices (a motion that keeps x only: ModelMotion::derivatives_at).
+/// (Inline: ModelMotion::frame() takes them for every coordinate of every frame it rebuilds.)
+inline double central_difference_at(const Eigen::MatrixXd& x, Eigen::Index i, Eigen::Index k, double dt_s) {
+  const Eigen::Index n = x.rows();
+  if (n < 2) return 0.0;
+  if (i == 0) return (x(1, k) - x(0, k)) / dt_s;
+  if (i == n - 1) return (x(n - 1, k) - x(n - 2, k)) / dt_s;
+  return (x(i + 1, k) - x(i - 1, k)) / (2 * dt_s);
+}
+inline double second_difference_at(const Eigen::MatrixXd& x, Eigen::Index i, Eigen::Index k, double dt_s) {
+  const Eigen::Index n = x.rows();
+  if (n < 3) return 0.0;
+  const Eigen::Index j = i < 1 ? 1 : i > n - 2 ? n - 2 : i;  // the ends take their neighbour's
+  return (x(j + 1, k) - 2 * x(j, k) + x(j - 1, k)) / (dt_s * dt_s);
+}
 
 /// Winter's residual analysis (Winter 2009, Biomechanics and Motor Control of Human Movement,
 /// Sect. 3.4.4.3), bounded above: per column, the residual RMS R(f) of (x - filtered at f) falls
