@@ -20,6 +20,7 @@
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/summary.hpp"
+#include "kin2grf/markers/presets.hpp"
 #include "test_support.hpp"
 
 using namespace kin2grf;
@@ -589,4 +590,50 @@ TEST(C3dRoundTrip, AMappedFileReleasedAsItIsReadGivesTheSameTrial) {
   EXPECT_EQ(mapped.plates->rate_hz, 5000.0);
   for (std::size_t p = 0; p < whole.plates->plates.size(); ++p)
     EXPECT_TRUE(mapped.plates->plates[p].force_N.cwiseEqual(whole.plates->plates[p].force_N).all()) << p;
+}
+
+// Vicon Nexus labels a subject's markers "Subject:LASI" (issue 10's "real files from other labs
+// run as they are"): the presets name markers alone, so such a file was "not recognised". The
+// common prefix is removed with a warning, the unlabelled "*n" kept, and the prefixed names still
+// find their markers (a mapping file written for the file's labels).
+TEST(C3dQuirks, ASubjectPrefixOnTheLabelsIsRemovedAndThePresetRecognised) {
+  Trial t = make_example_walk();
+  const std::vector<std::string> plain = t.markers.names;
+  for (auto& n : t.markers.names) n = "Sim01:" + n;
+  t.markers.names.push_back("*99");  // an unlabelled marker: no prefix in Nexus either
+  t.markers.descriptions.emplace_back();
+  t.markers.positions_m.push_back(t.markers.positions_m.front());
+  const auto dir = test::temp_dir("c3d_prefix");
+  const std::string path = (dir / "prefixed.c3d").string();
+  write_c3d(path, t);
+  const Trial r = load_trial(path);
+  ASSERT_EQ(r.markers.names.size(), plain.size() + 1);
+  EXPECT_TRUE(std::equal(plain.begin(), plain.end(), r.markers.names.begin()));
+  EXPECT_EQ(r.markers.names.back(), "*99");
+  EXPECT_EQ(r.markers.label_prefix, "Sim01:");
+  EXPECT_EQ(r.markers.find("Sim01:" + plain[2]), 2);
+  EXPECT_EQ(r.markers.find(plain[2]), 2);
+  EXPECT_EQ(r.markers.find("Other:" + plain[2]), -1);
+  EXPECT_TRUE(std::any_of(r.warnings.begin(), r.warnings.end(),
+                          [](const std::string& w) { return w.find("subject prefix 'Sim01:'") != std::string::npos; }));
+  const MarkerSet* set = recognise_marker_set(r.markers);
+  ASSERT_NE(set, nullptr);
+  EXPECT_EQ(set->name, "kin2grf-example");
+}
+
+TEST(C3dQuirks, TwoSubjectsOrAClashKeepTheLabelsAsTheyAre) {
+  MarkerTrajectories m;
+  m.names = {"A:LASI", "B:LASI", "C7"};
+  std::vector<std::string> warnings;
+  remove_subject_prefix(m, warnings);
+  EXPECT_EQ(m.names, (std::vector<std::string>{"A:LASI", "B:LASI", "C7"}));
+  EXPECT_TRUE(m.label_prefix.empty());
+  EXPECT_TRUE(warnings.empty());
+  m.names = {"A:LASI", "LASI"};  // without the prefix, two markers would be "LASI"
+  remove_subject_prefix(m, warnings);
+  EXPECT_EQ(m.names, (std::vector<std::string>{"A:LASI", "LASI"}));
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("kept"), std::string::npos) << warnings[0];
+  EXPECT_EQ(m.find("A:LASI"), 0);
+  EXPECT_EQ(m.find("LASI"), 1);
 }

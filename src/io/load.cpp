@@ -114,9 +114,39 @@ Trial load_by_extension(const std::string& path, const LoadOptions& options) {
 
 }  // namespace
 
+void remove_subject_prefix(MarkerTrajectories& m, std::vector<std::string>& warnings) {
+  std::string prefix;
+  std::size_t prefixed = 0;
+  for (const auto& n : m.names) {
+    const auto colon = n.find(':');
+    if (colon == std::string::npos) continue;
+    if (colon == 0) return;  // ":X" is no subject's name
+    const std::string p = n.substr(0, colon + 1);
+    if (prefixed++ == 0) prefix = p;
+    else if (p != prefix) return;  // several subjects: the labels as they are
+  }
+  if (prefixed == 0) return;
+  std::vector<std::string> stripped = m.names;
+  for (auto& n : stripped)
+    if (n.starts_with(prefix)) n.erase(0, prefix.size());
+  std::vector<std::string> sorted = stripped;
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end() ||
+      std::any_of(stripped.begin(), stripped.end(), [](const std::string& n) { return n.empty(); })) {
+    warnings.push_back("marker labels carry the subject prefix '" + prefix +
+                       "', kept: without it two labels would be the same");
+    return;
+  }
+  m.names = std::move(stripped);
+  m.label_prefix = prefix;
+  warnings.push_back("marker labels carry the subject prefix '" + prefix + "' (" + std::to_string(prefixed) + " of " +
+                     std::to_string(m.names.size()) + "); it is removed, and names with it still find the markers");
+}
+
 Trial load_trial(const std::string& path, const LoadOptions& options) {
   Trial t = load_by_extension(path, options);
   check_up_axis(t);
+  remove_subject_prefix(t.markers, t.warnings);
   return t;
 }
 

@@ -31,6 +31,8 @@ std::string unique_label(const std::vector<std::string>& taken, const std::strin
 int MarkerTrajectories::find(const std::string& name) const {
   for (std::size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return static_cast<int>(i);
+  if (!label_prefix.empty() && name.size() > label_prefix.size() && name.starts_with(label_prefix))
+    return find(name.substr(label_prefix.size()));
   return -1;
 }
 

@@ -37,9 +37,14 @@ struct MarkerTrajectories {
   int first_frame = 1;            ///< the file's frame number of row 0
   Eigen::VectorXd time_s;         ///< N
   Axis up_axis = Axis::Z;
+  /// The subject prefix removed from the labels ("Bob:" of Vicon's "Bob:LASI"), empty if none;
+  /// see remove_subject_prefix in io/load.hpp.
+  std::string label_prefix;
 
   [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
-  /// Index of a marker by exact name, or -1.
+  /// Index of a marker by exact name, or -1. A name given with the removed subject prefix
+  /// ("Bob:LASI" when the labels' "Bob:" was removed) finds the marker too, so that a mapping
+  /// file written for the file's own labels still works.
   [[nodiscard]] int find(const std::string& name) const;
   /// Frames (0-based) where the marker is missing (any coordinate NaN).
   [[nodiscard]] std::vector<Eigen::Index> missing_frames(int marker) const;
