@@ -213,3 +213,43 @@ TEST(Landmarks, OutliersRemovedInPlaceAreThoseOfTheCleanedCopy) {
   EXPECT_TRUE(none.empty());
   EXPECT_FALSE(std::isnan(again.positions_m[static_cast<std::size_t>(k)](40, 0)));
 }
+
+// Plug-in Gait takes a sacrum marker (SACR) in place of the two PSIS markers; such a file was
+// "not recognised". The two Plug-in Gait trials with their PSIS markers replaced by a SACR at
+// their midpoint are recognised as the SACR variants, and their landmarks are the originals'
+// (Harrington's pelvis depth uses the PSIS midpoint, which SACR then is).
+TEST(Landmarks, PlugInGaitWithASacrumMarkerIsRecognisedAndGivesTheSameLandmarks) {
+  KIN2GRF_REQUIRE_DATA();
+  for (const auto& [file, preset] : {std::pair<std::string, std::string>{"PiG_Motion-FlatFoot-Full.c3d", "plug-in-gait"},
+                                     {"PiG_Motion3_FF.c3d", "plug-in-gait-lower"}}) {
+    const Trial t = load_trial(test::data_dir() + "/btk_plugingait_walk/" + file);
+    const MarkerSet* original = recognise_marker_set(t.markers);
+    ASSERT_NE(original, nullptr);
+    ASSERT_EQ(original->name, preset);
+    MarkerTrajectories m = t.markers;
+    const int r = m.find("RPSI"), l = m.find("LPSI");
+    ASSERT_GE(r, 0);
+    ASSERT_GE(l, 0);
+    m.names.push_back("SACR");
+    m.descriptions.emplace_back();
+    m.positions_m.push_back(0.5 * (m.positions_m[static_cast<std::size_t>(r)] + m.positions_m[static_cast<std::size_t>(l)]));
+    m.names[static_cast<std::size_t>(r)] = "unused1", m.names[static_cast<std::size_t>(l)] = "unused2";
+    std::string why;
+    const MarkerSet* sacr = recognise_marker_set(m, &why);
+    ASSERT_NE(sacr, nullptr) << file << ": " << why;
+    EXPECT_EQ(sacr->name, preset + "-sacr") << file << ": " << why;
+    const Landmarks3D a = compute_landmarks(*original, t.markers, nullptr, {}, file);
+    const Landmarks3D b = compute_landmarks(*sacr, m, nullptr, {}, file);
+    for (int k = 0; k < kLandmarkCount; ++k) {
+      const auto& pa = a.p[static_cast<std::size_t>(k)];
+      const auto& pb = b.p[static_cast<std::size_t>(k)];
+      ASSERT_EQ(pa.rows(), pb.rows());
+      for (Eigen::Index i = 0; i < pa.rows(); ++i) {
+        ASSERT_EQ(pa.row(i).allFinite(), pb.row(i).allFinite()) << file << " landmark " << k << " frame " << i;
+        if (pa.row(i).allFinite()) {
+          EXPECT_LT((pa.row(i) - pb.row(i)).norm(), 1e-9) << file << " landmark " << k << " frame " << i;
+        }
+      }
+    }
+  }
+}
