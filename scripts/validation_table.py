@@ -83,7 +83,7 @@ print("\nMean (SD) over stances; total GRM: mean (SD) over the trials that have 
       + "".join(f"; {act}: {n} stance(s) left out, with them COP {c} %, {mm} mm" for act, (n, c, mm) in suspect.items() if n)
       + ".\n")
 
-cv_kinds = [k for k in ("speed-gate-ratio", "r", "split-distance", "torso-length", "torso-lag", "post-cutoff-cycles")
+cv_kinds = [k for k in ("speed-gate-ratio", "r", "split-distance", "torso-length", "torso-lag", "post-cutoff-cycles", "double-support-sta")
             if os.path.exists(os.path.join(out, f"cv-{k}.json"))]
 if cv_kinds:
     print("## Leave-one-lab-out (the settings chosen from data)\n")

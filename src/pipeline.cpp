@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
+#include <mutex>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/kinematics/filter.hpp"
@@ -39,6 +41,19 @@ std::optional<double> median_stance_s(const std::array<std::vector<bool>, 2>& co
   }
   if (durations.empty()) return std::nullopt;
   return median(durations);
+}
+
+std::vector<DoubleSupport> walking_double_supports(const std::array<std::vector<bool>, 2>& contact, Eigen::Index max_frames) {
+  std::vector<DoubleSupport> out;
+  const auto n = static_cast<Eigen::Index>(std::min(contact[0].size(), contact[1].size()));
+  const auto on = [&](int side, Eigen::Index i) { return static_cast<bool>(contact[static_cast<std::size_t>(side)][static_cast<std::size_t>(i)]); };
+  for (const IndexRun& run : runs_where(n, [&](Eigen::Index i) { return on(0, i) && on(1, i); })) {
+    if (run.first == 0 || run.last == n - 1 || run.last - run.first + 1 > max_frames) continue;
+    for (int t = 0; t < 2; ++t)
+      if (on(t, run.first - 1) && !on(1 - t, run.first - 1) && !on(t, run.last + 1) && on(1 - t, run.last + 1))
+        out.push_back({run.first, run.last, t});
+  }
+  return out;
 }
 
 namespace {
@@ -78,6 +93,8 @@ void check_options(const EstimateOptions& o) {
           "split distance (m)", o.solver.min_split_distance_m, "between 0 (none) and 1");
   require(finite(o.torso_lag_s) && o.torso_lag_s >= 0 && o.torso_lag_s <= 0.2, "torso lag (s)", o.torso_lag_s,
           "between 0 (none, the paper) and 0.2");
+  require(finite(o.double_support_sta_weight) && o.double_support_sta_weight >= 0 && o.double_support_sta_weight <= 1,
+          "double-support transition weight", o.double_support_sta_weight, "between 0 (none, the paper) and 1");
   require(o.grm_reference_m.allFinite(), "GRM reference (m)", o.grm_reference_m.x() + o.grm_reference_m.y(), "finite");
   if (o.mass_kg)
     require(finite(*o.mass_kg) && *o.mass_kg > 0 && (o.allow_unusual_mass || (*o.mass_kg >= kMassRangeKg[0] && *o.mass_kg <= kMassRangeKg[1])),
@@ -252,6 +269,11 @@ struct RawSolve {
   Eigen::MatrixXd point_x_m, point_gap_m;          ///< N x np: along progression; normal gap
   std::array<Eigen::VectorXd, 2> inclination_rad;  ///< per side: theta_A
   std::array<Eigen::MatrixXd, 2> sole_m;           ///< per side, N x 6: A, B, C (x, y)
+  // For the double-support transition (EstimateOptions::double_support_sta_weight): the frames
+  // where both feet are active, in order, and for each the solve's torque_per_normal (kJointCount
+  // x np, column-major). Only those frames: a long walk holds a fifth of its frames' worth.
+  std::vector<Eigen::Index> both_feet_frames;
+  std::vector<double> both_feet_torque_map;
 };
 
 /// Eqs. 5-10 on every frame (least squares, activation, semi-smooth iterations).
@@ -281,7 +303,12 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
   // Frames are independent: each chunk of frames (about 10 us each) has its own solver
   // (workspace) and writes only its own rows. The first chunk, on the calling thread, reports
   // the progress.
+  const bool keep_torque_map = o.double_support_sta_weight > 0;
+  std::mutex chunks_mutex;
+  std::map<std::size_t, std::pair<std::vector<Eigen::Index>, std::vector<double>>> chunk_maps;
   for_chunks(static_cast<std::size_t>(n), min_chunk_for(10e-6), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+    std::vector<Eigen::Index> map_frames;
+    std::vector<double> map_values;
     ContactSolver solver(r.model, r.calibration, o.solver);
     MotionFrame f;
     FrameContacts fc;
@@ -304,6 +331,15 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
         if (o.keep_all_series)
           for (int c = 0; c < 3; ++c) raw.sole_m[s_].block<1, 2>(i, 2 * c) = fc.sole[s_][static_cast<std::size_t>(c)].transpose();
       }
+      if (keep_torque_map) {
+        std::array<bool, 2> on{false, false};
+        for (Eigen::Index j = 0; j < np; ++j)
+          if (s.contact_active[static_cast<std::size_t>(j)]) on[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] = true;
+        if (on[0] && on[1]) {
+          map_frames.push_back(i);
+          map_values.insert(map_values.end(), s.torque_per_normal.data(), s.torque_per_normal.data() + s.torque_per_normal.size());
+        }
+      }
       raw.lambda.row(i) = s.contact_lambda.transpose();
       raw.torque.row(i) = s.joint_torque_Nm.transpose();
       raw.active[k] = s.contact_active;
@@ -311,7 +347,23 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
       cycled[k] = s.cycled;
       capped[k] = s.capped;
     }
+    if (keep_torque_map) {
+      const std::lock_guard<std::mutex> lock(chunks_mutex);
+      chunk_maps[chunk] = {std::move(map_frames), std::move(map_values)};
+    }
   });
+  {
+    std::size_t frames = 0, values = 0;
+    for (const auto& [chunk, m] : chunk_maps) frames += m.first.size(), values += m.second.size();
+    raw.both_feet_frames.reserve(frames);
+    raw.both_feet_torque_map.reserve(values);
+    for (auto& [chunk, m] : chunk_maps) {  // chunks in frame order; each let go once copied
+      raw.both_feet_frames.insert(raw.both_feet_frames.end(), m.first.begin(), m.first.end());
+      raw.both_feet_torque_map.insert(raw.both_feet_torque_map.end(), m.second.begin(), m.second.end());
+      std::vector<Eigen::Index>().swap(m.first);
+      std::vector<double>().swap(m.second);
+    }
+  }
   r.cycled_frames += static_cast<int>(std::count(cycled.begin(), cycled.end(), 1));
   r.capped_frames += static_cast<int>(std::count(capped.begin(), capped.end(), 1));
   const Eigen::MatrixXd& lam = raw.lambda;
@@ -323,6 +375,51 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
       throw InputError(trial.path + ": the contact solve gave a non-finite force at frame " +
                        std::to_string(r.first_frame_number + static_cast<int>(i)) + " (check the markers there)");
   return raw;
+}
+
+/// The double-support transition (EstimateOptions::double_support_sta_weight) on the
+/// post-filtered multipliers: in each walking double support the trailing foot's share of the
+/// vertical force becomes (1 - w) x its share + w x smooth_transition_share(u); each foot's
+/// normal multipliers are scaled to their new total (a foot's COP does not move), the sum is
+/// kept, and the joint torques move with the multipliers (the solve's torque_per_normal, linear
+/// in them). The tangential multipliers are left as solved.
+void double_support_transition(double w, const std::array<std::vector<bool>, 2>& contact, double rate_hz, const RawSolve& raw,
+                               Eigen::MatrixXd& lamf, EstimateResult& r) {
+  const auto stance = median_stance_s(contact, rate_hz);
+  if (!stance) return;
+  const auto max_frames = static_cast<Eigen::Index>(0.5 * *stance * rate_hz);
+  const int np = static_cast<int>(raw.point_side.size());
+  const auto supports = walking_double_supports(contact, max_frames);
+  for (const DoubleSupport& ds : supports) {
+    const auto t = static_cast<std::size_t>(ds.trailing);
+    const double frames = static_cast<double>(ds.last - ds.first + 1);
+    for (Eigen::Index k = ds.first; k <= ds.last; ++k) {
+      std::array<double, 2> fy{0.0, 0.0};
+      for (int j = 0; j < np; ++j) fy[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] += lamf(k, 2 * j);
+      if (!(fy[0] > 1.0 && fy[1] > 1.0)) continue;  // a foot the post-filter left without load: nothing to scale
+      const double total = fy[0] + fy[1];
+      const double u = (static_cast<double>(k - ds.first) + 0.5) / frames;
+      const double trailing = (1 - w) * fy[t] + w * smooth_transition_share(u) * total;
+      std::array<double, 2> factor{};
+      factor[t] = trailing / fy[t];
+      factor[1 - t] = (total - trailing) / fy[1 - t];
+      const auto it = std::lower_bound(raw.both_feet_frames.begin(), raw.both_feet_frames.end(), k);
+      // Every frame of a double support has both feet active in the solve (the contact states
+      // are the solve's), so it has its map; the test is a guard, not a case.
+      if (it == raw.both_feet_frames.end() || *it != k) continue;
+      const double* G = raw.both_feet_torque_map.data() + (it - raw.both_feet_frames.begin()) * kJointCount * np;
+      for (int j = 0; j < np; ++j) {
+        const double d = (factor[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] - 1) * lamf(k, 2 * j);
+        lamf(k, 2 * j) += d;
+        for (int q = 0; q < kJointCount; ++q) r.joint_torque_Nm(k, q) += d * G[j * kJointCount + q];
+      }
+    }
+  }
+  if (!supports.empty()) {
+    char b[200];
+    std::snprintf(b, sizeof b, "double support: %zu handovers blended (weight %g) towards a smooth transition", supports.size(), w);
+    r.messages.emplace_back(b);
+  }
 }
 
 /// The post-filter (Sect. 2.6) and each foot's force, COP, contact state, gap and sole.
@@ -359,6 +456,7 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, Raw
   for (Eigen::Index i = 0; i < n; ++i)
     for (int j = 0; j < np; ++j)
       if (!act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;
+  if (o.double_support_sta_weight > 0) double_support_transition(o.double_support_sta_weight, contact, rate_hz, raw, lamf, r);
 
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (int side = 0; side < 2; ++side) {

@@ -365,6 +365,8 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
   for (int c = 0; c < k; ++c)
     if (lamC[c] != 0.0) lamB -= BpX.col(1 + c) * lamC[c];
   sol.joint_torque_Nm = lamB.segment<kJointCount>(row::kDriving);
+  sol.torque_per_normal.resize(kJointCount, np);
+  for (int j = 0; j < np; ++j) sol.torque_per_normal.col(j) = -BpX.block<kJointCount, 1>(row::kDriving, 1 + 2 * j);
   return sol;
 }
 

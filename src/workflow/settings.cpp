@@ -64,6 +64,10 @@ void add_settings_options(CLI::App* c, Settings& a) {
                 "The upper body's fore-aft lag behind the pelvis, s: the HAT's fore-aft inertial force is delayed by this "
                 "time, less what the trunk markers already lag the hip by (0 = none, the paper)")
       ->check(CLI::Range(0.0, 0.2))->capture_default_str();
+  c->add_option("--double-support-sta", a.double_support_sta,
+                "Weight (0-1) of the smooth transition towards which each walking double support's split between the "
+                "feet is blended (0 = none, the paper)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
       ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
   c->add_option_function<std::string>(
@@ -136,6 +140,7 @@ EstimateOptions to_options(const Settings& a) {
   o.solver.min_split_distance_m = a.paper ? 0.0 : a.split_distance;
   o.torso_length = (a.paper || a.torso_length == "fixed") ? TorsoLength::Fixed : TorsoLength::Measured;
   o.torso_lag_s = a.paper ? 0.0 : a.torso_lag;
+  o.double_support_sta_weight = a.paper ? 0.0 : a.double_support_sta;
   o.landmarks.max_gap_frames = a.max_gap;
   o.landmarks.up_axis = parse_axis(a.up_axis);
   return o;
@@ -164,6 +169,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"min_split_distance_m", o.solver.min_split_distance_m},
           {"torso_length", torso_length_name(o.torso_length)},
           {"torso_lag_s", o.torso_lag_s},
+          {"double_support_sta_weight", o.double_support_sta_weight},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"kinematic_cutoff_rule", o.cutoff_from_noise ? "noise" : "fixed"},
           {"post_cutoff_hz", o.post_cutoff_hz},

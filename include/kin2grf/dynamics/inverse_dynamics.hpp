@@ -93,6 +93,9 @@ struct FrameSolution {
   /// Per contact point (n, t) pairs (fixed capacity: a frame's solve allocates nothing).
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 2 * kMaxContactPoints, 1> contact_lambda;
   std::array<bool, kMaxContactPoints> contact_active{};  ///< per contact point; false beyond them
+  /// d(joint torques) / d(normal multiplier) per contact point (column j: point j), so that a
+  /// split of the normal forces changed after the solve changes the torques with it.
+  Eigen::Matrix<double, kJointCount, Eigen::Dynamic, 0, kJointCount, kMaxContactPoints> torque_per_normal;
   int iterations = 0;
   bool cycled = false;
   bool capped = false;
