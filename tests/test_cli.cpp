@@ -84,6 +84,8 @@ TEST(CliInput, EveryBadNumericOptionIsRefusedNamingTheSetting) {
       {"--torso-lag -0.01", "torso-lag"},              {"--torso-lag 1", "torso-lag"},
       {"--post-cutoff-cycles -1", "post-filter cycles"}, {"--post-cutoff-cycles nan", "post-filter cycles"},
       {"--post-cutoff-cycles 60", "post-filter cycles"}, {"--post-cutoff 8 --post-cutoff-cycles 4", "give one of them"},
+      {"--double-support-sta -0.1", "double-support-sta"}, {"--double-support-sta 2", "double-support-sta"},
+      {"--double-support-sta nan", "double-support"},
   };
   for (const auto& c : cases) {
     const CliRun r = run("estimate " + trc + " --mass 70 " + c.option);
@@ -316,4 +318,36 @@ TEST(CliBatch, ABadLineNamesTheListAndTheLine) {
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("list.txt:2"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("--no-such-option"), std::string::npos) << r.out;
+}
+
+// The bundled example's TRC and GRF .mot are OpenSim's files, Y up as OpenSim and kin2grf's
+// readers take them: read with no up-axis warning, and validated together they give the C3D's
+// figures (a Z-up pair was read with the plates' COP 1.7 m from the feet: nothing compared).
+TEST(CliExample, TheTrcAndMotAreInOpenSimsFrameAndValidateLikeTheC3d) {
+  const auto dir = example_dir();
+  const CliRun info = run("info " + (dir / "example_walk.trc").string());
+  ASSERT_EQ(info.status, 0) << info.out;
+  EXPECT_EQ(info.out.find("up axis: the file's convention"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("up axis Y"), std::string::npos) << info.out;
+  const CliRun c3d = run("validate " + (dir / "example_walk.c3d").string());
+  const CliRun trc = run("validate " + (dir / "example_walk.trc").string() + " --plates " + (dir / "example_walk_grf.mot").string() +
+                         " --mass 70");
+  ASSERT_EQ(c3d.status, 0) << c3d.out;
+  ASSERT_EQ(trc.status, 0) << trc.out;
+  const auto row = [](const std::string& out, const std::string& key) {
+    const auto k = out.find(key);
+    return k == std::string::npos ? std::string() : out.substr(k, out.find('\n', k) - k);
+  };
+  // Vertical, anterior and COP; the moment is about the plate centre for the C3D's plates and
+  // about the mean COP for a .mot's, which has no geometry.
+  const auto first_three = [](const std::string& line) {
+    std::istringstream in(line.substr(std::min(line.size(), line.find("n = ") + 6)));
+    std::string v, x, a_, y, c, z;
+    in >> v >> x >> a_ >> y >> c >> z;
+    return v + " " + a_ + " " + c;
+  };
+  const std::string a = row(c3d.out, "per foot, mean"), b = row(trc.out, "per foot, mean");
+  ASSERT_FALSE(a.empty()) << c3d.out;
+  ASSERT_FALSE(b.empty()) << trc.out;
+  EXPECT_EQ(first_three(a), first_three(b)) << a << "\n" << b;
 }

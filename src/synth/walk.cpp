@@ -287,6 +287,38 @@ ForcePlateRecording upsampled(const ForcePlateRecording& rec, int factor) {
   return out;
 }
 
+// TRC and GRF .mot files are OpenSim's, whose convention is Y up (kin2grf's readers take it so):
+// the lab's (x, y, z), Z up, become (x, z, -y), a rotation about the x axis (the progression).
+Eigen::MatrixX3d y_up(const Eigen::MatrixX3d& x) {
+  Eigen::MatrixX3d y(x.rows(), 3);
+  y.col(0) = x.col(0);
+  y.col(1) = x.col(2);
+  y.col(2) = -x.col(1);
+  return y;
+}
+
+MarkerTrajectories y_up(const MarkerTrajectories& m) {
+  MarkerTrajectories out = m;
+  for (auto& P : out.positions_m) P = y_up(P);
+  out.up_axis = Axis::Y;
+  return out;
+}
+
+ForcePlate y_up(const ForcePlate& p) {
+  ForcePlate out = p;
+  out.force_N = y_up(p.force_N);
+  out.cop_m = y_up(p.cop_m);
+  out.free_moment_Nm = y_up(p.free_moment_Nm);
+  out.moment_centre_Nm = y_up(p.moment_centre_Nm);
+  const auto v = [](const Eigen::Vector3d& x) { return Eigen::Vector3d(x.x(), x.z(), -x.y()); };
+  for (auto& c : out.corners_m) c = v(c);
+  out.centre_m = v(p.centre_m);
+  Eigen::Matrix3d R;
+  R << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+  out.lab_R_plate = R * p.lab_R_plate;
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::string> write_examples(const std::string& dir, double seconds, double rate_hz, double analog_rate_hz) {
@@ -317,9 +349,9 @@ std::vector<std::string> write_examples(const std::string& dir, double seconds, 
     wo.rate_hz = rate_hz;
     Trial walk = make_example_walk(wo);
     const std::string base = (std::filesystem::path(dir) / "example_walk").string();
-    write_trc(base + ".trc", walk.markers);
+    write_trc(base + ".trc", y_up(walk.markers));
     const auto& p = walk.plates->plates;
-    auto t = grf_table(walk.plates->time_s, p[0], p[1]);
+    auto t = grf_table(walk.plates->time_s, y_up(p[0]), y_up(p[1]));
     t.name = "kin2grf_example_walk_plates";
     write_sto(base + "_grf.mot", t);
     // The C3D last, its plates at the analog rate in place of the marker-rate ones (no copy of the
@@ -338,8 +370,11 @@ std::vector<std::string> write_examples(const std::string& dir, double seconds, 
   t.plates = example_plates(r, t, 0);
   const std::string base = (std::filesystem::path(dir) / "example_squat").string();
   write_c3d(base + ".c3d", t);
+  // The TRC and .mot in OpenSim's frame (Y up): the .mot is the estimate on those markers.
+  t.plates.reset();
+  t.markers = y_up(t.markers);
   write_trc(base + ".trc", t.markers);
-  write_grf_mot(base + "_grf.mot", r);
+  write_grf_mot(base + "_grf.mot", estimate(t, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{}));
   written.push_back(base + ".c3d, .trc and _grf.mot (a squat on two plates)");
   return written;
 }
