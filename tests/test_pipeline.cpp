@@ -303,15 +303,19 @@ TEST(Estimate, ATorsoLagOutsideItsRangeIsRefusedNamingTheSetting) {
   expect_refused_naming([](EstimateOptions& o, double v) { o.torso_lag_s = v; }, {-0.01, 0.5, std::nan("")}, "torso lag");
 }
 
+namespace {
+/// A foot's contact states over n frames: true on each [first, end) given.
+std::vector<bool> runs(std::initializer_list<std::pair<int, int>> on, int n) {
+  std::vector<bool> c(static_cast<std::size_t>(n), false);
+  for (const auto& [a, b] : on)
+    for (int i = a; i < b; ++i) c[static_cast<std::size_t>(i)] = true;
+  return c;
+}
+}  // namespace
+
 TEST(Pipeline, MedianStanceBridgesFlickersAndLeavesOutRunsCutByTheWindow) {
   // 100 Hz: a flicker of 2 frames (20 ms) is bridged, 3 frames are not; runs under 5 frames and
   // runs touching either end of the window do not count.
-  const auto runs = [](std::initializer_list<std::pair<int, int>> on, int n) {
-    std::vector<bool> c(static_cast<std::size_t>(n), false);
-    for (const auto& [a, b] : on)
-      for (int i = a; i < b; ++i) c[static_cast<std::size_t>(i)] = true;
-    return c;
-  };
   // Right: 0-30 (cut by the start), 50-110 with a 2-frame flicker at 70: one stance of 0.60 s.
   // Left: 120-180 (0.60 s), 200-203 (too short), 250-300 (cut by the end).
   std::array<std::vector<bool>, 2> c{runs({{0, 30}, {50, 70}, {72, 110}}, 300), runs({{120, 180}, {200, 203}, {250, 300}}, 300)};
@@ -421,12 +425,6 @@ TEST(Estimate, ReleasingTheMarkersAndTheValidationSeriesChangesNoOutput) {
 // The double supports the transition prior applies to (EstimateOptions::double_support_sta_weight):
 // a step's handover only, not standing, a two-footed landing or a run cut by the window.
 TEST(Pipeline, WalkingDoubleSupportsAreTheHandoversBetweenSteps) {
-  const auto runs = [](std::initializer_list<std::pair<int, int>> on, int n) {
-    std::vector<bool> c(static_cast<std::size_t>(n), false);
-    for (const auto& [a, b] : on)
-      for (int i = a; i < b; ++i) c[static_cast<std::size_t>(i)] = true;
-    return c;
-  };
   // Right: 0-70, 120-190, 230-400; left: 0-10 (both from the first frame: cut by the window),
   // 60-130, 180-260 and 300-400 (both to the last frame: cut). Handovers at 60-69 (right
   // trailing), 120-129 (left), 180-189 (right) and 230-259 (left; 30 frames).
