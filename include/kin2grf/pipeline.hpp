@@ -52,7 +52,9 @@ struct EstimateOptions {
   /// faster than accelerations filtered at 6 Hz can follow; 76 % of the development walks'
   /// per-foot vertical squared error lies there. The total force is unchanged, each foot's COP
   /// too; the joint torques follow the new split (double_support_transition). Double supports
-  /// longer than half the median stance (standing, shuffling) are left as solved.
+  /// longer than half the median stance (standing, shuffling) are left as solved. kin2grf's
+  /// default 0.2, chosen leave-one-lab-out (`kin2grf study double-support-sta`; its grid stops at
+  /// 0.2, above which a 1 cm ground-level error costs a walk more than 0.2 points).
   double double_support_sta_weight = 0.2;
   std::optional<double> ground_level_m;    ///< else estimate_ground_level
   ContactModelOptions contact;
