@@ -323,7 +323,7 @@ TEST(CliBatch, ABadLineNamesTheListAndTheLine) {
 // The bundled example's TRC and GRF .mot are OpenSim's files, Y up as OpenSim and kin2grf's
 // readers take them: read with no up-axis warning, and validated together they give the C3D's
 // figures (a Z-up pair was read with the plates' COP 1.7 m from the feet: nothing compared).
-TEST(CliExample, TheTrcAndMotAreInOpenSimsFrameAndValidateLikeTheC3d) {
+TEST(CliExample, ItsOpenSimMarkerAndForceFilesAreYUpAndValidateLikeItsCaptureFile) {
   const auto dir = example_dir();
   const CliRun info = run("info " + (dir / "example_walk.trc").string());
   ASSERT_EQ(info.status, 0) << info.out;
@@ -350,4 +350,20 @@ TEST(CliExample, TheTrcAndMotAreInOpenSimsFrameAndValidateLikeTheC3d) {
   ASSERT_FALSE(a.empty()) << c3d.out;
   ASSERT_FALSE(b.empty()) << trc.out;
   EXPECT_EQ(first_three(a), first_three(b)) << a << "\n" << b;
+}
+
+// kin2grf's own GRF .mot from a Z-up C3D is in that lab's frame (OpenSim's convention is Y up).
+// Read back as plates, its vertical is found from the forces (a ground reaction is mostly
+// vertical), with a warning, and the estimate compared with itself is exact. Taken as Y up, its
+// COPs were all dropped as unloaded and nothing could be compared.
+TEST(CliExample, AGrfMotWrittenInAZUpFrameIsReadBackWithItsVertical) {
+  const auto dir = example_dir();
+  const std::string c3d = (dir / "example_walk.c3d").string(), mot = (dir / "roundtrip_grf.mot").string();
+  const CliRun e = run("estimate " + c3d + " -o " + mot);
+  ASSERT_EQ(e.status, 0) << e.out;
+  const CliRun info = run("info " + mot);
+  EXPECT_NE(info.out.find("the forces are largest along Z"), std::string::npos) << info.out;
+  const CliRun v = run("validate " + c3d + " --plates " + mot);
+  ASSERT_EQ(v.status, 0) << v.out;
+  EXPECT_NE(v.out.find("per foot, mean (SD), n = 4     0.0 (0.0)   0.0 (0.0)   0.0 (0.0)"), std::string::npos) << v.out;
 }

@@ -106,7 +106,7 @@ Trial load_by_extension(const std::string& path, const LoadOptions& options) {
     t.plates = grf_from_table(table, path, options.cop_threshold_N, t.warnings);
     if (!t.plates) t.warnings.push_back("no ground_force columns: not a GRF file (" +
                                         std::to_string(table.labels.size()) + " columns)");
-    if (t.plates) t.markers.up_axis = Axis::Y;
+    if (t.plates) t.markers.up_axis = t.plates->up_axis;
     return t;
   }
   throw InputError(path + ": unknown file type '." + ext + "' (kin2grf reads .c3d, .trc, .mot, .sto)");

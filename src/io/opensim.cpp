@@ -482,14 +482,32 @@ std::optional<ForcePlateRecording> grf_from_table(const Table& t, const std::str
       warnings.push_back(fp.name + ": no ground_torque columns; free moment taken as zero");
     }
     if (!fp.force_N.allFinite()) throw InputError(path + ": GRF column set '" + fp.name + "' has NaN forces");
+    rec.plates.push_back(std::move(fp));
+  }
+  // The vertical is OpenSim's Y, unless the forces say otherwise: a ground reaction is mostly
+  // vertical (the body's weight against at most a third of it fore-aft), so the axis that carries
+  // the most force, twice the next, is up (a .mot written in a Z-up lab's frame, e.g. kin2grf's
+  // own -o from a C3D, had its COPs dropped as unloaded and its plates read sideways).
+  Eigen::Vector3d load = Eigen::Vector3d::Zero();
+  for (const auto& fp : rec.plates) load += fp.force_N.cwiseAbs().colwise().sum().transpose();
+  Eigen::Index up = 1;
+  const double most = load.maxCoeff(&up);
+  double next = 0;
+  for (Eigen::Index a = 0; a < 3; ++a)
+    if (a != up) next = std::max(next, load[a]);
+  if (!(most > 0) || most < 2 * next) up = 1;
+  if (up != 1)
+    warnings.push_back(std::string("up axis: the forces are largest along ") + "XYZ"[up] + " (" + fmt(most / static_cast<double>(n)) +
+                       " N a sample against at most " + fmt(next / static_cast<double>(n)) + "), not OpenSim's Y: " + "XYZ"[up] +
+                       " is taken as up");
+  rec.up_axis = static_cast<Axis>(up);
+  for (auto& fp : rec.plates)
     for (Eigen::Index i = 0; i < n; ++i) {
-      if (std::abs(fp.force_N(i, 1)) < cop_threshold_N) {
+      if (std::abs(fp.force_N(i, up)) < cop_threshold_N) {
         fp.cop_m.row(i).setConstant(kNaN);  // stale or undefined COP of an unloaded plate
         fp.free_moment_Nm.row(i).setConstant(kNaN);
       }
     }
-    rec.plates.push_back(std::move(fp));
-  }
   return rec;
 }
 
