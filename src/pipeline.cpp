@@ -5,8 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <map>
-#include <mutex>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/kinematics/filter.hpp"
@@ -303,12 +301,12 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
   // Frames are independent: each chunk of frames (about 10 us each) has its own solver
   // (workspace) and writes only its own rows. The first chunk, on the calling thread, reports
   // the progress.
+  // Each chunk keeps its own frames' torque maps (for_chunks makes at most thread_count() chunks),
+  // joined in chunk order after the loop.
   const bool keep_torque_map = o.double_support_sta_weight > 0;
-  std::mutex chunks_mutex;
-  std::map<std::size_t, std::pair<std::vector<Eigen::Index>, std::vector<double>>> chunk_maps;
+  std::vector<std::pair<std::vector<Eigen::Index>, std::vector<double>>> chunk_maps(
+      keep_torque_map ? static_cast<std::size_t>(std::max(1, thread_count())) : 0);
   for_chunks(static_cast<std::size_t>(n), min_chunk_for(10e-6), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
-    std::vector<Eigen::Index> map_frames;
-    std::vector<double> map_values;
     ContactSolver solver(r.model, r.calibration, o.solver);
     MotionFrame f;
     FrameContacts fc;
@@ -336,8 +334,9 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
         for (Eigen::Index j = 0; j < np; ++j)
           if (s.contact_active[static_cast<std::size_t>(j)]) on[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] = true;
         if (on[0] && on[1]) {
-          map_frames.push_back(i);
-          map_values.insert(map_values.end(), s.torque_per_normal.data(), s.torque_per_normal.data() + s.torque_per_normal.size());
+          auto& [frames, values] = chunk_maps[chunk];
+          frames.push_back(i);
+          values.insert(values.end(), s.torque_per_normal.data(), s.torque_per_normal.data() + s.torque_per_normal.size());
         }
       }
       raw.lambda.row(i) = s.contact_lambda.transpose();
@@ -347,21 +346,17 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
       cycled[k] = s.cycled;
       capped[k] = s.capped;
     }
-    if (keep_torque_map) {
-      const std::lock_guard<std::mutex> lock(chunks_mutex);
-      chunk_maps[chunk] = {std::move(map_frames), std::move(map_values)};
-    }
   });
   {
     std::size_t frames = 0, values = 0;
-    for (const auto& [chunk, m] : chunk_maps) frames += m.first.size(), values += m.second.size();
+    for (const auto& [f, v] : chunk_maps) frames += f.size(), values += v.size();
     raw.both_feet_frames.reserve(frames);
     raw.both_feet_torque_map.reserve(values);
-    for (auto& [chunk, m] : chunk_maps) {  // chunks in frame order; each let go once copied
-      raw.both_feet_frames.insert(raw.both_feet_frames.end(), m.first.begin(), m.first.end());
-      raw.both_feet_torque_map.insert(raw.both_feet_torque_map.end(), m.second.begin(), m.second.end());
-      std::vector<Eigen::Index>().swap(m.first);
-      std::vector<double>().swap(m.second);
+    for (auto& [f, v] : chunk_maps) {  // chunks in frame order; each let go once copied
+      raw.both_feet_frames.insert(raw.both_feet_frames.end(), f.begin(), f.end());
+      raw.both_feet_torque_map.insert(raw.both_feet_torque_map.end(), v.begin(), v.end());
+      std::vector<Eigen::Index>().swap(f);
+      std::vector<double>().swap(v);
     }
   }
   r.cycled_frames += static_cast<int>(std::count(cycled.begin(), cycled.end(), 1));

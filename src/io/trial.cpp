@@ -44,6 +44,12 @@ std::vector<Eigen::Index> MarkerTrajectories::missing_frames(int marker) const {
   return out;
 }
 
+MarkerTrajectories rotated(MarkerTrajectories m, const Eigen::Matrix3d& R, Axis up_axis) {
+  for (auto& P : m.positions_m) P = (P * R.transpose()).eval();
+  m.up_axis = up_axis;
+  return m;
+}
+
 double ForcePlate::width_m() const { return (corners_m[0] - corners_m[1]).norm(); }
 double ForcePlate::length_m() const { return (corners_m[0] - corners_m[3]).norm(); }
 

@@ -92,10 +92,7 @@ OpenSimExportFiles write_opensim_export(const std::string& dir, const std::strin
   const OpenSimExportFiles out = opensim_export_paths(dir, stem);
   write_file_text(out.grf_mot, format_sto(t));
 
-  MarkerTrajectories m = trial.markers;
-  for (auto& P : m.positions_m) P = (P * R.transpose()).eval();  // NaN stays NaN (a blank in the TRC)
-  m.up_axis = Axis::Y;
-  write_file_text(out.markers_trc, format_trc(m, stem + "_markers.trc"));
+  write_file_text(out.markers_trc, format_trc(rotated(trial.markers, R, Axis::Y), stem + "_markers.trc"));
 
   write_file_text(out.external_loads_xml, external_loads_xml(stem + "_grf.mot", o));
   return out;

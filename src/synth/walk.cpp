@@ -289,34 +289,17 @@ ForcePlateRecording upsampled(const ForcePlateRecording& rec, int factor) {
 
 // TRC and GRF .mot files are OpenSim's, whose convention is Y up (kin2grf's readers take it so):
 // the lab's (x, y, z), Z up, become (x, z, -y), a rotation about the x axis (the progression).
-Eigen::MatrixX3d y_up(const Eigen::MatrixX3d& x) {
-  Eigen::MatrixX3d y(x.rows(), 3);
-  y.col(0) = x.col(0);
-  y.col(1) = x.col(2);
-  y.col(2) = -x.col(1);
-  return y;
-}
-
-MarkerTrajectories y_up(const MarkerTrajectories& m) {
-  MarkerTrajectories out = m;
-  for (auto& P : out.positions_m) P = y_up(P);
-  out.up_axis = Axis::Y;
-  return out;
-}
-
-ForcePlate y_up(const ForcePlate& p) {
-  ForcePlate out = p;
-  out.force_N = y_up(p.force_N);
-  out.cop_m = y_up(p.cop_m);
-  out.free_moment_Nm = y_up(p.free_moment_Nm);
-  out.moment_centre_Nm = y_up(p.moment_centre_Nm);
-  const auto v = [](const Eigen::Vector3d& x) { return Eigen::Vector3d(x.x(), x.z(), -x.y()); };
-  for (auto& c : out.corners_m) c = v(c);
-  out.centre_m = v(p.centre_m);
+Eigen::Matrix3d lab_to_y_up() {
   Eigen::Matrix3d R;
   R << 1, 0, 0, 0, 0, 1, 0, -1, 0;
-  out.lab_R_plate = R * p.lab_R_plate;
-  return out;
+  return R;
+}
+
+/// The plate's channels that grf_table writes (force, COP, free moment), in the Y-up frame.
+ForcePlate y_up(ForcePlate p) {
+  const Eigen::Matrix3d R = lab_to_y_up();
+  for (Eigen::MatrixX3d* X : {&p.force_N, &p.cop_m, &p.free_moment_Nm}) *X = (*X * R.transpose()).eval();
+  return p;
 }
 
 }  // namespace
@@ -349,7 +332,7 @@ std::vector<std::string> write_examples(const std::string& dir, double seconds, 
     wo.rate_hz = rate_hz;
     Trial walk = make_example_walk(wo);
     const std::string base = (std::filesystem::path(dir) / "example_walk").string();
-    write_trc(base + ".trc", y_up(walk.markers));
+    write_trc(base + ".trc", rotated(walk.markers, lab_to_y_up(), Axis::Y));
     const auto& p = walk.plates->plates;
     auto t = grf_table(walk.plates->time_s, y_up(p[0]), y_up(p[1]));
     t.name = "kin2grf_example_walk_plates";
@@ -372,7 +355,7 @@ std::vector<std::string> write_examples(const std::string& dir, double seconds, 
   write_c3d(base + ".c3d", t);
   // The TRC and .mot in OpenSim's frame (Y up): the .mot is the estimate on those markers.
   t.plates.reset();
-  t.markers = y_up(t.markers);
+  t.markers = rotated(std::move(t.markers), lab_to_y_up(), Axis::Y);
   write_trc(base + ".trc", t.markers);
   write_grf_mot(base + "_grf.mot", estimate(t, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{}));
   written.push_back(base + ".c3d, .trc and _grf.mot (a squat on two plates)");

@@ -50,6 +50,10 @@ struct MarkerTrajectories {
   [[nodiscard]] std::vector<Eigen::Index> missing_frames(int marker) const;
 };
 
+/// The markers in another lab frame: each position p becomes R p (a missing sample stays NaN), and
+/// `up_axis` is the new frame's (writing a TRC in OpenSim's Y-up frame).
+MarkerTrajectories rotated(MarkerTrajectories m, const Eigen::Matrix3d& R, Axis up_axis);
+
 /// One force plate (or one per-foot channel set of a processed GRF file).
 struct ForcePlate {
   std::string name;               ///< e.g. "FP1" or "right" for GRF .mot columns
