@@ -73,6 +73,8 @@ void check_options(const EstimateOptions& o) {
           "0 (no post-filter) or a number above 0 (paper: 12)");
   require(finite(o.post_cutoff_cycles) && o.post_cutoff_cycles >= 0 && o.post_cutoff_cycles <= 50, "post-filter cycles per stance",
           o.post_cutoff_cycles, "between 0 (the fixed post-filter cut-off) and 50 (kin2grf: 4)");
+  require(finite(o.min_kinematic_cycles) && o.min_kinematic_cycles >= 0 && o.min_kinematic_cycles <= 20, "kinematic cycles per stance",
+          o.min_kinematic_cycles, "between 0 (no floor) and 20 (kin2grf: 3.5)");
   require(finite(o.solver.r_N_per_m) && o.solver.r_N_per_m > 0, "activation parameter r (N/m)", o.solver.r_N_per_m,
           "a number above 0 (kin2grf: 1000, paper: 10000)");
   require(finite(o.contact.ground_shift_m) && std::abs(o.contact.ground_shift_m) <= 1.0, "ground shift (m)", o.contact.ground_shift_m,
@@ -188,6 +190,7 @@ ModelMotion kinematics_stage(const EstimateOptions& o, const Model& model, Estim
       r.messages.emplace_back(b);
     }
   }
+  r.position_cutoff_hz = r.kinematic_cutoff_hz;
   return compute_motion(model, lm, r.kinematic_cutoff_hz, o.torso_length);
 }
 
@@ -418,17 +421,21 @@ void double_support_transition(double w, const std::array<std::vector<bool>, 2>&
 }
 
 /// The post-filter (Sect. 2.6) and each foot's force, COP, contact state, gap and sole.
+/// Each foot's contact state per frame from the solve: any of its points active.
+std::array<std::vector<bool>, 2> foot_contact_states(const RawSolve& raw, Eigen::Index n) {
+  std::array<std::vector<bool>, 2> contact{std::vector<bool>(static_cast<std::size_t>(n)), std::vector<bool>(static_cast<std::size_t>(n))};
+  const auto np = raw.point_side.size();
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < np; ++j)
+      if (raw.active[static_cast<std::size_t>(i)][j]) contact[static_cast<std::size_t>(raw.point_side[j])][static_cast<std::size_t>(i)] = true;
+  return contact;
+}
+
 void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, RawSolve& raw) {
   const Eigen::Index n = raw.lambda.rows();
   const int np = static_cast<int>(raw.point_side.size());
   const Eigen::MatrixXd& lam = raw.lambda;
-  const auto& act = raw.active;
-  // Each foot's contact state: any of its points active.
-  std::array<std::vector<bool>, 2> contact{std::vector<bool>(static_cast<std::size_t>(n)), std::vector<bool>(static_cast<std::size_t>(n))};
-  for (Eigen::Index i = 0; i < n; ++i)
-    for (int j = 0; j < np; ++j)
-      if (act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)])
-        contact[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])][static_cast<std::size_t>(i)] = true;
+  const std::array<std::vector<bool>, 2> contact = foot_contact_states(raw, n);
   // Final filtering (Sect. 2.6): all multipliers at the post-filter cut-off, then inactive ones
   // back to zero. The cut-off follows the trial's stance duration (post_cutoff_cycles), within
   // what the marker rate allows.
@@ -450,7 +457,7 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, Raw
   r.joint_torque_Nm = post > 0 ? butterworth_filtfilt(std::move(raw.torque), rate_hz, post) : std::move(raw.torque);
   for (Eigen::Index i = 0; i < n; ++i)
     for (int j = 0; j < np; ++j)
-      if (!act[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;
+      if (!raw.active[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;
   if (o.double_support_sta_weight > 0) double_support_transition(o.double_support_sta_weight, contact, rate_hz, raw, lamf, r);
 
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -566,15 +573,55 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   auto [model, soles] = model_stage(o, r);
   r.model = std::move(model);
   ModelMotion motion = kinematics_stage(o, r.model, r);
-  lag_torso_stage(o, motion, r);
-  auto [running, calibration] = contact_stage(o, r.model, std::move(soles), r, motion);
-  r.calibration = std::move(calibration);
-  if (!o.keep_all_series) r.landmarks.p = {};  // the last to read them is contact_stage (the hip's speed)
+  // A second pass at a higher kinematic cut-off may follow (min_kinematic_cycles): only where
+  // the noise lowered it. Otherwise the landmarks go before the solve (a long trial's memory).
+  const bool may_raise = o.cutoff_from_noise && o.min_kinematic_cycles > 0 && r.kinematic_cutoff_hz < o.kinematic_cutoff_hz;
+  const std::size_t first_pass_messages = r.messages.size();
+  double seconds_kinematics = 0, seconds_dynamics = 0;
+  std::vector<bool> running;
+  RawSolve raw;
+  // The torso lag, the contact calibration and the solve (Eqs. 5-10) on `motion`.
+  const auto dynamics = [&](const ContactCalibration& contact_soles) {
+    const auto ta = clock::now();
+    lag_torso_stage(o, motion, r);
+    auto [run, calibration] = contact_stage(o, r.model, contact_soles, r, motion);
+    running = std::move(run);
+    r.calibration = std::move(calibration);
+    if (!o.keep_all_series && !may_raise) r.landmarks.p = {};  // the last to read them is contact_stage (the hip's speed)
+    const auto tb = clock::now();
+    raw = RawSolve();
+    raw = solve_stage(trial, o, r, motion, running);
+    seconds_kinematics += std::chrono::duration<double>(tb - ta).count();
+    seconds_dynamics += std::chrono::duration<double>(clock::now() - tb).count();
+  };
   const auto t1 = clock::now();
-  RawSolve raw = solve_stage(trial, o, r, motion, running);
-  const auto t2 = clock::now();
-  r.seconds_kinematics = std::chrono::duration<double>(t1 - t0).count();
-  r.seconds_dynamics = std::chrono::duration<double>(t2 - t1).count();
+  seconds_kinematics = std::chrono::duration<double>(t1 - t0).count();
+  dynamics(soles);
+  if (may_raise) {
+    // The stance floor: the dynamics' kinematics not below min_kinematic_cycles per stance, the
+    // stance from this first solve's contacts (as the post-filter takes it).
+    if (const auto stance = median_stance_s(foot_contact_states(raw, motion.frames()), motion.rate_hz)) {
+      const double floor_hz = std::min(o.kinematic_cutoff_hz, o.min_kinematic_cycles / *stance);
+      if (floor_hz > r.kinematic_cutoff_hz) {
+        const auto tk = clock::now();
+        r.messages.resize(first_pass_messages);  // the second pass says its own
+        r.kinematic_cutoff_hz = floor_hz;
+        char b[240];
+        std::snprintf(b, sizeof b,
+                      "kinematic cut-off for the dynamics raised to %.2f Hz: %g cycles over the median stance of %.3f s (the COP "
+                      "function's foot angle keeps %.2f Hz)",
+                      floor_hz, o.min_kinematic_cycles, *stance, r.position_cutoff_hz);
+        r.messages.emplace_back(b);
+        motion = ModelMotion();
+        motion = compute_motion(r.model, r.landmarks, floor_hz, o.torso_length, r.position_cutoff_hz);
+        seconds_kinematics += std::chrono::duration<double>(clock::now() - tk).count();
+        dynamics(soles);
+      }
+    }
+    if (!o.keep_all_series) r.landmarks.p = {};
+  }
+  r.seconds_kinematics = seconds_kinematics;
+  r.seconds_dynamics = seconds_dynamics;
   feet_stage(o, r, motion.rate_hz, raw);
   // What only the per-foot results needed is freed before the totals take their arrays: a long
   // trial's peak memory (issue 10).

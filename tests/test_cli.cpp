@@ -86,6 +86,8 @@ TEST(CliInput, EveryBadNumericOptionIsRefusedNamingTheSetting) {
       {"--post-cutoff-cycles 60", "post-filter cycles"}, {"--post-cutoff 8 --post-cutoff-cycles 4", "give one of them"},
       {"--double-support-sta -0.1", "double-support-sta"}, {"--double-support-sta 2", "double-support-sta"},
       {"--double-support-sta nan", "double-support"},
+      {"--min-kinematic-cycles -1", "min-kinematic-cycles"}, {"--min-kinematic-cycles 30", "min-kinematic-cycles"},
+      {"--min-kinematic-cycles nan", "kinematic cycles"},
   };
   for (const auto& c : cases) {
     const CliRun r = run("estimate " + trc + " --mass 70 " + c.option);

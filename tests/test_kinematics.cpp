@@ -223,3 +223,27 @@ TEST(Kinematics, TheNoiseLimitedCutOffOfALongTrialIsTheResidualAnalysisOfItsFirs
   EXPECT_LT(fc, 6.0);  // the noise lowers it
   EXPECT_EQ(fc, residual_analysis_cutoff(all, lm.rate_hz, 6.0));
 }
+
+// The COP function's foot angle at its own cut-off (min_kinematic_cycles): the foot's theta as the
+// chain builds it, filtered at that cut-off, i.e. what compute_motion at that cut-off gives.
+TEST(Kinematics, TheCopsFootAngleAtItsOwnCutoffIsTheFootsThetaFilteredThere) {
+  const Trial t = make_synthetic_trial({});
+  const auto r = run(SyntheticOptions{});
+  const SagittalLandmarks lm = synthetic_landmarks(t);
+  const ModelMotion at4 = compute_motion(r.model, lm, 4.0);
+  const ModelMotion mixed = compute_motion(r.model, lm, 6.0, TorsoLength::Measured, 4.0);
+  const ModelMotion plain = compute_motion(r.model, lm, 6.0);
+  ASSERT_EQ(mixed.cop_foot_angle_rad.rows(), lm.frames());
+  EXPECT_EQ(plain.cop_foot_angle_rad.size(), 0);
+  MotionFrame f4, fm, fp;
+  for (Eigen::Index i = 0; i < lm.frames(); i += 7) {
+    at4.frame(i, f4);
+    mixed.frame(i, fm);
+    plain.frame(i, fp);
+    for (int s = 0; s < 2; ++s) {
+      EXPECT_NEAR(fm.cop_foot_angle_rad[static_cast<std::size_t>(s)], f4.q(coord::theta(segment(s, kFoot))), 1e-12) << i;
+      EXPECT_TRUE(std::isnan(fp.cop_foot_angle_rad[static_cast<std::size_t>(s)]));
+    }
+    EXPECT_EQ(fm.q, fp.q);  // the model's own motion stays at 6 Hz
+  }
+}

@@ -278,8 +278,8 @@ int main(int argc, char** argv) {
   if (wanted("study")) {
     study = app.add_subcommand("study", "The paper's parameter studies on trials with plates: r, ground-shift, cutoff, post-cutoff-cycles, kinematic-cutoff, "
                                         "speed-gate(-ratio), noise, split-distance, torso-length, torso-lag, foot-model");
-    study->add_option("KIND", study_args.kind, "r | ground-shift | cutoff | post-cutoff-cycles | kinematic-cutoff | speed-gate | speed-gate-ratio | noise | split-distance | torso-length | torso-lag | double-support-sta | foot-model")
-        ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "post-cutoff-cycles", "kinematic-cutoff", "speed-gate", "speed-gate-ratio", "noise", "split-distance", "torso-length", "torso-lag", "double-support-sta", "foot-model"}));
+    study->add_option("KIND", study_args.kind, "r | ground-shift | cutoff | post-cutoff-cycles | kinematic-cutoff | speed-gate | speed-gate-ratio | noise | min-kinematic-cycles | split-distance | torso-length | torso-lag | double-support-sta | foot-model")
+        ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "post-cutoff-cycles", "kinematic-cutoff", "speed-gate", "speed-gate-ratio", "noise", "min-kinematic-cycles", "split-distance", "torso-length", "torso-lag", "double-support-sta", "foot-model"}));
     study->add_option("TRIAL", study_args.trials, "Trials with plates (the options below apply to all of them)");
     study->add_option("--trial-list", study_args.trial_list,
                       "File of lines 'activity|lab|name|TRIAL [options]', each trial with its own options");

@@ -36,6 +36,18 @@ struct EstimateOptions {
   /// Lower the kinematic cut-off to what the markers' noise allows (noise_limited_cutoff; kin2grf)
   /// or keep it fixed (the paper).
   bool cutoff_from_noise = true;
+  /// Where the markers' noise lowers the kinematic cut-off (cutoff_from_noise), the dynamics'
+  /// kinematics are not taken below this many cycles per stance: min(kinematic_cutoff_hz,
+  /// min_kinematic_cycles / the median stance duration, median_stance_s of a first solve at
+  /// the lowered cut-off), while the COP function's foot angle keeps the lowered cut-off
+  /// (compute_motion's cop_angle_cutoff_hz). Why: the residual analysis judges positions, where
+  /// the noise is a signal's equal sooner than in their second derivatives' forces, and a stance's
+  /// force is a pulse of its own duration whose harmonics the accelerations must keep (the same
+  /// reason as post_cutoff_cycles); the COP function's input is an angle, a position. 0: none.
+  /// kin2grf's default chosen leave-one-lab-out on the trials with 2 mm of marker noise (`kin2grf
+  /// study min-kinematic-cycles`); a trial the residual analysis leaves at kinematic_cutoff_hz
+  /// (every development trial as recorded) is not changed by it.
+  double min_kinematic_cycles = 3.5;
   /// The torso's hip-shoulder length: measured per frame (kin2grf) or fixed (the paper).
   TorsoLength torso_length = TorsoLength::Measured;
   /// The upper body's fore-aft lag behind the pelvis, s (kin2grf): the HAT COM's fore-aft
@@ -88,7 +100,10 @@ struct EstimateResult {
   std::string marker_set;
   double mass_kg = 0.0;
   SagittalFrame frame;
-  double kinematic_cutoff_hz = 0.0;  ///< the kinematic cut-off used (EstimateOptions::cutoff_from_noise)
+  double kinematic_cutoff_hz = 0.0;  ///< the dynamics' kinematic cut-off (EstimateOptions::cutoff_from_noise, min_kinematic_cycles)
+  /// The residual analysis' cut-off for positions (EstimateOptions::cutoff_from_noise), which the
+  /// COP function's foot angle takes; kinematic_cutoff_hz when the stance floor did not raise it.
+  double position_cutoff_hz = 0.0;
   double post_cutoff_hz = 0.0;       ///< the post-filter cut-off used (EstimateOptions::post_cutoff_cycles)
   Model model;
   /// The floor, the soles, the belt velocity, the progression speed and the speed gate the trial

@@ -98,7 +98,9 @@ void contact_frame(const Model& model, const ContactCalibration& soles, const Co
     const int foot = segment(side, kFoot), toes = segment(side, kToes);
     const auto sp = sole_points(soles, f, side);
     fc.sole[static_cast<std::size_t>(side)] = sp;
-    fc.foot_inclination_rad[side] = -(f.q(coord::theta(foot)) - soles.feet[static_cast<std::size_t>(side)].flat_angle_rad);
+    const double theta = f.cop_foot_angle_rad[static_cast<std::size_t>(side)];
+    fc.foot_inclination_rad[side] =
+        -((std::isnan(theta) ? f.q(coord::theta(foot)) : theta) - soles.feet[static_cast<std::size_t>(side)].flat_angle_rad);
     if (o.foot_model == FootModel::ThreePoint) {
       for (int k = 0; k < 3; ++k) {
         const MaterialPoint mp = material_point(model, f, k < 2 ? foot : toes, sp[k]);

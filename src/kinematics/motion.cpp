@@ -166,6 +166,9 @@ void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
     f.qdd(coord::phi(j)) = d2[static_cast<std::size_t>(3 + j)];
   }
   if (torso_ax_mps2.size() > i) f.qdd(coord::com_x(kTorso)) = torso_ax_mps2[i];
+  for (int s = 0; s < 2; ++s)
+    f.cop_foot_angle_rad[static_cast<std::size_t>(s)] =
+        cop_foot_angle_rad.rows() > i ? cop_foot_angle_rad(i, s) : std::numeric_limits<double>::quiet_NaN();
   if (dstar.rows() > i) {
     f.q.segment<4>(coord::dstar_x(0)) = dstar.row(i).transpose();
     f.qd.segment<4>(coord::dstar_x(0)) = dstar_d.row(i).transpose();
@@ -202,13 +205,24 @@ ModelMotion reconstruct_motion(const Model& model, Eigen::MatrixXd x, Eigen::Mat
   return mm;
 }
 
-ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz, TorsoLength torso) {
+ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz, TorsoLength torso, double cop_angle_cutoff_hz) {
   if (lm.frames() < 8) throw InputError("too few frames (" + std::to_string(lm.frames()) + ") for the kinematics");
   Eigen::MatrixXd x = independent_coordinates(lm);
   if (torso == TorsoLength::Fixed) x.conservativeResize(Eigen::NoChange, 11);
+  // The feet's absolute angles at the COP's own cut-off: the sum of the chain's columns (torso,
+  // hip, knee, ankle), the foot's theta as frame() builds it, filtered (a linear filter, so the
+  // sum of the filtered columns).
+  Eigen::MatrixX2d cop_angle;
+  if (cop_angle_cutoff_hz > 0 && cop_angle_cutoff_hz != cutoff_hz) {
+    cop_angle.resize(x.rows(), 2);
+    for (int s = 0; s < 2; ++s) cop_angle.col(s) = x.col(2) + x.middleCols(3 + 4 * s, 3).rowwise().sum();
+    cop_angle = butterworth_filtfilt(Eigen::MatrixXd(cop_angle), lm.rate_hz, cop_angle_cutoff_hz);
+  }
   if (cutoff_hz > 0) x = butterworth_filtfilt(std::move(x), lm.rate_hz, cutoff_hz);
   // Empty derivatives: each frame takes x's central differences (ModelMotion::derivatives_at).
-  return reconstruct_motion(model, std::move(x), Eigen::MatrixXd(), Eigen::MatrixXd(), lm.rate_hz, lm.time_s);
+  ModelMotion m = reconstruct_motion(model, std::move(x), Eigen::MatrixXd(), Eigen::MatrixXd(), lm.rate_hz, lm.time_s);
+  m.cop_foot_angle_rad = std::move(cop_angle);
+  return m;
 }
 
 void lag_torso_fore_aft(ModelMotion& m, double tau_s) {

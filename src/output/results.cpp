@@ -169,7 +169,8 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
                       {"speed_mps", r.calibration.progression_speed_mps},
                       {"how", r.frame.how}};
   j["contact_speed_gate_mps"] = r.calibration.speed_gate_mps;
-  j["kinematic_cutoff_hz"] = r.kinematic_cutoff_hz;  // the one used (lowered for noisy markers)
+  j["kinematic_cutoff_hz"] = r.kinematic_cutoff_hz;  // the dynamics' (lowered for noisy markers, not below the stance floor)
+  j["position_cutoff_hz"] = r.position_cutoff_hz;    // the COP function's foot angle's
   j["post_cutoff_hz"] = r.post_cutoff_hz;            // the one used (per stance, or fixed)
   const auto n = r.time_s.size();
   j["frames"] = {{"first", r.first_frame_number}, {"last", r.first_frame_number + n - 1}, {"count", n}};

@@ -102,6 +102,19 @@ std::vector<Setting> settings_for(const std::string& kind) {
       std::snprintf(b, sizeof b, "%.0f mm noise", mm);
       s.push_back({b, mm, [](EstimateOptions&) {}, mm / 1000.0});
     }
+  } else if (kind == "min-kinematic-cycles") {
+    // The stance floor of a noise-lowered kinematic cut-off (EstimateOptions::min_kinematic_cycles),
+    // measured where it acts: every setting with 2 mm of marker noise (as the `noise` study adds
+    // it). As recorded, no development trial's cut-off is lowered, so clean trials cannot choose.
+    for (double c : {0.0, 2.5, 3.0, 3.5, 4.0, 5.0}) {
+      std::snprintf(b, sizeof b, c > 0 ? "%.1f cycles, 2 mm" : "off, 2 mm", c);
+      s.push_back({b, c, [c](EstimateOptions& o) { o.min_kinematic_cycles = c; }, 0.002});
+    }
+    for (Setting& x : s) {
+      EstimateOptions o;
+      x.apply(o);
+      x.is_default = o.min_kinematic_cycles == EstimateOptions{}.min_kinematic_cycles;
+    }
   } else if (kind == "split-distance") {
     for (double d : {0.0, 0.05, 0.1, 0.15, 0.2}) {
       std::snprintf(b, sizeof b, d > 0 ? "%.2f m" : "off", d);
@@ -132,7 +145,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
     s.push_back({"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }});
     mark_default(s, [](const EstimateOptions& o) { return o.contact.foot_model; });
   } else {
-    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, post-cutoff-cycles, kinematic-cutoff, speed-gate, speed-gate-ratio, noise, split-distance, torso-length, torso-lag, double-support-sta, foot-model)");
+    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, post-cutoff-cycles, kinematic-cutoff, speed-gate, speed-gate-ratio, noise, min-kinematic-cycles, split-distance, torso-length, torso-lag, double-support-sta, foot-model)");
   }
   return s;
 }

@@ -33,6 +33,10 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("--kinematic-cutoff-rule", a.kinematic_cutoff_rule,
                 "noise: --kinematic-cutoff lowered where the markers' noise needs it (residual analysis); fixed: as given (--paper)")
       ->check(CLI::IsMember({"noise", "fixed"}))->capture_default_str();
+  c->add_option("--min-kinematic-cycles", a.min_kinematic_cycles,
+                "Where the noise rule lowers the kinematic cut-off, the dynamics' cut-off stays at least this many cycles "
+                "over the median stance (the COP function's foot angle keeps the lowered one); 0 = no floor")
+      ->check(CLI::Range(0.0, 20.0))->capture_default_str();
   c->add_option("--post-cutoff", a.post_cutoff,
                 "Multiplier post-filter at this fixed cut-off, Hz (the paper: 12; 0: none); replaces --post-cutoff-cycles");
   c->add_option_function<double>(
@@ -122,6 +126,7 @@ EstimateOptions to_options(const Settings& a) {
   const bool fixed_post_cutoff = a.post_cutoff || (a.paper && !a.post_cutoff_cycles_given);
   o.post_cutoff_cycles = fixed_post_cutoff ? 0.0 : a.post_cutoff_cycles;
   o.cutoff_from_noise = !a.paper && a.kinematic_cutoff_rule == "noise";
+  o.min_kinematic_cycles = a.min_kinematic_cycles;
   o.ground_level_m = a.ground_level;
   o.contact.foot_model = a.foot_model == "cop" ? FootModel::Cop : FootModel::ThreePoint;
   o.contact.ground_shift_m = a.ground_shift;
@@ -172,6 +177,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"double_support_sta_weight", o.double_support_sta_weight},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"kinematic_cutoff_rule", o.cutoff_from_noise ? "noise" : "fixed"},
+          {"min_kinematic_cycles", o.min_kinematic_cycles},
           {"post_cutoff_hz", o.post_cutoff_hz},
           {"post_cutoff_cycles", o.post_cutoff_cycles},
           {"anthropometry", o.anthropometry},

@@ -19,6 +19,7 @@
 
 #include <Eigen/Dense>
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,9 @@ Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm);
 /// q, qd, qdd of one frame (63 each, on the stack: the per-frame solve allocates nothing).
 struct MotionFrame {
   Eigen::Matrix<double, coord::kCount, 1> q, qd, qdd;
+  /// Per side (right, left): the foot's absolute angle the COP function reads (rad), NaN: the
+  /// foot's own theta in q (ModelMotion::cop_foot_angle_rad).
+  std::array<double, 2> cop_foot_angle_rad{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
 };
 
 /// The model's motion over a trial, held as what determines it: the independent coordinates and
@@ -73,6 +77,11 @@ struct ModelMotion {
   /// same numbers either way, bit for bit.
   Eigen::MatrixXd xd, xdd;
   Eigen::VectorXd torso_ax_mps2;       ///< N: the HAT COM's fore-aft acceleration (lag_torso_fore_aft)
+  /// N x 2 (right, left), or empty: the feet's absolute angles (rad) filtered at the positions'
+  /// cut-off, for the COP function, when the dynamics take a higher one (compute_motion's
+  /// cop_angle_cutoff_hz). The COP function maps an angle to a place: a position, whose noise
+  /// the residual analysis judges, not an acceleration.
+  Eigen::MatrixX2d cop_foot_angle_rad;
   /// N x 4: D* and its derivatives (coord::dstar_x); empty (zero in a frame) unless
   /// prepare_contacts kept them.
   Eigen::MatrixX4d dstar, dstar_d, dstar_dd;
@@ -102,9 +111,10 @@ enum class TorsoLength {
 };
 
 /// The whole kinematic step: independent coordinates, filter at cutoff_hz, differentiate,
-/// reconstruct.
+/// reconstruct. cop_angle_cutoff_hz > 0 (and not cutoff_hz): the COP function's foot angles
+/// are filtered at it instead (ModelMotion::cop_foot_angle_rad).
 ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz,
-                           TorsoLength torso = TorsoLength::Measured);
+                           TorsoLength torso = TorsoLength::Measured, double cop_angle_cutoff_hz = 0.0);
 
 /// The upper body's fore-aft lag (kin2grf, not in the paper). The HAT is one rigid segment whose
 /// COM follows the hip and shoulder landmarks, but most of its mass (viscera, arms, head, soft
