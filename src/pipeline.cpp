@@ -174,8 +174,10 @@ std::pair<Model, ContactCalibration> model_stage(const EstimateOptions& o, Estim
   return {build_model(measure_geometry(lm), r.mass_kg, anthropometric_table(o.anthropometry)), std::move(soles)};
 }
 
-/// Model coordinates and their derivatives, filtered at the kinematic cut-off.
-ModelMotion kinematics_stage(const EstimateOptions& o, const Model& model, EstimateResult& r) {
+/// Model coordinates and their derivatives, filtered at the kinematic cut-off. Where the noise
+/// lowered it and the stance floor may raise it again (min_kinematic_cycles), the unfiltered
+/// coordinates are kept in `unfiltered` for the second pass (half the landmarks' size).
+ModelMotion kinematics_stage(const EstimateOptions& o, const Model& model, EstimateResult& r, Eigen::MatrixXd& unfiltered) {
   const SagittalLandmarks& lm = r.landmarks;
   // The kinematic cut-off: the user's (6 Hz), lowered where the markers' own noise needs it
   // (Winter's residual analysis on the landmarks, noise_limited_cutoff).
@@ -191,7 +193,9 @@ ModelMotion kinematics_stage(const EstimateOptions& o, const Model& model, Estim
     }
   }
   r.position_cutoff_hz = r.kinematic_cutoff_hz;
-  return compute_motion(model, lm, r.kinematic_cutoff_hz, o.torso_length);
+  Eigen::MatrixXd x = model_coordinates(lm, o.torso_length);
+  if (o.min_kinematic_cycles > 0 && r.kinematic_cutoff_hz < o.kinematic_cutoff_hz) unfiltered = x;
+  return motion_from_coordinates(model, std::move(x), lm.rate_hz, lm.time_s, r.kinematic_cutoff_hz);
 }
 
 /// The upper body's fore-aft lag: what the trunk markers do not already show of it
@@ -213,7 +217,8 @@ void lag_torso_stage(const EstimateOptions& o, ModelMotion& motion, EstimateResu
 /// velocity (always, on a treadmill, from every frame's contact points), the progression speed
 /// and the speed gate.
 std::pair<std::vector<bool>, TrialCalibration> contact_stage(const EstimateOptions& o, const Model& model, ContactCalibration soles,
-                                                             EstimateResult& r, const ModelMotion& motion) {
+                                                             EstimateResult& r, const ModelMotion& motion,
+                                                             std::optional<double> progression_speed_mps = std::nullopt) {
   const SagittalLandmarks& lm = r.landmarks;
   const ContactModelOptions& co = o.contact;
   std::vector<bool> running;
@@ -249,7 +254,9 @@ std::pair<std::vector<bool>, TrialCalibration> contact_stage(const EstimateOptio
       r.messages.push_back(b);
     }
   }
-  cal.progression_speed_mps = r.frame.treadmill ? std::abs(cal.belt_velocity_mps) : progression_speed(lm);
+  // Overground, from the hip's landmark (or a first pass's, the landmarks then gone).
+  cal.progression_speed_mps =
+      r.frame.treadmill ? std::abs(cal.belt_velocity_mps) : progression_speed_mps ? *progression_speed_mps : progression_speed(lm);
   cal.speed_gate_mps = speed_gate_for(o.solver, cal.progression_speed_mps);
   if (o.solver.speed_gate_ratio > 0) {
     char b[160];
@@ -420,7 +427,6 @@ void double_support_transition(double w, const std::array<std::vector<bool>, 2>&
   }
 }
 
-/// The post-filter (Sect. 2.6) and each foot's force, COP, contact state, gap and sole.
 /// Each foot's contact state per frame from the solve: any of its points active.
 std::array<std::vector<bool>, 2> foot_contact_states(const RawSolve& raw, Eigen::Index n) {
   std::array<std::vector<bool>, 2> contact{std::vector<bool>(static_cast<std::size_t>(n)), std::vector<bool>(static_cast<std::size_t>(n))};
@@ -431,6 +437,7 @@ std::array<std::vector<bool>, 2> foot_contact_states(const RawSolve& raw, Eigen:
   return contact;
 }
 
+/// The post-filter (Sect. 2.6) and each foot's force, COP, contact state, gap and sole.
 void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, RawSolve& raw) {
   const Eigen::Index n = raw.lambda.rows();
   const int np = static_cast<int>(raw.point_side.size());
@@ -572,34 +579,32 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   sagittal_stage(trial, release, static_trial, set, o, r);
   auto [model, soles] = model_stage(o, r);
   r.model = std::move(model);
-  ModelMotion motion = kinematics_stage(o, r.model, r);
-  // A second pass at a higher kinematic cut-off may follow (min_kinematic_cycles): only where
-  // the noise lowered it. Otherwise the landmarks go before the solve (a long trial's memory).
-  const bool may_raise = o.cutoff_from_noise && o.min_kinematic_cycles > 0 && r.kinematic_cutoff_hz < o.kinematic_cutoff_hz;
+  Eigen::MatrixXd unfiltered;  // for a second pass (min_kinematic_cycles): only where the noise lowered the cut-off
+  ModelMotion motion = kinematics_stage(o, r.model, r, unfiltered);
   const std::size_t first_pass_messages = r.messages.size();
   double seconds_kinematics = 0, seconds_dynamics = 0;
   std::vector<bool> running;
   RawSolve raw;
   // The torso lag, the contact calibration and the solve (Eqs. 5-10) on `motion`.
-  const auto dynamics = [&](const ContactCalibration& contact_soles) {
+  const auto dynamics = [&](std::optional<double> progression_speed_mps) {
     const auto ta = clock::now();
     lag_torso_stage(o, motion, r);
-    auto [run, calibration] = contact_stage(o, r.model, contact_soles, r, motion);
+    auto [run, calibration] = contact_stage(o, r.model, soles, r, motion, progression_speed_mps);
     running = std::move(run);
     r.calibration = std::move(calibration);
-    if (!o.keep_all_series && !may_raise) r.landmarks.p = {};  // the last to read them is contact_stage (the hip's speed)
+    if (!o.keep_all_series) r.landmarks.p = {};  // the last to read them is contact_stage (the hip's speed)
     const auto tb = clock::now();
     raw = RawSolve();
+    r.cycled_frames = r.capped_frames = 0;  // solve_stage counts into them
     raw = solve_stage(trial, o, r, motion, running);
     seconds_kinematics += std::chrono::duration<double>(tb - ta).count();
     seconds_dynamics += std::chrono::duration<double>(clock::now() - tb).count();
   };
-  const auto t1 = clock::now();
-  seconds_kinematics = std::chrono::duration<double>(t1 - t0).count();
-  dynamics(soles);
-  if (may_raise) {
-    // The stance floor: the dynamics' kinematics not below min_kinematic_cycles per stance, the
-    // stance from this first solve's contacts (as the post-filter takes it).
+  seconds_kinematics = std::chrono::duration<double>(clock::now() - t0).count();
+  dynamics(std::nullopt);
+  // The stance floor (min_kinematic_cycles): the dynamics' kinematics not below that many cycles
+  // per stance, the stance from this first solve's contacts (as the post-filter takes it).
+  if (unfiltered.size() > 0) {
     if (const auto stance = median_stance_s(foot_contact_states(raw, motion.frames()), motion.rate_hz)) {
       const double floor_hz = std::min(o.kinematic_cutoff_hz, o.min_kinematic_cycles / *stance);
       if (floor_hz > r.kinematic_cutoff_hz) {
@@ -612,13 +617,16 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
                       "function's foot angle keeps %.2f Hz)",
                       floor_hz, o.min_kinematic_cycles, *stance, r.position_cutoff_hz);
         r.messages.emplace_back(b);
+        const double rate_hz = motion.rate_hz, speed_mps = r.calibration.progression_speed_mps;
+        Eigen::VectorXd time_s = std::move(motion.time_s);
         motion = ModelMotion();
-        motion = compute_motion(r.model, r.landmarks, floor_hz, o.torso_length, r.position_cutoff_hz);
+        raw = RawSolve();
+        motion = motion_from_coordinates(r.model, std::move(unfiltered), rate_hz, std::move(time_s), floor_hz, r.position_cutoff_hz);
         seconds_kinematics += std::chrono::duration<double>(clock::now() - tk).count();
-        dynamics(soles);
+        dynamics(speed_mps);
       }
     }
-    if (!o.keep_all_series) r.landmarks.p = {};
+    unfiltered = Eigen::MatrixXd();
   }
   r.seconds_kinematics = seconds_kinematics;
   r.seconds_dynamics = seconds_dynamics;

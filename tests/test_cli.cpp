@@ -369,3 +369,32 @@ TEST(CliExample, AGrfMotWrittenInAZUpFrameIsReadBackWithItsVertical) {
   ASSERT_EQ(v.status, 0) << v.out;
   EXPECT_NE(v.out.find("per foot, mean (SD), n = 4     0.0 (0.0)   0.0 (0.0)   0.0 (0.0)"), std::string::npos) << v.out;
 }
+
+// make-example --marker-noise: a walk as real capture records it, on which the noise rule lowers
+// the kinematic cut-off and the stance floor raises the dynamics' again (both in the JSON and
+// the messages); out of range, the option is named.
+TEST(CliExample, AWalkWithMarkerNoiseShowsBothCutoffs) {
+  const auto dir = kin2grf::test::temp_dir("cli_noisy_example");
+  ASSERT_EQ(run("make-example --seconds 6 --marker-noise 3 --out-dir " + dir.string()).status, 0);
+  const CliRun r = run("estimate " + (dir / "example_walk.c3d").string() + " --json " + (dir / "e.json").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("lowered from 6.0"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("raised to"), std::string::npos) << r.out;
+  std::ifstream in(dir / "e.json");
+  const auto j = nlohmann::json::parse(in);
+  const double dynamics = j["kinematic_cutoff_hz"], positions = j["position_cutoff_hz"];
+  EXPECT_LT(positions, 4.5);
+  EXPECT_GT(dynamics, positions + 0.3);
+  EXPECT_LE(dynamics, 6.0);
+  EXPECT_EQ(j["settings"]["min_kinematic_cycles"], 3.5);
+  // The same walk without noise: one cut-off, 6 Hz, for both.
+  const CliRun c = run("estimate " + (example_dir() / "example_walk.c3d").string() + " --json " + (dir / "c.json").string());
+  ASSERT_EQ(c.status, 0) << c.out;
+  std::ifstream cin_(dir / "c.json");
+  const auto k = nlohmann::json::parse(cin_);
+  EXPECT_EQ(k["kinematic_cutoff_hz"], 6.0);
+  EXPECT_EQ(k["position_cutoff_hz"], 6.0);
+  const CliRun bad = run("make-example --marker-noise 20 --out-dir " + (dir / "x").string());
+  EXPECT_EQ(bad.status, 2) << bad.out;
+  EXPECT_NE(bad.out.find("--marker-noise"), std::string::npos) << bad.out;
+}

@@ -220,8 +220,9 @@ int run_batch(const BatchArgs& a) {
 }
 
 /// The bundled examples (write_examples): a walk over two plates and a squat.
-int run_make_example(const std::string& dir, double seconds, double rate_hz, double analog_rate_hz) {
-  for (const auto& line : kin2grf::write_examples(dir, seconds, rate_hz, analog_rate_hz)) std::cout << "wrote " << line << "\n";
+int run_make_example(const std::string& dir, double seconds, double rate_hz, double analog_rate_hz, double noise_mm) {
+  for (const auto& line : kin2grf::write_examples(dir, seconds, rate_hz, analog_rate_hz, noise_mm / 1000.0))
+    std::cout << "wrote " << line << "\n";
   return 0;
 }
 
@@ -321,7 +322,7 @@ int main(int argc, char** argv) {
   }
 
   std::string example_dir = "example";
-  double example_seconds = 3.0, example_rate = 100.0, example_analog_rate = 0.0;
+  double example_seconds = 3.0, example_rate = 100.0, example_analog_rate = 0.0, example_noise_mm = 0.0;
   if (wanted("make-example")) {
     make_example = app.add_subcommand("make-example", "Write the synthetic example trial (C3D with plates, TRC, GRF .mot)");
     make_example->add_option("--out-dir", example_dir, "Output folder")->capture_default_str();
@@ -329,6 +330,8 @@ int main(int argc, char** argv) {
     make_example->add_option("--rate", example_rate, "Marker rate, Hz (50-2000)")->capture_default_str();
     make_example->add_option("--analog-rate", example_analog_rate,
                              "The walk's plates' rate, Hz: a whole multiple of the marker rate (default: the marker rate)");
+    make_example->add_option("--marker-noise", example_noise_mm,
+                             "Gaussian noise on the walk's marker coordinates, SD in mm (0-10; seeded)")->capture_default_str();
   }
 
   try {
@@ -345,7 +348,7 @@ int main(int argc, char** argv) {
     else if (chosen(study)) rc = run_study(study_args);
     else if (chosen(fit_cop)) rc = run_fit_cop(fit_args);
     else if (chosen(batch)) rc = run_batch(batch_args);
-    else if (chosen(make_example)) rc = run_make_example(example_dir, example_seconds, example_rate, example_analog_rate);
+    else if (chosen(make_example)) rc = run_make_example(example_dir, example_seconds, example_rate, example_analog_rate, example_noise_mm);
     // Standard output closed or full: the output is lost, so the run failed.
     std::cout.flush();
     if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout))

@@ -205,10 +205,15 @@ ModelMotion reconstruct_motion(const Model& model, Eigen::MatrixXd x, Eigen::Mat
   return mm;
 }
 
-ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz, TorsoLength torso, double cop_angle_cutoff_hz) {
+Eigen::MatrixXd model_coordinates(const SagittalLandmarks& lm, TorsoLength torso) {
   if (lm.frames() < 8) throw InputError("too few frames (" + std::to_string(lm.frames()) + ") for the kinematics");
   Eigen::MatrixXd x = independent_coordinates(lm);
   if (torso == TorsoLength::Fixed) x.conservativeResize(Eigen::NoChange, 11);
+  return x;
+}
+
+ModelMotion motion_from_coordinates(const Model& model, Eigen::MatrixXd x, double rate_hz, Eigen::VectorXd time_s, double cutoff_hz,
+                                    double cop_angle_cutoff_hz) {
   // The feet's absolute angles at the COP's own cut-off: the sum of the chain's columns (torso,
   // hip, knee, ankle), the foot's theta as frame() builds it, filtered (a linear filter, so the
   // sum of the filtered columns).
@@ -216,13 +221,17 @@ ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, doub
   if (cop_angle_cutoff_hz > 0 && cop_angle_cutoff_hz != cutoff_hz) {
     cop_angle.resize(x.rows(), 2);
     for (int s = 0; s < 2; ++s) cop_angle.col(s) = x.col(2) + x.middleCols(3 + 4 * s, 3).rowwise().sum();
-    cop_angle = butterworth_filtfilt(Eigen::MatrixXd(cop_angle), lm.rate_hz, cop_angle_cutoff_hz);
+    cop_angle = butterworth_filtfilt(Eigen::MatrixXd(cop_angle), rate_hz, cop_angle_cutoff_hz);
   }
-  if (cutoff_hz > 0) x = butterworth_filtfilt(std::move(x), lm.rate_hz, cutoff_hz);
+  if (cutoff_hz > 0) x = butterworth_filtfilt(std::move(x), rate_hz, cutoff_hz);
   // Empty derivatives: each frame takes x's central differences (ModelMotion::derivatives_at).
-  ModelMotion m = reconstruct_motion(model, std::move(x), Eigen::MatrixXd(), Eigen::MatrixXd(), lm.rate_hz, lm.time_s);
+  ModelMotion m = reconstruct_motion(model, std::move(x), Eigen::MatrixXd(), Eigen::MatrixXd(), rate_hz, std::move(time_s));
   m.cop_foot_angle_rad = std::move(cop_angle);
   return m;
+}
+
+ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz, TorsoLength torso, double cop_angle_cutoff_hz) {
+  return motion_from_coordinates(model, model_coordinates(lm, torso), lm.rate_hz, lm.time_s, cutoff_hz, cop_angle_cutoff_hz);
 }
 
 void lag_torso_fore_aft(ModelMotion& m, double tau_s) {

@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <random>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/c3d.hpp"
@@ -304,7 +305,13 @@ ForcePlate y_up(ForcePlate p) {
 
 }  // namespace
 
-std::vector<std::string> write_examples(const std::string& dir, double seconds, double rate_hz, double analog_rate_hz) {
+std::vector<std::string> write_examples(const std::string& dir, double seconds, double rate_hz, double analog_rate_hz,
+                                        double marker_noise_m) {
+  if (!(std::isfinite(marker_noise_m) && marker_noise_m >= 0 && marker_noise_m <= 0.01)) {
+    char b[128];
+    std::snprintf(b, sizeof b, "example marker noise (--marker-noise) %g mm: must be between 0 and 10", 1000 * marker_noise_m);
+    throw InputError(b);
+  }
   if (!(std::isfinite(seconds) && seconds >= 1.0 && seconds <= 600.0))
   {
     char b[128];
@@ -331,6 +338,12 @@ std::vector<std::string> write_examples(const std::string& dir, double seconds, 
     wo.duration_s = std::max(seconds, 2.5 * wo.stride_time_s);
     wo.rate_hz = rate_hz;
     Trial walk = make_example_walk(wo);
+    if (marker_noise_m > 0) {
+      std::mt19937 rng(1);
+      std::normal_distribution<double> noise(0.0, marker_noise_m);
+      for (auto& P : walk.markers.positions_m)
+        for (Eigen::Index i = 0; i < P.size(); ++i) P.data()[i] += noise(rng);
+    }
     const std::string base = (std::filesystem::path(dir) / "example_walk").string();
     write_trc(base + ".trc", rotated(walk.markers, lab_to_y_up(), Axis::Y));
     const auto& p = walk.plates->plates;

@@ -110,6 +110,14 @@ enum class TorsoLength {
   Fixed      ///< the median over the trial (the paper's rigid model)
 };
 
+/// The model's independent coordinates as compute_motion filters them: independent_coordinates,
+/// without the torso length column for TorsoLength::Fixed; at least 8 frames.
+Eigen::MatrixXd model_coordinates(const SagittalLandmarks& lm, TorsoLength torso);
+
+/// compute_motion from model_coordinates' columns (unfiltered), their rate and times.
+ModelMotion motion_from_coordinates(const Model& model, Eigen::MatrixXd x, double rate_hz, Eigen::VectorXd time_s, double cutoff_hz,
+                                    double cop_angle_cutoff_hz = 0.0);
+
 /// The whole kinematic step: independent coordinates, filter at cutoff_hz, differentiate,
 /// reconstruct. cop_angle_cutoff_hz > 0 (and not cutoff_hz): the COP function's foot angles
 /// are filtered at it instead (ModelMotion::cop_foot_angle_rad).
