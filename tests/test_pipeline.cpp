@@ -12,6 +12,7 @@
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/markers/presets.hpp"
+#include "kin2grf/numeric.hpp"
 #include "kin2grf/output/results.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
@@ -513,4 +514,50 @@ TEST(Estimate, ADoubleSupportWeightOutsideItsRangeIsRefusedNamingTheSetting) {
 TEST(Estimate, AStanceFloorOutsideItsRangeIsRefusedNamingTheSetting) {
   expect_refused_naming([](EstimateOptions& o, double v) { o.min_kinematic_cycles = v; }, {-1.0, 25.0, std::nan("")},
                         "kinematic cycles per stance");
+}
+
+// The failure mode: a trial cut mid-stance (a capture started late, a gap trimmed) gave that
+// stance's filter-edge forces with no word. Now each stance within half a period of the
+// kinematic cut-off of the window's ends is named, with its frames, and no other.
+TEST(Pipeline, AStanceAtTheWindowsEdgeIsNamedWithItsFramesAndNoOther) {
+  SyntheticWalkOptions wo;
+  wo.duration_s = 5.0;
+  const SyntheticWalk w = make_synthetic_walk(wo);
+  // The right foot's second stance, cut 0.2 s after it begins: the trial starts there.
+  const auto& st = w.stance[0];
+  Eigen::Index k = -1;
+  int begun = 0;
+  for (Eigen::Index i = 1; i < static_cast<Eigen::Index>(st.size()); ++i)
+    if (st[static_cast<std::size_t>(i)] && !st[static_cast<std::size_t>(i - 1)] && ++begun == 2) {
+      k = i + 20;
+      break;
+    }
+  ASSERT_GT(k, 0);
+  Trial t = w.trial;
+  const Eigen::Index n = t.markers.frames() - k;
+  for (auto& P : t.markers.positions_m) P = Eigen::MatrixX3d(P.bottomRows(n));
+  t.markers.time_s = Eigen::VectorXd(t.markers.time_s.tail(n));
+  t.markers.first_frame += static_cast<int>(k);
+  t.plates.reset();
+  const EstimateResult r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), {});
+  ASSERT_EQ(r.first_index, 0);
+  const auto reach = static_cast<Eigen::Index>(std::ceil(0.5 / r.kinematic_cutoff_hz * r.motion.rate_hz));  // 9 frames at 100 Hz
+  std::vector<std::string> expected;
+  for (int s = 0; s < 2; ++s)
+    for (const IndexRun& run : merge_close_runs(runs_where(r.time_s.size(), [&](Eigen::Index i) {
+                                                  return static_cast<bool>(r.feet[static_cast<std::size_t>(s)].contact[static_cast<std::size_t>(i)]);
+                                                }), 2))
+      if (run.first < reach || run.last > r.time_s.size() - 1 - reach)
+        expected.push_back(std::string(s ? "left" : "right") + " foot: the stance at frames " +
+                           std::to_string(r.first_frame_number + run.first) + "-" + std::to_string(r.first_frame_number + run.last));
+  std::vector<std::string> said;
+  for (const auto& m : r.messages)
+    if (m.find("of the window's") != std::string::npos) said.push_back(m);
+  ASSERT_EQ(said.size(), expected.size());
+  for (std::size_t i = 0; i < said.size(); ++i) EXPECT_EQ(said[i].rfind(expected[i], 0), 0u) << said[i];
+  // The cut stance is among them, named from the trial's first frame, as beginning at the start.
+  ASSERT_FALSE(said.empty());
+  EXPECT_NE(said.front().find("right foot: the stance at frames " + std::to_string(t.markers.first_frame) + "-"), std::string::npos)
+      << said.front();
+  EXPECT_NE(said.front().find("begins within 83 ms of the window's start"), std::string::npos) << said.front();
 }
