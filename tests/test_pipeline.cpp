@@ -506,12 +506,9 @@ TEST(Estimate, TheDoubleSupportTransitionMovesOnlyTheSplitAndByItsWeight) {
   EXPECT_TRUE(said);
 }
 
-TEST(Estimate, ADoubleSupportWeightOutsideItsRangeIsRefusedNamingTheSetting) {
+TEST(Estimate, ADoubleSupportWeightOrStanceFloorOutsideItsRangeIsRefusedNamingTheSetting) {
   expect_refused_naming([](EstimateOptions& o, double v) { o.double_support_sta_weight = v; }, {-0.1, 1.5, std::nan("")},
                         "double-support");
-}
-
-TEST(Estimate, AStanceFloorOutsideItsRangeIsRefusedNamingTheSetting) {
   expect_refused_naming([](EstimateOptions& o, double v) { o.min_kinematic_cycles = v; }, {-1.0, 25.0, std::nan("")},
                         "kinematic cycles per stance");
 }
