@@ -616,6 +616,14 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   double seconds_kinematics = 0, seconds_dynamics = 0;
   std::vector<bool> running;
   RawSolve raw;
+  // The solve's progress over both passes when a second may follow: the first reports the first
+  // half, the second the rest (or the first completes it), so a progress line never restarts.
+  EstimateOptions solve_o;
+  const bool two_pass_progress = unfiltered.size() > 0 && o.progress;
+  if (two_pass_progress) solve_o = o;
+  const auto set_pass = [&](long pass) {
+    if (two_pass_progress) solve_o.progress = [&o, pass](long done, long n) { o.progress(pass * n + done, 2 * n); };
+  };
   // The torso lag, the contact calibration and the solve (Eqs. 5-10) on `motion`.
   const auto dynamics = [&](std::optional<double> progression_speed_mps) {
     const auto ta = clock::now();
@@ -627,12 +635,14 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
     const auto tb = clock::now();
     raw = RawSolve();
     r.cycled_frames = r.capped_frames = 0;  // solve_stage counts into them
-    raw = solve_stage(trial, o, r, motion, running);
+    raw = solve_stage(trial, two_pass_progress ? solve_o : o, r, motion, running);
     seconds_kinematics += std::chrono::duration<double>(tb - ta).count();
     seconds_dynamics += std::chrono::duration<double>(clock::now() - tb).count();
   };
   seconds_kinematics = std::chrono::duration<double>(clock::now() - t0).count();
+  set_pass(0);
   dynamics(std::nullopt);
+  bool raised = false;
   // The stance floor (min_kinematic_cycles): the dynamics' kinematics not below that many cycles
   // per stance, the stance from this first solve's contacts (as the post-filter takes it).
   if (unfiltered.size() > 0) {
@@ -654,10 +664,13 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
         raw = RawSolve();
         motion = motion_from_coordinates(r.model, std::move(unfiltered), rate_hz, std::move(time_s), floor_hz, r.position_cutoff_hz);
         seconds_kinematics += std::chrono::duration<double>(clock::now() - tk).count();
+        set_pass(1);
         dynamics(speed_mps);
+        raised = true;
       }
     }
     unfiltered = Eigen::MatrixXd();
+    if (two_pass_progress && !raised) o.progress(2 * motion.frames(), 2 * motion.frames());  // one pass was enough: done
   }
   r.seconds_kinematics = seconds_kinematics;
   r.seconds_dynamics = seconds_dynamics;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <random>
 
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
@@ -140,7 +141,24 @@ TEST(NoisyMarkers, TheDynamicsKeepTheStancesHarmonicsAndTheCopAngleTheLoweredCut
     for (unsigned seed = 1; seed <= 4; ++seed) {
       const kin2grf::Trial noisy = with_noise(w.trial, 0.003, seed);
       const kin2grf::EstimateResult a = kin2grf::estimate(noisy, nullptr, *set, no_floor);
-      const kin2grf::EstimateResult b = kin2grf::estimate(noisy, nullptr, *set, defaults);
+      // The progress over both passes: one line that never goes back and ends complete.
+      kin2grf::EstimateOptions with_progress = defaults;
+      std::vector<std::pair<long, long>> progress;
+      std::mutex mu;
+      with_progress.progress = [&](long done, long total) {
+        const std::lock_guard<std::mutex> lock(mu);
+        progress.emplace_back(done, total);
+      };
+      const kin2grf::EstimateResult b = kin2grf::estimate(noisy, nullptr, *set, with_progress);
+      ASSERT_FALSE(progress.empty());
+      long most = 0;
+      for (const auto& [done, total] : progress) {
+        EXPECT_EQ(total, progress.front().second);
+        most = std::max(most, done);
+      }
+      EXPECT_EQ(progress.back().first, progress.back().second);
+      EXPECT_EQ(most, progress.front().second);
+      EXPECT_EQ(progress.front().second, 2 * b.time_s.size());
       EXPECT_LT(a.kinematic_cutoff_hz, 5.0);
       EXPECT_EQ(a.kinematic_cutoff_hz, a.position_cutoff_hz);
       // The same positions' cut-off; the dynamics' raised to 3.5 cycles over the first solve's
