@@ -25,14 +25,21 @@ double progression_speed(const SagittalLandmarks& lm) {
   return v.empty() ? 0.0 : median(v);
 }
 
+namespace {
+/// One foot's stances: its runs of contact, a flicker inside a stance (under 20 ms) bridged.
+std::vector<IndexRun> stance_runs(const std::vector<bool>& c, double rate_hz) {
+  const auto bridge = static_cast<Eigen::Index>(0.02 * rate_hz);
+  return merge_close_runs(runs_where(static_cast<Eigen::Index>(c.size()), [&](Eigen::Index i) { return c[static_cast<std::size_t>(i)]; }),
+                          bridge);
+}
+}  // namespace
+
 std::optional<double> median_stance_s(const std::array<std::vector<bool>, 2>& contact, double rate_hz) {
   if (!(rate_hz > 0)) return std::nullopt;
-  const auto bridge = static_cast<Eigen::Index>(0.02 * rate_hz);  // a flicker inside a stance
   std::vector<double> durations;
   for (const auto& c : contact) {
     const auto n = static_cast<Eigen::Index>(c.size());
-    const auto runs = runs_where(n, [&](Eigen::Index i) { return c[static_cast<std::size_t>(i)]; });
-    for (const IndexRun& run : merge_close_runs(runs, bridge)) {
+    for (const IndexRun& run : stance_runs(c, rate_hz)) {
       const auto frames = static_cast<double>(run.last - run.first + 1);
       if (run.first > 0 && run.last < n - 1 && frames >= 0.05 * rate_hz) durations.push_back(frames / rate_hz);
     }
@@ -286,7 +293,7 @@ struct RawSolve {
 
 /// Eqs. 5-10 on every frame (least squares, activation, semi-smooth iterations).
 RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResult& r, const ModelMotion& motion,
-                     const std::vector<bool>& running) {
+                     const std::vector<bool>& running, const std::function<void(long, long)>& progress) {
   const Eigen::Index n = motion.frames();
   RawSolve raw;
   {
@@ -323,8 +330,8 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
     const auto step = std::max<std::size_t>(1, (end - begin) / 100);
     for (std::size_t k = begin; k < end; ++k) {
       const auto i = static_cast<Eigen::Index>(k);
-      if (chunk == 0 && o.progress && (k - begin) % step == 0)
-        o.progress(static_cast<long>(static_cast<double>(k) / static_cast<double>(end) * static_cast<double>(n)), static_cast<long>(n));
+      if (chunk == 0 && progress && (k - begin) % step == 0)
+        progress(static_cast<long>(static_cast<double>(k) / static_cast<double>(end) * static_cast<double>(n)), static_cast<long>(n));
       motion.frame(i, f);
       contact_frame(r.model, r.calibration.contact, o.contact, is_running_frame(running, i), f, fc);
       const FrameSolution s = solver.solve(f.q, f.qdd, fc);
@@ -373,7 +380,7 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
   r.capped_frames += static_cast<int>(std::count(capped.begin(), capped.end(), 1));
   const Eigen::MatrixXd& lam = raw.lambda;
   const Eigen::MatrixXd& torque = raw.torque;
-  if (o.progress) o.progress(static_cast<long>(n), static_cast<long>(n));
+  if (progress) progress(static_cast<long>(n), static_cast<long>(n));
   // No NaN leaves the library: a frame the solve could not make finite is named, not written.
   for (Eigen::Index i = 0; i < n; ++i)
     if (!lam.row(i).allFinite() || !torque.row(i).allFinite())
@@ -388,11 +395,9 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
 /// normal multipliers are scaled to their new total (a foot's COP does not move), the sum is
 /// kept, and the joint torques move with the multipliers (the solve's torque_per_normal, linear
 /// in them). The tangential multipliers are left as solved.
-void double_support_transition(double w, const std::array<std::vector<bool>, 2>& contact, double rate_hz, const RawSolve& raw,
-                               Eigen::MatrixXd& lamf, EstimateResult& r) {
-  const auto stance = median_stance_s(contact, rate_hz);
-  if (!stance) return;
-  const auto max_frames = static_cast<Eigen::Index>(0.5 * *stance * rate_hz);
+void double_support_transition(double w, const std::array<std::vector<bool>, 2>& contact, double stance_s, double rate_hz,
+                               const RawSolve& raw, Eigen::MatrixXd& lamf, EstimateResult& r) {
+  const auto max_frames = static_cast<Eigen::Index>(0.5 * stance_s * rate_hz);
   const int np = static_cast<int>(raw.point_side.size());
   const auto supports = walking_double_supports(contact, max_frames);
   for (const DoubleSupport& ds : supports) {
@@ -445,11 +450,10 @@ void window_edge_messages(const std::array<std::vector<bool>, 2>& contact, doubl
   if (!(rate_hz > 0) || !(cutoff_hz > 0)) return;
   const double settle_s = 0.5 / cutoff_hz;
   const auto reach = static_cast<Eigen::Index>(std::ceil(settle_s * rate_hz));
-  const auto bridge = static_cast<Eigen::Index>(0.02 * rate_hz);  // a flicker inside a stance (median_stance_s)
   for (int side = 0; side < 2; ++side) {
     const auto& c = contact[static_cast<std::size_t>(side)];
     const auto n = static_cast<Eigen::Index>(c.size());
-    for (const IndexRun& run : merge_close_runs(runs_where(n, [&](Eigen::Index i) { return c[static_cast<std::size_t>(i)]; }), bridge)) {
+    for (const IndexRun& run : stance_runs(c, rate_hz)) {
       const bool at_start = run.first < reach, at_end = run.last > n - 1 - reach;
       if (!at_start && !at_end) continue;
       char b[320];
@@ -471,13 +475,14 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, Raw
   const Eigen::MatrixXd& lam = raw.lambda;
   const std::array<std::vector<bool>, 2> contact = foot_contact_states(raw, n);
   window_edge_messages(contact, rate_hz, r.kinematic_cutoff_hz, r);
+  const std::optional<double> stance = median_stance_s(contact, rate_hz);
   // Final filtering (Sect. 2.6): all multipliers at the post-filter cut-off, then inactive ones
   // back to zero. The cut-off follows the trial's stance duration (post_cutoff_cycles), within
   // what the marker rate allows.
   r.post_cutoff_hz = o.post_cutoff_hz;
   if (o.post_cutoff_cycles > 0) {
     char b[200];
-    if (const auto stance = median_stance_s(contact, rate_hz)) {
+    if (stance) {
       r.post_cutoff_hz = std::min(o.post_cutoff_cycles / *stance, 0.4 * rate_hz);
       std::snprintf(b, sizeof b, "post-filter cut-off %.1f Hz: %g cycles over the median stance of %.3f s", r.post_cutoff_hz,
                     o.post_cutoff_cycles, *stance);
@@ -493,7 +498,8 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, Raw
   for (Eigen::Index i = 0; i < n; ++i)
     for (int j = 0; j < np; ++j)
       if (!raw.active[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;
-  if (o.double_support_sta_weight > 0) double_support_transition(o.double_support_sta_weight, contact, rate_hz, raw, lamf, r);
+  if (o.double_support_sta_weight > 0 && stance)
+    double_support_transition(o.double_support_sta_weight, contact, *stance, rate_hz, raw, lamf, r);
 
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (int side = 0; side < 2; ++side) {
@@ -618,11 +624,10 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   RawSolve raw;
   // The solve's progress over both passes when a second may follow: the first reports the first
   // half, the second the rest (or the first completes it), so a progress line never restarts.
-  EstimateOptions solve_o;
   const bool two_pass_progress = unfiltered.size() > 0 && o.progress;
-  if (two_pass_progress) solve_o = o;
+  std::function<void(long, long)> progress = o.progress;
   const auto set_pass = [&](long pass) {
-    if (two_pass_progress) solve_o.progress = [&o, pass](long done, long n) { o.progress(pass * n + done, 2 * n); };
+    if (two_pass_progress) progress = [&o, pass](long done, long n) { o.progress(pass * n + done, 2 * n); };
   };
   // The torso lag, the contact calibration and the solve (Eqs. 5-10) on `motion`.
   const auto dynamics = [&](std::optional<double> progression_speed_mps) {
@@ -633,9 +638,8 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
     r.calibration = std::move(calibration);
     if (!o.keep_all_series) r.landmarks.p = {};  // the last to read them is contact_stage (the hip's speed)
     const auto tb = clock::now();
-    raw = RawSolve();
     r.cycled_frames = r.capped_frames = 0;  // solve_stage counts into them
-    raw = solve_stage(trial, two_pass_progress ? solve_o : o, r, motion, running);
+    raw = solve_stage(trial, o, r, motion, running, progress);
     seconds_kinematics += std::chrono::duration<double>(tb - ta).count();
     seconds_dynamics += std::chrono::duration<double>(clock::now() - tb).count();
   };

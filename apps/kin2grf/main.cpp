@@ -277,10 +277,10 @@ int main(int argc, char** argv) {
 
   StudyArgs study_args;
   if (wanted("study")) {
-    study = app.add_subcommand("study", "The paper's parameter studies on trials with plates: r, ground-shift, cutoff, post-cutoff-cycles, kinematic-cutoff, "
-                                        "speed-gate(-ratio), noise, split-distance, torso-length, torso-lag, foot-model");
-    study->add_option("KIND", study_args.kind, "r | ground-shift | cutoff | post-cutoff-cycles | kinematic-cutoff | speed-gate | speed-gate-ratio | noise | min-kinematic-cycles | split-distance | torso-length | torso-lag | double-support-sta | foot-model")
-        ->required()->check(CLI::IsMember({"r", "ground-shift", "cutoff", "post-cutoff-cycles", "kinematic-cutoff", "speed-gate", "speed-gate-ratio", "noise", "min-kinematic-cycles", "split-distance", "torso-length", "torso-lag", "double-support-sta", "foot-model"}));
+    std::string kinds;
+    for (const auto& k : kin2grf::study_kinds()) kinds += (kinds.empty() ? "" : " | ") + k;
+    study = app.add_subcommand("study", "The paper's parameter studies and kin2grf's, on trials with plates: " + kinds);
+    study->add_option("KIND", study_args.kind, "Which study")->required()->check(CLI::IsMember(kin2grf::study_kinds()));
     study->add_option("TRIAL", study_args.trials, "Trials with plates (the options below apply to all of them)");
     study->add_option("--trial-list", study_args.trial_list,
                       "File of lines 'activity|lab|name|TRIAL [options]', each trial with its own options");

@@ -1,6 +1,7 @@
 #include "kin2grf/io/trial.hpp"
 
 #include <algorithm>
+#include <random>
 
 namespace kin2grf {
 
@@ -48,6 +49,13 @@ MarkerTrajectories rotated(MarkerTrajectories m, const Eigen::Matrix3d& R, Axis 
   for (auto& P : m.positions_m) P = (P * R.transpose()).eval();
   m.up_axis = up_axis;
   return m;
+}
+
+void add_marker_noise(MarkerTrajectories& m, double sigma_m, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, sigma_m);
+  for (auto& P : m.positions_m)
+    for (Eigen::Index i = 0; i < P.size(); ++i) P.data()[i] += noise(rng);
 }
 
 double ForcePlate::width_m() const { return (corners_m[0] - corners_m[1]).norm(); }

@@ -21,7 +21,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <random>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/c3d.hpp"
@@ -338,12 +337,7 @@ std::vector<std::string> write_examples(const std::string& dir, double seconds, 
     wo.duration_s = std::max(seconds, 2.5 * wo.stride_time_s);
     wo.rate_hz = rate_hz;
     Trial walk = make_example_walk(wo);
-    if (marker_noise_m > 0) {
-      std::mt19937 rng(1);
-      std::normal_distribution<double> noise(0.0, marker_noise_m);
-      for (auto& P : walk.markers.positions_m)
-        for (Eigen::Index i = 0; i < P.size(); ++i) P.data()[i] += noise(rng);
-    }
+    if (marker_noise_m > 0) add_marker_noise(walk.markers, marker_noise_m, 1);
     const std::string base = (std::filesystem::path(dir) / "example_walk").string();
     write_trc(base + ".trc", rotated(walk.markers, lab_to_y_up(), Axis::Y));
     const auto& p = walk.plates->plates;

@@ -23,14 +23,15 @@ struct Setting {
   bool is_default = false;      ///< leaves kin2grf's default options as they are
 };
 
-/// Marks the settings that leave the fields `get` reads at kin2grf's defaults.
+/// Marks the settings that leave the fields `get` reads at kin2grf's defaults (the added marker
+/// noise is the study's condition, not a setting: min-kinematic-cycles is studied under noise).
 template <class Get>
 void mark_default(std::vector<Setting>& settings, Get get) {
   const EstimateOptions defaults;
   for (Setting& s : settings) {
     EstimateOptions o;
     s.apply(o);
-    s.is_default = s.marker_noise_m == 0 && get(o) == get(defaults);
+    s.is_default = get(o) == get(defaults);
   }
 }
 
@@ -110,11 +111,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
       std::snprintf(b, sizeof b, c > 0 ? "%.1f cycles, 2 mm" : "off, 2 mm", c);
       s.push_back({b, c, [c](EstimateOptions& o) { o.min_kinematic_cycles = c; }, 0.002});
     }
-    for (Setting& x : s) {
-      EstimateOptions o;
-      x.apply(o);
-      x.is_default = o.min_kinematic_cycles == EstimateOptions{}.min_kinematic_cycles;
-    }
+    mark_default(s, [](const EstimateOptions& o) { return o.min_kinematic_cycles; });
   } else if (kind == "split-distance") {
     for (double d : {0.0, 0.05, 0.1, 0.15, 0.2}) {
       std::snprintf(b, sizeof b, d > 0 ? "%.2f m" : "off", d);
@@ -145,7 +142,9 @@ std::vector<Setting> settings_for(const std::string& kind) {
     s.push_back({"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }});
     mark_default(s, [](const EstimateOptions& o) { return o.contact.foot_model; });
   } else {
-    throw InputError("unknown study '" + kind + "' (r, ground-shift, cutoff, post-cutoff-cycles, kinematic-cutoff, speed-gate, speed-gate-ratio, noise, min-kinematic-cycles, split-distance, torso-length, torso-lag, double-support-sta, foot-model)");
+    std::string kinds;
+    for (const auto& k : study_kinds()) kinds += (kinds.empty() ? "" : ", ") + k;
+    throw InputError("unknown study '" + kind + "' (" + kinds + ")");
   }
   return s;
 }
@@ -168,6 +167,13 @@ StudyCell pool(const std::vector<StudyTrialResult>& trials, const std::string& a
 }
 
 }  // namespace
+
+const std::vector<std::string>& study_kinds() {
+  static const std::vector<std::string> kinds{"r",     "ground-shift",         "cutoff",         "post-cutoff-cycles", "kinematic-cutoff",
+                                              "speed-gate", "speed-gate-ratio", "noise",     "min-kinematic-cycles", "split-distance",
+                                              "torso-length", "torso-lag",      "double-support-sta", "foot-model"};
+  return kinds;
+}
 
 StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& trials) {
   StudyResult res;
@@ -194,10 +200,7 @@ StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& tr
           Trial noisy;
           if (s.marker_noise_m > 0) {
             noisy = *t.trial;
-            std::mt19937 rng(static_cast<std::mt19937::result_type>(seed));
-            std::normal_distribution<double> g(0.0, s.marker_noise_m);
-            for (auto& P : noisy.markers.positions_m)
-              for (Eigen::Index i = 0; i < P.size(); ++i) P.data()[i] += g(rng);  // NaN stays NaN
+            add_marker_noise(noisy.markers, s.marker_noise_m, static_cast<unsigned>(seed));
           }
           const EstimateResult e = estimate(s.marker_noise_m > 0 ? noisy : *t.trial, t.static_trial, *t.marker_set, o);
           const ValidationResult v = validate(e, *t.plates);

@@ -54,6 +54,11 @@ struct MarkerTrajectories {
 /// `up_axis` is the new frame's (writing a TRC in OpenSim's Y-up frame).
 MarkerTrajectories rotated(MarkerTrajectories m, const Eigen::Matrix3d& R, Axis up_axis);
 
+/// Gaussian noise of SD sigma_m on every marker coordinate, from a generator seeded with `seed`
+/// (the same draw every time); a missing sample stays NaN. What real capture adds (the noise
+/// study, make-example --marker-noise).
+void add_marker_noise(MarkerTrajectories& m, double sigma_m, unsigned seed);
+
 /// One force plate (or one per-foot channel set of a processed GRF file).
 struct ForcePlate {
   std::string name;               ///< e.g. "FP1" or "right" for GRF .mot columns

@@ -93,6 +93,9 @@ struct StudyResult {
   std::vector<std::string> failures;  ///< trial + value + error, for runs that threw InputError
 };
 
+/// The study kinds run_study takes, in the order the command line lists them.
+const std::vector<std::string>& study_kinds();
+
 /// The kinds above; throws InputError for another.
 StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& trials);
 
