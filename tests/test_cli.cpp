@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
 
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +19,7 @@
 
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/opensim.hpp"
+#include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
 #include "test_support.hpp"
 
@@ -397,4 +401,137 @@ TEST(CliExample, AWalkWithMarkerNoiseShowsBothCutoffs) {
   const CliRun bad = run("make-example --marker-noise 20 --out-dir " + (dir / "x").string());
   EXPECT_EQ(bad.status, 2) << bad.out;
   EXPECT_NE(bad.out.find("--marker-noise"), std::string::npos) << bad.out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// What a run writes (issue 31): never onto an input of the run (every trial of a list, its static
+// and plates files, every other trial's outputs), never onto two outputs at once, devices and
+// FIFOs written in place, nothing left behind by a failed or killed run, one exit code (2) for
+// usage errors.
+
+namespace {
+/// A trial list of the example walk and squat, the squat validated against the walk's GRF file.
+std::filesystem::path example_list(const std::filesystem::path& dir) {
+  const auto list = dir / "list.txt";
+  const std::string walk = (example_dir() / "example_walk.c3d").string();
+  const std::string squat = (example_dir() / "example_squat.c3d").string();
+  kin2grf::write_file_text(list.string(), "walking|lab|walk|" + walk + " --mass 70\n" + "squat|lab|other|" + squat +
+                                              " --mass 70 --plates " + (dir / "walk_grf.mot").string() + "\n");
+  return list;
+}
+}  // namespace
+
+TEST(CliFiles, BatchStudyAndFitCopNeverWriteOntoAListedTrial) {
+  const auto dir = kin2grf::test::temp_dir("cli_list_clobber");
+  const auto trial = dir / "in.c3d";
+  std::filesystem::copy_file(example_dir() / "example_walk.c3d", trial);
+  const auto before = kin2grf::read_file_text(trial.string());
+  const auto list = dir / "list.txt";
+  kin2grf::write_file_text(list.string(), "walking|lab|walk|" + trial.string() + " --mass 70\n");
+  for (const std::string& cmd : {"batch " + list.string() + " --json ", "batch " + list.string() + " --csv ",
+                                "study r --trial-list " + list.string() + " --json ",
+                                "fit-cop --trial-list " + list.string() + " -o "}) {
+    const CliRun r = run(cmd + trial.string());
+    EXPECT_EQ(r.status, 2) << cmd << r.out;
+    EXPECT_NE(r.out.find("is an input of this run"), std::string::npos) << cmd << r.out;
+  }
+  EXPECT_EQ(kin2grf::read_file_text(trial.string()), before);
+}
+
+// Trial "walk" would write OUT/walk_grf.mot, which is trial "other"'s --plates file: refused
+// before anything runs (it ran, and "other" was validated against the new file).
+TEST(CliFiles, ABatchTrialsOutputIsNeverAnotherTrialsInput) {
+  const auto dir = kin2grf::test::temp_dir("cli_batch_cross");
+  const auto list = example_list(dir);
+  std::filesystem::copy_file(example_dir() / "example_walk_grf.mot", dir / "walk_grf.mot");
+  const auto before = kin2grf::read_file_text((dir / "walk_grf.mot").string());
+  const CliRun r = run("batch " + list.string() + " --jobs 1 --out-dir " + dir.string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("walk_grf.mot: is an input of this run"), std::string::npos) << r.out;
+  EXPECT_EQ(kin2grf::read_file_text((dir / "walk_grf.mot").string()), before);
+  EXPECT_FALSE(std::filesystem::exists(dir / "walk.csv"));
+}
+
+TEST(CliFiles, OneFileGivenAsTwoOutputsIsRefusedNamingBoth) {
+  const auto dir = kin2grf::test::temp_dir("cli_two_outputs");
+  const auto x = (dir / "x.csv").string();
+  const CliRun r = run("estimate " + example_trc() + " --mass 70 --csv " + x + " --json " + x);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("given twice as an output (--csv"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(x));
+}
+
+// A device stays a device, a FIFO gets the file through it, /dev/stdout prints it.
+TEST(CliFiles, DevicesFifosAndStandardOutputAreWrittenInPlace) {
+  const auto dir = kin2grf::test::temp_dir("cli_devices");
+  EXPECT_EQ(run("estimate " + example_trc() + " --mass 70 -o /dev/null --csv /dev/null").status, 2)
+      << "the same device twice is still two outputs onto one file";
+  const CliRun null = run("estimate " + example_trc() + " --mass 70 -o /dev/null");
+  EXPECT_EQ(null.status, 0) << null.out;
+  struct stat st {};
+  ASSERT_EQ(::stat("/dev/null", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode));
+  const CliRun out = run("estimate " + example_trc() + " --mass 70 --csv /dev/stdout", "2>/dev/null");
+  EXPECT_EQ(out.status, 0);
+  EXPECT_NE(out.out.find("frame,time_s"), std::string::npos) << out.out.substr(0, 300);
+  const auto fifo = dir / "pipe.csv";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const CliRun piped = run("estimate " + example_trc() + " --mass 70 --csv " + fifo.string() + " & cat " + fifo.string() +
+                           " | head -c 200; wait", "2>/dev/null");
+  EXPECT_NE(piped.out.find("frame,time_s"), std::string::npos) << piped.out;
+  ASSERT_EQ(::stat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+}
+
+// A later output that cannot be written fails the run, and the earlier outputs are not left:
+// -o was placed before --csv failed on a full disk.
+TEST(CliFiles, AFailedRunLeavesNoneOfItsOutputs) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const auto dir = kin2grf::test::temp_dir("cli_failed_run");
+  const auto mot = dir / "grf.mot";
+  const CliRun r = run("estimate " + example_trc() + " --mass 70 -o " + mot.string() + " --csv /dev/full");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("/dev/full"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::filesystem::is_empty(dir)) << "left: " << std::filesystem::directory_iterator(dir)->path();
+}
+
+// SIGTERM while the outputs are being written: their temporary files are removed. The run is held
+// on a FIFO no one reads (--csv), after -o's file is written and waits for the commit.
+TEST(CliFiles, ASignalRemovesTheTemporaryFiles) {
+  const auto dir = kin2grf::test::temp_dir("cli_sigterm");
+  const auto fifo = dir / "held.csv";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string cmd = std::string(KIN2GRF_CLI) + " estimate " + example_trc() + " --mass 70 -o " + (dir / "grf.mot").string() +
+                          " --csv " + fifo.string() + " >/dev/null 2>&1 & echo $!";
+  FILE* p = popen(cmd.c_str(), "r");
+  ASSERT_TRUE(p);
+  long pid = 0;
+  ASSERT_EQ(std::fscanf(p, "%ld", &pid), 1);
+  pclose(p);
+  auto temps = [&] {
+    int n = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) n += e.path().string().find("kin2grf-tmp") != std::string::npos;
+    return n;
+  };
+  for (int i = 0; i < 200 && temps() == 0; ++i) usleep(50000);
+  ASSERT_EQ(temps(), 1) << "the -o temporary file never appeared";
+  ASSERT_EQ(::kill(static_cast<pid_t>(pid), SIGTERM), 0);
+  for (int i = 0; i < 100 && ::kill(static_cast<pid_t>(pid), 0) == 0; ++i) usleep(50000);
+  EXPECT_EQ(temps(), 0);
+  EXPECT_FALSE(std::filesystem::exists(dir / "grf.mot"));
+}
+
+TEST(CliFiles, UsageErrorsExitTwoAndAClosedPipeIsNotACrash) {
+  EXPECT_EQ(run("estimate " + example_trc() + " --mas 64.9").status, 2);
+  EXPECT_EQ(run("estimat " + example_trc()).status, 2);
+  EXPECT_EQ(run("estimate").status, 2);
+  EXPECT_EQ(run("--help").status, 0);
+  EXPECT_EQ(run("--version").status, 0);
+  // `| head -1` with the reader gone before kin2grf writes: its own status, not a death by
+  // SIGPIPE (141).
+  const auto rc = kin2grf::test::temp_dir("cli_sigpipe") / "rc";
+  const std::string cmd = "{ " + std::string(KIN2GRF_CLI) + " info " + example_trc() + " 2>/dev/null; echo $? > " + rc.string() +
+                          "; } | true";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_EQ(kin2grf::read_file_text(rc.string()), "0\n");
 }

@@ -12,6 +12,7 @@
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/load.hpp"
+#include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/output/report.hpp"
 #include "kin2grf/pipeline.hpp"

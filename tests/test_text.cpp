@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
 #include "test_support.hpp"
 
@@ -151,27 +152,3 @@ TEST(Text, ParsePlainFieldsReadsARowAsSplittingAndParsingWould) {
   EXPECT_FALSE(parse_plain_fields("1\t2\t3\t4", '\t', fast = std::vector<double>(3)));  // too many
 }
 
-// Outputs are written as they are made (issue 10's memory), through a temporary file renamed at
-// the end: committed, the file holds what was written; abandoned (an exception on the way), the
-// old file is untouched and no temporary file is left.
-TEST(Text, AnAtomicFileReplacesTheFileOnlyWhenCommitted) {
-  const auto dir = test::temp_dir("atomic_file");
-  const std::string path = (dir / "out.csv").string();
-  write_file_text(path, "old\n");
-  {
-    AtomicFile f(path);
-    f.stream() << "half of a new";
-    // destroyed uncommitted
-  }
-  EXPECT_EQ(read_file_text(path), "old\n");
-  {
-    AtomicFile f(path);
-    for (int i = 0; i < 100000; ++i) f.stream() << i << '\n';
-    f.commit();
-  }
-  const std::string text = read_file_text(path);
-  EXPECT_EQ(text.substr(0, 4), "0\n1\n");
-  EXPECT_EQ(text.substr(text.size() - 6), "99999\n");
-  for (const auto& e : std::filesystem::directory_iterator(dir)) EXPECT_EQ(e.path().filename(), "out.csv");
-  EXPECT_THROW(AtomicFile((dir / "no such folder" / "out.csv").string()), InputError);
-}

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdint>
 #include <cstring>
@@ -13,6 +14,7 @@
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/summary.hpp"
+#include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/output/opensim_export.hpp"
 #include "kin2grf/output/report.hpp"
@@ -65,15 +67,22 @@ void print_messages(const kin2grf::EstimateResult& r) {
             << " frames/s\n";
 }
 
-void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
-  for (const auto& o : outputs) kin2grf::ensure_not_an_input(o, inputs);
+/// No output replaces an input of the run, nor another output of it.
+void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs,
+                   const std::vector<std::string>& names = {}) {
+  kin2grf::ensure_distinct_outputs(outputs, names);
+  kin2grf::ensure_no_output_is_an_input(outputs, inputs);
 }
 
 int run_estimate(const EstimateArgs& a) {
-  check_outputs({a.out_mot, a.out_csv, a.out_json}, kin2grf::input_files(a));
-  if (!a.opensim_dir.empty()) {
-    const auto f = kin2grf::opensim_export_paths(a.opensim_dir, std::filesystem::path(a.trial).stem().string());
-    check_outputs({f.grf_mot, f.markers_trc, f.external_loads_xml}, kin2grf::input_files(a));
+  {
+    std::vector<std::string> out = {a.out_mot, a.out_csv, a.out_json}, names = {"-o", "--csv", "--json"};
+    if (!a.opensim_dir.empty()) {
+      const auto f = kin2grf::opensim_export_paths(a.opensim_dir, std::filesystem::path(a.trial).stem().string());
+      out.insert(out.end(), {f.grf_mot, f.markers_trc, f.external_loads_xml});
+      names.insert(names.end(), 3, "--opensim");
+    }
+    check_outputs(out, kin2grf::input_files(a), names);
   }
   {
     // From 8 MB of file on, the trial's series alone outgrow the heap's 32 MB of huge pages.
@@ -119,7 +128,7 @@ struct ValidateArgs {
 int run_validate(const ValidateArgs& a) {
   auto in = kin2grf::input_files(a.est);
   in.push_back(a.plates);
-  check_outputs({a.out_json, a.report}, in);
+  check_outputs({a.out_json, a.report}, in, {"--json", "--report"});
   const auto run = kin2grf::validate_trial(a.est, a.plates, a.options, a.zero_offset, kin2grf::solve_progress(stderr));
   print_messages(run.estimate);
   std::cout << kin2grf::format_validation_table(a.est.trial, run.validation);
@@ -137,14 +146,11 @@ struct StudyArgs {
 };
 
 int run_study(const StudyArgs& a) {
-  {
-    std::vector<std::string> in = a.trials;
-    in.push_back(a.trial_list);
-    check_outputs({a.out_json, a.report}, in);
-  }
+  check_outputs({a.out_json, a.report}, {a.trial_list}, {"--json", "--report"});
   auto inputs = a.trial_list.empty() ? std::vector<kin2grf::TrialListEntry>{} : kin2grf::read_trial_list(a.trial_list);
   for (auto& e : kin2grf::trial_list_of_files(a.trials, a.est, a.plates)) inputs.push_back(std::move(e));
   if (inputs.empty()) throw kin2grf::InputError("study: give TRIAL files or --trial-list FILE");
+  check_outputs({a.out_json, a.report}, kin2grf::list_input_files(inputs));
   const kin2grf::LoadedTrials L = kin2grf::load_trials(inputs);
   const auto& st = L.study;
   std::cerr << "kin2grf: study " << a.kind << " on " << st.size() << " trials\n";
@@ -174,6 +180,7 @@ int run_fit_cop(const FitCopArgs& a) {
   for (auto& in : kin2grf::read_trial_list(a.trial_list))
     if (a.activity.empty() || in.activity == a.activity) inputs.push_back(in);
   if (inputs.empty()) throw kin2grf::InputError(a.trial_list + ": no trial of activity '" + a.activity + "'");
+  check_outputs({a.out}, kin2grf::list_input_files(inputs));
   const kin2grf::LoadedTrials L = kin2grf::load_trials(inputs);
   // Start (and, without --fit-angles, keep) the paper's event angles.
   const kin2grf::CopFunction start = kin2grf::CopFunction::paper();
@@ -197,8 +204,16 @@ struct BatchArgs {
 
 /// batch: every trial of a list, on all cores, past failures, into one summary table.
 int run_batch(const BatchArgs& a) {
-  check_outputs({a.out_csv, a.out_json}, {a.trial_list});
+  check_outputs({a.out_csv, a.out_json}, {a.trial_list}, {"--csv", "--json"});
   const auto entries = kin2grf::read_trial_list(a.trial_list);
+  {
+    // The summaries replace no trial's input and no trial's own output (--out-dir).
+    std::vector<std::string> out = {a.out_csv, a.out_json}, names = {"--csv", "--json"};
+    if (!a.out_dir.empty())
+      for (const auto& e : entries)
+        for (auto& f : kin2grf::batch_trial_outputs(e, a.out_dir)) out.push_back(std::move(f)), names.push_back("--out-dir");
+    check_outputs(out, kin2grf::list_input_files(entries), names);
+  }
   kin2grf::BatchOptions o;
   o.jobs = a.jobs > 0 ? a.jobs : static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   o.out_dir = a.out_dir, o.progress = kin2grf::batch_progress(stderr);
@@ -337,9 +352,15 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; every usage error exits 2 (README, "Exit status").
+    return app.exit(e) == 0 ? 0 : 2;
   }
+  // A run's outputs are placed together at its end, or not at all; a signal removes their
+  // temporary files. A closed standard output (`| head -1`) is not a reason to die half way.
+  kin2grf::install_output_cleanup_on_signals();
+  std::signal(SIGPIPE, SIG_IGN);
   try {
+    kin2grf::OutputTransaction outputs;
     int rc = 0;
     auto chosen = [](const CLI::App* c) { return c && c->parsed(); };
     if (chosen(info)) rc = run_info(info_file, info_json, info_threshold, info_zero, info_up_axis);
@@ -349,9 +370,11 @@ int main(int argc, char** argv) {
     else if (chosen(fit_cop)) rc = run_fit_cop(fit_args);
     else if (chosen(batch)) rc = run_batch(batch_args);
     else if (chosen(make_example)) rc = run_make_example(example_dir, example_seconds, example_rate, example_analog_rate, example_noise_mm);
-    // Standard output closed or full: the output is lost, so the run failed.
+    outputs.commit();
+    // Standard output full or failing: what it was to show is lost, so the run failed. A reader
+    // that stopped reading (a closed pipe) asked for no more.
     std::cout.flush();
-    if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout))
+    if ((!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout)) && errno != EPIPE)
       throw kin2grf::InputError(std::string("cannot write to standard output (") + std::strerror(errno) + ")");
     return rc;
   } catch (const kin2grf::InputError& e) {

@@ -9,6 +9,7 @@
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/c3d.hpp"
 #include "kin2grf/io/force_plate.hpp"
+#include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
 
 namespace kin2grf {

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/parallel.hpp"
 

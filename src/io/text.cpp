@@ -114,52 +114,6 @@ MappedFile::~MappedFile() {
   if (mapped_) ::munmap(const_cast<char*>(mapped_), size_);
 }
 
-AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
-  namespace fs = std::filesystem;
-  const fs::path target(path_);
-  tmp_ = (target.parent_path() / (target.filename().string() + ".kin2grf-tmp")).string();
-  out_ = std::make_unique<std::ofstream>(tmp_, std::ios::binary);
-  if (!*out_) throw InputError(path_ + ": cannot open for writing (" + std::strerror(errno) + ")");
-}
-
-AtomicFile::~AtomicFile() {
-  if (committed_) return;
-  out_.reset();
-  std::error_code ec;
-  std::filesystem::remove(tmp_, ec);
-}
-
-std::ostream& AtomicFile::stream() { return *out_; }
-
-void AtomicFile::commit() {
-  out_->flush();
-  const bool ok = static_cast<bool>(*out_);
-  const int err = errno;
-  out_->close();
-  if (!ok || !*out_) throw InputError(path_ + ": write failed (" + std::strerror(err) + ")");
-  std::error_code ec;
-  std::filesystem::rename(tmp_, path_, ec);
-  if (ec) throw InputError(path_ + ": cannot replace the file (" + ec.message() + ")");
-  committed_ = true;
-}
-
-void write_file_text(const std::string& path, std::string_view text) {
-  AtomicFile f(path);
-  f.stream() << text;
-  f.commit();
-}
-
-void ensure_not_an_input(const std::string& output, const std::vector<std::string>& inputs) {
-  namespace fs = std::filesystem;
-  for (const auto& in : inputs) {
-    if (in.empty() || output.empty()) continue;
-    std::error_code ec;
-    const bool same = fs::exists(output, ec) && fs::equivalent(output, in, ec);
-    if (same || (!ec && fs::weakly_canonical(output, ec) == fs::weakly_canonical(in, ec)))
-      throw InputError(output + ": is an input of this run (" + in + "); refusing to overwrite it");
-  }
-}
-
 bool is_blank(std::string_view s) {
   for (const char c : s)
     if (c != ' ' && c != '\t' && c != '\r' && c != '\n' && c != '\v' && c != '\f') return false;

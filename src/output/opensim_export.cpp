@@ -6,6 +6,7 @@
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/opensim.hpp"
+#include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
 
 namespace kin2grf {
@@ -45,9 +46,7 @@ OpenSimExportFiles opensim_export_paths(const std::string& dir, const std::strin
 OpenSimExportFiles write_opensim_export(const std::string& dir, const std::string& stem, const Trial& trial,
                                         const EstimateResult& r, const OpenSimExportOptions& o) {
   namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw InputError(dir + ": cannot create the OpenSim export folder (" + ec.message() + ")");
+  ensure_output_folder(dir);
   // Lab -> OpenSim: rows forward, up, right.
   Eigen::Matrix3d R;
   R.row(0) = r.frame.forward.transpose();

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "kin2grf/io/opensim.hpp"
+#include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/numeric.hpp"
 

@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "kin2grf/io/output_file.hpp"
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/c3d.hpp"
 #include "kin2grf/io/force_plate.hpp"
@@ -330,7 +331,7 @@ std::vector<std::string> write_examples(const std::string& dir, double seconds, 
                   analog_rate_hz, rate_hz);
     throw InputError(b);
   }
-  std::filesystem::create_directories(dir);
+  ensure_output_folder(dir);
   std::vector<std::string> written;
   {
     SyntheticWalkOptions wo;

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/output/results.hpp"
 #include "kin2grf/io/json.hpp"
@@ -69,6 +70,11 @@ ValidationRun validate_trial(const Settings& s, const std::string& plates_file, 
   return run;
 }
 
+std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir) {
+  const auto base = (std::filesystem::path(out_dir) / file_stem(entry.name)).string();
+  return {base + ".csv", base + "_grf.mot", base + ".json"};
+}
+
 BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& options) {
   BatchRow row;
   row.activity = entry.activity, row.lab = entry.lab, row.name = entry.name, row.trial = entry.settings.trial;
@@ -92,20 +98,16 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
       fill_validation(row, *v);
     }
     if (!options.out_dir.empty()) {
-      const auto base = std::filesystem::path(options.out_dir) / file_stem(entry.name);
-      const Settings& s = entry.settings;
-      const std::vector<std::string> inputs = [&] {
-        auto in = input_files(s);
-        in.push_back(entry.plates);
-        return in;
-      }();
-      const std::string csv = base.string() + ".csv", mot = base.string() + "_grf.mot", json = base.string() + ".json";
-      for (const auto& o : {csv, mot, json}) ensure_not_an_input(o, inputs);
+      // The trial's files are placed together, with the batch's, or not at all.
+      OutputTransaction outputs;
+      const auto written = batch_trial_outputs(entry, options.out_dir);
+      const std::string &csv = written[0], &mot = written[1], &json = written[2];
       write_results_csv(csv, r);
-      auto settings = settings_json(s, estimate_options);
+      auto settings = settings_json(entry.settings, estimate_options);
       write_grf_mot(mot, r, settings.dump());
       write_file_text(json, json_text(v ? validation_json(entry.name, r, *v, settings) : results_summary(r, settings)));
-      row.outputs = {csv, mot, json};
+      outputs.commit();
+      row.outputs = written;
     }
     row.ok = true;
   } catch (const std::bad_alloc&) {
@@ -150,12 +152,17 @@ std::vector<std::size_t> longest_first(const std::vector<TrialListEntry>& entrie
 std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, const BatchOptions& options) {
   if (options.jobs < 1) throw InputError("jobs " + std::to_string(options.jobs) + ": must be at least 1");
   if (!options.out_dir.empty()) {
-    // One trial's outputs must not replace another's.
+    // One trial's outputs must not replace another's, nor any trial's input (a trial's name may
+    // be another's --plates file).
     std::set<std::string> stems;
-    for (const auto& e : entries)
+    std::vector<std::string> outputs;
+    for (const auto& e : entries) {
       if (!stems.insert(file_stem(e.name)).second)
         throw InputError("two trials of the batch are named '" + e.name + "': their outputs would share a name");
-    std::filesystem::create_directories(options.out_dir);
+      for (auto& f : batch_trial_outputs(e, options.out_dir)) outputs.push_back(std::move(f));
+    }
+    ensure_no_output_is_an_input(outputs, list_input_files(entries));
+    ensure_output_folder(options.out_dir);
   }
   std::vector<BatchRow> rows(entries.size());
   // Rows stay in the list's order whatever order the trials run in.

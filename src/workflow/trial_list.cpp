@@ -49,6 +49,15 @@ std::vector<TrialListEntry> read_trial_list(const std::string& path) {
   return out;
 }
 
+std::vector<std::string> list_input_files(const std::vector<TrialListEntry>& entries) {
+  std::vector<std::string> in;
+  for (const auto& e : entries) {
+    for (auto& f : input_files(e.settings)) in.push_back(std::move(f));
+    in.push_back(e.plates);
+  }
+  return in;
+}
+
 std::vector<TrialListEntry> trial_list_of_files(const std::vector<std::string>& files, const Settings& settings,
                                                 const std::string& plates) {
   std::vector<TrialListEntry> out;

@@ -50,30 +50,6 @@ class MappedFile {
   std::size_t size_ = 0;
   std::string copy_;
 };
-/// A file written through a temporary file in the same folder (PATH.kin2grf-tmp), renamed over
-/// `path` by commit(): a failed or interrupted run leaves the old file (or none), never half a
-/// file. Written as it is made, so a long trial's output is never held whole in memory (issue 10).
-/// Destroyed uncommitted (an exception on the way), the temporary file is removed.
-class AtomicFile {
- public:
-  explicit AtomicFile(std::string path);
-  ~AtomicFile();
-  AtomicFile(const AtomicFile&) = delete;
-  AtomicFile& operator=(const AtomicFile&) = delete;
-  std::ostream& stream();
-  /// Flushes, checks every write succeeded, renames: InputError naming the file otherwise.
-  void commit();
-
- private:
-  std::string path_, tmp_;
-  std::unique_ptr<std::ofstream> out_;
-  bool committed_ = false;
-};
-/// Write through a temporary file renamed at the end (no half file on failure).
-void write_file_text(const std::string& path, std::string_view text);
-/// InputError when `output` is one of `inputs` (the same file by any name): an output never
-/// overwrites a run's input.
-void ensure_not_an_input(const std::string& output, const std::vector<std::string>& inputs);
 /// Largest file the readers take (a 10-minute trial at 2 kHz markers and 10 kHz analog is
 /// about 2 GB; more is refused before anything is allocated).
 inline constexpr std::uintmax_t kMaxInputBytes = std::uintmax_t{4} << 30;

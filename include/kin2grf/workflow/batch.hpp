@@ -59,6 +59,8 @@ struct ValidationRun {
 ValidationRun validate_trial(const Settings& settings, const std::string& plates_file, const ValidationOptions& validation,
                              const std::string& zero_offset, std::function<void(long, long)> progress = {});
 
+/// The files a trial of the batch writes into `out_dir`: NAME.csv, NAME_grf.mot, NAME.json.
+std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir);
 /// One trial: never throws for the trial's own faults (they are the row's error).
 BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& options = {});
 /// Every trial, rows in the list's order.

@@ -26,6 +26,10 @@ TrialListEntry parse_trial_list_line(const std::string& line, const std::string&
 /// Every trial of the file; InputError naming the file and line on a bad one, or when empty.
 std::vector<TrialListEntry> read_trial_list(const std::string& path);
 
+/// Every file the entries read (trials, static trials, plates, mapping and COP-function files):
+/// what no output of a run over them may replace.
+std::vector<std::string> list_input_files(const std::vector<TrialListEntry>& entries);
+
 /// Entries for trial files given one by one (the same settings and plates file for all): each its
 /// own lab, named by its file name, activity "trials".
 std::vector<TrialListEntry> trial_list_of_files(const std::vector<std::string>& files, const Settings& settings,
