@@ -535,3 +535,23 @@ TEST(CliFiles, UsageErrorsExitTwoAndAClosedPipeIsNotACrash) {
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   EXPECT_EQ(kin2grf::read_file_text(rc.string()), "0\n");
 }
+
+// The recipe: a long TRC (and C3D) truncated to 4 KB 20 ms after `estimate` starts. Each
+// run ends with a result (the read had finished) or an error naming the file; never a signal.
+TEST(CliFiles, AnInputTruncatedWhileReadIsNeverASignal) {
+  const auto dir = kin2grf::test::temp_dir("cli_truncated");
+  ASSERT_EQ(run("make-example --seconds 120 --out-dir " + dir.string()).status, 0);
+  int errors = 0;
+  for (const char* ext : {"trc", "c3d"}) {
+    const auto original = dir / (std::string("example_walk.") + ext);
+    for (int k = 0; k < 6; ++k) {
+      const auto copy = dir / (std::string("cut.") + ext);
+      std::filesystem::copy_file(original, copy, std::filesystem::copy_options::overwrite_existing);
+      const CliRun r = run("estimate " + copy.string() + " --mass 70 & (sleep 0.00" + std::to_string(5 + k % 3 * 2) + "; truncate -s 4096 " +
+                           copy.string() + "); wait $!");
+      EXPECT_TRUE(r.status == 0 || r.status == 2) << ext << " try " << k << ": status " << r.status << "\n" << r.out;
+      errors += r.status == 2;
+    }
+  }
+  RecordProperty("runs_ending_in_an_error", errors);
+}

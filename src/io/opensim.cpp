@@ -53,7 +53,9 @@ MarkerTrajectories read_trc(const std::string& path, std::vector<std::string>* w
   // The rows' text is released as they are parsed (issue 10's memory: a long trial's text and its
   // markers are not held whole together).
   const MappedFile file(path, /*populate=*/false);
-  return parse_trc(file.text(), path, warnings, [&](std::size_t begin, std::size_t end) { file.release(begin, end); });
+  return file.read([&] {
+    return parse_trc(file.text(), path, warnings, [&](std::size_t begin, std::size_t end) { file.release(begin, end); });
+  });
 }
 
 namespace {
@@ -282,7 +284,7 @@ void write_trc(const std::string& path, const MarkerTrajectories& m) {
 
 Table read_sto(const std::string& path) {
   const MappedFile file(path);
-  return parse_sto(file.text(), path);
+  return file.read([&] { return parse_sto(file.text(), path); });
 }
 
 Table parse_sto(std::string_view text, const std::string& path) {

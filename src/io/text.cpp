@@ -13,7 +13,12 @@
 #include <sstream>
 #include <utility>
 
+#include <atomic>
+#include <csignal>
+#include <mutex>
+
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -90,17 +95,91 @@ std::vector<std::uint8_t> read_file_bytes(const std::string& path) { return read
 
 std::string read_file_text(const std::string& path) { return read_whole_file<std::string>(path); }
 
-MappedFile::MappedFile(const std::string& path, bool populate) {
+namespace {
+
+// The mapped inputs, for the SIGBUS handler: a fixed table read without a lock (a signal may come
+// while any lock is held). A file mapped while the table is full is read into memory instead.
+struct MappedSlot {
+  std::atomic<std::uintptr_t> begin{0}, end{0};
+  std::atomic<bool> used{false}, faulted{false};
+};
+constexpr int kMappedSlots = 256;
+MappedSlot mapped_slots[kMappedSlots];
+struct sigaction previous_sigbus {};
+
+extern "C" void on_sigbus(int sig, siginfo_t* info, void* context) {
+  const auto addr = reinterpret_cast<std::uintptr_t>(info->si_addr);
+  for (auto& s : mapped_slots) {
+    if (!s.used.load() || addr < s.begin.load() || addr >= s.end.load()) continue;
+    // A page of the mapped input past the file's new end: zeros in its place, the file marked
+    // changed, and the read goes on to its end, where the change is reported.
+    const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+    void* at = reinterpret_cast<void*>(addr / page * page);
+    if (::mmap(at, page, PROT_READ, MAP_PRIVATE | MAP_ANONYMOUS | MAP_FIXED, -1, 0) != MAP_FAILED) {
+      s.faulted.store(true);
+      return;
+    }
+    break;
+  }
+  // Not ours: the disposition there was before, on the same fault again.
+  ::sigaction(SIGBUS, &previous_sigbus, nullptr);
+  if ((previous_sigbus.sa_flags & SA_SIGINFO) && previous_sigbus.sa_sigaction) previous_sigbus.sa_sigaction(sig, info, context);
+}
+
+void install_sigbus_handler() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    struct sigaction sa {};
+    sa.sa_sigaction = on_sigbus;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_SIGINFO | SA_NODEFER;
+    ::sigaction(SIGBUS, &sa, &previous_sigbus);
+  });
+}
+
+int claim_slot(const char* begin, std::size_t size) {
+  for (int k = 0; k < kMappedSlots; ++k) {
+    bool expected = false;
+    auto& s = mapped_slots[k];
+    if (!s.used.load() && s.used.compare_exchange_strong(expected, true)) {
+      s.faulted.store(false);
+      s.begin.store(reinterpret_cast<std::uintptr_t>(begin));
+      s.end.store(reinterpret_cast<std::uintptr_t>(begin) + size);
+      return k;
+    }
+  }
+  return -1;
+}
+
+long long mtime_ns(const struct stat& st) { return static_cast<long long>(st.st_mtim.tv_sec) * 1000000000LL + st.st_mtim.tv_nsec; }
+
+}  // namespace
+
+MappedFile::MappedFile(const std::string& path, bool populate) : path_(path) {
   const std::size_t size = checked_input_size(path);
-  const int fd = size > 0 ? ::open(path.c_str(), O_RDONLY | O_CLOEXEC) : -1;
-  void* p = fd >= 0 ? ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | (populate ? MAP_POPULATE : 0), fd, 0) : MAP_FAILED;
-  if (fd >= 0) ::close(fd);  // the mapping keeps the file
+  fd_ = size > 0 ? ::open(path.c_str(), O_RDONLY | O_CLOEXEC) : -1;
+  struct stat st {};
+  void* p = MAP_FAILED;
+  if (fd_ >= 0 && ::fstat(fd_, &st) == 0 && static_cast<std::size_t>(st.st_size) == size) {
+    install_sigbus_handler();
+    p = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | (populate ? MAP_POPULATE : 0), fd_, 0);
+  }
+  if (p != MAP_FAILED) {
+    slot_ = claim_slot(static_cast<const char*>(p), size);
+    if (slot_ < 0) {
+      ::munmap(p, size);
+      p = MAP_FAILED;
+    }
+  }
   if (p == MAP_FAILED) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
     copy_ = read_file_text(path);
     return;
   }
   mapped_ = static_cast<const char*>(p);
   size_ = size;
+  mtime_ns_ = mtime_ns(st);
 }
 
 void MappedFile::release(std::size_t begin, std::size_t end) const {
@@ -110,8 +189,28 @@ void MappedFile::release(std::size_t begin, std::size_t end) const {
   if (last > first) ::madvise(const_cast<char*>(mapped_) + first, last - first, MADV_DONTNEED);
 }
 
+bool MappedFile::changed() const {
+  if (!mapped_) return false;
+  if (mapped_slots[slot_].faulted.load()) return true;
+  struct stat st {};
+  return ::fstat(fd_, &st) != 0 || static_cast<std::size_t>(st.st_size) != size_ || mtime_ns(st) != mtime_ns_;
+}
+
+void MappedFile::ensure_unchanged() const {
+  if (!changed()) return;
+  struct stat st {};
+  const bool known = ::fstat(fd_, &st) == 0;
+  throw InputError(path_ + ": the file changed while it was read (" + std::to_string(size_) + " bytes when opened" +
+                   (known && static_cast<std::size_t>(st.st_size) != size_ ? ", " + std::to_string(st.st_size) + " now" : std::string()) +
+                   "); read it again once the program writing it has finished");
+}
+
 MappedFile::~MappedFile() {
-  if (mapped_) ::munmap(const_cast<char*>(mapped_), size_);
+  if (mapped_) {
+    ::munmap(const_cast<char*>(mapped_), size_);
+    mapped_slots[slot_].used.store(false);
+  }
+  if (fd_ >= 0) ::close(fd_);
 }
 
 bool is_blank(std::string_view s) {

@@ -22,11 +22,15 @@ void split_views(std::string_view s, char delim, std::vector<std::string_view>& 
 std::vector<std::uint8_t> read_file_bytes(const std::string& path);
 std::string read_file_text(const std::string& path);
 
-/// A regular file's text, mapped read-only (POSIX mmap, populated at once): no zeroed buffer and
-/// no copy. Reading a 1.5 MB TRC into a string was a fifth of a short estimate, mostly page
-/// faults on the fresh buffer (issue 11). The file is checked as read_file_text() checks it; an
-/// empty file, or one that cannot be mapped, is read into memory instead. (As with every reader
-/// that maps: a file cut short by another program while it is being read stops the process.)
+/// A regular file's text, mapped read-only (POSIX mmap): no zeroed buffer and no copy. Reading a
+/// 1.5 MB TRC into a string was a fifth of a short estimate, mostly page faults on the fresh
+/// buffer. The file is checked as read_file_text() checks it; an empty file, or one that cannot be
+/// mapped, is read into memory instead.
+///
+/// A mapped file that another program cuts short while it is read would stop the process with
+/// SIGBUS on the first page past its new end. kin2grf's SIGBUS handler maps a page of zeros there
+/// instead and marks the file changed (a signal that is not about a mapped input is passed on as
+/// before); read() then reports the change, whatever the parser made of the zeros.
 class MappedFile {
  public:
   /// `populate`: read every page at once (a text parsed whole); false: pages are read as touched
@@ -41,14 +45,36 @@ class MappedFile {
     return {reinterpret_cast<const std::uint8_t*>(t.data()), t.size()};
   }
   /// The pages wholly inside bytes [begin, end) leave the process's memory (they are read again
-  /// from the page cache if touched): a long capture read front to back is never resident whole
-  /// (issue 10's memory). Nothing for a file read into memory.
+  /// from the page cache if touched): a long capture read front to back is never resident whole.
+  /// Nothing for a file read into memory.
   void release(std::size_t begin, std::size_t end) const;
+  /// Whether the file was cut short, grew or was rewritten since it was opened (a page past its
+  /// new end was touched, or its size or modification time differ).
+  bool changed() const;
+  /// InputError naming the file when changed().
+  void ensure_unchanged() const;
+  /// parse() on the file, then ensure_unchanged(); an InputError of the parser's is replaced by
+  /// the change's when the file changed (the parser read zeros, not the file).
+  template <class Parse>
+  auto read(Parse&& parse) const -> decltype(parse()) {
+    try {
+      auto result = parse();
+      ensure_unchanged();
+      return result;
+    } catch (const std::exception&) {
+      ensure_unchanged();
+      throw;
+    }
+  }
 
  private:
   const char* mapped_ = nullptr;
   std::size_t size_ = 0;
   std::string copy_;
+  std::string path_;
+  int fd_ = -1;
+  int slot_ = -1;  ///< in the SIGBUS handler's table of mapped inputs
+  long long mtime_ns_ = 0;
 };
 /// Largest file the readers take (a 10-minute trial at 2 kHz markers and 10 kHz analog is
 /// about 2 GB; more is refused before anything is allocated).
