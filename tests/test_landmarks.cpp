@@ -3,12 +3,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <random>
 
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/json.hpp"
 #include "kin2grf/io/load.hpp"
+#include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
@@ -252,4 +254,58 @@ TEST(Landmarks, PlugInGaitWithASacrumMarkerIsRecognisedAndGivesTheSameLandmarks)
       }
     }
   }
+}
+
+// Hostile and mistaken mapping files (issue 31): each refused with the file and the landmark
+// named. They were accepted: a pelvis_up of -0.5 m, four identical pelvis markers, two rules in one
+// landmark, an unknown landmark name (ignored).
+TEST(MappingFile, MistakesAreRefusedNamingTheLandmark) {
+  const nlohmann::json good = read_json_file(std::string(KIN2GRF_SOURCE_DIR) + "/data/presets/kin2grf-example.json");
+  const nlohmann::json pelvis = {{"rasis", "RASI"}, {"lasis", "LASI"}, {"rpsis", "RPSI"}, {"lpsis", "LPSI"}};
+  const nlohmann::json same = {{"rasis", "RASI"}, {"lasis", "RASI"}, {"rpsis", "RASI"}, {"lpsis", "RASI"}};
+  const struct {
+    const char* what;
+    std::function<void(nlohmann::json&)> edit;
+    const char* said;
+  } cases[] = {
+      {"negative torso", [&](auto& j) { j["landmarks"]["shoulder"] = {{"pelvis_up", -0.5}, {"pelvis", pelvis}}; }, "pelvis_up -0.5"},
+      {"one marker four times", [&](auto& j) { j["landmarks"]["hip"] = {{"harrington", same}}; }, "the same marker 'RASI'"},
+      {"two rules", [&](auto& j) { j["landmarks"]["knee_r"] = {{"marker", "RKJC"}, {"mean", {"RKJC", "LKJC"}}}; }, "two rules"},
+      {"unknown landmark", [&](auto& j) { j["landmarks"]["kneee_r"] = {{"marker", "RKJC"}}; }, "unknown landmark 'kneee_r'"},
+      {"unknown rule", [&](auto& j) { j["landmarks"]["knee_r"] = {{"markr", "RKJC"}}; }, "unknown rule"},
+  };
+  EXPECT_NO_THROW((void)parse_marker_set(good, "good.json"));
+  for (const auto& c : cases) {
+    nlohmann::json j = good;
+    c.edit(j);
+    try {
+      (void)parse_marker_set(j, "map.json");
+      ADD_FAILURE() << c.what << ": accepted";
+    } catch (const InputError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("map.json"), std::string::npos) << c.what << ": " << m;
+      EXPECT_NE(m.find(c.said), std::string::npos) << c.what << ": " << m;
+    }
+  }
+}
+
+// A mapping file whose unknown rule is an array nested 100,000 deep: the message printed the rule
+// with a recursive dump() and the stack overflowed (exit 139). The depth is now bounded where the
+// file is read.
+TEST(MappingFile, NestingDeeperThanTheLimitIsRefusedAtParse) {
+  const auto dir = test::temp_dir("deep_mapping");
+  const std::string path = (dir / "deep.json").string();
+  std::string text = R"({"name": "deep", "landmarks": {"hip": {"oops": )";
+  text += std::string(100000, '[') + std::string(100000, ']') + "}}}";
+  write_file_text(path, text);
+  try {
+    (void)load_marker_set(path);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ": JSON nested more than 64 levels deep"), std::string::npos) << e.what();
+  }
+  // 64 levels are read.
+  const std::string ok = std::string(64, '[') + std::string(64, ']');
+  EXPECT_NO_THROW((void)parse_json_text(ok, "ok"));
+  EXPECT_THROW((void)parse_json_text("[" + ok + "]", "deep"), InputError);
 }

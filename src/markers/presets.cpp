@@ -13,6 +13,43 @@ namespace kin2grf {
 
 const std::vector<std::pair<std::string, std::string>>& builtin_preset_texts();  // generated
 
+namespace {
+
+constexpr const char* kRuleKinds[] = {"marker", "mean", "harrington", "static", "functional", "pelvis_up", "virtual_hallux"};
+
+/// Every key of "landmarks" is a landmark kin2grf knows: a misspelt one would be ignored.
+void check_landmark_names(const nlohmann::json& lm, const std::string& source) {
+  if (!lm.is_object()) throw InputError(source + ": \"landmarks\" is not an object of landmark rules");
+  for (const auto& [key, value] : lm.items()) {
+    bool known = false;
+    for (int id = 0; id < kLandmarkCount; ++id) known = known || key == landmark_name(id);
+    if (known) continue;
+    std::string names;
+    for (int id = 0; id < kLandmarkCount; ++id) names += std::string(id ? ", " : "") + landmark_name(id);
+    throw InputError(source + ": unknown landmark '" + key + "' (the landmarks are: " + names + ")");
+  }
+}
+
+/// A landmark has exactly one rule: with two, which one is meant?
+void check_one_rule(const nlohmann::json& r, const std::string& where) {
+  if (!r.is_object()) throw InputError(where + ": the rule is not an object (" + json_excerpt(r) + ")");
+  std::vector<std::string> found;
+  for (const char* k : kRuleKinds)
+    if (r.contains(k)) found.emplace_back(k);
+  if (found.size() > 1) throw InputError(where + ": two rules in one landmark ('" + found[0] + "' and '" + found[1] + "')");
+}
+
+/// The pelvis's markers (harrington, pelvis_up) are distinct markers: four times one marker has
+/// no pelvis frame.
+void check_distinct_pelvis_markers(const std::map<std::string, std::string>& pelvis, const std::string& where) {
+  for (auto a = pelvis.begin(); a != pelvis.end(); ++a)
+    for (auto b = std::next(a); b != pelvis.end(); ++b)
+      if (a->second == b->second)
+        throw InputError(where + ": the pelvis's " + a->first + " and " + b->first + " are the same marker '" + a->second + "'");
+}
+
+}  // namespace
+
 MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
   MarkerSet s;
   try {
@@ -20,9 +57,11 @@ MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
     s.description = j.value("description", "");
     s.signature = j.value("signature", std::vector<std::string>{});
     const auto& lm = j.at("landmarks");
+    check_landmark_names(lm, source);
     for (int id = 0; id < kLandmarkCount; ++id) {
       if (!lm.contains(landmark_name(id))) throw InputError(source + ": landmark '" + landmark_name(id) + "' has no rule");
       const auto& r = lm.at(landmark_name(id));
+      check_one_rule(r, source + ": landmark '" + landmark_name(id) + "'");
       LandmarkRule rule;
       if (r.contains("marker")) { rule.kind = "marker"; rule.markers = {r["marker"].get<std::string>()}; }
       else if (r.contains("mean")) { rule.kind = "mean"; rule.markers = r["mean"].get<std::vector<std::string>>(); }
@@ -48,12 +87,18 @@ MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
           throw InputError(source + ": landmark '" + landmark_name(id) + "': sway_gain " + std::to_string(rule.sway_gain) +
                            " is outside 0-1.5 (0.5: measured walking; 1: a rigid upright torso)");
         rule.pelvis = r.at("pelvis").get<std::map<std::string, std::string>>();
+        // The hip-to-shoulder length of an adult's upright torso is 0.4-0.6 m.
+        if (!(rule.value >= 0.2 && rule.value <= 1.0))
+          throw InputError(source + ": landmark '" + landmark_name(id) + "': pelvis_up " + std::to_string(rule.value) +
+                           " m is not a torso length (0.2-1.0 m above the hip centre)");
       } else if (r.contains("virtual_hallux")) {
         rule.kind = "virtual_hallux";
         rule.value = r["virtual_hallux"].get<double>();
       } else {
-        throw InputError(source + ": landmark '" + landmark_name(id) + "': unknown rule " + r.dump());
+        throw InputError(source + ": landmark '" + landmark_name(id) + "': unknown rule " + json_excerpt(r) +
+                         " (a rule is one of: marker, mean, harrington, static, functional, pelvis_up, virtual_hallux)");
       }
+      check_distinct_pelvis_markers(rule.pelvis, source + ": landmark '" + landmark_name(id) + "'");
       if ((rule.kind == "marker" || rule.kind == "mean" || rule.kind == "static") && rule.markers.empty())
         throw InputError(source + ": landmark '" + landmark_name(id) + "' names no marker");
       s.rules[static_cast<std::size_t>(id)] = rule;
@@ -69,7 +114,7 @@ MarkerSet load_marker_set(const std::string& path) { return parse_marker_set(rea
 const std::vector<MarkerSet>& builtin_marker_sets() {
   static const std::vector<MarkerSet> sets = [] {
     std::vector<MarkerSet> v;
-    for (const auto& [name, text] : builtin_preset_texts()) v.push_back(parse_marker_set(nlohmann::json::parse(text), name));
+    for (const auto& [name, text] : builtin_preset_texts()) v.push_back(parse_marker_set(parse_json_text(text, name), name));
     // Recognition order: the more specific sets first.
     std::stable_sort(v.begin(), v.end(), [](const MarkerSet& a, const MarkerSet& b) { return a.signature.size() > b.signature.size(); });
     return v;
