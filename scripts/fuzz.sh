@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Build the libFuzzer targets with clang, the library itself under ASan/UBSan (the `fuzz`
-# preset), and run each parser target for SECONDS (default 30) under -rss_limit_mb=2048, seeded
+# preset), and run each target (C3D, TRC, STO, mapping files, COP-function files, trial lists),
+# two at a time, for SECONDS each (default 30) under -rss_limit_mb=2048, seeded
 # with a corpus the project makes itself (files written by kin2grf's writers and the damaged files
 # of tests/corpus; no shared data).
 # Exits non-zero on any crash, leak, timeout or out-of-memory; a reproducer is left in build/fuzz.
@@ -19,7 +20,8 @@ if [ ! -x "$cli" ]; then
   cli=build/dev/kin2grf
 fi
 corpus=build/fuzz/corpus
-mkdir -p "$corpus/c3d" "$corpus/trc" "$corpus/sto"
+targets="c3d trc sto mapping cop_function trial_list"
+for t in $targets; do mkdir -p "$corpus/$t"; done
 "$cli" make-example --seconds 1 --out-dir "$corpus/seed" >/dev/null
 cp "$corpus"/seed/*.c3d "$corpus/c3d/"
 cp "$corpus"/seed/*.trc "$corpus/trc/"
@@ -28,14 +30,30 @@ cp "$corpus"/seed/*.mot "$corpus/sto/"
 cp tests/corpus/*.c3d "$corpus/c3d/"
 cp tests/corpus/*.trc "$corpus/trc/"
 cp tests/corpus/*.mot "$corpus/sto/"
-status=0
-for t in c3d trc sto; do
-  echo "fuzz_$t: ${seconds} s"
+# The JSON and list inputs: the presets (mapping files), the fitted COP functions and the damaged
+# one, and the development trial list.
+cp data/presets/*.json "$corpus/mapping/"
+cp data/cop-function/*.json tests/corpus/cop_*.json "$corpus/cop_function/"
+cp scripts/trials.txt "$corpus/trial_list/"
+printf 'walking|lab|a|a.c3d --mass 70 --plates p.mot\r\nrunning|b|c.trc --paper\n' >"$corpus/trial_list/small.txt"
+
+# Two targets at a time (one per core of the 2-core machines this runs on).
+run_target() {
+  local t=$1
   if ! (cd build/fuzz && ./fuzz/fuzz_$t -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
           -print_final_stats=1 "corpus/$t" >"fuzz_$t.log" 2>&1); then
-    echo "fuzz_$t FAILED:"; tail -40 "build/fuzz/fuzz_$t.log"; status=1
-  else
-    grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "build/fuzz/fuzz_$t.log" | tr '\n' ' '; echo
+    echo "fuzz_$t FAILED:"; tail -40 "build/fuzz/fuzz_$t.log"; return 1
   fi
+  echo "fuzz_$t: ${seconds} s, $(grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "build/fuzz/fuzz_$t.log" | tr '\n' ' ')"
+}
+status=0
+set -- $targets
+while [ $# -gt 0 ]; do
+  run_target "$1" & first=$!
+  second=""
+  if [ $# -gt 1 ]; then run_target "$2" & second=$!; fi
+  wait "$first" || status=1
+  if [ -n "$second" ]; then wait "$second" || status=1; fi
+  shift; [ $# -gt 0 ] && shift
 done
 exit $status

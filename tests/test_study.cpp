@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
 #include "kin2grf/validation/cop_fit.hpp"
+#include "kin2grf/workflow/trial_list.hpp"
 #include "kin2grf/validation/metrics.hpp"
 #include "kin2grf/validation/study.hpp"
 #include "kin2grf/validation/validate.hpp"
@@ -135,4 +137,49 @@ TEST(Study, NoiseStudyPoolsEightDistinctDraws) {
   ASSERT_EQ(noisy.size(), 8 * clean);
   ASSERT_TRUE(noisy[0].metrics.vertical && noisy[clean].metrics.vertical);
   EXPECT_NE(noisy[0].metrics.vertical->rrmse_percent, noisy[clean].metrics.vertical->rrmse_percent);
+}
+
+// One parser reads a whole list (issue 31: 100,000 lines took 12 s, a line of 200,000 options
+// 20 s to refuse): a line's options never leak into the next, line endings may be LF, CRLF or a
+// lone CR, a byte-order mark is skipped, and an overlong line is refused at once.
+TEST(TrialList, EachLineHasOnlyItsOwnOptionsWhateverTheLineEndings) {
+  const std::string text = "\xEF\xBB\xBF# comment\r"
+                           "walking|labA|one|a.c3d --mass 70 --paper --r 500 --plates p.mot\r\n"
+                           "walking|labB|two|b.c3d\r"
+                           "running|labC|three|c.c3d --max-gap 4\n";
+  const auto list = parse_trial_list(text, "list.txt");
+  ASSERT_EQ(list.size(), 3u);
+  EXPECT_EQ(list[0].activity, "walking");
+  EXPECT_EQ(list[0].line, 2);
+  EXPECT_TRUE(list[0].settings.paper);
+  EXPECT_TRUE(list[0].settings.r_given);
+  EXPECT_EQ(list[0].settings.mass.value_or(0), 70);
+  EXPECT_EQ(list[0].plates, "p.mot");
+  const Settings defaults;
+  EXPECT_EQ(list[1].settings.trial, "b.c3d");
+  EXPECT_FALSE(list[1].settings.paper);
+  EXPECT_FALSE(list[1].settings.r_given);
+  EXPECT_EQ(list[1].settings.r, defaults.r);
+  EXPECT_FALSE(list[1].settings.mass.has_value());
+  EXPECT_TRUE(list[1].plates.empty());
+  EXPECT_EQ(list[1].line, 3);
+  EXPECT_EQ(list[2].settings.max_gap, 4);
+  EXPECT_EQ(list[2].line, 4);
+}
+
+TEST(TrialList, AHostileLineIsRefusedAtOnceNamingTheLine) {
+  std::string many = "walking|lab|x|a.c3d";
+  for (int k = 0; k < 200000; ++k) many += " --r 5";
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    (void)parse_trial_list("walking|lab|ok|a.c3d\n" + many + "\n", "list.txt");
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("list.txt:2: a line of"), std::string::npos) << e.what();
+  }
+  std::string words = "walking|lab|x|a.c3d";
+  for (int k = 0; k < 1001; ++k) words += " -";
+  EXPECT_THROW((void)parse_trial_list(words, "list.txt"), InputError);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+  EXPECT_THROW((void)parse_trial_list("\xEF\xBB\xBF\r\n# only a comment\r", "list.txt"), InputError);
 }

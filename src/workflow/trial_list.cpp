@@ -7,47 +7,85 @@
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/load.hpp"
+#include "kin2grf/io/text.hpp"
 
 namespace kin2grf {
 
-TrialListEntry parse_trial_list_line(const std::string& line, const std::string& where) {
-  std::vector<std::string> fields;
-  std::size_t start = 0;
-  for (std::size_t bar; fields.size() < 3 && (bar = line.find('|', start)) != std::string::npos; start = bar + 1)
-    fields.push_back(line.substr(start, bar - start));
-  if (fields.size() < 2) throw InputError(where + ": expected activity|lab|name|TRIAL [options]");
-  TrialListEntry e;
-  e.activity = fields[0];
-  e.lab = fields[1];  // the old 3-field form: the name is the lab
-  e.name = fields.back();
-  for (const auto& f : fields)
-    if (f.empty()) throw InputError(where + ": an empty field in activity|lab|name");
-  CLI::App parser{"trial"};
-  add_settings_options(&parser, e.settings);
-  parser.add_option("--plates", e.plates);
-  try {
-    parser.parse(line.substr(start), false);
-  } catch (const CLI::ParseError& err) {
-    throw InputError(where + ": " + err.what());
-  }
-  return e;
-}
+namespace {
 
-std::vector<TrialListEntry> read_trial_list(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the trial list");
+/// A trial line's options are read by one parser per list (building CLI11's parser for each line
+/// made a long list slow: 100,000 lines took 12 s).
+class TrialLineParser {
+ public:
+  TrialLineParser() {
+    add_settings_options(&app_, settings_);
+    app_.add_option("--plates", plates_);
+  }
+  TrialListEntry parse(std::string_view line, const std::string& where) {
+    if (line.size() > kMaxTrialLineChars)
+      throw InputError(where + ": a line of " + std::to_string(line.size()) + " characters, more than the " +
+                       std::to_string(kMaxTrialLineChars) + " a trial line may have");
+    std::vector<std::string> fields;
+    std::size_t start = 0;
+    for (std::size_t bar; fields.size() < 3 && (bar = line.find('|', start)) != std::string::npos; start = bar + 1)
+      fields.emplace_back(line.substr(start, bar - start));
+    if (fields.size() < 2) throw InputError(where + ": expected activity|lab|name|TRIAL [options]");
+    TrialListEntry e;
+    e.activity = fields[0];
+    e.lab = fields[1];  // the old 3-field form: the name is the lab
+    e.name = fields.back();
+    for (const auto& f : fields)
+      if (f.empty()) throw InputError(where + ": an empty field in activity|lab|name");
+    const std::string rest(line.substr(start));
+    std::size_t words = 0;
+    for (std::size_t k = 0; k < rest.size(); ++k) words += rest[k] != ' ' && (k == 0 || rest[k - 1] == ' ');
+    if (words > kMaxTrialLineWords)
+      throw InputError(where + ": " + std::to_string(words) + " words of options, more than the " + std::to_string(kMaxTrialLineWords) +
+                       " a trial line may have");
+    settings_ = Settings{};
+    plates_.clear();
+    app_.clear();
+    try {
+      app_.parse(rest, false);
+    } catch (const CLI::ParseError& err) {
+      throw InputError(where + ": " + err.what());
+    }
+    e.settings = settings_;
+    e.plates = plates_;
+    return e;
+  }
+
+ private:
+  CLI::App app_{"trial"};
+  Settings settings_;
+  std::string plates_;
+};
+
+}  // namespace
+
+TrialListEntry parse_trial_list_line(const std::string& line, const std::string& where) { return TrialLineParser().parse(line, where); }
+
+std::vector<TrialListEntry> parse_trial_list(std::string_view text, const std::string& path) {
+  // A UTF-8 byte-order mark (Windows editors) is no part of the first line.
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+  TrialLineParser parser;
   std::vector<TrialListEntry> out;
-  std::string line;
   int number = 0;
-  while (std::getline(in, line)) {
+  while (!text.empty()) {
+    // Lines end with LF, CRLF or a lone CR (old Mac editors).
+    const auto end = text.find_first_of("\r\n");
+    std::string_view line = text.substr(0, end);
+    text.remove_prefix(end == std::string_view::npos ? text.size() : end + (text.substr(end, 2) == "\r\n" ? 2 : 1));
     ++number;
-    if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    out.push_back(parse_trial_list_line(line, path + ":" + std::to_string(number)));
+    if (line.empty() || line[0] == '#' || is_blank(line)) continue;
+    out.push_back(parser.parse(line, path + ":" + std::to_string(number)));
     out.back().line = number;
   }
   if (out.empty()) throw InputError(path + ": no trials in the list");
   return out;
 }
+
+std::vector<TrialListEntry> read_trial_list(const std::string& path) { return parse_trial_list(read_file_text(path), path); }
 
 std::vector<std::string> list_input_files(const std::vector<TrialListEntry>& entries) {
   std::vector<std::string> in;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "kin2grf/io/trial.hpp"
@@ -24,7 +25,13 @@ struct TrialListEntry {
 /// One line (not a comment); `where` names it in errors ("list.txt:12").
 TrialListEntry parse_trial_list_line(const std::string& line, const std::string& where);
 /// Every trial of the file; InputError naming the file and line on a bad one, or when empty.
+/// Lines end with LF, CRLF or CR; a UTF-8 byte-order mark is skipped.
 std::vector<TrialListEntry> read_trial_list(const std::string& path);
+/// The same for a list's text; `path` names it in errors.
+std::vector<TrialListEntry> parse_trial_list(std::string_view text, const std::string& path);
+/// A trial line is at most this long, with at most this many words of options (a hostile list
+/// is refused at once, not after seconds of parsing).
+inline constexpr std::size_t kMaxTrialLineChars = 65536, kMaxTrialLineWords = 1000;
 
 /// Every file the entries read (trials, static trials, plates, mapping and COP-function files):
 /// what no output of a run over them may replace.
