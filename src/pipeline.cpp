@@ -63,6 +63,12 @@ std::vector<DoubleSupport> walking_double_supports(const std::array<std::vector<
 
 namespace {
 
+std::string format_number(double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
+
 void require(bool ok, const std::string& setting, double value, const std::string& allowed) {
   if (ok) return;
   char b[64];
@@ -161,8 +167,15 @@ void sagittal_stage(const Trial& trial, Trial* release, const Trial* static_tria
   r.foot_lateral_m = std::move(win.foot_lateral_m);
   r.landmarks = std::move(win.landmarks);
   const SagittalLandmarks& lm = r.landmarks;
-  if (2.0 * o.kinematic_cutoff_hz >= lm.rate_hz || 2.0 * o.post_cutoff_hz >= lm.rate_hz)
-    throw InputError(trial.path + ": cut-off frequencies must be below half the marker rate (" + std::to_string(lm.rate_hz) + " Hz)");
+  // The zero-lag filter's single pass runs at cut-off / 0.802 (Winter's correction), which must
+  // be below the Nyquist frequency.
+  const double limit = max_zero_lag_cutoff_hz(lm.rate_hz);
+  for (const auto& [value, name] : {std::pair{o.kinematic_cutoff_hz, "kinematic cut-off (--kinematic-cutoff)"},
+                                    std::pair{o.post_cutoff_hz, "post-filter cut-off (--post-cutoff)"}})
+    if (value >= limit)
+      throw InputError(trial.path + ": the " + name + " of " + format_number(value) + " Hz is too high for the marker rate of " +
+                       format_number(lm.rate_hz) + " Hz: a zero-lag Butterworth filter takes cut-offs below " + format_number(limit) +
+                       " Hz (half the rate times Winter's two-pass correction 0.802)");
   r.time_s = lm.time_s;
 }
 

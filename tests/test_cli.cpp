@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "kin2grf/io/c3d.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/output_file.hpp"
@@ -554,4 +555,56 @@ TEST(CliFiles, AnInputTruncatedWhileReadIsNeverASignal) {
     }
   }
   RecordProperty("runs_ending_in_an_error", errors);
+}
+
+// A user's mistakes that ended in "internal error" (exit 3) now end in an error naming the file
+// or the option (exit 2), or are read as meant (a Time column in milliseconds).
+TEST(CliFiles, MistakesThatWereInternalErrorsAreNamed) {
+  const auto dir = kin2grf::test::temp_dir("cli_mistakes");
+  const std::string trc = example_trc();
+  // The zero-lag filter's limit at 100 Hz is 40.1 Hz (Nyquist x 0.802), not 50.
+  for (const std::string& opt : std::vector<std::string>{"--kinematic-cutoff 49.9", "--post-cutoff 49.99", "--kinematic-cutoff 40.2"}) {
+    const CliRun r = run("estimate " + trc + " --mass 70 " + opt);
+    EXPECT_EQ(r.status, 2) << opt << r.out;
+    EXPECT_NE(r.out.find(opt.substr(0, opt.find(' '))), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("below 40.11 Hz"), std::string::npos) << r.out;
+  }
+  EXPECT_EQ(run("estimate " + trc + " --mass 70 --kinematic-cutoff 40").status, 0);
+  // A TRC whose Time column is in ms: read as seconds it was a 0.1 Hz trial.
+  std::istringstream in(kin2grf::read_file_text(trc));
+  std::string text, line;
+  for (int k = 0; std::getline(in, line); ++k) {
+    if (k >= 5 && !line.empty()) {
+      const auto a = line.find('\t'), b = line.find('\t', a + 1);
+      line = line.substr(0, a + 1) + std::to_string(std::stod(line.substr(a + 1, b - a - 1)) * 1000.0) + line.substr(b);
+    }
+    text += line + "\n";
+  }
+  const auto ms = dir / "ms.trc";
+  kin2grf::write_file_text(ms.string(), text);
+  const CliRun info = run("info " + ms.string());
+  EXPECT_EQ(info.status, 0) << info.out;
+  EXPECT_NE(info.out.find("100 Hz"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("milliseconds"), std::string::npos) << info.out;
+  EXPECT_EQ(run("estimate " + ms.string() + " --mass 70").status, 0);
+  // A C3D whose POINT:RATE is 1e-30.
+  auto t = kin2grf::load_trial((example_dir() / "example_walk.c3d").string());
+  t.markers.rate_hz = 1e-30;
+  t.plates.reset();
+  const auto slow = dir / "slow.c3d";
+  kin2grf::write_c3d(slow.string(), t);
+  const CliRun c = run("estimate " + slow.string() + " --mass 70");
+  EXPECT_EQ(c.status, 2) << c.out;
+  EXPECT_NE(c.out.find("POINT:RATE is 1e-30 Hz"), std::string::npos) << c.out;
+  // An output folder that is a file.
+  const auto file = dir / "a-file";
+  kin2grf::write_file_text(file.string(), "x");
+  const CliRun m = run("make-example --out-dir " + file.string());
+  EXPECT_EQ(m.status, 2) << m.out;
+  EXPECT_NE(m.out.find(file.string() + ": is a file, not a folder"), std::string::npos) << m.out;
+  const auto list = dir / "list.txt";
+  kin2grf::write_file_text(list.string(), "walking|lab|walk|" + trc + " --mass 70\n");
+  const CliRun b = run("batch " + list.string() + " --out-dir " + file.string());
+  EXPECT_EQ(b.status, 2) << b.out;
+  EXPECT_NE(b.out.find(file.string() + ": is a file, not a folder"), std::string::npos) << b.out;
 }

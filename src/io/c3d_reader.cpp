@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -306,9 +307,10 @@ C3dFile read_c3d_header(std::span<const std::uint8_t> bytes, const std::string& 
     throw InputError(path + ": POINT:SCALE is " + std::to_string(f.point_scale) +
                      " (must be a finite non-zero number)");
   }
-  if (!std::isfinite(f.point_rate_hz) || f.point_rate_hz <= 0 || f.point_rate_hz > 1e6) {
-    throw InputError(path + ": POINT:RATE is " + std::to_string(f.point_rate_hz) +
-                     " Hz (must be positive and finite)");
+  if (!(f.point_rate_hz >= kMinMarkerRateHz && f.point_rate_hz <= kMaxMarkerRateHz)) {
+    char rate[64];
+    std::snprintf(rate, sizeof rate, "%g", f.point_rate_hz);
+    throw InputError(path + ": POINT:RATE is " + rate + " Hz, not a motion-capture rate (1 Hz to 1 MHz)");
   }
   if (f.last_frame < f.first_frame) {
     throw InputError(path + ": last frame " + std::to_string(f.last_frame) +

@@ -242,14 +242,23 @@ MarkerTrajectories parse_trc(std::string_view text, const std::string& path, std
     // every derivative), with a warning. The spacing over the whole column, not a median step:
     // times written with 3 decimals (0.017 s at 60 Hz) would fake a 58.8 Hz rate.
     const double rate = static_cast<double>(n - 1) / (m.time_s[n - 1] - m.time_s[0]);
-    if (std::isfinite(rate) && std::abs(rate - m.rate_hz) > 0.01 * rate) {
+    if (std::isfinite(rate) && std::abs(1000.0 * rate - m.rate_hz) <= 0.01 * m.rate_hz) {
+      // The Time column in milliseconds (some exporters): read as seconds it would make a
+      // 100 Hz trial 0.1 Hz. Its spacing is DataRate's exactly when divided by 1000.
+      m.time_s /= 1000.0;
+      if (warnings)
+        warnings->push_back("the Time column is in milliseconds (its spacing is DataRate's " + fmt(m.rate_hz) +
+                            " Hz times 1000); read as seconds");
+    } else if (std::isfinite(rate) && std::abs(rate - m.rate_hz) > 0.01 * rate) {
       if (warnings)
         warnings->push_back("DataRate says " + fmt(m.rate_hz) + " Hz but the Time column spans " + std::to_string(n) +
                             " frames at " + fmt(rate) + " Hz; the Time column's rate is used");
       m.rate_hz = rate;
     }
   }
-  if (!(m.rate_hz > 0 && m.rate_hz < 1e6)) throw InputError(where(path, 2) + ": DataRate " + fmt(m.rate_hz) + " Hz is not a sampling rate");
+  if (!(m.rate_hz >= kMinMarkerRateHz && m.rate_hz <= kMaxMarkerRateHz))
+    throw InputError(where(path, 2) + ": a rate of " + fmt(m.rate_hz) + " Hz (DataRate, or the Time column's spacing) is not a " +
+                     "motion-capture rate (1 Hz to 1 MHz); is the Time column in seconds?");
   return m;
 }
 

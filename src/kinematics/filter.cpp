@@ -8,6 +8,8 @@
 #include <stdexcept>
 
 namespace kin2grf {
+
+double zero_lag_correction() { return std::pow(std::sqrt(2.0) - 1.0, 0.25); }
 namespace {
 
 struct Biquad {
@@ -67,7 +69,7 @@ struct ZeroLagDesign {
 };
 
 ZeroLagDesign design_zero_lag(Eigen::Index n, double rate_hz, double cutoff_hz) {
-  const double C = std::pow(std::sqrt(2.0) - 1.0, 0.25);  // Winter's two-pass correction
+  const double C = zero_lag_correction();
   const double fc = cutoff_hz / C;
   if (!(fc > 0) || fc >= 0.5 * rate_hz) {
     throw std::invalid_argument("butterworth_filtfilt: cut-off " + std::to_string(cutoff_hz) +

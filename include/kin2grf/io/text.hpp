@@ -79,6 +79,9 @@ class MappedFile {
 /// Largest file the readers take (a 10-minute trial at 2 kHz markers and 10 kHz analog is
 /// about 2 GB; more is refused before anything is allocated).
 inline constexpr std::uintmax_t kMaxInputBytes = std::uintmax_t{4} << 30;
+/// The marker rates the readers take: slower is no motion capture (a Time column in milliseconds
+/// read as seconds, a damaged POINT:RATE), faster no camera.
+inline constexpr double kMinMarkerRateHz = 1.0, kMaxMarkerRateHz = 1e6;
 /// Whether a cell or line holds only blanks (space, tab, CR, LF, VT, FF).
 bool is_blank(std::string_view s);
 /// Strict number parse ("nan"/"NaN" accepted as NaN, empty -> NaN when allow_empty).

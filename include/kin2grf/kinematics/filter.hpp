@@ -15,6 +15,12 @@
 
 namespace kin2grf {
 
+/// Winter's two-pass correction C = (2^(1/2) - 1)^(1/4) = 0.802 (see above).
+double zero_lag_correction();
+/// The highest cut-off a zero-lag filter takes at `rate_hz`: its single pass (cut-off / C) must be
+/// below the Nyquist frequency, so every cut-off must be below 0.5 * rate * C (40.1 Hz at 100 Hz).
+inline double max_zero_lag_cutoff_hz(double rate_hz) { return 0.5 * rate_hz * zero_lag_correction(); }
+
 /// Zero-lag (forward-backward) 2nd-order Butterworth low-pass, -3 dB at cutoff_hz overall.
 /// Requires finite samples; cutoff must be below the Nyquist frequency.
 Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, double cutoff_hz);
