@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -14,6 +15,7 @@
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/c3d.hpp"
+#include "kin2grf/io/force_plate.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/synth/example.hpp"
 #include "kin2grf/io/cop_function.hpp"
@@ -636,4 +638,96 @@ TEST(C3dQuirks, TwoSubjectsOrAClashKeepTheLabelsAsTheyAre) {
   EXPECT_NE(warnings[0].find("kept"), std::string::npos) << warnings[0];
   EXPECT_EQ(m.find("A:LASI"), 0);
   EXPECT_EQ(m.find("LASI"), 1);
+}
+
+// Plate data that were accepted without a word (issue 31): a type-4 plate with a NaN or all-zero
+// CAL_MATRIX became "never loaded" (validate blamed the clock), a 3e38 matrix gave 6.9e42 N, NaN
+// samples split a stance unseen, a .mot whose vertical was negated made its plate "never loaded".
+namespace {
+struct TwoPlates {
+  AnalogData analog;
+  std::vector<PlateDescription> plates;
+};
+/// Two type-4 plates side by side, identity calibration, 700 N on each from 0.2 to 0.8 s.
+TwoPlates two_type4_plates() {
+  TwoPlates t;
+  t.analog.rate_hz = 1000;
+  t.analog.values = Eigen::MatrixXd::Zero(1000, 12);
+  for (int c = 0; c < 12; ++c) t.analog.labels.push_back("ch" + std::to_string(c)), t.analog.units.push_back(c % 6 < 3 ? "N" : "Nmm");
+  t.analog.values.block(200, 2, 600, 1).setConstant(700.0);
+  t.analog.values.block(200, 8, 600, 1).setConstant(700.0);
+  for (int p = 0; p < 2; ++p) {
+    PlateDescription d;
+    d.name = "FP" + std::to_string(p + 1);
+    d.type = 4;
+    const double x0 = 0.6 * p;
+    d.corners << x0 + 0.6, x0, x0, x0 + 0.6,  //
+        0.4, 0.4, 0, 0,                         //
+        0, 0, 0, 0;
+    d.origin = Eigen::Vector3d(0, 0, -0.04);
+    for (int c = 0; c < 6; ++c) d.channels.push_back(6 * p + c);
+    t.plates.push_back(d);
+  }
+  return t;
+}
+bool said(const std::vector<std::string>& w, const std::string& a, const std::string& b) {
+  for (const auto& m : w)
+    if (m.find(a) != std::string::npos && m.find(b) != std::string::npos) return true;
+  return false;
+}
+}  // namespace
+
+TEST(PlateData, ABrokenCalibrationOrAnAbsurdForceLeavesThePlateOutWithItsName) {
+  {
+    auto t = two_type4_plates();
+    std::vector<std::string> w;
+    const auto rec = compute_plates(t.analog, t.plates, {}, "lab.c3d", w);
+    ASSERT_EQ(rec.plates.size(), 2u);
+    EXPECT_TRUE(w.empty());
+  }
+  const struct {
+    double value;
+    bool whole;
+    const char* said;
+  } cases[] = {{std::numeric_limits<double>::quiet_NaN(), false, "not finite"}, {0.0, true, "all zero"}, {3e38, false, "is no ground reaction"}};
+  for (const auto& c : cases) {
+    auto t = two_type4_plates();
+    if (c.whole) t.plates[1].cal_matrix.setConstant(c.value);
+    else t.plates[1].cal_matrix(2, 2) = c.value;
+    std::vector<std::string> w;
+    const auto rec = compute_plates(t.analog, t.plates, {}, "lab.c3d", w);
+    ASSERT_EQ(rec.plates.size(), 1u) << c.said;
+    EXPECT_EQ(rec.plates[0].name, "FP1");
+    EXPECT_TRUE(said(w, "lab.c3d: FP2", c.said)) << c.said << ": " << (w.empty() ? "" : w[0]);
+  }
+}
+
+TEST(PlateData, NonFiniteSamplesAreNamedWithTheirTimes) {
+  auto t = two_type4_plates();
+  t.analog.values(500, 2) = std::numeric_limits<double>::quiet_NaN();
+  t.analog.values(510, 3) = std::numeric_limits<double>::infinity();
+  std::vector<std::string> w;
+  const auto rec = compute_plates(t.analog, t.plates, {}, "lab.c3d", w);
+  ASSERT_EQ(rec.plates.size(), 2u);
+  EXPECT_TRUE(said(w, "FP1: 2 analog samples are NaN or infinite", "0.5 s to 0.51 s")) << (w.empty() ? "" : w[0]);
+}
+
+TEST(PlateData, AGrfFileWhoseVerticalPointsDownIsReadNegatedWithAWarning) {
+  Table t;
+  t.labels = grf_labels();
+  t.data = Eigen::MatrixXd::Zero(100, static_cast<Eigen::Index>(t.labels.size()));
+  for (Eigen::Index i = 0; i < 100; ++i) {
+    t.data(i, 0) = 0.01 * static_cast<double>(i);
+    if (i >= 20 && i < 80) t.data(i, 2) = -700, t.data(i, 1) = 50;  // right foot: force on the plate
+    if (i >= 50) t.data(i, 8) = 700;                                // left foot: on the body
+  }
+  std::vector<std::string> w;
+  const auto rec = grf_from_table(t, "grf.mot", 10, w);
+  ASSERT_TRUE(rec);
+  ASSERT_EQ(rec->plates.size(), 2u);
+  EXPECT_EQ(rec->plates[0].force_N(30, 1), 700);
+  EXPECT_EQ(rec->plates[0].force_N(30, 0), -50);
+  EXPECT_EQ(rec->plates[1].force_N(60, 1), 700);
+  EXPECT_TRUE(said(w, "grf.mot: ground_force: its vertical force points down", "0.2 to 0.79 s")) << (w.empty() ? "" : w.back());
+  EXPECT_FALSE(said(w, "1_ground_force", "points down"));
 }

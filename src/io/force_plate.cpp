@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "kin2grf/error.hpp"
@@ -12,6 +13,12 @@ namespace kin2grf {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string fmt(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
 
 /// Scale of a moment channel's unit to N m (N mm is the C3D norm when units are missing).
 double moment_unit_scale(const std::string& unit, std::vector<std::string>& warnings,
@@ -90,6 +97,42 @@ PlateLoads plate_loads(const Eigen::MatrixXd& ch, const PlateDescription& d,
   return L;
 }
 
+/// The time of analog sample i, for messages.
+std::string sample_time(const AnalogData& analog, Eigen::Index i) {
+  return fmt(analog.first_time_s + static_cast<double>(i) / analog.rate_hz) + " s";
+}
+
+/// Non-finite samples are named with their times (the force there is unknown, and a stance they
+/// fall in is split); a force no human exerts (a damaged calibration: 3e38 gave 6.9e42 N) leaves
+/// the plate out. False: leave the plate out.
+bool plate_samples_plausible(const Eigen::MatrixXd& ch, const PlateLoads& L, const std::string& name, const AnalogData& analog,
+                             const std::string& path, std::vector<std::string>& warnings) {
+  Eigen::Index bad = 0, first = -1, last = -1;
+  for (Eigen::Index i = 0; i < ch.rows(); ++i)
+    if (!ch.row(i).allFinite()) {
+      ++bad;
+      if (first < 0) first = i;
+      last = i;
+    }
+  if (bad > 0)
+    warnings.push_back(path + ": " + name + ": " + std::to_string(bad) + " analog samples are NaN or infinite (" +
+                       sample_time(analog, first) + (last > first ? " to " + sample_time(analog, last) : std::string()) +
+                       "): the plate's force there is unknown");
+  Eigen::Index at = -1;
+  double peak = 0;
+  for (Eigen::Index i = 0; i < L.F.rows(); ++i) {
+    const double f = L.F.row(i).norm();
+    if (std::isfinite(f) && f > peak) peak = f, at = i;
+  }
+  if (peak > kMaxPlausibleForceN) {
+    warnings.push_back(path + ": " + name + ": a force of " + fmt(peak) + " N at " + sample_time(analog, at) +
+                       " is no ground reaction (more than " + fmt(kMaxPlausibleForceN) +
+                       " N): check the plate's calibration (CAL_MATRIX) and its channels' SCALE; the plate is left out");
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 Eigen::Matrix3d plate_axes(const Eigen::Matrix<double, 3, 4>& c) {
@@ -116,6 +159,15 @@ ForcePlateRecording compute_plates(const AnalogData& analog,
   rec.time_s.resize(n);
   for (Eigen::Index i = 0; i < n; ++i) rec.time_s[i] = analog.first_time_s + static_cast<double>(i) / analog.rate_hz;
   for (const auto& d : plates) {
+    // A type-4 plate's calibration matrix turns its signals into forces: NaN or all zero (an
+    // unused plate's, a damaged file's) gives no force, and the plate read as "never loaded" made
+    // validate blame the clock.
+    if (d.type == 4 && (!d.cal_matrix.allFinite() || d.cal_matrix.isZero(0.0))) {
+      warnings.push_back(path + ": " + d.name + ": FORCE_PLATFORM:CAL_MATRIX is " +
+                         (d.cal_matrix.allFinite() ? "all zero" : "not finite (NaN or infinity)") +
+                         ": the plate's forces cannot be computed; it is left out");
+      continue;
+    }
     ForcePlate fp;
     fp.name = d.name;
     fp.type = d.type;
@@ -184,6 +236,7 @@ ForcePlateRecording compute_plates(const AnalogData& analog,
         L = loads(ch);
       }
     }
+    if (!plate_samples_plausible(ch, L, d.name, analog, path, warnings)) continue;
     const Eigen::Matrix3d& R = fp.lab_R_plate;
     fp.force_N = L.F * R.transpose();
     fp.moment_centre_Nm = L.Mc * R.transpose();

@@ -513,13 +513,32 @@ std::optional<ForcePlateRecording> grf_from_table(const Table& t, const std::str
                        " N a sample against at most " + fmt(next / static_cast<double>(n)) + "), not OpenSim's Y: " + "XYZ"[up] +
                        " is taken as up");
   rec.up_axis = static_cast<Axis>(up);
-  for (auto& fp : rec.plates)
+  for (auto& fp : rec.plates) {
+    // OpenSim's GRF is the force on the body: its vertical points up while a foot stands. A
+    // column set whose load points down holds the force on the plate (another tool's
+    // convention); read as it is, every stance was "never loaded".
+    double down = 0, upward = 0;
+    Eigen::Index first = -1, last = -1;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double v = fp.force_N(i, up);
+      if (std::abs(v) < cop_threshold_N) continue;
+      (v < 0 ? down : upward) += std::abs(v);
+      if (v < 0) last = i, first = first < 0 ? i : first;
+    }
+    if (down > 2 * upward && first >= 0) {
+      fp.force_N = -fp.force_N;
+      fp.free_moment_Nm = -fp.free_moment_Nm;
+      warnings.push_back(path + ": " + fp.name + ": its vertical force points down (loaded from " + fmt(rec.time_s[first]) + " to " +
+                         fmt(rec.time_s[last]) + " s): it is the force on the plate, not on the body as OpenSim's GRF files hold; " +
+                         "read negated");
+    }
     for (Eigen::Index i = 0; i < n; ++i) {
       if (std::abs(fp.force_N(i, up)) < cop_threshold_N) {
         fp.cop_m.row(i).setConstant(kNaN);  // stale or undefined COP of an unloaded plate
         fp.free_moment_Nm.row(i).setConstant(kNaN);
       }
     }
+  }
   return rec;
 }
 

@@ -49,6 +49,10 @@ struct PlateDescription {
   Eigen::Matrix<double, 6, 6> cal_matrix = Eigen::Matrix<double, 6, 6>::Identity();
 };
 
+/// The largest force a plate may show and still be read: no human's ground reaction comes near
+/// (a 150 kg sprinter's landing is under 15 kN); more is a damaged calibration or scale.
+inline constexpr double kMaxPlausibleForceN = 50000.0;
+
 struct PlateProcessing {
   double cop_threshold_N = 10.0;
   ZeroOffset zero_offset = ZeroOffset::None;
