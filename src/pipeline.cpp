@@ -133,8 +133,11 @@ double resolve_mass(const Trial& trial, const EstimateOptions& o) {
 /// markers -> landmarks -> the sagittal frame and window (r.frame, r.landmarks, r.time_s...).
 /// `release` (the trial, when the caller gave it up): its marker samples are released once the
 /// landmarks are made, the last use of them.
-void sagittal_stage(const Trial& trial, Trial* release, const Trial* static_trial, const MarkerSet& set,
+void sagittal_stage(const Trial& trial, Trial* release, const Trial* static_trial, const MarkerSet& given_set,
                     const EstimateOptions& o, EstimateResult& r) {
+  std::vector<std::string> repeated;
+  const std::optional<MarkerSet> chosen = given_set.preset ? choose_repeated_markers(given_set, trial.markers, repeated) : std::nullopt;
+  const MarkerSet& set = chosen ? *chosen : given_set;
   if (trial.markers.frames() == 0) throw InputError(trial.path + ": the trial has no marker frames");
   std::vector<std::string> cleaning;
   // A trial the caller gave up is cleaned in place (`release` is `trial` then); otherwise the
@@ -157,6 +160,7 @@ void sagittal_stage(const Trial& trial, Trial* release, const Trial* static_tria
   for (const auto& w : trial.warnings) r.messages.push_back("input: " + w);
   if (static_trial)
     for (const auto& w : static_trial->warnings) r.messages.push_back("static trial: " + w);
+  r.messages.insert(r.messages.end(), repeated.begin(), repeated.end());
   r.messages.insert(r.messages.end(), cleaning.begin(), cleaning.end());
   r.messages.insert(r.messages.end(), lm3.messages.begin(), lm3.messages.end());
   r.frame = detect_sagittal_frame(lm3, markers, o.landmarks);

@@ -309,3 +309,95 @@ TEST(MappingFile, NestingDeeperThanTheLimitIsRefusedAtParse) {
   EXPECT_NO_THROW((void)parse_json_text(ok, "ok"));
   EXPECT_THROW((void)parse_json_text("[" + ok + "]", "deep"), InputError);
 }
+
+namespace {
+/// The example walk with its knee and ankle centres replaced by medial and lateral markers 5 cm
+/// either side, each pair under one label (a Helen-Hayes file's RKNE twice, RANK twice), the
+/// lateral one first when `lateral_first`.
+Trial walk_with_repeated_labels(bool lateral_first) {
+  Trial t = make_example_walk();
+  MarkerTrajectories& m = t.markers;
+  const auto& rk = m.positions_m[static_cast<std::size_t>(m.find("RKJC"))];
+  const auto& lk = m.positions_m[static_cast<std::size_t>(m.find("LKJC"))];
+  MarkerTrajectories out = m;
+  out.names.clear(), out.positions_m.clear(), out.descriptions.clear();
+  for (std::size_t k = 0; k < m.names.size(); ++k) {
+    const std::string& n = m.names[k];
+    if (n != "RKJC" && n != "RAJC") {
+      out.names.push_back(n), out.positions_m.push_back(m.positions_m[k]), out.descriptions.push_back("");
+      continue;
+    }
+    Eigen::MatrixX3d lateral = m.positions_m[k], medial = m.positions_m[k];
+    for (Eigen::Index i = 0; i < m.frames(); ++i) {
+      // The example walks along x with z up: lateral is along y, away from the left knee.
+      const Eigen::Vector3d out_dir(0, rk(i, 1) > lk(i, 1) ? 1.0 : -1.0, 0);
+      lateral.row(i) += 0.05 * out_dir.transpose();
+      medial.row(i) -= 0.05 * out_dir.transpose();
+    }
+    const std::string label = n == "RKJC" ? "RKNE" : "RANK";
+    for (const auto* p : lateral_first ? std::array{&lateral, &medial} : std::array{&medial, &lateral}) {
+      out.names.push_back(unique_label(out.names, label, out.names.size(), &t.warnings));
+      out.positions_m.push_back(*p), out.descriptions.push_back("");
+    }
+  }
+  t.markers = std::move(out);
+  return t;
+}
+}  // namespace
+
+// The marker-set regression of issue 31: a repeated label became NAME#k and a landmark naming NAME
+// was refused, but the first occurrence could not be named at all. Now the k-th label NAME is
+// NAME#k (the first also NAME#1), a mapping file can use all four markers of a file with two RKNE
+// and two RANK, and a preset takes the lateral one of a medial-lateral pair, saying so.
+TEST(RepeatedLabels, AMappingFileNamesEachOccurrenceAndAPresetTakesTheLateralOne) {
+  const MarkerSet* example = find_marker_set("kin2grf-example");
+  ASSERT_TRUE(example);
+  EstimateOptions o;
+  const EstimateResult reference = estimate(make_example_walk(), nullptr, *example, o);
+  for (const bool lateral_first : {true, false}) {
+    const Trial t = walk_with_repeated_labels(lateral_first);
+    EXPECT_GE(t.markers.find("RKNE#1"), 0);
+    EXPECT_EQ(t.markers.find("RKNE#1"), t.markers.find("RKNE"));
+    EXPECT_EQ(t.markers.find("RKNE#2"), t.markers.find("RKNE") + 1);
+    // The mapping: each centre the mean of its medial and lateral marker, all four named.
+    MarkerSet mapping = *example;
+    mapping.preset = false;
+    mapping.rules[2] = LandmarkRule{"mean", {"RKNE#1", "RKNE#2"}, {}, {}, 0.0, 0.0};
+    mapping.rules[3] = LandmarkRule{"mean", {"RANK#1", "RANK#2"}, {}, {}, 0.0, 0.0};
+    ASSERT_EQ(landmark_name(2), std::string("knee_r"));
+    ASSERT_EQ(landmark_name(3), std::string("ankle_r"));
+    const EstimateResult r = estimate(t, nullptr, mapping, o);
+    ASSERT_EQ(r.time_s.size(), reference.time_s.size());
+    EXPECT_TRUE(test::matrices_near(r.landmarks.p[2], reference.landmarks.p[2], 1e-9));
+    // A mapping naming the bare label is refused, naming both occurrences.
+    MarkerSet bare = *example;
+    bare.preset = false;
+    bare.rules[2] = LandmarkRule{"marker", {"RKNE"}, {}, {}, 0.0, 0.0};
+    bare.rules[3] = LandmarkRule{"mean", {"RANK#1", "RANK#2"}, {}, {}, 0.0, 0.0};
+    try {
+      (void)estimate(t, nullptr, bare, o);
+      ADD_FAILURE() << "a repeated label taken silently";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("as RKNE#1 or RKNE#2"), std::string::npos) << e.what();
+    }
+    // A preset naming the bare label takes the lateral one (5 cm out) and says which.
+    MarkerSet preset = bare;
+    preset.preset = true;
+    preset.rules[3] = LandmarkRule{"marker", {"RANK"}, {}, {}, 0.0, 0.0};
+    std::vector<std::string> messages;
+    const auto chosen = choose_repeated_markers(preset, t.markers, messages);
+    ASSERT_TRUE(chosen);
+    const std::string lateral = lateral_first ? "#1" : "#2";
+    EXPECT_EQ(chosen->rules[2].markers[0], "RKNE" + lateral);
+    EXPECT_EQ(chosen->rules[3].markers[0], "RANK" + lateral);
+    ASSERT_EQ(messages.size(), 2u);
+    EXPECT_NE(messages[0].find("takes RKNE" + lateral + ", the lateral one (100 mm farther"), std::string::npos) << messages[0];
+    // The estimate with the preset runs and says it (in the sagittal plane the two markers are one
+    // point: the landmarks are the reference's).
+    const EstimateResult p = estimate(t, nullptr, preset, o);
+    EXPECT_NE(std::find_if(p.messages.begin(), p.messages.end(),
+                           [](const std::string& m) { return m.find("the lateral one") != std::string::npos; }),
+              p.messages.end());
+    EXPECT_TRUE(test::matrices_near(p.landmarks.p[2], reference.landmarks.p[2], 1e-9));
+  }
+}

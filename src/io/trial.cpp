@@ -24,14 +24,25 @@ const char* to_string(Side s) {
 std::string unique_label(const std::vector<std::string>& taken, const std::string& name, std::size_t index,
                          std::vector<std::string>* warnings) {
   if (std::find(taken.begin(), taken.end(), name) == taken.end()) return name;
-  const std::string renamed = name + "#" + std::to_string(index + 1);
-  if (warnings) warnings->push_back("marker label '" + name + "' repeated; the later one is named " + renamed);
+  // The k-th label NAME is NAME#k (in the file's order), so that a mapping file can name each
+  // occurrence: NAME#1 is the first (still called NAME), NAME#2 the second, ...
+  std::size_t k = 2;
+  while (std::find(taken.begin(), taken.end(), name + "#" + std::to_string(k)) != taken.end()) ++k;
+  const std::string renamed = name + "#" + std::to_string(k);
+  if (warnings)
+    warnings->push_back("marker label '" + name + "' repeated (column " + std::to_string(index + 1) + "); this one is named " + renamed +
+                        ", the first " + name + " (" + name + "#1)");
   return renamed;
 }
 
 int MarkerTrajectories::find(const std::string& name) const {
   for (std::size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return static_cast<int>(i);
+  // NAME#1: the first of a repeated label, which keeps its plain name.
+  if (name.size() > 2 && name.ends_with("#1")) {
+    const std::string base = name.substr(0, name.size() - 2);
+    if (find(base + "#2") >= 0) return find(base);
+  }
   if (!label_prefix.empty() && name.size() > label_prefix.size() && name.starts_with(label_prefix))
     return find(name.substr(label_prefix.size()));
   return -1;

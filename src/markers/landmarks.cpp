@@ -23,15 +23,29 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 const char* kNames[kLandmarkCount] = {"shoulder", "hip",     "knee_r", "ankle_r", "heel_r", "mt_r",
                                       "hallux_r", "knee_l", "ankle_l", "heel_l",  "mt_l",   "hallux_l"};
 
+/// How many labels NAME the file had (the readers renamed the k-th to NAME#k).
+std::size_t occurrences(const MarkerTrajectories& m, const std::string& name) {
+  std::size_t n = 0;
+  for (const auto& other : m.names) {
+    if (other == name) ++n;
+    else if (other.size() > name.size() + 1 && other.compare(0, name.size() + 1, name + "#") == 0 &&
+             other.find_first_not_of("0123456789", name.size() + 1) == std::string::npos)
+      ++n;
+  }
+  return n;
+}
+
 Eigen::MatrixX3d marker(const MarkerTrajectories& m, const std::string& name, const std::string& path,
                         const std::string& what) {
   const int k = m.find(name);
   if (k < 0) throw InputError(path + ": marker '" + name + "' (needed for " + what + ") is not in the trial");
-  // The readers rename a repeated label NAME#k: a landmark must not silently take either one.
-  for (const auto& other : m.names)
-    if (other.size() > name.size() + 1 && other.compare(0, name.size() + 1, name + "#") == 0)
-      throw InputError(path + ": marker '" + name + "' (needed for " + what + ") appears more than once in the file (" +
-                       name + ", " + other + "): rename one, or map the landmark to the one meant");
+  // The readers rename the k-th label NAME to NAME#k: a landmark must not silently take one.
+  if (const std::size_t n = occurrences(m, name); n > 1) {
+    std::string which;
+    for (std::size_t j = 1; j <= n; ++j) which += (j > 1 ? (j == n ? " or " : ", ") : "") + name + "#" + std::to_string(j);
+    throw InputError(path + ": marker '" + name + "' (needed for " + what + ") appears " + std::to_string(n) +
+                     " times in the file: name the one meant in a mapping file (--markers) as " + which + " (in the file's order)");
+  }
   const Eigen::MatrixX3d& p = m.positions_m[static_cast<std::size_t>(k)];
   // compute_landmarks releases a marker after the last landmark that reads it: reading it later is
   // a bug of that bookkeeping, never silently an empty series.
@@ -170,6 +184,94 @@ Eigen::MatrixX3d functional_joint_centre(const std::vector<Eigen::MatrixX3d>& pr
 }  // namespace
 
 const char* landmark_name(int id) { return kNames[id]; }
+
+namespace {
+/// The mean of every marker at frame i, or NaN.
+Eigen::Vector3d marker_centroid(const MarkerTrajectories& m, Eigen::Index i) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (const auto& q : m.positions_m)
+    if (q.rows() == m.frames() && q.row(i).allFinite()) c += q.row(i).transpose(), ++count;
+  return count ? Eigen::Vector3d(c / count) : Eigen::Vector3d::Constant(kNaN);
+}
+
+/// The body's horizontal medial-lateral axis: across the direction the markers' centroid
+/// travels over the trial. None when it travels less than 0.3 m (a treadmill, a trial in place).
+std::optional<Eigen::Vector3d> lateral_axis(const MarkerTrajectories& m) {
+  Eigen::Vector3d first = Eigen::Vector3d::Constant(kNaN), last = first;
+  for (Eigen::Index i = 0; i < m.frames() && !first.allFinite(); ++i) first = marker_centroid(m, i);
+  for (Eigen::Index i = m.frames() - 1; i >= 0 && !last.allFinite(); --i) last = marker_centroid(m, i);
+  const int up = static_cast<int>(m.up_axis);
+  Eigen::Vector3d travel = last - first;
+  travel[up] = 0;
+  if (!travel.allFinite() || travel.norm() < 0.3) return std::nullopt;
+  Eigen::Vector3d vertical = Eigen::Vector3d::Zero();
+  vertical[up] = 1;
+  return vertical.cross(travel).normalized();
+}
+
+/// Medians over (up to 200 of) the frames where both markers exist: |a's offset from the
+/// centroid along `lateral`|, |b's|, and the share of their separation that lies along `lateral`.
+std::array<double, 3> medial_lateral_measure(const MarkerTrajectories& m, const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b,
+                                             const Eigen::Vector3d& lateral) {
+  std::array<std::vector<double>, 3> v;
+  for (Eigen::Index i = 0; i < m.frames() && v[0].size() < 200; ++i) {
+    const Eigen::Vector3d c = marker_centroid(m, i);
+    if (!a.row(i).allFinite() || !b.row(i).allFinite() || !c.allFinite()) continue;
+    const Eigen::Vector3d ab = (b.row(i) - a.row(i)).transpose();
+    v[0].push_back(std::abs((a.row(i).transpose() - c).dot(lateral)));
+    v[1].push_back(std::abs((b.row(i).transpose() - c).dot(lateral)));
+    v[2].push_back(ab.norm() > 0 ? std::abs(ab.dot(lateral)) / ab.norm() : 0.0);
+  }
+  std::array<double, 3> out{};
+  for (int k = 0; k < 3; ++k) {
+    if (v[k].empty()) return {0, 0, 0};
+    std::nth_element(v[k].begin(), v[k].begin() + static_cast<std::ptrdiff_t>(v[k].size() / 2), v[k].end());
+    out[k] = v[k][v[k].size() / 2];
+  }
+  return out;
+}
+}  // namespace
+
+std::optional<MarkerSet> choose_repeated_markers(const MarkerSet& set, const MarkerTrajectories& m, std::vector<std::string>& messages) {
+  std::optional<MarkerSet> out;
+  bool looked = false;  // the lateral axis is found once, when first needed
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  bool travels = false;
+  for (const auto& name : set.motion_markers()) {
+    if (occurrences(m, name) != 2 || m.find(name) < 0 || m.find(name + "#2") < 0) continue;
+    // The presets' markers of a joint's medial-lateral pair (knee, ankle) are the lateral ones.
+    // Two markers under one label are such a pair when what separates them lies across the
+    // direction of travel (a medial and a lateral marker are at one fore-aft place and height).
+    // Then the one farther out from the body's centroid is taken; otherwise (a heel and a toe
+    // under one label, or a trial that does not travel) nothing is guessed.
+    if (!looked) {
+      const auto found = lateral_axis(m);
+      looked = true, travels = found.has_value();
+      if (found) axis = *found;
+    }
+    if (!travels) continue;
+    const auto& p1 = m.positions_m[static_cast<std::size_t>(m.find(name))];
+    const auto& p2 = m.positions_m[static_cast<std::size_t>(m.find(name + "#2"))];
+    const auto [d1, d2, across] = medial_lateral_measure(m, p1, p2, axis);
+    if (across < 0.8) continue;
+    const std::string taken = d2 > d1 ? name + "#2" : name + "#1";
+    if (!out) out = set;
+    for (auto& r : out->rules) {
+      for (auto* list : {&r.markers, &r.cluster})
+        for (auto& s : *list)
+          if (s == name) s = taken;
+      for (auto& [key, s] : r.pelvis)
+        if (s == name) s = taken;
+    }
+    char b[64];
+    std::snprintf(b, sizeof b, "%.0f mm", 1e3 * std::abs(d2 - d1));
+    messages.push_back("marker '" + name + "' appears twice, a medial-lateral pair; the " + set.name + " preset takes " + taken +
+                       ", the lateral one (" + b + " farther from the body's centre line); a mapping file (--markers) can name " +
+                       "the other (" + name + "#1, " + name + "#2 in the file's order)");
+  }
+  return out;
+}
 
 std::vector<std::string> MarkerSet::motion_markers() const {
   std::vector<std::string> out;

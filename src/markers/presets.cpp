@@ -114,7 +114,10 @@ MarkerSet load_marker_set(const std::string& path) { return parse_marker_set(rea
 const std::vector<MarkerSet>& builtin_marker_sets() {
   static const std::vector<MarkerSet> sets = [] {
     std::vector<MarkerSet> v;
-    for (const auto& [name, text] : builtin_preset_texts()) v.push_back(parse_marker_set(parse_json_text(text, name), name));
+    for (const auto& [name, text] : builtin_preset_texts()) {
+      v.push_back(parse_marker_set(parse_json_text(text, name), name));
+      v.back().preset = true;
+    }
     // Recognition order: the more specific sets first.
     std::stable_sort(v.begin(), v.end(), [](const MarkerSet& a, const MarkerSet& b) { return a.signature.size() > b.signature.size(); });
     return v;

@@ -65,12 +65,20 @@ struct MarkerSet {
   std::string description;
   std::vector<std::string> signature;  ///< markers whose presence recognises the set
   std::array<LandmarkRule, kLandmarkCount> rules;
+  bool preset = false;  ///< one of kin2grf's built-in presets (not a user's mapping file)
   /// Every marker a motion trial must have.
   [[nodiscard]] std::vector<std::string> motion_markers() const;
 };
 
 /// A landmark's name in marker-set files ("shoulder", "hip", "knee_r", ...).
 const char* landmark_name(int id);
+
+/// A preset's marker that the file holds more than once (the readers name the k-th NAME#k; a
+/// Helen-Hayes file with medial and lateral markers under one label): the lateral occurrence, the
+/// one farther from the body's centre line in the horizontal plane, is taken, and `messages` says
+/// which. The set with those names, or nothing when no marker it uses is repeated. A mapping file
+/// names the occurrence itself (NAME#1, NAME#2).
+std::optional<MarkerSet> choose_repeated_markers(const MarkerSet& set, const MarkerTrajectories& m, std::vector<std::string>& messages);
 
 struct LandmarkOptions {
   int max_gap_frames = 10;
