@@ -8,6 +8,7 @@
 
 #include <csignal>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -609,4 +610,28 @@ TEST(CliFiles, MistakesThatWereInternalErrorsAreNamed) {
   const CliRun b = run("batch " + list.string() + " --out-dir " + file.string());
   EXPECT_EQ(b.status, 2) << b.out;
   EXPECT_NE(b.out.find(file.string() + ": is a file, not a folder"), std::string::npos) << b.out;
+}
+
+// Smaller slips of issue 31: a TRC with a byte-order mark or lone-CR lines was "not a TRC file"; a
+// folder or /dev/zero given as the trial was "unknown file type '.'".
+TEST(CliFiles, ABomOrCrOnlyTrcIsReadAndAFolderIsNamedAsOne) {
+  const auto dir = kin2grf::test::temp_dir("cli_bom_cr");
+  const std::string text = kin2grf::read_file_text(example_trc());
+  std::string cr = text;
+  std::replace(cr.begin(), cr.end(), '\n', '\r');
+  kin2grf::write_file_text((dir / "bom.trc").string(), "\xEF\xBB\xBF" + text);
+  kin2grf::write_file_text((dir / "cr.trc").string(), cr);
+  const auto reference = kin2grf::load_trial(example_trc());
+  for (const char* name : {"bom.trc", "cr.trc"}) {
+    const auto t = kin2grf::load_trial((dir / name).string());
+    EXPECT_EQ(t.markers.names, reference.markers.names) << name;
+    ASSERT_EQ(t.markers.frames(), reference.markers.frames()) << name;
+    EXPECT_TRUE(kin2grf::test::matrices_near(t.markers.positions_m[3], reference.markers.positions_m[3], 0)) << name;
+  }
+  const CliRun folder = run("estimate " + dir.string() + " --mass 70");
+  EXPECT_EQ(folder.status, 2);
+  EXPECT_NE(folder.out.find(dir.string() + ": is a directory"), std::string::npos) << folder.out;
+  const CliRun zero = run("estimate /dev/zero --mass 70");
+  EXPECT_EQ(zero.status, 2);
+  EXPECT_NE(zero.out.find("/dev/zero: is not a regular file"), std::string::npos) << zero.out;
 }

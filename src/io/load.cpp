@@ -84,6 +84,7 @@ void check_up_axis(Trial& t) {
 }
 
 Trial load_by_extension(const std::string& path, const LoadOptions& options) {
+  check_input_file(path);  // a folder or /dev/zero is named as such, not as an unknown file type
   const std::string ext = extension(path);
   if (ext == "c3d") {
     C3dReadOptions o = options.c3d;

@@ -24,7 +24,11 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// The lines of a text, views into it (no copy), without their '\r'.
 std::vector<std::string_view> lines_of(std::string_view text) {
   std::vector<std::string_view> lines;
-  split_views(text, '\n', lines);
+  // A UTF-8 byte-order mark (Windows editors) is no part of the first line; a file of lone CRs
+  // (old Mac editors) is split on them.
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+  const bool cr_only = text.find('\n') == std::string_view::npos && text.find('\r') != std::string_view::npos;
+  split_views(text, cr_only ? '\r' : '\n', lines);
   for (auto& l : lines)
     if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
   return lines;

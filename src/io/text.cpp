@@ -91,6 +91,8 @@ Buffer read_whole_file(const std::string& path) {
 
 }  // namespace
 
+void check_input_file(const std::string& path) { (void)checked_input_size(path); }
+
 std::vector<std::uint8_t> read_file_bytes(const std::string& path) { return read_whole_file<std::vector<std::uint8_t>>(path); }
 
 std::string read_file_text(const std::string& path) { return read_whole_file<std::string>(path); }

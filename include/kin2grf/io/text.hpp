@@ -18,6 +18,9 @@ std::string to_lower(std::string s);
 std::vector<std::string> split(std::string_view s, std::string_view delims, bool keep_empty);
 /// The fields of `s` between `delim`s (empty ones kept), as views into `s`; `out` is reused.
 void split_views(std::string_view s, char delim, std::vector<std::string_view>& out);
+/// InputError naming the file unless it is a regular file kin2grf can read (not missing, not a
+/// folder, device or pipe, not over kMaxInputBytes).
+void check_input_file(const std::string& path);
 /// Whole file as bytes; InputError naming the file when it cannot be opened.
 std::vector<std::uint8_t> read_file_bytes(const std::string& path);
 std::string read_file_text(const std::string& path);
