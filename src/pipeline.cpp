@@ -707,12 +707,28 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
 
 }  // namespace
 
+namespace {
+/// Every error of an estimate names the trial's file: the model and the frame finders know only
+/// numbers ("segment torso length 5.5 m is not plausible" did not say which file).
+template <class Run>
+EstimateResult naming_the_trial(const std::string& path, Run&& run) {
+  try {
+    return run();
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    if (path.empty() || what.rfind(path, 0) == 0) throw;
+    throw InputError(path + ": " + what);
+  }
+}
+}  // namespace
+
 EstimateResult estimate(const Trial& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o) {
-  return estimate_impl(trial, nullptr, static_trial, set, o);
+  return naming_the_trial(trial.path, [&] { return estimate_impl(trial, nullptr, static_trial, set, o); });
 }
 
 EstimateResult estimate(Trial&& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o) {
-  return estimate_impl(trial, &trial, static_trial, set, o);
+  const std::string path = trial.path;
+  return naming_the_trial(path, [&] { return estimate_impl(trial, &trial, static_trial, set, o); });
 }
 
 LabFootFrame lab_foot_frame(const EstimateResult& r, int side, Eigen::Index i) {

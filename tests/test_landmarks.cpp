@@ -401,3 +401,68 @@ TEST(RepeatedLabels, AMappingFileNamesEachOccurrenceAndAPresetTakesTheLateralOne
     EXPECT_TRUE(test::matrices_near(p.landmarks.p[2], reference.landmarks.p[2], 1e-9));
   }
 }
+
+// Two markers swapped for one frame (the heel jumps 17 cm to the MT head and back at 100 Hz, 17
+// m/s, under the 30 m/s jump limit) were taken as motion. A one-frame excursion of more than
+// 100 g is now a gap, named; a step of a virtual marker (the sample nearer its neighbours than
+// they are to each other) is left.
+TEST(MarkerOutliers, TwoMarkersSwappedForOneFrameBecomeGapsNamed) {
+  Trial t = make_example_walk();
+  auto& m = t.markers;
+  const auto heel = static_cast<std::size_t>(m.find("RHEE")), mt = static_cast<std::size_t>(m.find("RMT1"));
+  const Eigen::Index i = 120;
+  const Eigen::RowVector3d a = m.positions_m[heel].row(i), b = m.positions_m[mt].row(i);
+  ASSERT_GT((a - b).norm(), 0.15);
+  m.positions_m[heel].row(i) = b;
+  m.positions_m[mt].row(i) = a;
+  std::vector<std::string> messages;
+  const auto cleaned = without_marker_outliers(m, {}, messages);
+  ASSERT_TRUE(cleaned);
+  EXPECT_FALSE(cleaned->positions_m[heel].row(i).allFinite());
+  EXPECT_FALSE(cleaned->positions_m[mt].row(i).allFinite());
+  ASSERT_EQ(messages.size(), 2u);
+  EXPECT_NE(messages[0].find("RHEE: 1 sample(s) no body can produce (frame " + std::to_string(m.first_frame + i)), std::string::npos)
+      << messages[0];
+  // The clean walk has none, and a step (the rest of the trial moved 3 cm) is no spike.
+  Trial clean = make_example_walk();
+  std::vector<std::string> none;
+  EXPECT_FALSE(without_marker_outliers(clean.markers, {}, none));
+  auto& P = clean.markers.positions_m[heel];
+  P.bottomRows(P.rows() - i).col(0).array() += 0.03;
+  EXPECT_FALSE(without_marker_outliers(clean.markers, {}, none));
+}
+
+// Markers 2 cm below the floor's true place (a ground calibration error): the feet's lowest
+// flat-stance landmark is 5 mm up, nearer than a marker's radius, and the message says so. The
+// example's own 25 mm is not flagged.
+TEST(GroundLevel, AMarkerFloorOffsetIsNamed) {
+  const MarkerSet* example = find_marker_set("kin2grf-example");
+  ASSERT_TRUE(example);
+  auto said = [](const EstimateResult& r) {
+    for (const auto& m : r.messages)
+      if (m.find("may be offset") != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_FALSE(said(estimate(make_example_walk(), nullptr, *example, {})));
+  Trial low = make_example_walk();
+  for (auto& P : low.markers.positions_m) P.col(2).array() -= 0.02;
+  EXPECT_TRUE(said(estimate(low, nullptr, *example, {})));
+}
+
+// An error of the model or the frame finders names the trial's file (it said only "segment torso
+// length 5.5 m is not plausible"): markers in cm read as mm make a 16 m tall walker.
+TEST(Pipeline, AModelErrorNamesTheTrialsFile) {
+  const MarkerSet* example = find_marker_set("kin2grf-example");
+  ASSERT_TRUE(example);
+  Trial t = make_example_walk();
+  t.path = "walk-in-cm.c3d";
+  for (auto& P : t.markers.positions_m) P *= 10.0;
+  try {
+    (void)estimate(t, nullptr, *example, {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("walk-in-cm.c3d: ", 0), 0u) << m;
+    EXPECT_NE(m.find("units"), std::string::npos) << m;
+  }
+}

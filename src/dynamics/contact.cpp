@@ -271,8 +271,17 @@ GroundLevel estimate_ground_level(const SagittalLandmarks& lm) {
     lowest = std::min({lowest, median_or_zero(he), median_or_zero(hm)});
   }
   if (lowest >= 0.0 && lowest <= 0.15) {
-    return {0.0, "ground level 0 m (lab floor; lowest flat-stance foot landmark " + std::to_string(lowest * 1000).substr(0, 5) +
-                     " mm above it)"};
+    std::string message = "ground level 0 m (lab floor; lowest flat-stance foot landmark " + std::to_string(lowest * 1000).substr(0, 5) +
+                          " mm above it)";
+    // A skin marker's centre stands at least its radius (7-12 mm) above the floor, and a heel or
+    // MT-head marker at flat foot at most about 60 mm (24-55 mm on the development trials): outside
+    // that, the markers and the floor are likely offset (a ground calibration error), which moves
+    // every contact and COP.
+    if (lowest < kMinFootMarkerHeightM || lowest > kMaxFootMarkerHeightM)
+      message += "; that is " + std::string(lowest < kMinFootMarkerHeightM ? "nearer the floor than a marker's radius" :
+                                                                          "higher than a foot marker stands at flat foot") +
+                 ": the markers and the floor may be offset (check the ground calibration; --ground-level sets the floor)";
+    return {0.0, message};
   }
   return {lowest, "ground level " + std::to_string(lowest).substr(0, 6) +
                      " m: the flat-stance foot landmarks are not 0-150 mm above the lab floor, so the lowest of them is taken"};

@@ -298,6 +298,8 @@ namespace {
 std::vector<Eigen::Index> outlier_samples(const MarkerTrajectories& m, std::size_t k) {
   const Eigen::Index n = m.frames();
   const double limit = kMaxMarkerSpeedMps / std::max(m.rate_hz, 1e-9) + 0.02;
+  const double dt = 1.0 / std::max(m.rate_hz, 1e-9);
+  const double spike = std::max(0.02, 0.5 * kMaxMarkerAccelMps2 * dt * dt);
   const auto& P = m.positions_m[k];
   // Usable samples: finite and inside any capture volume.
   std::vector<bool> ok(static_cast<std::size_t>(n));
@@ -308,8 +310,15 @@ std::vector<Eigen::Index> outlier_samples(const MarkerTrajectories& m, std::size
   }
   for (Eigen::Index i = 1; i + 1 < n; ++i) {
     if (!ok[static_cast<std::size_t>(i - 1)] || !ok[static_cast<std::size_t>(i)] || !ok[static_cast<std::size_t>(i + 1)]) continue;
-    if ((P.row(i) - P.row(i - 1)).norm() > limit && (P.row(i + 1) - P.row(i)).norm() > limit &&
-        (P.row(i + 1) - P.row(i - 1)).norm() < limit) {
+    const bool jump = (P.row(i) - P.row(i - 1)).norm() > limit && (P.row(i + 1) - P.row(i)).norm() > limit &&
+                      (P.row(i + 1) - P.row(i - 1)).norm() < limit;
+    // A sample's excursion from its neighbours' midpoint is a dt^2 / 2: past kMaxMarkerAccelMps2
+    // (and 2 cm, above any marker noise) it is no motion: two markers swapped for a frame (a heel
+    // jumping 17 cm and back at 100 Hz, 17 m/s, under the speed limit).
+    // A spike, not a step: the sample leaves farther than its neighbours are apart (a virtual
+    // marker's discontinuity is a step, not a swap: it is left).
+    const double excursion = (P.row(i) - 0.5 * (P.row(i - 1) + P.row(i + 1))).norm();
+    if (jump || (excursion > spike && excursion > (P.row(i + 1) - P.row(i - 1)).norm())) {
       ok[static_cast<std::size_t>(i)] = false;
       where.push_back(i);
     }
@@ -323,8 +332,9 @@ std::string outlier_message(const MarkerTrajectories& m, std::size_t k, const st
   for (std::size_t w = 0; w < where.size() && w < 5; ++w) frames += (w ? ", " : "") + std::to_string(m.first_frame + where[w]);
   if (where.size() > 5) frames += ", ...";
   return m.names[k] + ": " + std::to_string(where.size()) + " sample(s) no body can produce (frame " + frames +
-         ": outside the lab or a one-frame jump faster than " + std::to_string(static_cast<int>(kMaxMarkerSpeedMps)) +
-         " m/s) treated as gaps";
+         ": outside the lab, a one-frame jump faster than " + std::to_string(static_cast<int>(kMaxMarkerSpeedMps)) +
+         " m/s, or a one-frame excursion of more than " + std::to_string(static_cast<int>(kMaxMarkerAccelMps2 / 9.81)) +
+         " g, such as two markers swapped) treated as gaps";
 }
 
 bool checked(const MarkerTrajectories& m, std::size_t k, const std::vector<std::string>& only) {
@@ -566,7 +576,7 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
         const Eigen::Vector3d d = (lm.p[landmark(side, kMt)].row(i) - lm.p[landmark(side, kHeel)].row(i)).transpose();
         if (d.allFinite()) s += horizontal(d);
       }
-    if (s.norm() == 0) throw InputError("cannot find the direction of progression (no pelvis travel, no feet)");
+    if (s.norm() == 0) throw InputError("cannot find the direction of progression: the pelvis does not travel and the feet give no direction (check the up axis, --up-axis, and the heel and MT markers)");
     dir = s.normalized();
     f.treadmill = true;
     f.how = "heel-to-toe direction (treadmill or stationary trial)";

@@ -37,7 +37,8 @@ Model build_model(const BodyGeometry& g, double mass, const AnthropometricTable&
   m.anthropometry = t.name;
   auto set = [&](int s, int prox, int distal, double L, const SegmentInertia& si) {
     if (!(L > 0.005) || L > 2.0)
-      throw InputError(std::string("segment ") + segment_name(s) + " length " + std::to_string(L) + " m is not plausible");
+      throw InputError(std::string("segment ") + segment_name(s) + " length " + std::to_string(L) +
+                       " m is not plausible: are the markers' units right (C3D POINT:UNITS, the TRC's Units)?");
     Body& b = m.bodies[s];
     b.proximal = prox;
     b.points[0] = distal;

@@ -190,6 +190,11 @@ struct BeltVelocitySamples {
   [[nodiscard]] std::optional<double> median_mps() const;
 };
 
+/// The heights a heel or MT-head skin marker's centre stands above the floor at flat foot: at
+/// least a marker's radius, at most about 60 mm (24-55 mm on the development trials). The lowest
+/// flat-stance foot landmark outside them is reported as a likely marker-floor offset.
+inline constexpr double kMinFootMarkerHeightM = 0.008, kMaxFootMarkerHeightM = 0.070;
+
 /// Automatic ground level: 0 (the lab floor, where capture systems put it) when the feet's
 /// flat-stance landmarks stand 0-150 mm above it; otherwise the lowest of them (a raised or
 /// offset walkway), with a message.

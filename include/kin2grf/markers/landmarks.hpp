@@ -134,10 +134,13 @@ struct SagittalFrame {
 ///  - a coordinate beyond kMaxLabCoordinateM (no capture volume is 10 km; 1e300 would overflow);
 ///  - a one-frame spike: a sample farther than kMaxMarkerSpeedMps x dt + 2 cm from both neighbours
 ///    while the neighbours are within that of each other (a marker does not leave and come back in
-///    two frames faster than a thrown ball).
+///    two frames faster than a thrown ball);
+///  - a one-frame excursion from the neighbours' midpoint of more than kMaxMarkerAccelMps2 x dt^2 / 2
+///    and 2 cm: 100 g, beyond a skin marker's heel-strike transient (tens of g); two markers swapped
+///    for one frame (5 cm at 100 Hz).
 /// `only`: the markers to check (a set's motion_markers()); empty: all. Returns the cleaned copy,
 /// or nothing (and no copy) when every sample is usable.
-inline constexpr double kMaxLabCoordinateM = 1e4, kMaxMarkerSpeedMps = 30.0;
+inline constexpr double kMaxLabCoordinateM = 1e4, kMaxMarkerSpeedMps = 30.0, kMaxMarkerAccelMps2 = 1000.0;
 std::optional<MarkerTrajectories> without_marker_outliers(const MarkerTrajectories& markers, const std::vector<std::string>& only,
                                                           std::vector<std::string>& messages);
 /// The same, in place (no copy: for a caller that has given the trial up). Returns the number of
