@@ -336,10 +336,12 @@ Trial walk_with_repeated_labels(bool lateral_first) {
     }
     const std::string label = n == "RKJC" ? "RKNE" : "RANK";
     for (const auto* p : lateral_first ? std::array{&lateral, &medial} : std::array{&medial, &lateral}) {
-      out.names.push_back(unique_label(out.names, label, out.names.size(), &t.warnings));
+      out.names.push_back(label);
       out.positions_m.push_back(*p), out.descriptions.push_back("");
     }
   }
+  UniqueLabels unique;  // as the readers name them
+  for (std::size_t k = 0; k < out.names.size(); ++k) out.names[k] = unique.add(out.names[k], k, &t.warnings);
   t.markers = std::move(out);
   return t;
 }

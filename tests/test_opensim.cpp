@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <mutex>
 
@@ -266,4 +267,30 @@ TEST(Trc, TheRowsTextIsReleasedOnlyOnceParsedAndTheMarkersAreTheSame) {
   ASSERT_EQ(released.names, kept.names);
   for (std::size_t k = 0; k < kept.positions_m.size(); ++k)
     EXPECT_TRUE(released.positions_m[k].cwiseEqual(kept.positions_m[k]).all()) << kept.names[k];
+}
+
+// The 10-minute fuzz run of issue 31 found a TRC header of thousands of one repeated label taking
+// seconds: naming the k-th NAME#k searched NAME#2, NAME#3, ... for each. It is linear now.
+TEST(Trc, ThousandsOfOneRepeatedLabelAreNamedAtOnce) {
+  const int n = 20000;
+  std::string text = "PathFileType\t4\t(X/Y/Z)\tx.trc\nDataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\n100\t100\t2\t" +
+                     std::to_string(n) + "\tmm\nFrame#\tTime";
+  for (int k = 0; k < n; ++k) text += "\tM\t\t";
+  text += "\n\t";
+  for (int k = 0; k < n; ++k) text += "\tX\tY\tZ";
+  text += "\n";
+  for (int f = 1; f <= 2; ++f) {
+    text += std::to_string(f) + "\t" + std::to_string(0.01 * (f - 1));
+    for (int k = 0; k < n; ++k) text += "\t1\t2\t3";
+    text += "\n";
+  }
+  std::vector<std::string> warnings;
+  const auto start = std::chrono::steady_clock::now();
+  const auto m = parse_trc(text, "x.trc", &warnings);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+  ASSERT_EQ(m.names.size(), static_cast<std::size_t>(n));
+  EXPECT_EQ(m.names[0], "M");
+  EXPECT_EQ(m.names[1], "M#2");
+  EXPECT_EQ(m.names[n - 1], "M#" + std::to_string(n));
+  EXPECT_EQ(warnings.size(), 11u);  // ten named, then one for the rest
 }

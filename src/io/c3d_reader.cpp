@@ -443,6 +443,7 @@ double read_c3d_points(const C3dFile& f, const Bytes& b, const C3dLayout& l, con
   m.time_s.resize(nframes);
   for (long i = 0; i < nframes; ++i) m.time_s[i] = static_cast<double>(f.first_frame - 1 + i) / f.point_rate_hz;
   std::vector<int> point_slot;
+  UniqueLabels unique;
   for (int k = 0; k < npoints; ++k) {
     std::string name = k < static_cast<int>(labels.size()) ? labels[k] : "";
     if (name.empty()) name = "*" + std::to_string(k + 1);
@@ -450,12 +451,13 @@ double read_c3d_points(const C3dFile& f, const Bytes& b, const C3dLayout& l, con
       t.model_outputs.push_back(name);
       continue;
     }
-    name = unique_label(m.names, name, static_cast<std::size_t>(k), &t.warnings);
+    name = unique.add(name, static_cast<std::size_t>(k), &t.warnings);
     m.names.push_back(name);
     m.descriptions.push_back(k < static_cast<int>(descs.size()) ? descs[k] : "");
     m.positions_m.emplace_back(nframes, 3);
     point_slot.push_back(k);
   }
+  unique.finish(&t.warnings);
   const double scale = std::abs(f.point_scale);
   const long block = frames_per_block(frame_bytes);
   for (long i0 = 0; i0 < nframes; i0 += block) {

@@ -111,8 +111,10 @@ TrcHeader parse_trc_header(const std::vector<std::string_view>& lines, const std
     throw InputError(where(path, 3) + ": expected 'Frame#<tab>Time<tab>names...'");
   }
   {
-    std::vector<std::string> unique;  // a label used twice: the later one is NAME#k (unique_label)
-    for (std::size_t i = 0; i < names.size(); ++i) unique.push_back(unique_label(unique, names[i], i, warnings));
+    std::vector<std::string> unique;  // a label used twice: the k-th is NAME#k
+    UniqueLabels labels;
+    for (std::size_t i = 0; i < names.size(); ++i) unique.push_back(labels.add(names[i], i, warnings));
+    labels.finish(warnings);
     th.names = std::move(unique);
   }
   if (static_cast<double>(th.names.size()) != nmark_decl) {

@@ -21,18 +21,20 @@ const char* to_string(Side s) {
   }
 }
 
-std::string unique_label(const std::vector<std::string>& taken, const std::string& name, std::size_t index,
-                         std::vector<std::string>* warnings) {
-  if (std::find(taken.begin(), taken.end(), name) == taken.end()) return name;
-  // The k-th label NAME is NAME#k (in the file's order), so that a mapping file can name each
-  // occurrence: NAME#1 is the first (still called NAME), NAME#2 the second, ...
-  std::size_t k = 2;
-  while (std::find(taken.begin(), taken.end(), name + "#" + std::to_string(k)) != taken.end()) ++k;
-  const std::string renamed = name + "#" + std::to_string(k);
-  if (warnings)
+std::string UniqueLabels::add(const std::string& name, std::size_t index, std::vector<std::string>* warnings) {
+  if (taken_.insert(name).second) return name;
+  std::size_t& k = next_.try_emplace(name, 2).first->second;
+  std::string renamed;
+  do renamed = name + "#" + std::to_string(k++);
+  while (!taken_.insert(renamed).second);
+  if (warnings && ++repeats_ <= 10)
     warnings->push_back("marker label '" + name + "' repeated (column " + std::to_string(index + 1) + "); this one is named " + renamed +
                         ", the first " + name + " (" + name + "#1)");
   return renamed;
+}
+
+void UniqueLabels::finish(std::vector<std::string>* warnings) const {
+  if (warnings && repeats_ > 10) warnings->push_back("and " + std::to_string(repeats_ - 10) + " more repeated marker labels, named NAME#k likewise");
 }
 
 int MarkerTrajectories::find(const std::string& name) const {

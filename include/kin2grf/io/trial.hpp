@@ -13,6 +13,8 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace kin2grf {
@@ -22,10 +24,22 @@ enum class Side { Right, Left, General };
 
 const char* to_string(Axis a);
 
-/// A label read from a file, made unique: `name`, or NAME#k (k = index + 1) with a warning when
-/// `taken` already holds it (a label used twice is never silently shadowed by the first).
-std::string unique_label(const std::vector<std::string>& taken, const std::string& name, std::size_t index,
-                         std::vector<std::string>* warnings);
+/// The labels read from a file, made unique as they come: the k-th label NAME is NAME#k (the
+/// first keeps NAME), with a warning, so that a label used twice is never silently shadowed by the
+/// first and a mapping file can name each occurrence. Linear in the labels (a file of 10,000
+/// repeats is read at once).
+class UniqueLabels {
+ public:
+  /// `index`: the label's column (for the warning).
+  std::string add(const std::string& name, std::size_t index, std::vector<std::string>* warnings);
+  /// After the last label: one warning for the repeats past the tenth.
+  void finish(std::vector<std::string>* warnings) const;
+
+ private:
+  std::unordered_set<std::string> taken_;
+  std::unordered_map<std::string, std::size_t> next_;  ///< the next k to try for NAME#k
+  std::size_t repeats_ = 0;
+};
 const char* to_string(Side s);
 
 /// Marker trajectories of one trial, N frames x 3 per marker, metres, lab frame.
