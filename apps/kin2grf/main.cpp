@@ -151,8 +151,7 @@ int run_study(const StudyArgs& a) {
   for (auto& e : kin2grf::trial_list_of_files(a.trials, a.est, a.plates)) inputs.push_back(std::move(e));
   if (inputs.empty()) throw kin2grf::InputError("study: give TRIAL files or --trial-list FILE");
   check_outputs({a.out_json, a.report}, kin2grf::list_input_files(inputs));
-  const kin2grf::LoadedTrials L = kin2grf::load_trials(inputs);
-  const auto& st = L.study;
+  const auto st = kin2grf::study_trials(inputs);
   std::cerr << "kin2grf: study " << a.kind << " on " << st.size() << " trials\n";
   const auto res = kin2grf::run_study(a.kind, st);
   std::cout << kin2grf::format_study_table(res);
@@ -181,18 +180,18 @@ int run_fit_cop(const FitCopArgs& a) {
     if (a.activity.empty() || in.activity == a.activity) inputs.push_back(in);
   if (inputs.empty()) throw kin2grf::InputError(a.trial_list + ": no trial of activity '" + a.activity + "'");
   check_outputs({a.out}, kin2grf::list_input_files(inputs));
-  const kin2grf::LoadedTrials L = kin2grf::load_trials(inputs);
+  const auto trials = kin2grf::study_trials(inputs);
   // Start (and, without --fit-angles, keep) the paper's event angles.
   const kin2grf::CopFunction start = kin2grf::CopFunction::paper();
-  const auto res = kin2grf::fit_cop_on_trials(L.study, start, a.min_force, a.fit_angles, a.leave_one_out);
+  const auto res = kin2grf::fit_cop_on_trials(trials, start, a.min_force, a.fit_angles, a.leave_one_out);
   kin2grf::CopFitProvenance prov;
   prov.command = "kin2grf fit-cop --trial-list " + a.trial_list + " --activity " + a.activity + (a.fit_angles ? " --fit-angles" : "") +
                  (a.leave_one_out ? " --leave-one-out" : "");
   prov.activity = a.activity;
   prov.min_force_fraction = a.min_force;
   prov.fit_angles = a.fit_angles;
-  std::cout << kin2grf::format_cop_fit(res, L.study, start, prov);
-  const nlohmann::json j = kin2grf::cop_fit_json(res, L.study, start, prov);
+  std::cout << kin2grf::format_cop_fit(res, trials, start, prov);
+  const nlohmann::json j = kin2grf::cop_fit_json(res, trials, start, prov);
   if (!a.out.empty()) kin2grf::write_file_text(a.out, kin2grf::json_text(j));
   return 0;
 }

@@ -125,10 +125,12 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
   CopFitOnTrials out;
   // The samples depend on the kinematics only (sole points, inclination, kept stances), not on
   // the COP function the estimate ran with.
+  // One trial held at a time (a fit over many long trials): loaded, used, let go.
   for (std::size_t k = 0; k < n; ++k) {
     const auto& t = trials[k];
-    const auto e = estimate(*t.trial, t.static_trial, *t.marker_set, t.options);
-    collect_cop_samples(e, validate(e, *t.plates), min_force, per[k]);
+    const StudyTrialData d = t.data();
+    const auto e = estimate(*d.trial, d.static_trial, *d.marker_set, t.options);
+    collect_cop_samples(e, validate(e, *d.plates), min_force, per[k]);
     out.samples_per_trial.push_back(per[k].theta_rad.size());
   }
   // Leave one LAB out: a trial's held-out fit uses no trial of its lab (same lab, same set-up).
@@ -149,12 +151,13 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
     const auto& t = trials[k];
     const auto others = pooled(k);
     if (others.theta_rad.size() < 20) continue;
+    const StudyTrialData d = t.data();
     auto cop_rrmse = [&](const CopFunction& f) {
       EstimateOptions o = t.options;
       o.contact.cop = f;
       o.contact.running_cop.reset();  // the candidate alone, on every frame
-      const auto e = estimate(*t.trial, t.static_trial, *t.marker_set, o);
-      return mean_rrmse(validate(e, *t.plates).stances).cop;
+      const auto e = estimate(*d.trial, d.static_trial, *d.marker_set, o);
+      return mean_rrmse(validate(e, *d.plates).stances).cop;
     };
     out.leave_one_out.push_back(
         {t.name, cop_rrmse(start), cop_rrmse(CopFunction{}), cop_rrmse(out.fit.function), cop_rrmse(fit_fn(others).function)});

@@ -175,6 +175,39 @@ const std::vector<std::string>& study_kinds() {
   return kinds;
 }
 
+namespace {
+
+/// One trial at one setting.
+StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const Setting& s, std::string& failure) {
+  StudyTrialResult tr{t.name, t.activity, t.lab_or_name(), {}, std::numeric_limits<double>::quiet_NaN(), false};
+  EstimateOptions o = t.options;
+  s.apply(o);
+  try {
+    const int draws = s.marker_noise_m > 0 ? kNoiseRealizations : 1;
+    double grm_sum = 0;
+    int grm_n = 0;
+    for (int seed = 1; seed <= draws; ++seed) {
+      Trial noisy;
+      if (s.marker_noise_m > 0) {
+        noisy = *d.trial;
+        add_marker_noise(noisy.markers, s.marker_noise_m, static_cast<unsigned>(seed));
+      }
+      const EstimateResult e = estimate(s.marker_noise_m > 0 ? noisy : *d.trial, d.static_trial, *d.marker_set, o);
+      const ValidationResult v = validate(e, *d.plates);
+      tr.stances.insert(tr.stances.end(), v.stances.begin(), v.stances.end());
+      if (v.total && v.total->metrics.moment) grm_sum += v.total->metrics.moment->rrmse_percent, ++grm_n;
+    }
+    if (grm_n > 0) tr.total_grm = grm_sum / grm_n;
+  } catch (const InputError& err) {
+    tr.failed = true;
+    tr.stances.clear();
+    failure = t.name + " at " + s.label + ": " + err.what();
+  }
+  return tr;
+}
+
+}  // namespace
+
 StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& trials) {
   StudyResult res;
   res.kind = kind;
@@ -182,42 +215,28 @@ StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& tr
   for (const auto& t : trials)
     if (std::find(activities.begin(), activities.end(), t.activity) == activities.end()) activities.push_back(t.activity);
   if (activities.size() > 1) activities.push_back("all");
-  for (const Setting& s : settings_for(kind)) {
-    StudyRow row;
-    row.label = s.label;
-    row.value = s.value;
-    row.is_default = s.is_default;
-    std::vector<StudyTrialResult> per_trial;
-    for (const auto& t : trials) {
-      StudyTrialResult tr{t.name, t.activity, t.lab_or_name(), {}, std::numeric_limits<double>::quiet_NaN(), false};
-      EstimateOptions o = t.options;
-      s.apply(o);
-      try {
-        const int draws = s.marker_noise_m > 0 ? kNoiseRealizations : 1;
-        double grm_sum = 0;
-        int grm_n = 0;
-        for (int seed = 1; seed <= draws; ++seed) {
-          Trial noisy;
-          if (s.marker_noise_m > 0) {
-            noisy = *t.trial;
-            add_marker_noise(noisy.markers, s.marker_noise_m, static_cast<unsigned>(seed));
-          }
-          const EstimateResult e = estimate(s.marker_noise_m > 0 ? noisy : *t.trial, t.static_trial, *t.marker_set, o);
-          const ValidationResult v = validate(e, *t.plates);
-          tr.stances.insert(tr.stances.end(), v.stances.begin(), v.stances.end());
-          if (v.total && v.total->metrics.moment) grm_sum += v.total->metrics.moment->rrmse_percent, ++grm_n;
-        }
-        if (grm_n > 0) tr.total_grm = grm_sum / grm_n;
-      } catch (const InputError& err) {
-        tr.failed = true;
-        tr.stances.clear();
-        res.failures.push_back(t.name + " at " + s.label + ": " + err.what());
-      }
-      per_trial.push_back(std::move(tr));
+  const std::vector<Setting> settings = settings_for(kind);
+  // Trial by trial, every setting on each: a trial is loaded once and let go before the next
+  // (a study of many long trials holds one at a time). A trial that cannot be loaded ends the
+  // study, naming its file; one that fails at a setting is that setting's failure.
+  res.per_trial.assign(settings.size(), {});
+  std::vector<std::vector<std::string>> failures(settings.size());
+  for (const auto& t : trials) {
+    const StudyTrialData d = t.data();
+    for (std::size_t k = 0; k < settings.size(); ++k) {
+      std::string failure;
+      res.per_trial[k].push_back(run_setting(t, d, settings[k], failure));
+      if (!failure.empty()) failures[k].push_back(std::move(failure));
     }
-    for (const auto& a : activities) row.cells.push_back(pool(per_trial, a));
+  }
+  for (std::size_t k = 0; k < settings.size(); ++k) {
+    StudyRow row;
+    row.label = settings[k].label;
+    row.value = settings[k].value;
+    row.is_default = settings[k].is_default;
+    for (const auto& a : activities) row.cells.push_back(pool(res.per_trial[k], a));
     res.rows.push_back(std::move(row));
-    res.per_trial.push_back(std::move(per_trial));
+    res.failures.insert(res.failures.end(), failures[k].begin(), failures[k].end());
   }
   return res;
 }

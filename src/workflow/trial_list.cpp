@@ -112,35 +112,52 @@ std::vector<TrialListEntry> trial_list_of_files(const std::vector<std::string>& 
   return out;
 }
 
-LoadedTrials load_trials(const std::vector<TrialListEntry>& entries) {
-  LoadedTrials L;
-  // Reserved up front: StudyTrial points into these vectors.
-  L.trials.reserve(entries.size()), L.statics.reserve(entries.size()), L.plates.reserve(entries.size()), L.sets.reserve(entries.size());
+namespace {
+/// What a study trial's pointers point into while it is used.
+struct HeldTrial {
+  Trial trial;
+  std::optional<Trial> static_trial, plates_file;
+  MarkerSet set;
+};
+}  // namespace
+
+std::vector<StudyTrial> study_trials(const std::vector<TrialListEntry>& entries) {
+  std::vector<StudyTrial> out;
+  out.reserve(entries.size());
   for (const auto& in : entries) {
-    L.trials.push_back(load_trial(in.settings.trial, load_options("unloaded")));
+    // Each file is checked now (a missing one ends the command before any work), read when used.
+    for (const auto* f : {&in.settings.trial, &in.settings.static_trial, &in.plates})
+      if (!f->empty()) check_input_file(*f);
     StudyTrial x;
     x.name = in.name;
     x.activity = in.activity;
     x.lab = in.lab;
-    x.trial = &L.trials.back();
-    if (!in.settings.static_trial.empty()) {
-      L.statics.push_back(load_trial(in.settings.static_trial));
-      x.static_trial = &L.statics.back();
-    }
-    const Trial* source = x.trial;
-    if (!in.plates.empty()) {
-      L.plates.push_back(load_trial(in.plates, load_options("unloaded")));
-      source = &L.plates.back();
-    }
-    if (!source->plates || source->plates->plates.empty()) throw InputError(source->path + ": no force plates; give --plates");
-    x.plates = &*source->plates;
-    MarkerSet custom;
-    L.sets.push_back(resolve_marker_set(in.settings, *x.trial, custom));
-    x.marker_set = &L.sets.back();
     x.options = to_options(in.settings);
-    L.study.push_back(x);
+    x.load = [settings = in.settings, plates = in.plates] {
+      auto held = std::make_shared<HeldTrial>();
+      held->trial = load_trial(settings.trial, load_options("unloaded"));
+      StudyTrialData d;
+      d.trial = &held->trial;
+      if (!settings.static_trial.empty()) {
+        held->static_trial = load_trial(settings.static_trial);
+        d.static_trial = &*held->static_trial;
+      }
+      const Trial* source = &held->trial;
+      if (!plates.empty()) {
+        held->plates_file = load_trial(plates, load_options("unloaded"));
+        source = &*held->plates_file;
+      }
+      if (!source->plates || source->plates->plates.empty()) throw InputError(source->path + ": no force plates; give --plates");
+      d.plates = &*source->plates;
+      MarkerSet custom;
+      held->set = resolve_marker_set(settings, held->trial, custom);
+      d.marker_set = &held->set;
+      d.held = held;
+      return d;
+    };
+    out.push_back(std::move(x));
   }
-  return L;
+  return out;
 }
 
 }  // namespace kin2grf

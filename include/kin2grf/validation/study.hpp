@@ -19,6 +19,8 @@
 
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -30,6 +32,16 @@
 namespace kin2grf {
 
 /// One trial of a study, loaded, with its own options (mass etc.).
+/// A study trial's data, held while it is used: the trial, its static trial and plates, its
+/// marker set. Pointers into data the caller keeps, or into `held` (a trial loaded for the use).
+struct StudyTrialData {
+  const Trial* trial = nullptr;
+  const Trial* static_trial = nullptr;
+  const ForcePlateRecording* plates = nullptr;
+  const MarkerSet* marker_set = nullptr;
+  std::shared_ptr<const void> held;  ///< what the pointers point into, when loaded for this use
+};
+
 struct StudyTrial {
   std::string name, activity;
   std::string lab;  ///< the recording's lab (or data source): the unit of leave-one-lab-out
@@ -40,6 +52,12 @@ struct StudyTrial {
   const ForcePlateRecording* plates = nullptr;
   const MarkerSet* marker_set = nullptr;
   EstimateOptions options;
+  /// When set, the trial is loaded by this each time it is used and let go after, so that a study
+  /// of many trials holds one at a time (the pointers above are then unused); InputError naming
+  /// the file when it cannot be read or has no plates.
+  std::function<StudyTrialData()> load;
+  /// The data: load() when set, else the pointers.
+  [[nodiscard]] StudyTrialData data() const { return load ? load() : StudyTrialData{trial, static_trial, plates, marker_set, nullptr}; }
 };
 
 struct StudyCell {

@@ -42,20 +42,11 @@ std::vector<std::string> list_input_files(const std::vector<TrialListEntry>& ent
 std::vector<TrialListEntry> trial_list_of_files(const std::vector<std::string>& files, const Settings& settings,
                                                 const std::string& plates);
 
-/// A list's trials loaded once for a study or a fit: each entry's trial, static trial, plates
-/// (its own or --plates; plate offsets removed from unloaded samples) and marker set, and the
-/// StudyTrial that points into them. Movable, not copyable (the pointers stay valid on a move).
-struct LoadedTrials {
-  std::vector<Trial> trials, statics, plates;
-  std::vector<MarkerSet> sets;
-  std::vector<StudyTrial> study;
-  LoadedTrials() = default;
-  LoadedTrials(const LoadedTrials&) = delete;
-  LoadedTrials& operator=(const LoadedTrials&) = delete;
-  LoadedTrials(LoadedTrials&&) = default;
-  LoadedTrials& operator=(LoadedTrials&&) = default;
-};
-/// InputError naming the file when an entry's trial cannot be read or has no plates.
-LoadedTrials load_trials(const std::vector<TrialListEntry>& entries);
+/// A list's trials for a study or a fit, each loaded when it is used and let go after (its trial,
+/// static trial, plates, its own or --plates with plate offsets removed from unloaded samples, and
+/// marker set): memory does not grow with the number of trials. Every file is checked to exist
+/// now; InputError naming the file when one does not, or later when one cannot be read or has no
+/// plates.
+std::vector<StudyTrial> study_trials(const std::vector<TrialListEntry>& entries);
 
 }  // namespace kin2grf
