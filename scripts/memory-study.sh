@@ -4,14 +4,18 @@
 # (with its two plates) as a long C3D of about 16 MB, listed N times under four labs; the peak
 # must not grow with N. Uses the release build.
 #   bash scripts/memory-study.sh [N_FIT] [N_STUDY] [SECONDS]     (defaults 400, 40, 600 s a trial)
+# The old build at bbeadbe, for comparison: KIN2GRF=/path/to/old/kin2grf bash scripts/memory-study.sh 40 8
 set -euo pipefail
 cd "$(dirname "$0")/.."
 N_FIT=${1:-400}
 N_STUDY=${2:-40}
 SECONDS_TRIAL=${3:-600}
-cmake --preset release >/dev/null
-cmake --build --preset release --target kin2grf_cli >/dev/null
-K=build/release/kin2grf
+# KIN2GRF=path/to/kin2grf measures another build (the release build by default).
+if [ -z "${KIN2GRF:-}" ]; then
+  cmake --preset release >/dev/null
+  cmake --build --preset release --target kin2grf_cli >/dev/null
+fi
+K=${KIN2GRF:-build/release/kin2grf}
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 "$K" make-example --out-dir "$WORK" --seconds "$SECONDS_TRIAL" >/dev/null
