@@ -111,7 +111,7 @@ TEST(OutputFile, ATransactionPlacesItsFilesTogetherOrNotAtAll) {
   const std::string a = (dir / "a.csv").string(), b = (dir / "b.json").string(), old = (dir / "old.mot").string();
   write_file_text(old, "old\n");
   {
-    OutputTransaction run;
+    OutputTransaction run(true);
     write_file_text(a, "a\n");
     write_file_text(old, "new\n");
     EXPECT_FALSE(fs::exists(a));
@@ -121,7 +121,7 @@ TEST(OutputFile, ATransactionPlacesItsFilesTogetherOrNotAtAll) {
   EXPECT_EQ(names_in(dir), std::vector<std::string>{"old.mot"});
   EXPECT_EQ(read_file_text(old), "old\n");
   {
-    OutputTransaction run;
+    OutputTransaction run(true);
     std::thread worker([&] {
       OutputTransaction trial;
       write_file_text(b, "b\n");
@@ -135,6 +135,17 @@ TEST(OutputFile, ATransactionPlacesItsFilesTogetherOrNotAtAll) {
   EXPECT_EQ(read_file_text(a), "a\n");
   EXPECT_EQ(read_file_text(b), "b\n");
   EXPECT_EQ(names_in(dir), (std::vector<std::string>{"a.csv", "b.json", "old.mot"}));
+  // Without a run's transaction (a library or Python caller), each worker's transaction places
+  // its own files: a batch's trials on several threads never hand files to one another.
+  std::vector<std::thread> workers;
+  for (int w = 0; w < 4; ++w)
+    workers.emplace_back([&, w] {
+      OutputTransaction trial;
+      write_file_text((dir / ("w" + std::to_string(w) + ".csv")).string(), "w\n");
+      trial.commit();
+    });
+  for (auto& t : workers) t.join();
+  for (int w = 0; w < 4; ++w) EXPECT_TRUE(fs::exists(dir / ("w" + std::to_string(w) + ".csv"))) << w;
 }
 
 // Two writers of one file (two runs at once) each rename a whole file of their own: the file is

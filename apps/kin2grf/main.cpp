@@ -359,7 +359,7 @@ int main(int argc, char** argv) {
   kin2grf::install_output_cleanup_on_signals();
   std::signal(SIGPIPE, SIG_IGN);
   try {
-    kin2grf::OutputTransaction outputs;
+    kin2grf::OutputTransaction outputs(/*whole_run=*/true);
     int rc = 0;
     auto chosen = [](const CLI::App* c) { return c && c->parsed(); };
     if (chosen(info)) rc = run_info(info_file, info_json, info_threshold, info_zero, info_up_axis);

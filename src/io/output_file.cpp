@@ -252,11 +252,11 @@ void write_file_text(const std::string& path, std::string_view text) {
   f.commit();
 }
 
-OutputTransaction::OutputTransaction() : parent_(thread_transaction), previous_on_thread_(thread_transaction) {
+OutputTransaction::OutputTransaction(bool whole_run) : parent_(thread_transaction), previous_on_thread_(thread_transaction) {
   if (!parent_) {
     OutputTransaction* none = nullptr;
-    if (root_transaction.compare_exchange_strong(none, this)) root_ = true;
-    else parent_ = none;  // the process's outermost, on another thread
+    if (whole_run && root_transaction.compare_exchange_strong(none, this)) root_ = true;
+    else parent_ = root_transaction.load();  // the run's, on another thread; or none: standalone
   }
   thread_transaction = this;
 }

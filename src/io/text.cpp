@@ -123,9 +123,10 @@ extern "C" void on_sigbus(int sig, siginfo_t* info, void* context) {
     }
     break;
   }
-  // Not ours: the disposition there was before, on the same fault again.
+  // Not ours: the disposition there was before (a host's handler, or the default's end of the
+  // process) takes the same fault again when the instruction is retried on return.
+  (void)sig, (void)context;
   ::sigaction(SIGBUS, &previous_sigbus, nullptr);
-  if ((previous_sigbus.sa_flags & SA_SIGINFO) && previous_sigbus.sa_sigaction) previous_sigbus.sa_sigaction(sig, info, context);
 }
 
 void install_sigbus_handler() {

@@ -48,13 +48,15 @@ void write_file_text(const std::string& path, std::string_view text);
 
 /// The outputs of one run (or of one trial of a batch), placed together or not at all. While one
 /// is alive on a thread, AtomicFile::commit() on that thread hands it the finished temporary file
-/// instead of renaming it; with none on the thread, the process's outermost transaction (the CLI's
-/// run) takes it; with none at all (a library or Python caller), the file is renamed at once.
+/// instead of renaming it; with none on the thread, the whole run's transaction (the CLI's) takes
+/// it; with none at all (a library or Python caller), the file is renamed at once.
 /// commit() of a nested transaction hands its files to the enclosing one; commit() of the
 /// outermost renames them all. Destroyed uncommitted, it removes every temporary file it holds.
 class OutputTransaction {
  public:
-  OutputTransaction();
+  /// `whole_run`: the process's outermost (a program's run, which worker threads hand their
+  /// files to); otherwise nested in the thread's, or in the run's, or standalone when neither is.
+  explicit OutputTransaction(bool whole_run = false);
   ~OutputTransaction();
   OutputTransaction(const OutputTransaction&) = delete;
   OutputTransaction& operator=(const OutputTransaction&) = delete;
