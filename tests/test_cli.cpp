@@ -3,6 +3,7 @@
 // trial is the project's own synthetic example (make-example), so no shared data is needed.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -478,6 +479,13 @@ TEST(CliFiles, DevicesFifosAndStandardOutputAreWrittenInPlace) {
   const CliRun out = run("estimate " + example_trc() + " --mass 70 --csv /dev/stdout", "2>/dev/null");
   EXPECT_EQ(out.status, 0);
   EXPECT_NE(out.out.find("frame,time_s"), std::string::npos) << out.out.substr(0, 300);
+  // A character device made with mknod (the recipe; root only): still one after --csv.
+  const auto dev = dir / "null-device";
+  if (::mknod(dev.c_str(), S_IFCHR | 0666, makedev(1, 3)) == 0) {
+    EXPECT_EQ(run("estimate " + example_trc() + " --mass 70 --csv " + dev.string()).status, 0);
+    ASSERT_EQ(::stat(dev.c_str(), &st), 0);
+    EXPECT_TRUE(S_ISCHR(st.st_mode));
+  }
   const auto fifo = dir / "pipe.csv";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   const CliRun piped = run("estimate " + example_trc() + " --mass 70 --csv " + fifo.string() + " & cat " + fifo.string() +
