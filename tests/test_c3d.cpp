@@ -211,8 +211,10 @@ TEST(C3dCorrupt, RandomByteFlipsNeverCrash) {
       ++errors;
     }
   }
-  EXPECT_EQ(errors + reads, 1500);
+  // Anything but a trial or an InputError fails the test by escaping. Both outcomes occur: a flip
+  // in the structure is refused, one in a sample still reads (the flips reach both).
   EXPECT_GT(errors, 0);
+  EXPECT_GT(reads, 0);
 }
 
 TEST(C3dShared, Walking2MatchesOpenSimReferenceAt2p80s) {
