@@ -4,7 +4,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
 #include <mutex>
+#include <sstream>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/load.hpp"
@@ -293,4 +298,116 @@ TEST(Trc, ThousandsOfOneRepeatedLabelAreNamedAtOnce) {
   EXPECT_EQ(m.names[1], "M#2");
   EXPECT_EQ(m.names[n - 1], "M#" + std::to_string(n));
   EXPECT_EQ(warnings.size(), 11u);  // ten named, then one for the rest
+}
+
+// ---------------------------------------------------------------------------------------------
+// The TRC kin2grf writes for OpenSim, read by OpenSim's own rules (opensim-core,
+// OpenSim/Common/FileAdapter.cpp and TRCFileAdapter.cpp, TRCFileAdapter::extendRead), restated
+// here rather than through kin2grf's reader:
+// - a line is split by FileAdapter::tokenize on the delimiters "\t\r" (data) or " \t\r" (first
+//   line); a run of delimiters is one, so an empty field is no token at all;
+// - getNextLine skips lines with no token;
+// - line 1 starts with PathFileType; line 2 is exactly the 8 keys DataRate CameraRate NumFrames
+//   NumMarkers Units OrigDataRate OrigDataStartFrame OrigNumFrames; line 3 has as many values;
+// - line 4 is Frame#, Time and NumMarkers labels; line 5 is X1 Y1 Z1 X2 ...;
+// - every data row has exactly 3 NumMarkers + 2 tokens (else RowLengthMismatch), each read by
+//   std::stod (which takes "NaN").
+namespace {
+::testing::AssertionResult opensim_reads_trc(const std::string& text) {
+  auto tokenize = [](const std::string& line, const std::string& delims) {
+    std::vector<std::string> tokens;
+    std::string cur;
+    for (const char c : line) {
+      if (delims.find(c) != std::string::npos) {
+        if (!cur.empty()) tokens.push_back(cur), cur.clear();
+      } else {
+        cur += c;
+      }
+    }
+    if (!cur.empty()) tokens.push_back(cur);
+    return tokens;
+  };
+  std::istringstream in(text);
+  std::string line;
+  std::getline(in, line);
+  if (tokenize(line, " \t\r").empty() || tokenize(line, " \t\r")[0] != "PathFileType") return ::testing::AssertionFailure() << "MissingHeader";
+  auto next = [&] {
+    while (std::getline(in, line)) {
+      auto t = tokenize(line, "\t\r");
+      if (!t.empty()) return t;
+    }
+    return std::vector<std::string>{};
+  };
+  const std::vector<std::string> keys_expected = {"DataRate", "CameraRate", "NumFrames", "NumMarkers", "Units", "OrigDataRate",
+                                                  "OrigDataStartFrame", "OrigNumFrames"};
+  const auto keys = next();
+  if (keys != keys_expected) return ::testing::AssertionFailure() << "metadata keys";
+  const auto values = next();
+  if (values.size() != keys.size()) return ::testing::AssertionFailure() << "MetaDataLengthMismatch";
+  const std::size_t markers = std::stoul(values[3]);
+  const auto labels = next();
+  if (labels.size() != markers + 2 || labels[0] != "Frame#" || labels[1] != "Time")
+    return ::testing::AssertionFailure() << "IncorrectNumColumnLabels: " << labels.size() << " for " << markers << " markers";
+  const auto xyz = next();
+  for (std::size_t k = 0; k < markers; ++k)
+    for (int a = 0; a < 3; ++a)
+      if (xyz.at(3 * k + static_cast<std::size_t>(a)) != std::string(1, "XYZ"[a]) + std::to_string(k + 1))
+        return ::testing::AssertionFailure() << "UnexpectedColumnLabel " << xyz.at(3 * k + static_cast<std::size_t>(a));
+  std::size_t rows = 0;
+  for (auto row = next(); !row.empty(); row = next(), ++rows) {
+    if (row.size() != 3 * markers + 2)
+      return ::testing::AssertionFailure() << "RowLengthMismatch at data row " << rows + 1 << ": " << row.size() << " tokens, expected "
+                                           << 3 * markers + 2;
+    for (const auto& t : row) {
+      std::size_t used = 0;
+      (void)std::stod(t, &used);
+      if (used == 0) return ::testing::AssertionFailure() << "not a number: " << t;
+    }
+  }
+  if (rows != std::stoul(values[2])) return ::testing::AssertionFailure() << rows << " rows, NumFrames " << values[2];
+  return ::testing::AssertionSuccess();
+}
+}  // namespace
+
+// A trial with gaps, the last marker's among them (the trailing empty fields OpenSim dropped:
+// walking2.c3d's export had 835 of 1249 rows short), is read by OpenSim's rules and, by
+// kin2grf's reader, back with the same gaps.
+TEST(Trc, AnExportWithGapsIsReadByOpenSimsRules) {
+  Trial t = make_example_walk();
+  auto& m = t.markers;
+  m.positions_m.back().middleRows(10, 20).setConstant(std::numeric_limits<double>::quiet_NaN());
+  m.positions_m.front().middleRows(50, 5).setConstant(std::numeric_limits<double>::quiet_NaN());
+  m.positions_m[3](70, 1) = std::numeric_limits<double>::quiet_NaN();
+  const std::string text = format_trc(m, "gaps.trc");
+  EXPECT_TRUE(opensim_reads_trc(text));
+  const auto back = parse_trc(text, "gaps.trc");
+  EXPECT_FALSE(back.positions_m.back().row(15).allFinite());
+  EXPECT_TRUE(back.positions_m.back().row(9).allFinite());
+  EXPECT_FALSE(back.positions_m.front().row(52).allFinite());
+  EXPECT_TRUE(std::isnan(back.positions_m[3](70, 1)));
+}
+
+// Every development trial's OpenSim export (estimate --opensim) is read by OpenSim's rules.
+TEST(SharedOpenSim, EveryExportsTrcIsReadByOpenSimsRules) {
+  KIN2GRF_REQUIRE_DATA();
+  std::ifstream list(std::string(KIN2GRF_SOURCE_DIR) + "/scripts/trials.txt");
+  ASSERT_TRUE(list);
+  const auto dir = test::temp_dir("opensim_rules");
+  int trials = 0;
+  for (std::string line; std::getline(list, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::size_t bar = 0;
+    for (int k = 0; k < 3; ++k) bar = line.find('|', bar) + 1;
+    std::string args = line.substr(bar);
+    for (std::size_t p; (p = args.find("DATA")) != std::string::npos;) args.replace(p, 4, test::data_dir());
+    if (const auto p = args.find("--plates "); p != std::string::npos) args.erase(p, args.find(' ', p + 9) - p);
+    const auto out = dir / std::to_string(trials++);
+    const std::string cmd = std::string(KIN2GRF_CLI) + " estimate " + args + " --opensim " + out.string() + " >/dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    for (const auto& e : std::filesystem::directory_iterator(out))
+      if (e.path().extension() == ".trc") {
+        EXPECT_TRUE(opensim_reads_trc(read_file_text(e.path().string()))) << line;
+      }
+  }
+  EXPECT_GE(trials, 10);
 }

@@ -280,12 +280,16 @@ std::string format_trc(const MarkerTrajectories& m, const std::string& file_name
   os << "\n\t";
   for (std::size_t k = 0; k < m.names.size(); ++k) os << "\tX" << k + 1 << "\tY" << k + 1 << "\tZ" << k + 1;
   os << "\n\n";
+  // A missing coordinate is written NaN, never left empty: OpenSim's TRC reader (FileAdapter::
+  // tokenize) drops empty fields, so a row with a gap came out short and was refused
+  // (RowLengthMismatch); "NaN" is a field of its own that it reads as missing, as it writes them.
   for (Eigen::Index i = 0; i < n; ++i) {
     os << m.first_frame + i << "\t" << fmt(m.time_s[i]);
     for (const auto& P : m.positions_m) {
       for (int a = 0; a < 3; ++a) {
         os << "\t";
         if (std::isfinite(P(i, a))) os << fmt(P(i, a) * 1000.0);
+        else os << "NaN";
       }
     }
     os << "\n";
