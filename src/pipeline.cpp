@@ -111,7 +111,7 @@ void check_options(const EstimateOptions& o) {
   require(o.grm_reference_m.allFinite(), "GRM reference (m)", o.grm_reference_m.x() + o.grm_reference_m.y(), "finite");
   if (o.mass_kg)
     require(finite(*o.mass_kg) && *o.mass_kg > 0 && (o.allow_unusual_mass || (*o.mass_kg >= kMassRangeKg[0] && *o.mass_kg <= kMassRangeKg[1])),
-            "body mass (kg)", *o.mass_kg, "between 20 and 300 (or allowed as unusual)");
+            "body mass (kg)", *o.mass_kg, "between 20 and 300 (--force-mass takes an unusual one)");
 }
 
 namespace {
@@ -120,11 +120,11 @@ namespace {
 double resolve_mass(const Trial& trial, const EstimateOptions& o) {
   if (o.mass_kg) return *o.mass_kg;  // checked by check_options
   if (!trial.body_mass_kg)
-    throw InputError(trial.path + ": no body mass: the file stores none (PROCESSING:Bodymass, SUBJECT(S):WEIGHT); give the mass");
+    throw InputError(trial.path + ": no body mass: the file stores none (PROCESSING:Bodymass, SUBJECT(S):WEIGHT); give the mass (--mass KG)");
   const double m = *trial.body_mass_kg;
   if (!o.allow_unusual_mass && !(m >= kMassRangeKg[0] && m <= kMassRangeKg[1])) {
     char b[200];
-    std::snprintf(b, sizeof b, ": the file's body mass %g kg is outside 20-300 kg; give the mass (or allow an unusual one)", m);
+    std::snprintf(b, sizeof b, ": the file's body mass %g kg is outside 20-300 kg; give the mass (--mass KG), or --force-mass to take it", m);
     throw InputError(trial.path + b);
   }
   return m;

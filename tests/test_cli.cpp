@@ -643,3 +643,30 @@ TEST(CliFiles, ABomOrCrOnlyTrcIsReadAndAFolderIsNamedAsOne) {
   EXPECT_EQ(zero.status, 2);
   EXPECT_NE(zero.out.find("/dev/zero: is not a regular file"), std::string::npos) << zero.out;
 }
+
+// Errors that suggest (issue 30, item 6): a misspelt option, subcommand or preset gets a "did you
+// mean", the mass messages name their flags, and a GRF file given as the trial is named as one.
+TEST(CliSuggest, SlipsGetASuggestionOrTheFlagToUse) {
+  const std::string trc = example_trc();
+  const CliRun option = run("estimate " + trc + " --mas 64.9");
+  EXPECT_EQ(option.status, 2);
+  EXPECT_NE(option.out.find("unknown option '--mas'; did you mean --mass?"), std::string::npos) << option.out;
+  const CliRun command = run("estimat " + trc);
+  EXPECT_EQ(command.status, 2);
+  EXPECT_NE(command.out.find("did you mean 'estimate'?"), std::string::npos) << command.out;
+  const CliRun preset = run("estimate " + trc + " --mass 70 --markers plug-in-gat");
+  EXPECT_EQ(preset.status, 2);
+  EXPECT_NE(preset.out.find("did you mean plug-in-gait?"), std::string::npos) << preset.out;
+  EXPECT_NE(preset.out.find("presets: "), std::string::npos) << preset.out;
+  const CliRun mass = run("estimate " + trc);
+  EXPECT_EQ(mass.status, 2);
+  EXPECT_NE(mass.out.find("--mass KG"), std::string::npos) << mass.out;
+  const CliRun unusual = run("estimate " + trc + " --mass 15");
+  EXPECT_EQ(unusual.status, 2);
+  EXPECT_NE(unusual.out.find("--force-mass"), std::string::npos) << unusual.out;
+  const CliRun grf = run("estimate " + (example_dir() / "example_walk_grf.mot").string() + " --mass 70");
+  EXPECT_EQ(grf.status, 2);
+  EXPECT_NE(grf.out.find("a force file"), std::string::npos) << grf.out;
+  EXPECT_NE(grf.out.find("--plates"), std::string::npos) << grf.out;
+  EXPECT_EQ(kin2grf::closest_match("xyzzy", {"estimate", "validate"}), "");
+}

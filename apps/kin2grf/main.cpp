@@ -240,6 +240,34 @@ int run_make_example(const std::string& dir, double seconds, double rate_hz, dou
   return 0;
 }
 
+/// "Did you mean ...?" for a misspelt subcommand (the first word) or long option of the chosen
+/// subcommand, on standard error after CLI11's own message.
+void suggest_spelling(CLI::App& app, int argc, char** argv, const std::vector<std::string>& commands) {
+  if (argc < 2) return;
+  const std::string first = argv[1];
+  if (first.empty() || first[0] == '-') return;
+  if (std::find(commands.begin(), commands.end(), first) == commands.end()) {
+    if (const auto near = kin2grf::closest_match(first, commands); !near.empty())
+      std::cerr << "kin2grf: unknown command '" << first << "'; did you mean '" << near << "'?\n";
+    return;
+  }
+  const CLI::App* sub = nullptr;
+  for (const CLI::App* c : app.get_subcommands([](const CLI::App*) { return true; }))
+    if (c->get_name() == first) sub = c;
+  if (!sub) return;
+  std::vector<std::string> names;
+  for (const CLI::Option* o : sub->get_options())
+    for (const auto& l : o->get_lnames()) names.push_back("--" + l);
+  for (int i = 2; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.rfind("--", 0) != 0) continue;
+    const std::string flag = word.substr(0, word.find('='));
+    if (std::find(names.begin(), names.end(), flag) != names.end()) continue;
+    if (const auto near = kin2grf::closest_match(flag, names); !near.empty())
+      std::cerr << "kin2grf: unknown option '" << flag << "'; did you mean " << near << "?\n";
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -351,8 +379,11 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // --help and --version exit 0; every usage error exits 2 (README, "Exit status").
-    return app.exit(e) == 0 ? 0 : 2;
+    // --help and --version exit 0; every usage error exits 2 (README, "Exit status"), with a
+    // suggestion for a misspelt subcommand or option.
+    if (app.exit(e) == 0) return 0;
+    suggest_spelling(app, argc, argv, commands);
+    return 2;
   }
   // A run's outputs are placed together at its end, or not at all; a signal removes their
   // temporary files. A closed standard output (`| head -1`) is not a reason to die half way.

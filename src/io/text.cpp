@@ -352,6 +352,30 @@ void split_views(std::string_view s, char delim, std::vector<std::string_view>& 
   out.emplace_back(d + start, n - start);
 }
 
+std::string closest_match(const std::string& word, const std::vector<std::string>& candidates) {
+  const std::string w = to_lower(word);
+  const std::size_t allowed = std::clamp<std::size_t>(w.size() / 3, 1, 3);
+  std::string best;
+  std::size_t best_d = allowed + 1;
+  for (const auto& c : candidates) {
+    const std::string v = to_lower(c);
+    // Levenshtein distance, one row at a time.
+    std::vector<std::size_t> row(v.size() + 1);
+    for (std::size_t j = 0; j <= v.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= w.size(); ++i) {
+      std::size_t diagonal = row[0];
+      row[0] = i;
+      for (std::size_t j = 1; j <= v.size(); ++j) {
+        const std::size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (w[i - 1] == v[j - 1] ? 0 : 1)});
+        diagonal = up;
+      }
+    }
+    if (row[v.size()] < best_d) best_d = row[v.size()], best = c;
+  }
+  return best;
+}
+
 std::string extension(const std::string& path) {
   const auto ext = std::filesystem::path(path).extension().string();
   return ext.empty() ? "" : to_lower(ext.substr(1));

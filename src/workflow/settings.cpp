@@ -9,6 +9,7 @@
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/trial.hpp"
+#include "kin2grf/io/text.hpp"
 #include "kin2grf/markers/presets.hpp"
 #include "kin2grf/parallel.hpp"
 
@@ -188,11 +189,25 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
 }
 
 const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, MarkerSet& custom, std::string* why) {
+  std::vector<std::string> presets;
+  for (const auto& s : builtin_marker_sets()) presets.push_back(s.name);
   if (!a.markers.empty()) {
     if (const auto* set = find_marker_set(a.markers)) return *set;
+    std::error_code ec;
+    if (!std::filesystem::exists(a.markers, ec)) {
+      // Neither a preset nor a file: most likely a preset's name misspelt.
+      std::string list;
+      for (const auto& n : presets) list += (list.empty() ? "" : ", ") + n;
+      const std::string near = closest_match(a.markers, presets);
+      throw InputError("--markers " + a.markers + ": neither a preset nor a file" + (near.empty() ? "" : "; did you mean " + near + "?") +
+                       " (presets: " + list + "; or a mapping file, docs/MARKERSETS.md)");
+    }
     custom = load_marker_set(a.markers);
     return custom;
   }
+  if (trial.markers.names.empty() && trial.plates && !trial.plates->plates.empty())
+    throw InputError(a.trial + ": a force file (ground reaction columns, no markers), not a motion trial: give the markers' file as "
+                     "the trial and this one to validate with --plates");
   std::string reason;
   const auto* set = recognise_marker_set(trial.markers, &reason);
   if (!set) {

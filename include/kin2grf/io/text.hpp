@@ -95,6 +95,10 @@ bool parse_double(std::string_view s, double& out);
 /// False for anything else (blank fields, exponents, NaN, more or fewer fields), and then `out`
 /// is undefined: the caller takes its general path.
 bool parse_plain_fields(std::string_view line, char delim, std::span<double> out);
+/// The candidate nearest `word` by edit distance (case-insensitive), when it is near enough to be
+/// a slip (at most a third of the word's length, at least 1, at most 3 edits); else empty. For
+/// "did you mean ...?" on a misspelt option, subcommand or preset.
+std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
 /// Lower-case file extension without the dot ("c3d", "trc", "mot", "sto").
 std::string extension(const std::string& path);
 
