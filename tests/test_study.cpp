@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "kin2grf/error.hpp"
@@ -19,6 +20,7 @@
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
 #include "kin2grf/validation/cop_fit.hpp"
+#include "kin2grf/workflow/batch.hpp"
 #include "kin2grf/workflow/trial_list.hpp"
 #include "kin2grf/validation/metrics.hpp"
 #include "kin2grf/validation/study.hpp"
@@ -229,4 +231,23 @@ TEST(Study, TrialsAreLoadedOneAtATimeAndLetGo) {
   EXPECT_LE(counts->loads, 6);
   EXPECT_EQ(counts->most_alive, 1);
   EXPECT_EQ(counts->alive, 0);
+}
+
+// The batch CSV keeps full precision (issue 30: it rounded to 4 significant figures): each number
+// reads back as the row's own double.
+TEST(Batch, TheCsvKeepsFullPrecision) {
+  const auto dir = test::temp_dir("batch_precision");
+  const auto files = write_examples(dir.string(), 3.0, 100.0, 0.0);
+  TrialListEntry e = parse_trial_list_line("walking|lab|walk|" + (dir / "example_walk.c3d").string() + " --mass 70", "list:1");
+  const BatchRow row = run_batch_entry(e);
+  ASSERT_TRUE(row.ok) << row.error;
+  const std::string csv = batch_csv({row});
+  const std::string line = csv.substr(csv.find('\n') + 1);
+  std::vector<std::string> cells;
+  std::stringstream ss(line);
+  for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+  ASSERT_GE(cells.size(), 13u);
+  EXPECT_EQ(std::stod(cells[12]), row.vertical) << cells[12];  // vertical_rrmse_pct
+  EXPECT_EQ(std::stod(cells[9]), row.mass_kg);
+  EXPECT_GT(cells[12].size(), 6u) << "more than 4 significant figures";
 }

@@ -1,6 +1,7 @@
 #include "kin2grf/workflow/batch.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <atomic>
 #include <cctype>
 #include <chrono>
@@ -191,10 +192,12 @@ std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, cons
 
 namespace {
 std::string cell(double v) {
+  // Full precision, the shortest text that reads back as the same double (it was %.4g: a table
+  // for analysis, not for the eye, which format_batch_table serves).
   if (!std::isfinite(v)) return "";
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
 }
 std::string quoted(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
