@@ -167,6 +167,15 @@ TEST(TrialList, EachLineHasOnlyItsOwnOptionsWhateverTheLineEndings) {
   EXPECT_EQ(list[1].line, 3);
   EXPECT_EQ(list[2].settings.max_gap, 4);
   EXPECT_EQ(list[2].line, 4);
+  // A plain path line (issue 30): named by its file, its own lab.
+  const auto plain = parse_trial_list("\"data/walk one.c3d\"\ndata/run.trc --mass 60\n", "plain.txt");
+  ASSERT_EQ(plain.size(), 2u);
+  EXPECT_EQ(plain[0].settings.trial, "data/walk one.c3d");  // quoted: a path with a space
+  EXPECT_EQ(plain[1].settings.trial, "data/run.trc");
+  EXPECT_EQ(plain[1].name, "run.trc");
+  EXPECT_EQ(plain[1].lab, "run.trc");
+  EXPECT_EQ(plain[1].activity, "trials");
+  EXPECT_EQ(plain[1].settings.mass.value_or(0), 60);
 }
 
 TEST(TrialList, AHostileLineIsRefusedAtOnceNamingTheLine) {

@@ -29,11 +29,16 @@ class TrialLineParser {
     std::size_t start = 0;
     for (std::size_t bar; fields.size() < 3 && (bar = line.find('|', start)) != std::string::npos; start = bar + 1)
       fields.emplace_back(line.substr(start, bar - start));
-    if (fields.size() < 2) throw InputError(where + ": expected activity|lab|name|TRIAL [options]");
+    // A plain line "TRIAL [options]" (no '|'): the trial is named by its file, its own lab, as
+    // trials given one by one are.
+    const bool plain = fields.empty();
+    if (!plain && fields.size() < 2) throw InputError(where + ": expected activity|lab|name|TRIAL [options], or TRIAL [options]");
     TrialListEntry e;
-    e.activity = fields[0];
-    e.lab = fields[1];  // the old 3-field form: the name is the lab
-    e.name = fields.back();
+    if (!plain) {
+      e.activity = fields[0];
+      e.lab = fields[1];  // the old 3-field form: the name is the lab
+      e.name = fields.back();
+    }
     for (const auto& f : fields)
       if (f.empty()) throw InputError(where + ": an empty field in activity|lab|name");
     const std::string rest(line.substr(start));
@@ -52,6 +57,10 @@ class TrialLineParser {
     }
     e.settings = settings_;
     e.plates = plates_;
+    if (plain) {
+      e.activity = "trials";
+      e.name = e.lab = std::filesystem::path(e.settings.trial).filename().string();
+    }
     return e;
   }
 

@@ -1,6 +1,7 @@
 // kin2grf trial lists: the file `study`, `fit-cop` and `batch` read. One trial a line:
 //   activity|lab|name|TRIAL [settings as on the command line] [--plates FILE]
-// '#' starts a comment line; the older "activity|name|TRIAL" is read with each trial its own lab.
+// '#' starts a comment line; the older "activity|name|TRIAL" is read with each trial its own lab;
+// a plain line "TRIAL [options]" is the trial named by its file, activity "trials", its own lab.
 // Paths are as written (relative to the working directory).
 #pragma once
 
