@@ -390,6 +390,7 @@ TEST(Trc, AnExportWithGapsIsReadByOpenSimsRules) {
 // Every development trial's OpenSim export (estimate --opensim) is read by OpenSim's rules.
 TEST(SharedOpenSim, EveryExportsTrcIsReadByOpenSimsRules) {
   KIN2GRF_REQUIRE_DATA();
+  KIN2GRF_REQUIRE_CLI();
   std::ifstream list(std::string(KIN2GRF_SOURCE_DIR) + "/scripts/trials.txt");
   ASSERT_TRUE(list);
   const auto dir = test::temp_dir("opensim_rules");

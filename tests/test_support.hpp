@@ -50,3 +50,10 @@ bool foot_active(const FrameSolution& s, const FrameContacts& fc, int side);
       GTEST_SKIP() << "shared recordings not found at '" << ::kin2grf::test::data_dir()        \
                    << "' (set KIN2GRF_DATA_DIR or place ../shared/data beside the checkout)"; \
   } while (0)
+
+/// Tests that run the command line skip where it is not built (the sanitizer build makes the
+/// test executable alone).
+#define KIN2GRF_REQUIRE_CLI()                                                                   \
+  do {                                                                                         \
+    if (std::string(KIN2GRF_CLI).empty() || !std::filesystem::exists(KIN2GRF_CLI)) GTEST_SKIP() << "the command line is not built here: " << KIN2GRF_CLI; \
+  } while (0)
