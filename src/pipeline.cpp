@@ -240,9 +240,13 @@ void lag_torso_stage(const EstimateOptions& o, ModelMotion& motion, EstimateResu
 /// Which frames take the running COP function, and the rest of the trial's calibration: the belt
 /// velocity (always, on a treadmill, from every frame's contact points), the progression speed
 /// and the speed gate.
-std::pair<std::vector<bool>, TrialCalibration> contact_stage(const EstimateOptions& o, const Model& model, ContactCalibration soles,
-                                                             EstimateResult& r, const ModelMotion& motion,
-                                                             std::optional<double> progression_speed_mps = std::nullopt) {
+struct ContactPlan {
+  std::vector<bool> running;                  ///< frames that take the running COP function
+  std::array<std::vector<bool>, 2> landing;   ///< per side, frames where the foot is still landing (landing_frames)
+  TrialCalibration calibration;
+};
+ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactCalibration soles, EstimateResult& r,
+                          const ModelMotion& motion, std::optional<double> progression_speed_mps = std::nullopt) {
   const SagittalLandmarks& lm = r.landmarks;
   const ContactModelOptions& co = o.contact;
   std::vector<bool> running;
@@ -258,18 +262,28 @@ std::pair<std::vector<bool>, TrialCalibration> contact_stage(const EstimateOptio
   }
   TrialCalibration cal;
   cal.contact = std::move(soles);
-  if (r.frame.treadmill) {
-    // Measured on every treadmill trial, whatever the solver's settings: validation's still-foot
-    // rule takes it too.
+  std::array<std::vector<bool>, 2> landing;
+  const bool touchdown = co.touchdown_fraction > 0;
+  const Eigen::Index n = motion.frames();
+  std::array<std::vector<int>, 2> lowest;
+  std::array<Eigen::VectorXd, 2> gap, rate, speed;  // per side, the lowest sole point's (touchdown rule)
+  if (r.frame.treadmill || touchdown) {
+    // The belt: measured on every treadmill trial, whatever the solver's settings (validation's
+    // still-foot rule takes it too). The lowest sole points' descents, for the touchdown rule.
     BeltVelocitySamples samples;
     MotionFrame f;
     FrameContacts fc;
-    for (Eigen::Index i = 0; i < motion.frames(); ++i) {
+    if (touchdown)
+      for (int side = 0; side < 2; ++side) gap[side].resize(n), rate[side].resize(n), speed[side].resize(n), lowest[side].resize(static_cast<std::size_t>(n));
+    for (Eigen::Index i = 0; i < n; ++i) {
       motion.frame(i, f);
       contact_frame(model, cal.contact, co, is_running_frame(running, i), f, fc);
-      samples.add(fc);
+      if (r.frame.treadmill) samples.add(fc);
+      if (touchdown)
+        for (int side = 0; side < 2; ++side)
+          gap[side][i] = fc.lowest_gap_m[side], rate[side][i] = fc.lowest_gap_rate_mps[side], speed[side][i] = fc.lowest_velocity_x_mps[side], lowest[side][static_cast<std::size_t>(i)] = fc.lowest_point[side];
     }
-    if (const auto belt = samples.median_mps()) {
+    if (const auto belt = r.frame.treadmill ? samples.median_mps() : std::nullopt) {
       cal.belt_velocity_mps = *belt;
       char b[128];
       std::snprintf(b, sizeof b, std::abs(*belt) < 0.05 ? "no progression (stationary trial): ground velocity %.2f m/s"
@@ -288,7 +302,17 @@ std::pair<std::vector<bool>, TrialCalibration> contact_stage(const EstimateOptio
                   o.solver.speed_gate_ratio, cal.progression_speed_mps, o.solver.speed_gate_floor_mps);
     r.messages.push_back(b);
   }
-  return {std::move(running), std::move(cal)};
+  if (touchdown) {
+    LandingRule rule;
+    rule.fraction = co.touchdown_fraction;
+    rule.min_speed_mps = std::max(0.1, 0.1 * cal.progression_speed_mps);
+    rule.swing_speed_mps = cal.speed_gate_mps;
+    for (int side = 0; side < 2; ++side) {
+      speed[side] = (speed[side].array() - cal.belt_velocity_mps).abs().matrix();
+      landing[side] = landing_frames(gap[side], rate[side], speed[side], lowest[side], rule);
+    }
+  }
+  return {std::move(running), std::move(landing), std::move(cal)};
 }
 
 /// The per-frame solve's raw results (before the post-filter).
@@ -310,7 +334,8 @@ struct RawSolve {
 
 /// Eqs. 5-10 on every frame (least squares, activation, semi-smooth iterations).
 RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResult& r, const ModelMotion& motion,
-                     const std::vector<bool>& running, const std::function<void(long, long)>& progress) {
+                     const std::vector<bool>& running, const std::array<std::vector<bool>, 2>& landing,
+                     const std::function<void(long, long)>& progress) {
   const Eigen::Index n = motion.frames();
   RawSolve raw;
   {
@@ -351,6 +376,7 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
         progress(static_cast<long>(static_cast<double>(k) / static_cast<double>(end) * static_cast<double>(n)), static_cast<long>(n));
       motion.frame(i, f);
       contact_frame(r.model, r.calibration.contact, o.contact, is_running_frame(running, i), f, fc);
+      for (int side = 0; side < 2; ++side) fc.landing[side] = is_running_frame(landing[side], i);
       const FrameSolution s = solver.solve(f.q, f.qdd, fc);
       for (Eigen::Index j = 0; j < np; ++j) {
         const ContactPoint& p = fc.points[static_cast<std::size_t>(j)];
@@ -638,6 +664,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   const std::size_t first_pass_messages = r.messages.size();
   double seconds_kinematics = 0, seconds_dynamics = 0;
   std::vector<bool> running;
+  std::array<std::vector<bool>, 2> landing;
   RawSolve raw;
   // The solve's progress over both passes when a second may follow: the first reports the first
   // half, the second the rest (or the first completes it), so a progress line never restarts.
@@ -650,13 +677,14 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   const auto dynamics = [&](std::optional<double> progression_speed_mps) {
     const auto ta = clock::now();
     lag_torso_stage(o, motion, r);
-    auto [run, calibration] = contact_stage(o, r.model, soles, r, motion, progression_speed_mps);
-    running = std::move(run);
-    r.calibration = std::move(calibration);
+    ContactPlan plan = contact_stage(o, r.model, soles, r, motion, progression_speed_mps);
+    running = std::move(plan.running);
+    landing = std::move(plan.landing);
+    r.calibration = std::move(plan.calibration);
     if (!o.keep_all_series) r.landmarks.p = {};  // the last to read them is contact_stage (the hip's speed)
     const auto tb = clock::now();
     r.cycled_frames = r.capped_frames = 0;  // solve_stage counts into them
-    raw = solve_stage(trial, o, r, motion, running, progress);
+    raw = solve_stage(trial, o, r, motion, running, landing, progress);
     seconds_kinematics += std::chrono::duration<double>(tb - ta).count();
     seconds_dynamics += std::chrono::duration<double>(clock::now() - tb).count();
   };

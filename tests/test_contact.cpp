@@ -172,3 +172,110 @@ TEST(Contact, EachFramesContactsAreTheWholeTrialsBitForBit) {
     }
   }
 }
+
+namespace {
+
+/// A foot's lowest sole point at 200 Hz as the pipeline sees it: the true height (m) filtered
+/// without lag at 6 Hz, its rate by central differences; the speed along the ground is the true
+/// one (fast in swing, 0 once landed).
+struct SoleSeries {
+  Eigen::VectorXd gap, rate, speed;
+  std::vector<int> point;
+  double rate_hz = 200.0;
+};
+
+SoleSeries filtered_sole(const Eigen::VectorXd& height, const Eigen::VectorXd& speed) {
+  SoleSeries s;
+  s.gap = butterworth_filtfilt(height, s.rate_hz, 6.0);
+  const Eigen::Index n = height.size();
+  s.rate = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index i = 1; i + 1 < n; ++i) s.rate[i] = (s.gap[i + 1] - s.gap[i - 1]) * s.rate_hz / 2;
+  s.speed = speed;
+  s.point.assign(static_cast<std::size_t>(n), 0);
+  return s;
+}
+
+/// The first frame after the last landing frame (-1: none).
+Eigen::Index landed_frame(const std::vector<bool>& landing) {
+  for (Eigen::Index i = static_cast<Eigen::Index>(landing.size()) - 1; i >= 0; --i)
+    if (landing[static_cast<std::size_t>(i)]) return i + 1;
+  return -1;
+}
+
+LandingRule rule_at(double fraction) {
+  LandingRule r;
+  r.fraction = fraction;
+  r.swing_speed_mps = 1.0;
+  return r;
+}
+
+}  // namespace
+
+// A heel landing at 0.3 m/s of descent: the zero-lag filtered descent speed passes half its
+// pre-impact value at the impact, so the rule at 0.5 lands the foot within 10 ms of it; at 1.0
+// (from the peak) before it; the frames before stay free of load.
+TEST(Contact, ALandingFootTakesNoLoadBeforeItsDescentHasStopped) {
+  const Eigen::Index n = 400, impact = 200;  // 2 s at 200 Hz, impact at 1 s
+  Eigen::VectorXd h(n), v(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i - impact) / 200.0;
+    h[i] = t < 0 ? std::min(0.3 * -t, 0.06) : 0.0;  // 6 cm up, then down at 0.3 m/s to the floor
+    v[i] = t < 0 ? 1.5 : 0.0;
+  }
+  const SoleSeries s = filtered_sole(h, v);
+  const Eigen::Index half = landed_frame(landing_frames(s.gap, s.rate, s.speed, s.point, rule_at(0.5)));
+  EXPECT_NEAR(static_cast<double>(half), static_cast<double>(impact), 2.0);
+  const Eigen::Index peak = landed_frame(landing_frames(s.gap, s.rate, s.speed, s.point, rule_at(1.0)));
+  EXPECT_LT(peak, impact);
+  EXPECT_GT(peak, impact - 20);  // within 100 ms: the filter's reach
+  // Without the rule (fraction 0) nothing is held back.
+  const auto none = landing_frames(s.gap, s.rate, s.speed, s.point, rule_at(0.0));
+  EXPECT_EQ(std::count(none.begin(), none.end(), true), 0);
+}
+
+// A swing foot whose descent slows to a hover 10-12 mm up for 260 ms (still sinking, as
+// PiG_Motion3's left foot does) before its final approach lands at the final approach, not when
+// the hover slows its descent.
+TEST(Contact, AFootHoveringBeforeItsFinalApproachLandsAtTheApproach) {
+  const Eigen::Index n = 300, impact = 150;  // impact at 0.75 s
+  Eigen::VectorXd h(n), v(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / 200.0, ti = static_cast<double>(impact) / 200.0;
+    if (t < 0.3) h[i] = 0.06;
+    else if (t < 0.46) h[i] = 0.06 - 0.3 * (t - 0.3);                  // down at 0.3 m/s to 12 mm
+    else if (t < ti - 0.03) h[i] = 0.012 - 0.002 * (t - 0.46) / 0.26;  // the hover, sinking 2 mm
+    else h[i] = t < ti ? 0.010 * (ti - t) / 0.03 : 0.0;                // the final approach, 0.33 m/s
+    v[i] = t < ti ? 1.5 : 0.0;
+  }
+  const SoleSeries s = filtered_sole(h, v);
+  const Eigen::Index landed = landed_frame(landing_frames(s.gap, s.rate, s.speed, s.point, rule_at(0.5)));
+  EXPECT_GT(landed, impact - 8);  // not at the hover (from frame 92 on)
+  EXPECT_LE(landed, impact + 4);
+}
+
+// A planted foot (never in swing) whose lowest point sinks 15 mm as it rolls is not landing;
+// nor is a landed foot whose lowest point then switches to the forefoot slapping down, nor one
+// that settles slowly after a fast drop.
+TEST(Contact, APlantedFootsDescentsAreNotLandings) {
+  const Eigen::Index n = 300;
+  Eigen::VectorXd h(n), still = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index i = 0; i < n; ++i) h[i] = -0.015 * std::clamp((static_cast<double>(i) - 100) / 60.0, 0.0, 1.0);
+  const SoleSeries planted = filtered_sole(h, still);
+  const auto none = landing_frames(planted.gap, planted.rate, planted.speed, planted.point, rule_at(0.5));
+  EXPECT_EQ(std::count(none.begin(), none.end(), true), 0);
+
+  // A 2 m/s drop landing at frame 100, then 60 mm/s of settling for 100 ms in the same descent,
+  // then (frame 220 on) the forefoot (point B) slapping down at 0.5 m/s.
+  Eigen::VectorXd d(n), v(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i - 100) / 200.0;
+    d[i] = t < 0 ? std::min(2.0 * -t, 0.3) : -0.06 * std::min(t, 0.1);
+    if (i >= 220) d[i] -= 0.5 * std::min((static_cast<double>(i) - 220) / 200.0, 0.02);
+    v[i] = t < 0 ? 1.5 : 0.0;
+  }
+  SoleSeries s = filtered_sole(d, v);
+  for (Eigen::Index i = 220; i < n; ++i) s.point[static_cast<std::size_t>(i)] = 1;
+  const auto landing = landing_frames(s.gap, s.rate, s.speed, s.point, rule_at(0.5));
+  const Eigen::Index landed = landed_frame(landing);
+  EXPECT_NEAR(static_cast<double>(landed), 100.0, 3.0);  // the drop, not the settling or the slap
+}

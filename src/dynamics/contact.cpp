@@ -101,6 +101,15 @@ void contact_frame(const Model& model, const ContactCalibration& soles, const Co
     const double theta = f.cop_foot_angle_rad[static_cast<std::size_t>(side)];
     fc.foot_inclination_rad[side] =
         -((std::isnan(theta) ? f.q(coord::theta(foot)) : theta) - soles.feet[static_cast<std::size_t>(side)].flat_angle_rad);
+    {
+      // The lowest sole point and its vertical velocity (A, B on the foot, C on the toes).
+      const std::size_t k = sp[0].y() <= sp[1].y() && sp[0].y() <= sp[2].y() ? 0 : sp[1].y() <= sp[2].y() ? 1 : 2;
+      fc.lowest_gap_m[static_cast<std::size_t>(side)] = sp[k].y() - ground;
+      fc.lowest_point[static_cast<std::size_t>(side)] = static_cast<int>(k);
+      const Eigen::Vector2d v = material_point(model, f, k < 2 ? foot : toes, sp[k]).v;
+      fc.lowest_gap_rate_mps[static_cast<std::size_t>(side)] = v.y();
+      fc.lowest_velocity_x_mps[static_cast<std::size_t>(side)] = v.x();
+    }
     if (o.foot_model == FootModel::ThreePoint) {
       for (int k = 0; k < 3; ++k) {
         const MaterialPoint mp = material_point(model, f, k < 2 ? foot : toes, sp[k]);
@@ -139,6 +148,54 @@ void contact_frame(const Model& model, const ContactCalibration& soles, const Co
     cp.jac_tangent.add(c, 1.0);
     fc.points.push_back(std::move(cp));
   }
+}
+
+std::vector<bool> landing_frames(const Eigen::VectorXd& gap, const Eigen::VectorXd& rate, const Eigen::VectorXd& speed,
+                                 const std::vector<int>& point, const LandingRule& rule) {
+  const Eigen::Index n = gap.size();
+  std::vector<bool> out(static_cast<std::size_t>(n), false);
+  if (!(rule.fraction > 0)) return out;
+  // A foot is away (in swing) once its lowest sole point has moved along the ground faster than
+  // the swing speed since it last landed; only an away foot lands.
+  bool away = false;
+  Eigen::Index seen = 0;  // frames before this have been looked at for the away state
+  const auto look_until = [&](Eigen::Index last) {
+    for (; seen <= last; ++seen)
+      if (!(rule.swing_speed_mps > 0) || speed[seen] > rule.swing_speed_mps) away = true;
+  };
+  // Descents of one sole point: a switch of the lowest point (the forefoot slapping down after a
+  // heel strike) begins a new run; a pause slower than kPause does not end one (a hovering swing
+  // foot's filtered rate ripples by a few mm/s about zero before its final approach).
+  constexpr double kPause = 0.01;  // m/s
+  std::vector<IndexRun> runs;
+  for (const IndexRun& r : runs_where(n, [&](Eigen::Index i) { return rate[i] < kPause; })) {
+    Eigen::Index first = r.first;
+    for (Eigen::Index i = r.first + 1; i <= r.last + 1; ++i)
+      if (i > r.last || point[static_cast<std::size_t>(i)] != point[static_cast<std::size_t>(first)]) runs.push_back({first, i - 1}), first = i;
+  }
+  for (const IndexRun& run : runs) {
+    look_until(run.last);
+    if (!away) continue;
+    const double drop = gap[run.first] - gap.segment(run.first, run.last - run.first + 1).minCoeff();
+    if (!(drop >= rule.min_drop_m)) continue;
+    // The final approach's peak: the last local peak of the descent speed that is an approach (a
+    // swing foot's descent can slow and speed up again before the final approach; a landed
+    // foot's slow settling after it is not one).
+    const double least =
+        std::max(rule.min_speed_mps, rule.min_peak_share * -rate.segment(run.first, run.last - run.first + 1).minCoeff());
+    Eigen::Index peak = -1;
+    for (Eigen::Index i = run.last; i >= run.first && peak < 0; --i) {
+      const double d = -rate[i];
+      if (d >= least && (i == run.first || d >= -rate[i - 1]) && (i == run.last || d >= -rate[i + 1])) peak = i;
+    }
+    if (peak < 0) continue;
+    Eigen::Index landed = peak;
+    while (landed <= run.last && -rate[landed] > rule.fraction * -rate[peak]) ++landed;
+    for (Eigen::Index i = run.first; i < landed; ++i) out[static_cast<std::size_t>(i)] = true;
+    away = false;
+    seen = landed;
+  }
+  return out;
 }
 
 std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCalibration& soles, const ContactModelOptions& o,

@@ -295,6 +295,9 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
     for (int j = 0; j < np; ++j)
       if (std::abs(fc.points[static_cast<std::size_t>(j)].velocity.x() - belt_velocity_mps_) > speed_gate_mps_)
         allowed &= ~(1U << j);
+  // A foot still landing (landing_frames) takes no load yet.
+  for (int j = 0; j < np; ++j)
+    if (fc.landing[static_cast<std::size_t>(fc.points[static_cast<std::size_t>(j)].side)]) allowed &= ~(1U << j);
   unsigned active = allowed;
   std::uint64_t seen = 0;  // the active sets tried (2^6 of them at most)
   SmallVector lamC = SmallVector::Zero(k);

@@ -95,6 +95,14 @@ std::vector<Setting> settings_for(const std::string& kind) {
     mark_default(s, [](const EstimateOptions& o) {
       return std::tuple(o.solver.speed_gate_ratio, o.solver.speed_gate_mps, o.solver.speed_gate_floor_mps);
     });
+  } else if (kind == "touchdown-fraction") {
+    // The touchdown rule (landing_frames): off, or a landing foot loaded from the frame its
+    // final approach's descent speed has fallen to this fraction of its peak.
+    for (double f : {0.0, 0.5, 0.7, 0.8, 0.9, 1.0}) {
+      std::snprintf(b, sizeof b, f > 0 ? "%.1f of the peak" : "off", f);
+      s.push_back({b, f, [f](EstimateOptions& o) { o.contact.touchdown_fraction = f; }});
+    }
+    mark_default(s, [](const EstimateOptions& o) { return o.contact.touchdown_fraction; });
   } else if (kind == "noise") {
     // Robustness to what real capture does (issue 10): 0, 1, 2, 3 mm of Gaussian noise on every
     // marker coordinate, kNoiseRealizations seeded draws per level (the same draws for every run),
@@ -170,7 +178,7 @@ StudyCell pool(const std::vector<StudyTrialResult>& trials, const std::string& a
 
 const std::vector<std::string>& study_kinds() {
   static const std::vector<std::string> kinds{"r",     "ground-shift",         "cutoff",         "post-cutoff-cycles", "kinematic-cutoff",
-                                              "speed-gate", "speed-gate-ratio", "noise",     "min-kinematic-cycles", "split-distance",
+                                              "speed-gate", "speed-gate-ratio", "touchdown-fraction", "noise",     "min-kinematic-cycles", "split-distance",
                                               "torso-length", "torso-lag",      "double-support-sta", "foot-model"};
   return kinds;
 }

@@ -59,6 +59,10 @@ void add_settings_options(CLI::App* c, Settings& a) {
       ->check(CLI::Range(0.0, 20.0))->capture_default_str();
   c->add_option("--speed-gate-floor", a.speed_gate_floor, "Lowest speed gate with --speed-gate-ratio, m/s")
       ->check(CLI::Range(0.0, 20.0))->capture_default_str();
+  c->add_option("--touchdown-fraction", a.touchdown_fraction,
+                "A landing foot takes no load before its descent speed, past the final approach's peak, has fallen to this "
+                "fraction of the peak (1: from the peak on; 0 = off, the default and the paper)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   c->add_option("--split-distance", a.split_distance,
                 "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
@@ -143,6 +147,7 @@ EstimateOptions to_options(const Settings& a) {
   o.solver.speed_gate_mps = a.paper ? 0.0 : a.speed_gate;
   o.solver.speed_gate_ratio = a.paper ? 0.0 : a.speed_gate_ratio;
   o.solver.speed_gate_floor_mps = a.speed_gate_floor;
+  o.contact.touchdown_fraction = a.paper ? 0.0 : a.touchdown_fraction;
   o.solver.min_split_distance_m = a.paper ? 0.0 : a.split_distance;
   o.torso_length = (a.paper || a.torso_length == "fixed") ? TorsoLength::Fixed : TorsoLength::Measured;
   o.torso_lag_s = a.paper ? 0.0 : a.torso_lag;
@@ -172,6 +177,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"speed_gate_mps", o.solver.speed_gate_mps},
           {"speed_gate_ratio", o.solver.speed_gate_ratio},
           {"speed_gate_floor_mps", o.solver.speed_gate_floor_mps},
+          {"touchdown_fraction", o.contact.touchdown_fraction},
           {"min_split_distance_m", o.solver.min_split_distance_m},
           {"torso_length", torso_length_name(o.torso_length)},
           {"torso_lag_s", o.torso_lag_s},

@@ -33,7 +33,8 @@ struct Settings {
          split_distance = SolverOptions{}.min_split_distance_m, speed_gate_ratio = SolverOptions{}.speed_gate_ratio,
          speed_gate_floor = SolverOptions{}.speed_gate_floor_mps, torso_lag = EstimateOptions{}.torso_lag_s,
          double_support_sta = EstimateOptions{}.double_support_sta_weight,
-         min_kinematic_cycles = EstimateOptions{}.min_kinematic_cycles;
+         min_kinematic_cycles = EstimateOptions{}.min_kinematic_cycles,
+         touchdown_fraction = ContactModelOptions{}.touchdown_fraction;
   bool paper = false, r_given = false, anthropometry_given = false;
   std::optional<double> ground_level;
   std::optional<double> post_cutoff;  ///< given: the post-filter at this fixed cut-off, Hz
