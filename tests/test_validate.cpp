@@ -264,3 +264,65 @@ TEST(SyntheticWalk, PlatesCarryTheKinematicTotalsOneStanceEach) {
   // The totals agree up to the post-filter: the plates carry the kinematic totals.
   EXPECT_LT(v.total->metrics.vertical->rrmse_percent, 8.0);
 }
+
+// The marker-plate time offset (step 6): plates whose clock runs 30 ms late are found 30 ms
+// behind from the whole body's vertical force, said in a note, and compared after alignment
+// only when asked.
+TEST(Validate, AMarkerPlateTimeOffsetIsFoundAndAlignedOnRequest) {
+  auto s = synthetic_with_exact_plates();
+  const auto v0 = validate(s.estimate, s.plates);
+  ASSERT_TRUE(v0.sync.has_value());
+  EXPECT_NEAR(v0.sync->offset_s, 0.0, 0.002);
+  EXPECT_EQ(v0.plate_shift_s, 0.0);
+  s.plates.time_s.array() += 0.03;  // a plate event at t is recorded at t + 30 ms
+  const auto late = validate(s.estimate, s.plates);
+  ASSERT_TRUE(late.sync.has_value());
+  EXPECT_NEAR(late.sync->offset_s, -0.03, 0.004);
+  EXPECT_LT(late.sync->uncertainty_s, 0.015);
+  EXPECT_GT(late.sync->error_as_recorded_N, 3 * late.sync->error_at_offset_N);
+  bool said = false;
+  for (const auto& n : late.notes) said = said || n.find("lag the markers by 30 ms") != std::string::npos;
+  EXPECT_TRUE(said);
+  ASSERT_FALSE(late.stances.empty());
+  const double as_recorded = mean_rrmse(late.stances).vertical;
+  EXPECT_GT(as_recorded, 5.0);  // the default compares as recorded: the figures never change silently
+  ValidationOptions o;
+  o.sync = ValidationOptions::Sync::Auto;
+  const auto aligned = validate(s.estimate, s.plates, o);
+  EXPECT_NEAR(aligned.plate_shift_s, -0.03, 0.004);
+  EXPECT_LT(mean_rrmse(aligned.stances).vertical, 1.0);
+  o.sync = ValidationOptions::Sync::Fixed;
+  o.plate_shift_s = -0.03;
+  EXPECT_LT(mean_rrmse(validate(s.estimate, s.plates, o).stances).vertical, 1.0);
+}
+
+// The same on a recorded walk (walking2.c3d): its plates' analog clock shifted by +-40 ms.
+TEST(SharedValidate, APlateClockShiftedBy40msIsFoundOnARecordedWalk) {
+  KIN2GRF_REQUIRE_DATA();
+  LoadOptions lo;
+  lo.c3d.zero_offset = ZeroOffset::Unloaded;
+  const Trial t = load_trial(test::data_file("opensim_c3d_overground_walk/walking2.c3d"), lo);
+  EstimateOptions eo;
+  eo.mass_kg = 64.9;
+  const auto e = estimate(t, nullptr, *recognise_marker_set(t.markers), eo);
+  const auto v0 = validate(e, *t.plates);
+  ASSERT_TRUE(v0.sync.has_value());
+  EXPECT_LT(std::abs(v0.sync->offset_s), 0.006);  // the file's own clocks agree
+  const double recorded = mean_rrmse(v0.stances).vertical;
+  for (double shift : {0.04, -0.04}) {
+    ForcePlateRecording plates = *t.plates;
+    plates.time_s.array() += shift;
+    const auto v = validate(e, plates);
+    ASSERT_TRUE(v.sync.has_value()) << shift;
+    EXPECT_NEAR(v.sync->offset_s, v0.sync->offset_s - shift, 0.006) << shift;
+    ValidationOptions o;
+    o.sync = ValidationOptions::Sync::Auto;
+    const auto aligned = validate(e, plates, o);
+    ASSERT_FALSE(aligned.stances.empty()) << shift;
+    EXPECT_NEAR(mean_rrmse(aligned.stances).vertical, recorded, 0.5) << shift;
+    // As recorded (the default), the shifted plates score worse or lose the stance to the window.
+    if (!v.stances.empty()) {
+      EXPECT_GT(mean_rrmse(v.stances).vertical, recorded + 2.0) << shift;
+    }
+  }
+}

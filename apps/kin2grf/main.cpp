@@ -315,6 +315,10 @@ int main(int argc, char** argv) {
     validate->add_option("--threshold", val.options.threshold_N, "Stance: measured vertical force above this, N")->capture_default_str();
     validate->add_option("--zero-offset", val.zero_offset, "C3D plate offsets: none, zero or unloaded")
         ->check(CLI::IsMember({"none", "zero", "unloaded"}))->capture_default_str();
+    validate->add_option_function<std::string>(
+        "--sync", [&val](const std::string& t) { kin2grf::parse_sync(t, val.options); },
+        "Marker-plate time offset: none (compare as recorded; the offset is reported), auto (compare after shifting the plates "
+        "by the estimated offset) or SECONDS (shift the plates by this; + when the plates led)");
   }
 
   StudyArgs study_args;

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
@@ -507,10 +508,63 @@ void compare_totals(const EstimateResult& e, ValidationResult& v, const std::vec
   v.total = std::move(tv);
 }
 
+/// Step 6 (SyncEstimate) from a comparison made with the plates as recorded.
+std::optional<SyncEstimate> estimate_sync(const EstimateResult& e, const ValidationResult& v, double threshold_N) {
+  if (e.kinematic_total.rows() != e.time_s.size()) return std::nullopt;
+  const Eigen::Index n = e.time_s.size();
+  const double rate = e.motion.rate_hz;
+  if (!(rate > 0) || !(e.kinematic_cutoff_hz > 0) || e.kinematic_cutoff_hz >= max_zero_lag_cutoff_hz(rate)) return std::nullopt;
+  Eigen::VectorXd plates = Eigen::VectorXd::Zero(n);
+  std::vector<bool> recorded(static_cast<std::size_t>(n), true);
+  for (const MeasuredPlate& mp : v.plates)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (std::isfinite(mp.force_N(i, 1))) plates[i] += mp.force_N(i, 1);
+      else recorded[static_cast<std::size_t>(i)] = false;
+    }
+  if (n < 20) return std::nullopt;
+  plates = butterworth_filtfilt(plates, rate, e.kinematic_cutoff_hz);
+  const int kmax = static_cast<int>(std::lround(kMaxSyncShiftS * rate));
+  // Frames where the plates carry load; the loss is the median absolute difference, robust to
+  // the frames where a foot stands beside the plates (a minority on a walk over plates).
+  std::vector<Eigen::Index> loaded;
+  for (Eigen::Index i = kmax; i + kmax < n; ++i) {
+    bool ok = true;
+    for (Eigen::Index j = i - kmax; j <= i + kmax && ok; ++j) ok = recorded[static_cast<std::size_t>(j)];
+    if (ok && plates[i] > threshold_N) loaded.push_back(i);
+  }
+  const int frames = static_cast<int>(loaded.size());
+  if (frames < 10) return std::nullopt;
+  std::vector<double> err, d(loaded.size());
+  for (int k = -kmax; k <= kmax; ++k) {
+    for (std::size_t q = 0; q < loaded.size(); ++q) d[q] = std::abs(e.kinematic_total(loaded[q], 1) - plates[loaded[q] - k]);
+    err.push_back(median(d));
+  }
+  const auto best = static_cast<int>(std::min_element(err.begin(), err.end()) - err.begin());
+  if (best == 0 || best + 1 == static_cast<int>(err.size())) return std::nullopt;
+  const auto at = [&](int k) { return err[static_cast<std::size_t>(k)]; };
+  SyncEstimate s;
+  s.offset_s = (best - kmax + parabola_vertex_offset(at(best - 1), at(best), at(best + 1), false)) / rate;
+  s.error_at_offset_N = at(best);
+  s.error_as_recorded_N = at(kmax);
+  s.frames = frames;
+  // Half-width of the shifts within 10 % of the least RMSE (linear between frames).
+  const double level = 1.1 * at(best);
+  double lo = -kmax, hi = kmax;
+  for (int k = best; k > 0; --k)
+    if (at(k - 1) > level) {
+      lo = k - 1 + (level - at(k - 1)) / (at(k) - at(k - 1)) - kmax;
+      break;
+    }
+  for (int k = best; k + 1 < static_cast<int>(err.size()); ++k)
+    if (at(k + 1) > level) {
+      hi = k + (level - at(k)) / (at(k + 1) - at(k)) - kmax;
+      break;
+    }
+  s.uncertainty_s = 0.5 * (hi - lo) / rate;
+  return s;
+}
 
-}  // namespace
-
-ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& rec, const ValidationOptions& o) {
+ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateRecording& rec, const ValidationOptions& o) {
   ValidationResult v;
   v.mass_kg = e.mass_kg;
   v.first_frame_number = e.first_frame_number;
@@ -530,6 +584,40 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
     if (c.kept) v.stances.push_back(compare_stance(e, v, c, o));
   std::sort(v.stances.begin(), v.stances.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   compare_totals(e, v, cands, o);
+  return v;
+}
+
+}  // namespace
+
+ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& rec, const ValidationOptions& o) {
+  ValidationResult v = validate_as_recorded(e, rec, o);
+  const std::optional<SyncEstimate> sync = estimate_sync(e, v, o.threshold_N);
+  double shift = 0.0;
+  if (o.sync == ValidationOptions::Sync::Fixed) shift = o.plate_shift_s;
+  else if (o.sync == ValidationOptions::Sync::Auto && sync) shift = sync->offset_s;
+  char b[400];
+  if (shift != 0.0) {
+    ForcePlateRecording shifted = rec;
+    shifted.time_s.array() += shift;
+    v = validate_as_recorded(e, shifted, o);
+    std::snprintf(b, sizeof b, "compared with the plates shifted by %+.1f ms (%s)", 1000 * shift,
+                  o.sync == ValidationOptions::Sync::Auto ? "--sync auto: the estimated marker-plate offset" : "--sync");
+    v.notes.emplace_back(b);
+  } else if (o.sync == ValidationOptions::Sync::Auto) {
+    v.notes.emplace_back("--sync auto: no marker-plate offset could be estimated; compared as recorded");
+  }
+  v.sync = sync;
+  v.plate_shift_s = shift;
+  // An offset beyond a frame and 10 ms that the data pin down is worth a word when not applied.
+  if (sync && shift == 0.0 && std::abs(sync->offset_s) > std::max(0.010, 1.0 / e.motion.rate_hz) &&
+      sync->uncertainty_s < std::abs(sync->offset_s)) {
+    std::snprintf(b, sizeof b,
+                  "the plates seem to %s the markers by %.0f ms (+-%.0f ms; median |plates - kinematics| of the total vertical force %.0f N "
+                  "as recorded, %.0f N shifted): check the capture's synchronisation; --sync auto compares after aligning them",
+                  sync->offset_s > 0 ? "lead" : "lag", 1000 * std::abs(sync->offset_s), 1000 * sync->uncertainty_s,
+                  sync->error_as_recorded_N, sync->error_at_offset_N);
+    v.notes.emplace_back(b);
+  }
   return v;
 }
 
@@ -627,6 +715,15 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
                                             {"cop", num(m.cop)},      {"moment", num(m.moment)}};
   }
   j["mean_rrmse_percent"] = means;
+  if (v.sync)
+    j["sync"] = {{"estimated_offset_ms", 1000 * v.sync->offset_s},
+                 {"uncertainty_ms", 1000 * v.sync->uncertainty_s},
+                 {"frames", v.sync->frames},
+                 {"total_vertical_error_as_recorded_N", v.sync->error_as_recorded_N},
+                 {"total_vertical_error_at_offset_N", v.sync->error_at_offset_N},
+                 {"applied_shift_ms", 1000 * v.plate_shift_s}};
+  else
+    j["sync"] = {{"estimated_offset_ms", nullptr}, {"applied_shift_ms", 1000 * v.plate_shift_s}};
   j["excluded"] = v.excluded;
   j["notes"] = v.notes;
   return j;
@@ -686,6 +783,13 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
        << cell(v.total->metrics.anterior) << text("-") << cell(v.total->metrics.moment) << "\n";
   os << label("paper, Table 1 (24 gait)") << text("4.1 (1.1)") << text("11.2 (1.7)") << text("-") << text("5.3 (1.1)") << "\n";
   os << label("Fluit et al. (paper's Tab. 1)") << text("2.7") << text("9.3") << text("-") << text("7.4") << "\n";
+  if (v.sync) {
+    std::snprintf(buf, sizeof buf, "marker-plate offset: %+.0f ms (+-%.1f; + = the plates lead; median |plates - kinematics| of the total vertical force "
+                                   "%.0f N as recorded, %.0f N at the offset); applied: %+.0f ms\n",
+                  1000 * v.sync->offset_s, 1000 * v.sync->uncertainty_s, v.sync->error_as_recorded_N, v.sync->error_at_offset_N,
+                  1000 * v.plate_shift_s);
+    os << buf;
+  }
   for (const auto& x : v.excluded) os << "excluded: " << x << "\n";
   for (const auto& x : v.notes) os << "note: " << x << "\n";
   return os.str();

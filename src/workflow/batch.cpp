@@ -67,8 +67,25 @@ ValidationRun validate_trial(const Settings& s, const std::string& plates_file, 
   run.settings["plates"] = source.path;
   run.settings["threshold_N"] = vo.threshold_N;
   run.settings["zero_offset"] = zero_offset;
+  run.settings["sync"] = vo.sync == ValidationOptions::Sync::None   ? nlohmann::json("none")
+                         : vo.sync == ValidationOptions::Sync::Auto ? nlohmann::json("auto")
+                                                                    : nlohmann::json(vo.plate_shift_s);
   run.plates_path = source.path;
   return run;
+}
+
+void parse_sync(const std::string& text, ValidationOptions& vo) {
+  if (text == "none" || text.empty()) {
+    vo.sync = ValidationOptions::Sync::None;
+  } else if (text == "auto") {
+    vo.sync = ValidationOptions::Sync::Auto;
+  } else {
+    double shift = 0;
+    if (!parse_double(text, shift) || !std::isfinite(shift) || std::abs(shift) > 1.0)
+      throw InputError("--sync " + text + ": must be none, auto or a shift of the plates in seconds between -1 and 1 (0.04: the plates led by 40 ms)");
+    vo.sync = ValidationOptions::Sync::Fixed;
+    vo.plate_shift_s = shift;
+  }
 }
 
 std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir) {

@@ -36,6 +36,8 @@
 //    not the estimate's contact state) outside every kept stance of that foot is left out. Vertical, anterior and the GRM about the midpoint of the plate
 //    centres in use (without geometry: the mean measured COP over those frames, the belt's
 //    centre on a treadmill).
+// 6. The marker-plate time offset (SyncEstimate, below), reported always; applied only when
+//    asked (ValidationOptions::sync).
 #pragma once
 
 #include <Eigen/Dense>
@@ -84,6 +86,29 @@ struct ValidationOptions {
   double edge_margin_m = 0.03;
   double still_speed_mps = 0.3;            ///< the other foot stands on a plate only when this still
   double total_mismatch_fraction = 0.15;   ///< of body weight (step 5)
+  /// The marker-plate time offset (step 6): None compares as recorded and only reports the
+  /// estimated offset; Auto compares after shifting the plates by it; Fixed by plate_shift_s.
+  enum class Sync { None, Auto, Fixed } sync = Sync::None;
+  double plate_shift_s = 0.0;  ///< Sync::Fixed: added to the plates' times (+: the plates led the markers)
+};
+
+/// Step 6: the time offset between the markers and the plates, from the whole body. The plates'
+/// summed vertical force equals the kinematic total sum m (a_y + g) wherever they carry every
+/// loaded foot; the kinematic total depends on the markers alone (not on the contact model). The
+/// plates' sum is filtered like the kinematics (zero-lag Butterworth at the dynamics' kinematic
+/// cut-off) and shifted by whole frames up to +-kMaxSyncShiftS; over the frames where the plates
+/// are loaded, the shift of least median |plates - kinematics| (robust to the frames where a foot
+/// stands beside the plates, a minority on a walk over plates), refined by a parabola, is the
+/// offset. + = the plates lead the markers (a plate event at t shows in the markers at
+/// t + offset); shifting the plates' times by +offset aligns them. Its uncertainty is the
+/// half-width of the shifts whose median error lies within 10 % of the least: a flat minimum (a
+/// circuit whose feet are mostly off the plates) pins nothing down.
+inline constexpr double kMaxSyncShiftS = 0.1;
+struct SyncEstimate {
+  double offset_s = 0.0;
+  double uncertainty_s = 0.0;
+  double error_as_recorded_N = 0.0, error_at_offset_N = 0.0;  ///< median |plates - kinematics| at shift 0 and at the offset
+  int frames = 0;  ///< frames compared
 };
 
 struct ComponentMetrics {
@@ -132,6 +157,10 @@ struct ValidationResult {
   /// Per-frame measured per-foot series (sum of the foot's kept stances; NaN elsewhere).
   std::array<Eigen::MatrixX2d, 2> measured_force_N;
   std::array<Eigen::VectorXd, 2> measured_cop_x_m;
+  /// Step 6, from the plates as recorded (none without a total window of 10 frames, or when the
+  /// best shift lies at the search's limit).
+  std::optional<SyncEstimate> sync;
+  double plate_shift_s = 0.0;  ///< the shift the comparison above was made with (0 unless Sync::Auto or Fixed)
 };
 
 ValidationResult validate(const EstimateResult& estimate, const ForcePlateRecording& plates,

@@ -59,6 +59,11 @@ struct ValidationRun {
 ValidationRun validate_trial(const Settings& settings, const std::string& plates_file, const ValidationOptions& validation,
                              const std::string& zero_offset, std::function<void(long, long)> progress = {});
 
+/// `--sync` as the user gives it: "none" (report the marker-plate offset only), "auto" (compare
+/// after shifting the plates by it) or a shift in seconds (+: the plates led the markers);
+/// InputError naming the value otherwise.
+void parse_sync(const std::string& text, ValidationOptions& validation);
+
 /// The files a trial of the batch writes into `out_dir`: NAME.csv, NAME_grf.mot, NAME.json.
 std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir);
 /// One trial: never throws for the trial's own faults (they are the row's error).
