@@ -86,6 +86,8 @@ void check_options(const EstimateOptions& o) {
           "0 (no post-filter) or a number above 0 (paper: 12)");
   require(finite(o.post_cutoff_cycles) && o.post_cutoff_cycles >= 0 && o.post_cutoff_cycles <= 50, "post-filter cycles per stance",
           o.post_cutoff_cycles, "between 0 (the fixed post-filter cut-off) and 50 (kin2grf: 4)");
+  require(finite(o.post_cutoff_floor_ratio) && o.post_cutoff_floor_ratio >= 0 && o.post_cutoff_floor_ratio <= 10,
+          "post-filter floor (x the kinematic cut-off)", o.post_cutoff_floor_ratio, "between 0 (none) and 10");
   require(finite(o.min_kinematic_cycles) && o.min_kinematic_cycles >= 0 && o.min_kinematic_cycles <= 20, "kinematic cycles per stance",
           o.min_kinematic_cycles, "between 0 (no floor) and 20 (kin2grf: 3.5)");
   require(finite(o.solver.r_N_per_m) && o.solver.r_N_per_m > 0, "activation parameter r (N/m)", o.solver.r_N_per_m,
@@ -526,9 +528,16 @@ void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, Raw
   if (o.post_cutoff_cycles > 0) {
     char b[200];
     if (stance) {
-      r.post_cutoff_hz = std::min(o.post_cutoff_cycles / *stance, 0.4 * rate_hz);
-      std::snprintf(b, sizeof b, "post-filter cut-off %.1f Hz: %g cycles over the median stance of %.3f s", r.post_cutoff_hz,
-                    o.post_cutoff_cycles, *stance);
+      const double per_stance = o.post_cutoff_cycles / *stance, floor_hz = o.post_cutoff_floor_ratio * r.kinematic_cutoff_hz;
+      r.post_cutoff_hz = std::min(std::max(per_stance, floor_hz), 0.4 * rate_hz);
+      if (per_stance >= floor_hz)
+        std::snprintf(b, sizeof b, "post-filter cut-off %.1f Hz: %g cycles over the median stance of %.3f s", r.post_cutoff_hz,
+                      o.post_cutoff_cycles, *stance);
+      else
+        std::snprintf(b, sizeof b,
+                      "post-filter cut-off %.1f Hz: %g x the kinematic cut-off, above %g cycles over the median stance of %.3f s "
+                      "(%.1f Hz)",
+                      r.post_cutoff_hz, o.post_cutoff_floor_ratio, o.post_cutoff_cycles, *stance, per_stance);
     } else {
       std::snprintf(b, sizeof b, "post-filter cut-off %g Hz (fixed): no complete stance to scale it to", o.post_cutoff_hz);
     }

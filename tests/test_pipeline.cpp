@@ -367,6 +367,27 @@ TEST(Estimate, ThePostFilterFollowsTheStanceDuration) {
   EXPECT_NEAR(cutoff[1] / cutoff[0], stance[0] / stance[1], 0.1 * stance[0] / stance[1]);
 }
 
+// A slow walker (2.2 s strides, stances near 1.4 s): 4 cycles per stance is under 3 Hz; with a
+// floor of 0.75 x the 6 Hz kinematic cut-off the post-filter stays at 4.5 Hz, and says why.
+TEST(Estimate, APostFilterFloorKeepsASlowWalksCutOffAtTheKinematics) {
+  SyntheticWalkOptions wo;
+  wo.stride_time_s = 2.2;
+  wo.speed_mps = 0.4;
+  wo.duration_s = 4 * wo.stride_time_s;
+  const SyntheticWalk w = make_synthetic_walk(wo);
+  const auto plain = estimate(w.trial, nullptr, *find_marker_set("kin2grf-example"), {});
+  EXPECT_LT(plain.post_cutoff_hz, 3.5);
+  EstimateOptions o;
+  o.post_cutoff_floor_ratio = 0.75;
+  const auto floored = estimate(w.trial, nullptr, *find_marker_set("kin2grf-example"), o);
+  EXPECT_DOUBLE_EQ(floored.post_cutoff_hz, 0.75 * floored.kinematic_cutoff_hz);
+  bool said = false;
+  for (const auto& m : floored.messages) said = said || m.find("x the kinematic cut-off") != std::string::npos;
+  EXPECT_TRUE(said);
+  o.post_cutoff_floor_ratio = -1;
+  EXPECT_THROW(estimate(w.trial, nullptr, *find_marker_set("kin2grf-example"), o), InputError);
+}
+
 TEST(Estimate, AStandingTrialKeepsTheFixedPostFilterAndSaysWhy) {
   SyntheticOptions so;
   so.squat_depth = 0.0;

@@ -95,6 +95,13 @@ std::vector<Setting> settings_for(const std::string& kind) {
     mark_default(s, [](const EstimateOptions& o) {
       return std::tuple(o.solver.speed_gate_ratio, o.solver.speed_gate_mps, o.solver.speed_gate_floor_mps);
     });
+  } else if (kind == "post-cutoff-floor") {
+    // The post-filter's floor as a multiple of the dynamics' kinematic cut-off.
+    for (double f : {0.0, 0.5, 0.75, 1.0, 1.5, 2.0}) {
+      std::snprintf(b, sizeof b, f > 0 ? "%.2f x kinematic" : "none", f);
+      s.push_back({b, f, [f](EstimateOptions& o) { o.post_cutoff_floor_ratio = f; }});
+    }
+    mark_default(s, [](const EstimateOptions& o) { return o.post_cutoff_floor_ratio; });
   } else if (kind == "touchdown-fraction") {
     // The touchdown rule (landing_frames): off, or a landing foot loaded from the frame its
     // final approach's descent speed has fallen to this fraction of its peak.
@@ -178,7 +185,7 @@ StudyCell pool(const std::vector<StudyTrialResult>& trials, const std::string& a
 
 const std::vector<std::string>& study_kinds() {
   static const std::vector<std::string> kinds{"r",     "ground-shift",         "cutoff",         "post-cutoff-cycles", "kinematic-cutoff",
-                                              "speed-gate", "speed-gate-ratio", "touchdown-fraction", "noise",     "min-kinematic-cycles", "split-distance",
+                                              "speed-gate", "speed-gate-ratio", "touchdown-fraction", "post-cutoff-floor", "noise",     "min-kinematic-cycles", "split-distance",
                                               "torso-length", "torso-lag",      "double-support-sta", "foot-model"};
   return kinds;
 }

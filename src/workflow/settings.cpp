@@ -44,6 +44,10 @@ void add_settings_options(CLI::App* c, Settings& a) {
        "--post-cutoff-cycles", [&a](double v) { a.post_cutoff_cycles = v, a.post_cutoff_cycles_given = true; },
        "Multiplier post-filter cut-off as cycles per stance: this over the trial's median stance duration (default 4; "
        "0, --paper or a trial with no complete stance: 12 Hz)");
+  c->add_option("--post-cutoff-floor", a.post_cutoff_floor,
+                "The per-stance post-filter cut-off is not taken below this multiple of the dynamics' kinematic cut-off "
+                "(0 = no floor, the default)")
+      ->check(CLI::Range(0.0, 10.0))->capture_default_str();
   c->add_option("--ground-level", a.ground_level, "Floor height in the lab's up axis, m (default: estimated)");
   c->add_option("--grm-reference", a.grm_reference,
                  "GRM reference point in the sagittal frame: along progression and up from the lab origin, m (default 0 0)")
@@ -130,6 +134,7 @@ EstimateOptions to_options(const Settings& a) {
   if (a.post_cutoff) o.post_cutoff_hz = *a.post_cutoff;
   const bool fixed_post_cutoff = a.post_cutoff || (a.paper && !a.post_cutoff_cycles_given);
   o.post_cutoff_cycles = fixed_post_cutoff ? 0.0 : a.post_cutoff_cycles;
+  o.post_cutoff_floor_ratio = a.post_cutoff_floor;
   o.cutoff_from_noise = !a.paper && a.kinematic_cutoff_rule == "noise";
   o.min_kinematic_cycles = a.min_kinematic_cycles;
   o.ground_level_m = a.ground_level;
@@ -187,6 +192,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"min_kinematic_cycles", o.min_kinematic_cycles},
           {"post_cutoff_hz", o.post_cutoff_hz},
           {"post_cutoff_cycles", o.post_cutoff_cycles},
+          {"post_cutoff_floor_ratio", o.post_cutoff_floor_ratio},
           {"anthropometry", o.anthropometry},
           {"ground_level_m", o.ground_level_m ? nlohmann::json(*o.ground_level_m) : nlohmann::json("auto")},
           {"ground_shift_m", o.contact.ground_shift_m},

@@ -34,7 +34,8 @@ struct Settings {
          speed_gate_floor = SolverOptions{}.speed_gate_floor_mps, torso_lag = EstimateOptions{}.torso_lag_s,
          double_support_sta = EstimateOptions{}.double_support_sta_weight,
          min_kinematic_cycles = EstimateOptions{}.min_kinematic_cycles,
-         touchdown_fraction = ContactModelOptions{}.touchdown_fraction;
+         touchdown_fraction = ContactModelOptions{}.touchdown_fraction,
+         post_cutoff_floor = EstimateOptions{}.post_cutoff_floor_ratio;
   bool paper = false, r_given = false, anthropometry_given = false;
   std::optional<double> ground_level;
   std::optional<double> post_cutoff;  ///< given: the post-filter at this fixed cut-off, Hz
