@@ -42,8 +42,8 @@ print("Every figure is rRMSE in % (the paper's Eq. 12) unless a unit says otherw
       "plate (see `include/kin2grf/validation/validate.hpp`).\n")
 
 print("## Means per activity\n")
-print("| activity | configuration | stances (trials) | vertical | anterior | COP | COP RMSE mm | moment (plate centre) | total GRM (trials) |")
-print("|---|---|---|---|---|---|---|---|---|")
+print("| activity | configuration | stances (trials) | vertical | anterior | COP | COP RMSE mm | COP RMSE % foot | moment (plate centre) | total GRM (trials) |")
+print("|---|---|---|---|---|---|---|---|---|---|")
 activities = []
 suspect = {}
 for a, _, _ in rows:
@@ -65,17 +65,18 @@ for act in activities:
         ok = lambda s, k: k in ("vertical", "anterior") or not s.get("cop_reference_suspect", False)
         r = lambda k: mean_sd([s["rrmse_percent"][k] for s in st if ok(s, k)])
         cop_mm = mean_sd([s["rmse"]["cop_mm"] for s in st if ok(s, "cop")])
+        cop_foot = mean_sd([s["cop_rmse_percent_foot"] for s in st if ok(s, "cop") and s.get("cop_rmse_percent_foot") is not None])
         if config == "defaults":
             suspect[act] = (sum(1 for s in st if not ok(s, "cop")),
                             mean_sd([s["rrmse_percent"]["cop"] for s in st]),
                             mean_sd([s["rmse"]["cop_mm"] for s in st]))
-        print(f"| {act} | {config} | {len(st)} ({trials}) | {r('vertical')} | {r('anterior')} | {r('cop')} | {cop_mm} | "
+        print(f"| {act} | {config} | {len(st)} ({trials}) | {r('vertical')} | {r('anterior')} | {r('cop')} | {cop_mm} | {cop_foot} | "
               f"{r('moment')} | {mean_sd(tot)} ({len(tot)}) |")
-print("| walking | the paper, Table 1 (24 trials, total) | | 4.1 (1.1) | 11.2 (1.7) | | | | 5.3 (1.1) |")
-print("| walking | Fluit et al. (paper's Table 1) | | 2.7 | 9.3 | | | | 7.4 |")
-print("| walking | an independent implementation (METHOD.md) | 16 (7) | 17.5 | 12.9 | 10.4 | about 30 | 19.0 | 10.0 |")
-print("| running | an independent implementation (METHOD.md) | 14 | 6.1 | 21.5 | 13.5 | | 17.3 | 10.8 |")
-print("| jump landing | an independent implementation (METHOD.md) | | 52 | 31 | 107 | | 79 | 20 |")
+print("| walking | the paper, Table 1 (24 trials, total) | | 4.1 (1.1) | 11.2 (1.7) | | | | | 5.3 (1.1) |")
+print("| walking | Fluit et al. (paper's Table 1) | | 2.7 | 9.3 | | | | | 7.4 |")
+print("| walking | an independent implementation (METHOD.md) | 16 (7) | 17.5 | 12.9 | 10.4 | about 30 | | 19.0 | 10.0 |")
+print("| running | an independent implementation (METHOD.md) | 14 | 6.1 | 21.5 | 13.5 | | | 17.3 | 10.8 |")
+print("| jump landing | an independent implementation (METHOD.md) | | 52 | 31 | 107 | | | 79 | 20 |")
 print("\nMean (SD) over stances; total GRM: mean (SD) over the trials that have a total window. COP, COP RMSE "
       "and moment leave out the stances whose plate fails `validate`'s registration check (under more than half "
       "the body weight the plate's COP lies a median of more than 15 mm beyond the foot's heel and toe markers: "

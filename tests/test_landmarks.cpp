@@ -468,3 +468,32 @@ TEST(Pipeline, AModelErrorNamesTheTrialsFile) {
     EXPECT_NE(m.find("units"), std::string::npos) << m;
   }
 }
+
+// A toe marker 10 mm ahead of the MT head (a marker mapped as the toe that is not on it: a toe
+// segment a quarter of any measured one) cannot carry the COP's roll: the estimate takes
+// virtual toes of 0.3 x the ankle-MT length instead and says so; the other foot keeps its marker.
+TEST(Landmarks, AToeMarkerTooNearTheMtHeadIsReplacedByVirtualToes) {
+  Trial t = make_synthetic_trial({});
+  auto& mk = t.markers;
+  const int mt = mk.find("RMT1"), toe = mk.find("RHLX"), ankle = mk.find("RAJC");
+  ASSERT_GE(mt, 0);
+  ASSERT_GE(toe, 0);
+  ASSERT_GE(ankle, 0);
+  const auto& M = mk.positions_m[static_cast<std::size_t>(mt)];
+  const auto& A = mk.positions_m[static_cast<std::size_t>(ankle)];
+  auto& T = mk.positions_m[static_cast<std::size_t>(toe)];
+  for (Eigen::Index i = 0; i < T.rows(); ++i) T.row(i) = M.row(i) + 0.010 * (M.row(i) - A.row(i)).normalized();
+  const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+  bool right = false, left = false;
+  for (const auto& m : r.messages) {
+    right = right || (m.rfind("hallux_r:", 0) == 0 && m.find("too near for a toe") != std::string::npos);
+    left = left || m.rfind("hallux_l:", 0) == 0;
+  }
+  EXPECT_TRUE(right);
+  EXPECT_FALSE(left);
+  const auto& lm = r.landmarks;
+  const Eigen::Index i = lm.frames() / 2;
+  const double toe_m = (lm.p[landmark(0, kHallux)].row(i) - lm.p[landmark(0, kMt)].row(i)).norm();
+  const double foot_m = (lm.p[landmark(0, kMt)].row(i) - lm.p[landmark(0, kAnkle)].row(i)).norm();
+  EXPECT_NEAR(toe_m, kVirtualToeShare * foot_m, 1e-9);
+}

@@ -40,6 +40,8 @@ TEST(Validate, ExactPlatesGiveNearZeroError) {
     EXPECT_LT(st.metrics.moment->rmse, 1e-6);
     EXPECT_EQ(st.cop_beyond_foot_m, 0.0);
     EXPECT_FALSE(st.cop_reference_suspect);
+    EXPECT_GT(st.foot_length_m, 0.15);  // an adult's sole, heel to toe (the COP's error in % of it)
+    EXPECT_LT(st.foot_length_m, 0.35);
   }
   ASSERT_TRUE(v.total.has_value());
   EXPECT_LT(v.total->metrics.vertical->rmse, 1e-6);

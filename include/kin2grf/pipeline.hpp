@@ -39,7 +39,7 @@ struct EstimateOptions {
   /// the solve's switching, not to remove what the kinematics kept; 4 cycles over a slow walker's
   /// 1.75 s stance is 2.3 Hz, which clipped a held-out slow walk's loading peak (784 N measured,
   /// 719 estimated; at a fixed 12 Hz its error halved). Off by default: every development trial's
-  /// per-stance cut-off (5.6-16 Hz) lies above 0.75 x 6 Hz, so `kin2grf study post-cutoff-floor`
+  /// per-stance cut-off (5.0-16.7 Hz) lies above 0.75 x 6 Hz, so `kin2grf study post-cutoff-floor`
   /// cannot tell 0, 0.5 and 0.75 apart (criterion 8.59 %) and 1.0 costs a little (8.62 %).
   double post_cutoff_floor_ratio = 0.0;
   /// Lower the kinematic cut-off to what the markers' noise allows (noise_limited_cutoff; kin2grf)

@@ -59,6 +59,10 @@ struct LandmarkRule {
 /// upright torso (gain 1) gives the heavy HAT segment the pelvis's whole fore-aft oscillation,
 /// which over-brakes the body at heel strike and moves load to the leading foot too early.
 inline constexpr double kTrunkSwayGain = 0.5;
+/// Toes (sagittal_landmarks): the presets' virtual toes are 0.3 x the ankle-MT length (the hallux
+/// tip about a third of that ahead of the MT head); a toe marker nearer the MT head than half
+/// of it is not on the toe and is replaced by them, with a message.
+inline constexpr double kVirtualToeShare = 0.3, kMinToeShare = 0.15;
 
 struct MarkerSet {
   std::string name;

@@ -42,6 +42,7 @@
 
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -126,6 +127,9 @@ struct StanceValidation {
   /// cop_beyond_foot_m > max_cop_beyond_foot_m: metrics.cop and metrics.moment are kept for the
   /// record but left out of mean_rrmse and of the COP fit.
   bool cop_reference_suspect = false;
+  /// The foot's sole length, heel to toe sole point (median over the stance; NaN without the
+  /// sole series): the COP's RMSE is also given in % of it.
+  double foot_length_m = std::numeric_limits<double>::quiet_NaN();
   ComponentMetrics metrics;
   std::optional<double> onset_error_ms, offset_error_ms;  ///< estimate - plate; + = late
   /// Time shift of the estimate's vertical force that best matches the plate over the stance
