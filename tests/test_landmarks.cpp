@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <random>
 
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
@@ -496,4 +497,34 @@ TEST(Landmarks, AToeMarkerTooNearTheMtHeadIsReplacedByVirtualToes) {
   const double toe_m = (lm.p[landmark(0, kHallux)].row(i) - lm.p[landmark(0, kMt)].row(i)).norm();
   const double foot_m = (lm.p[landmark(0, kMt)].row(i) - lm.p[landmark(0, kAnkle)].row(i)).norm();
   EXPECT_NEAR(toe_m, kVirtualToeShare * foot_m, 1e-9);
+}
+
+// The trunk ablation (study trunk-ablation): the example set without its shoulder markers puts
+// the model torso above its hip centres' mean, needs no trunk marker (a trial whose trunk
+// markers are gone still runs) and says so; a hip rule it cannot stand a torso on is named.
+TEST(Landmarks, WithoutTrunkMarkersTheTorsoStandsOnTheHipCentre) {
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  std::string why;
+  const auto ablated = without_trunk_markers(set, why);
+  ASSERT_TRUE(ablated.has_value()) << why;
+  EXPECT_EQ(ablated->rules[kShoulder].kind, "pelvis_up");
+  const auto needed = ablated->motion_markers();
+  EXPECT_EQ(std::count(needed.begin(), needed.end(), "RSHO"), 0);
+  Trial t = make_synthetic_trial({});
+  for (const char* name : {"RSHO", "LSHO"}) {
+    const int k = t.markers.find(name);
+    ASSERT_GE(k, 0);
+    t.markers.positions_m[static_cast<std::size_t>(k)].setConstant(std::numeric_limits<double>::quiet_NaN());
+  }
+  const auto r = estimate(t, nullptr, *ablated, EstimateOptions{});
+  bool said = false;
+  for (const auto& m : r.messages) said = said || m.find("trunk markers not used") != std::string::npos;
+  EXPECT_TRUE(said);
+  // The shoulder point stands 0.5 m above the hip centre (upright; it sways only fore-aft).
+  const Eigen::Index i = r.landmarks.frames() / 2;
+  EXPECT_NEAR(r.landmarks.p[kShoulder](i, 1) - r.landmarks.p[kHip](i, 1), 0.5, 1e-9);
+  MarkerSet functional_hip = set;
+  functional_hip.rules[kHip].kind = "functional";
+  EXPECT_FALSE(without_trunk_markers(functional_hip, why).has_value());
+  EXPECT_NE(why.find("'functional'"), std::string::npos);
 }

@@ -273,10 +273,32 @@ std::optional<MarkerSet> choose_repeated_markers(const MarkerSet& set, const Mar
   return out;
 }
 
+std::optional<MarkerSet> without_trunk_markers(const MarkerSet& set, std::string& why) {
+  const LandmarkRule& shoulder = set.rules[kShoulder];
+  if (shoulder.kind == "pelvis_up") return set;
+  const LandmarkRule& hip = set.rules[kHip];
+  const bool from_pelvis = hip.kind == "harrington" && !hip.pelvis.empty();
+  const bool from_markers = (hip.kind == "mean" || hip.kind == "marker") && !hip.markers.empty();
+  if (!from_pelvis && !from_markers) {
+    why = set.name + ": the hip centre is made by a '" + hip.kind + "' rule, above which kin2grf puts no model torso";
+    return std::nullopt;
+  }
+  MarkerSet out = set;
+  out.name = set.name + " without trunk markers";
+  LandmarkRule& r = out.rules[kShoulder];
+  r = LandmarkRule{};
+  r.kind = "pelvis_up";
+  r.value = 0.5;  // the presets' model torso (plug-in-gait-lower and the others)
+  r.sway_gain = kTrunkSwayGain;
+  if (from_pelvis) r.pelvis = hip.pelvis;
+  else r.markers = hip.markers;  // upright above their mean
+  return out;
+}
+
 std::vector<std::string> MarkerSet::motion_markers() const {
   std::vector<std::string> out;
   for (const auto& r : rules) {
-    if (r.kind == "marker" || r.kind == "mean") out.insert(out.end(), r.markers.begin(), r.markers.end());
+    if (r.kind == "marker" || r.kind == "mean" || r.kind == "pelvis_up") out.insert(out.end(), r.markers.begin(), r.markers.end());
     if (r.kind == "static") out.insert(out.end(), r.cluster.begin(), r.cluster.end());
     if (r.kind == "functional") {
       out.insert(out.end(), r.cluster.begin(), r.cluster.end());
@@ -405,6 +427,16 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
         const double ax = -0.24 * pv.depth[i] - 0.0099, ay = -0.30 * pv.width[i] - 0.0109;
         P.row(i) = pv.origin.row(i) + ax * pv.x.row(i) + ay * pv.y.row(i);
       }
+    } else if (r.kind == "pelvis_up" && r.pelvis.empty()) {
+      // The model torso above a hip centre made of markers (without_trunk_markers on a set whose
+      // hip rule is a mean): upright above their mean.
+      Eigen::Vector3d up = Eigen::Vector3d::Zero();
+      up[static_cast<int>(options.up_axis.value_or(m.up_axis))] = 1.0;
+      P = mean_of(m, r.markers, path, what);
+      P.rowwise() += (r.value * up).transpose();
+      out.messages.push_back("shoulder: the torso is an upright segment of " + std::to_string(r.value).substr(0, 4) +
+                             " m above the hip centre, its top swaying by " + std::to_string(r.sway_gain).substr(0, 4) +
+                             " x the hip's fore-aft oscillation (trunk markers not used)");
     } else if (r.kind == "pelvis_up") {
       const Pelvis pv = pelvis(m, r.pelvis, path);
       // Without upper-body markers the torso is an upright segment above the hip centre: the

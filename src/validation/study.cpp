@@ -21,6 +21,7 @@ struct Setting {
   std::function<void(EstimateOptions&)> apply;
   double marker_noise_m = 0.0;  ///< the `noise` study: Gaussian noise added to every marker coordinate
   bool is_default = false;      ///< leaves kin2grf's default options as they are
+  bool without_trunk = false;   ///< the `trunk-ablation` study: the trial's trunk and arm markers unused
 };
 
 /// Marks the settings that leave the fields `get` reads at kin2grf's defaults (the added marker
@@ -95,6 +96,11 @@ std::vector<Setting> settings_for(const std::string& kind) {
     mark_default(s, [](const EstimateOptions& o) {
       return std::tuple(o.solver.speed_gate_ratio, o.solver.speed_gate_mps, o.solver.speed_gate_floor_mps);
     });
+  } else if (kind == "trunk-ablation") {
+    // What the estimate owes to the trunk and arm markers (issue 29): every trial as recorded,
+    // and with the model torso above the pelvis instead (without_trunk_markers).
+    s.push_back({"intact", 0, [](EstimateOptions&) {}, 0.0, true});
+    s.push_back({"trunk markers removed", 1, [](EstimateOptions&) {}, 0.0, false, true});
   } else if (kind == "post-cutoff-floor") {
     // The post-filter's floor as a multiple of the dynamics' kinematic cut-off.
     for (double f : {0.0, 0.5, 0.75, 1.0, 1.5, 2.0}) {
@@ -185,7 +191,7 @@ StudyCell pool(const std::vector<StudyTrialResult>& trials, const std::string& a
 
 const std::vector<std::string>& study_kinds() {
   static const std::vector<std::string> kinds{"r",     "ground-shift",         "cutoff",         "post-cutoff-cycles", "kinematic-cutoff",
-                                              "speed-gate", "speed-gate-ratio", "touchdown-fraction", "post-cutoff-floor", "noise",     "min-kinematic-cycles", "split-distance",
+                                              "speed-gate", "speed-gate-ratio", "touchdown-fraction", "post-cutoff-floor", "trunk-ablation", "noise",     "min-kinematic-cycles", "split-distance",
                                               "torso-length", "torso-lag",      "double-support-sta", "foot-model"};
   return kinds;
 }
@@ -207,7 +213,13 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
         noisy = *d.trial;
         add_marker_noise(noisy.markers, s.marker_noise_m, static_cast<unsigned>(seed));
       }
-      const EstimateResult e = estimate(s.marker_noise_m > 0 ? noisy : *d.trial, d.static_trial, *d.marker_set, o);
+      std::optional<MarkerSet> ablated;
+      if (s.without_trunk) {
+        std::string why;
+        ablated = without_trunk_markers(*d.marker_set, why);
+        if (!ablated) throw InputError(why);
+      }
+      const EstimateResult e = estimate(s.marker_noise_m > 0 ? noisy : *d.trial, d.static_trial, ablated ? *ablated : *d.marker_set, o);
       const ValidationResult v = validate(e, *d.plates);
       tr.stances.insert(tr.stances.end(), v.stances.begin(), v.stances.end());
       if (v.total && v.total->metrics.moment) grm_sum += v.total->metrics.moment->rrmse_percent, ++grm_n;

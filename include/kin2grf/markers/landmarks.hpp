@@ -44,7 +44,7 @@ namespace kin2grf {
 
 struct LandmarkRule {
   std::string kind;                  ///< marker, mean, harrington, static, functional, pelvis_up, virtual_hallux
-  std::vector<std::string> markers;  ///< marker / mean / static markers; functional: the distal cluster
+  std::vector<std::string> markers;  ///< marker / mean / static markers; functional: the distal cluster; pelvis_up without pelvis: hip centres
   std::vector<std::string> cluster;  ///< static: tracking cluster; functional: the proximal cluster
   std::map<std::string, std::string> pelvis;  ///< harrington / pelvis_up: rasis, lasis, rpsis, lpsis | sacrum
   double value = 0.0;                ///< pelvis_up length (m), virtual_hallux fraction
@@ -73,6 +73,13 @@ struct MarkerSet {
   /// Every marker a motion trial must have.
   [[nodiscard]] std::vector<std::string> motion_markers() const;
 };
+
+/// The set as if the trial had no trunk or arm markers (an ablation: how much the estimate owes
+/// to them): the shoulder point becomes the model torso above the pelvis (pelvis_up, swaying by
+/// kTrunkSwayGain), above the hip centre of the hip's rule (its pelvis markers, or the mean of
+/// its hip-centre markers). None when the hip centre is made otherwise (`why` says so); a set
+/// without trunk markers already is returned as it is.
+std::optional<MarkerSet> without_trunk_markers(const MarkerSet& set, std::string& why);
 
 /// A landmark's name in marker-set files ("shoulder", "hip", "knee_r", ...).
 const char* landmark_name(int id);
