@@ -57,10 +57,11 @@ py::dict estimate(const std::string& trial, const std::vector<std::string>& word
 }
 
 py::dict validate(const std::string& trial, const std::vector<std::string>& words, const std::string& plates,
-                  double threshold_N, const std::string& zero_offset) {
+                  double threshold_N, const std::string& zero_offset, const std::string& sync) {
   const auto s = settings_from(trial, words);
   kin2grf::ValidationOptions vo;
   vo.threshold_N = threshold_N;
+  kin2grf::parse_sync(sync, vo);
   std::optional<kin2grf::ValidationRun> run;
   {
     py::gil_scoped_release nogil;
@@ -116,7 +117,8 @@ PYBIND11_MODULE(_kin2grf, m) {
   py::register_exception<kin2grf::InputError>(m, "InputError", PyExc_ValueError);
   m.def("estimate", &estimate, py::arg("trial"), py::arg("words"));
   m.def("validate", &validate, py::arg("trial"), py::arg("words"), py::arg("plates"), py::arg("threshold_N"),
-        py::arg("zero_offset"));
+        py::arg("zero_offset"), py::arg("sync"));
   m.def("batch_lines", &batch_lines, py::arg("lines"), py::arg("jobs"), py::arg("out_dir"));
   m.def("settings_help", &settings_help);
+  m.def("batch_columns", [] { return kin2grf::batch_csv_columns(); });
 }

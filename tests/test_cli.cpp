@@ -308,11 +308,11 @@ TEST(CliBatch, RunsEveryTrialPastAFailureAndTheTableDoesNotDependOnJobs) {
   EXPECT_TRUE(j["trials"][0]["ok"].get<bool>());
   EXPECT_TRUE(j["trials"][0]["validated"].get<bool>());
   EXPECT_GT(j["trials"][0]["stances"].get<int>(), 0);
-  EXPECT_TRUE(j["trials"][0]["vertical_rrmse_pct"].is_number());
+  EXPECT_TRUE(j["trials"][0]["vertical_rrmse_percent"].is_number());
   EXPECT_FALSE(j["trials"][1]["ok"].get<bool>());
   EXPECT_TRUE(j["trials"][2]["ok"].get<bool>());
   EXPECT_FALSE(j["trials"][2]["validated"].get<bool>());  // a TRC has no plates
-  EXPECT_TRUE(j["trials"][2]["vertical_rrmse_pct"].is_null());
+  EXPECT_TRUE(j["trials"][2]["vertical_rrmse_percent"].is_null());
   for (const char* f : {"with-plates.csv", "with-plates_grf.mot", "with-plates.json", "markers-only.csv"})
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / f)) << f;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "missing.csv"));

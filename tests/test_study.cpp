@@ -256,7 +256,7 @@ TEST(Batch, TheCsvKeepsFullPrecision) {
   std::stringstream ss(line);
   for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
   ASSERT_GE(cells.size(), 13u);
-  EXPECT_EQ(std::stod(cells[12]), row.vertical) << cells[12];  // vertical_rrmse_pct
+  EXPECT_EQ(std::stod(cells[12]), row.vertical) << cells[12];  // vertical_rrmse_percent
   EXPECT_EQ(std::stod(cells[9]), row.mass_kg);
   EXPECT_GT(cells[12].size(), 6u) << "more than 4 significant figures";
 }

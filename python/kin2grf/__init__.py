@@ -19,7 +19,12 @@ from __future__ import annotations
 import os
 from typing import Any, Iterable
 
-import numpy as np
+try:
+    import numpy as np
+except ImportError as e:  # the module's arrays are numpy's
+    raise ImportError("kin2grf's Python module needs numpy, which this interpreter does not have: run it with "
+                      "/usr/bin/python3 after `bash scripts/setup.sh` (Debian's python3-numpy), or install numpy "
+                      "into this interpreter (python3 -m pip install numpy)") from e
 
 from . import _kin2grf
 from ._kin2grf import InputError
@@ -65,12 +70,21 @@ def _text(v: Any) -> str:
     return os.fspath(v) if isinstance(v, os.PathLike) else str(v)
 
 
+def _is_integer_column(name: str) -> bool:
+    """The estimate table's frame numbers, contact states and solver iterations are integers."""
+    return name in ("frame", "iterations") or name.startswith("contact_")
+
+
 def _table(columns: list[str], values: np.ndarray):
     try:
         import pandas as pd
     except ImportError:
-        return {c: values[:, k] for k, c in enumerate(columns)}
-    return pd.DataFrame(values, columns=columns)
+        return {c: values[:, k].astype(np.int64) if _is_integer_column(c) else values[:, k] for k, c in enumerate(columns)}
+    df = pd.DataFrame(values, columns=columns)
+    for c in columns:
+        if _is_integer_column(c) and np.isfinite(df[c]).all():
+            df[c] = df[c].astype(np.int64)
+    return df
 
 
 class Estimate:
@@ -104,10 +118,13 @@ def estimate(trial: str | os.PathLike, **settings) -> Estimate:
 
 
 def validate(trial: str | os.PathLike, plates: str | os.PathLike | None = None, threshold: float = 20.0,
-             zero_offset: str = "unloaded", **settings) -> dict:
+             zero_offset: str = "unloaded", sync: str | float = "none", **settings) -> dict:
     """Estimate, then compare with the trial's plates (or `plates`, a GRF .mot or C3D), as
-    `kin2grf validate`. Returns the ``--json`` document, with the estimate under "estimate"."""
-    d = _kin2grf.validate(os.fspath(trial), _words(settings), os.fspath(plates) if plates else "", float(threshold), zero_offset)
+    `kin2grf validate`. Returns the ``--json`` document, with the estimate under "estimate".
+    `sync`: "none" (compare as recorded; the marker-plate offset is reported under "sync"),
+    "auto" (compare after shifting the plates by it) or a shift in seconds (+ when the plates led)."""
+    d = _kin2grf.validate(os.fspath(trial), _words(settings), os.fspath(plates) if plates else "", float(threshold), zero_offset,
+                          _text(sync))
     out = d["validation"]
     out["estimate"] = Estimate(d["estimate"])
     return out
@@ -138,4 +155,20 @@ def batch(trials: str | os.PathLike | Iterable[str], jobs: int | None = None, cl
         import pandas as pd
     except ImportError:
         return rows
-    return pd.DataFrame(rows)
+    # The CSV's column order (kin2grf batch --csv), then the row's other fields.
+    first = [c for c in _kin2grf.batch_columns() if rows and c in rows[0]]
+    rest = [c for c in (rows[0] if rows else {}) if c not in first]
+    return pd.DataFrame(rows, columns=first + rest)
+
+
+def _settings_doc() -> str:
+    lines = ["", "Settings (keyword arguments; kin2grf.settings() lists them too):", ""]
+    for d in settings():
+        default = "" if d["flag"] or not d["default"] else f" (default {d['default']})"
+        lines.append(f"    {d['name']}{' (flag)' if d['flag'] else ''}{default}: {d['help']}")
+    return "\n".join(lines) + "\n"
+
+
+# help(kin2grf.estimate) and help(kin2grf.validate) list every setting, from the command line's parser.
+estimate.__doc__ = (estimate.__doc__ or "") + "\n" + _settings_doc()
+validate.__doc__ = (validate.__doc__ or "") + "\n" + _settings_doc()

@@ -225,10 +225,20 @@ std::string quoted(const std::string& s) {
 nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 }  // namespace
 
+const std::vector<std::string>& batch_csv_columns() {
+  static const std::vector<std::string> columns{
+      "activity",        "lab",         "name",     "trial",  "ok",
+      "frames",          "duration_s",  "seconds",  "frames_per_s",
+      "mass_kg",         "marker_set",  "stances",  "vertical_rrmse_percent",
+      "anterior_rrmse_percent", "cop_rrmse_percent", "moment_rrmse_percent", "total_vertical_rrmse_percent",
+      "total_grm_rrmse_percent", "error"};
+  return columns;
+}
+
 std::string batch_csv(const std::vector<BatchRow>& rows) {
   std::ostringstream os;
-  os << "activity,lab,name,trial,ok,frames,duration_s,seconds,frames_per_s,mass_kg,marker_set,stances,"
-        "vertical_rrmse_pct,anterior_rrmse_pct,cop_rrmse_pct,moment_rrmse_pct,total_vertical_rrmse_pct,total_grm_rrmse_pct,error\n";
+  for (std::size_t k = 0; k < batch_csv_columns().size(); ++k) os << (k ? "," : "") << batch_csv_columns()[k];
+  os << '\n';
   for (const auto& r : rows)
     os << quoted(r.activity) << ',' << quoted(r.lab) << ',' << quoted(r.name) << ',' << quoted(r.trial) << ','
        << (r.ok ? 1 : 0) << ',' << r.frames << ',' << cell(r.duration_s) << ',' << cell(r.seconds) << ','
@@ -263,9 +273,9 @@ nlohmann::json batch_row_json(const BatchRow& r) {
   return {{"activity", r.activity}, {"lab", r.lab}, {"name", r.name}, {"trial", r.trial}, {"ok", r.ok},
           {"error", r.ok ? nlohmann::json(nullptr) : nlohmann::json(r.error)}, {"frames", r.frames},
           {"duration_s", r.duration_s}, {"seconds", r.seconds}, {"mass_kg", r.mass_kg}, {"marker_set", r.marker_set},
-          {"validated", r.validated}, {"stances", r.stances}, {"vertical_rrmse_pct", number(r.vertical)},
-          {"anterior_rrmse_pct", number(r.anterior)}, {"cop_rrmse_pct", number(r.cop)}, {"moment_rrmse_pct", number(r.moment)},
-          {"total_vertical_rrmse_pct", number(r.total_vertical)}, {"total_grm_rrmse_pct", number(r.total_grm)},
+          {"validated", r.validated}, {"stances", r.stances}, {"vertical_rrmse_percent", number(r.vertical)},
+          {"anterior_rrmse_percent", number(r.anterior)}, {"cop_rrmse_percent", number(r.cop)}, {"moment_rrmse_percent", number(r.moment)},
+          {"total_vertical_rrmse_percent", number(r.total_vertical)}, {"total_grm_rrmse_percent", number(r.total_grm)},
           {"messages", r.messages}, {"outputs", r.outputs}};
 }
 

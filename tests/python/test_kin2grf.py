@@ -75,12 +75,26 @@ def test_table_and_columns(example):
         assert list(t.columns) == r.columns
     except ImportError:
         assert set(t) == set(r.columns)
+    # Frame numbers and contact states are integers, as in the CSV.
+    for c in ("frame", "contact_r", "contact_l", "iterations"):
+        assert np.issubdtype(np.asarray(t[c]).dtype, np.integer), c
     assert r.summary["mass_kg"] == 70.0
+
+
+def test_help_lists_every_setting():
+    for f in (kin2grf.estimate, kin2grf.validate):
+        for name in ("speed_gate_ratio", "mass", "touchdown_fraction", "post_cutoff_floor", "paper"):
+            assert f"    {name}" in f.__doc__, (f.__name__, name)
 
 
 def test_validate_compares_the_example_plates(example):
     v = kin2grf.validate(example / "example_walk.c3d")
     assert v["mean_rrmse_percent"]["all"]["stances"] == 2
+    assert v["sync"]["applied_shift_ms"] == 0.0
+    shifted = kin2grf.validate(example / "example_walk.c3d", sync=0.02)
+    assert shifted["sync"]["applied_shift_ms"] == pytest.approx(20.0)
+    with pytest.raises(kin2grf.InputError, match="--sync"):
+        kin2grf.validate(example / "example_walk.c3d", sync="sometimes")
     assert isinstance(v["estimate"], kin2grf.Estimate)
     with pytest.raises(kin2grf.InputError, match="no force plates"):
         kin2grf.validate(example / "example_walk.trc", mass=70)
@@ -122,6 +136,10 @@ def test_batch_locally_and_on_a_dask_cluster(example, tmp_path):
     assert list(local["ok"]) == [True, False, True]
     assert "no-such.trc" in local["error"][1]
     assert local["stances"][0] == 2
+    # The CSV's column order and names (kin2grf batch --csv), then the row's other fields.
+    assert list(local.columns)[:5] == ["activity", "lab", "name", "trial", "ok"]
+    assert list(local.columns).index("vertical_rrmse_percent") < list(local.columns).index("error")
+    assert "validated" in local.columns
     # The file form of the list gives the same rows.
     listing = tmp_path / "list.txt"
     listing.write_text("# a comment\n" + "\n".join(lines) + "\n")

@@ -71,6 +71,8 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
 /// Every trial, rows in the list's order.
 std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, const BatchOptions& options = {});
 
+/// The batch CSV's columns, in order (the Python DataFrame takes the same order).
+const std::vector<std::string>& batch_csv_columns();
 /// The summary table: CSV (one header line, one line per trial; empty cells for NaN) and JSON
 /// (an array of objects with the same fields, null for NaN).
 std::string batch_csv(const std::vector<BatchRow>& rows);
