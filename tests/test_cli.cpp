@@ -670,3 +670,23 @@ TEST(CliSuggest, SlipsGetASuggestionOrTheFlagToUse) {
   EXPECT_NE(grf.out.find("--plates"), std::string::npos) << grf.out;
   EXPECT_EQ(kin2grf::closest_match("xyzzy", {"estimate", "validate"}), "");
 }
+
+// The demo's recorded walk (data/example, bundled with its licence and source): validate gives
+// the figures the README quotes, from the project's own files (no shared data needed).
+TEST(CliExample, TheBundledRecordedWalkValidatesAsTheReadmeSays) {
+  KIN2GRF_REQUIRE_CLI();
+  const std::filesystem::path dir = std::filesystem::path(KIN2GRF_SOURCE_DIR) / "data" / "example";
+  ASSERT_TRUE(std::filesystem::exists(dir / "LICENSE-Apache-2.0.txt"));
+  ASSERT_TRUE(std::filesystem::exists(dir / "README.md"));
+  const CliRun v = run("validate " + (dir / "walking2.c3d").string() + " --mass 64.9");
+  ASSERT_EQ(v.status, 0) << v.out;
+  const auto k = v.out.find("right foot on FP1");
+  ASSERT_NE(k, std::string::npos) << v.out;
+  std::istringstream in(v.out.substr(k + std::string("right foot on FP1").size()));
+  double vertical = 0, anterior = 0, cop = 0;
+  in >> vertical >> anterior >> cop;
+  EXPECT_NEAR(vertical, 5.1, 0.15) << v.out;  // README: 5.1 / 7.6 / 6.3
+  EXPECT_NEAR(anterior, 7.6, 0.15) << v.out;
+  EXPECT_NEAR(cop, 6.3, 0.15) << v.out;
+  EXPECT_NE(v.out.find("left foot is partly off the plate"), std::string::npos) << v.out;
+}
