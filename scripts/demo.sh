@@ -13,7 +13,7 @@ rec=out/recorded-walk
 mkdir -p "$rec"
 echo "== A recorded walk (data/example/walking2.c3d; its source and licence: data/example/README.md)"
 $k estimate data/example/walking2.c3d --mass 64.9 -o "$rec/estimated_grf.mot" --csv "$rec/estimated.csv" \
-  --json "$rec/estimated.json" --opensim "$rec/opensim"
+  --json "$rec/estimated.json" --events "$rec/gait_events.csv" --report "$rec/estimate.html" --opensim "$rec/opensim"
 $k validate data/example/walking2.c3d --mass 64.9 --json "$rec/validation.json" --report "$rec/validation.html"
 echo
 echo "== kin2grf's synthetic example (make-example)"
@@ -23,7 +23,7 @@ $k estimate out/example/example_walk.c3d -o out/example/estimated_grf.mot \
   --csv out/example/estimated.csv --json out/example/estimated.json --opensim out/example/opensim
 echo
 echo "Outputs in out/recorded-walk/: the recorded walk's estimate (estimated_grf.mot, estimated.csv,"
-echo "  estimated.json), its validation against the walk's own force plate (validation.html, validation.json)"
+echo "  estimated.json, gait_events.csv, estimate.html: its plots without plates), its validation against the walk's own force plate (validation.html, validation.json)"
 echo "  and opensim/ (GRF .mot, markers .trc and ExternalLoads .xml for OpenSim's inverse dynamics)."
 echo "Outputs in out/example/: the synthetic walk (example_walk.c3d, .trc, _grf.mot), a squat, and the walk's"
 echo "  estimate (estimated_grf.mot, estimated.csv, estimated.json, opensim/). Its plates are synthetic (the model's"

@@ -48,6 +48,24 @@ std::optional<double> median_stance_s(const std::array<std::vector<bool>, 2>& co
   return median(durations);
 }
 
+std::vector<GaitEvent> gait_events(const std::array<std::vector<bool>, 2>& contact, const Eigen::VectorXd& time_s, double rate_hz) {
+  std::vector<GaitEvent> out;
+  if (!(rate_hz > 0)) return out;
+  for (int side = 0; side < 2; ++side) {
+    const auto& c = contact[static_cast<std::size_t>(side)];
+    const auto n = static_cast<Eigen::Index>(std::min<std::size_t>(c.size(), static_cast<std::size_t>(time_s.size())));
+    for (const IndexRun& run : stance_runs(c, rate_hz)) {
+      if (static_cast<double>(run.last - run.first + 1) < 0.05 * rate_hz) continue;  // no stance is that short
+      if (run.first > 0 && run.first < n) out.push_back({"Foot Strike", side, run.first, time_s[run.first]});
+      if (run.last + 1 < n) out.push_back({"Foot Off", side, run.last + 1, time_s[run.last + 1]});
+    }
+  }
+  std::stable_sort(out.begin(), out.end(), [](const GaitEvent& a, const GaitEvent& b) {
+    return a.index != b.index ? a.index < b.index : a.side < b.side;
+  });
+  return out;
+}
+
 std::vector<DoubleSupport> walking_double_supports(const std::array<std::vector<bool>, 2>& contact, Eigen::Index max_frames) {
   std::vector<DoubleSupport> out;
   const auto n = static_cast<Eigen::Index>(std::min(contact[0].size(), contact[1].size()));

@@ -579,3 +579,31 @@ TEST(Pipeline, AStanceAtTheWindowsEdgeIsNamedWithItsFramesAndNoOther) {
       << said.front();
   EXPECT_NE(said.front().find("begins within 83 ms of the window's start"), std::string::npos) << said.front();
 }
+
+// Gait events from the contact states: a strike at each stance's first frame and a foot off at
+// the first frame after it; a flicker under 20 ms is bridged, a run under 50 ms is no stance, and
+// a stance cut by the window's ends gives no event at that end.
+TEST(Pipeline, GaitEventsAreTheStancesEndsInsideTheWindow) {
+  const double rate = 100.0;
+  const Eigen::Index n = 200;
+  Eigen::VectorXd t(n);
+  for (Eigen::Index i = 0; i < n; ++i) t[i] = static_cast<double>(i) / rate;
+  std::array<std::vector<bool>, 2> c{std::vector<bool>(n, false), std::vector<bool>(n, false)};
+  for (Eigen::Index i = 0; i < 40; ++i) c[0][static_cast<std::size_t>(i)] = true;     // cut by the start: a foot off at 40
+  for (Eigen::Index i = 100; i < 170; ++i) c[0][static_cast<std::size_t>(i)] = true;  // strike 100, off 170
+  c[0][130] = false;                                                                  // a 10 ms flicker, bridged
+  for (Eigen::Index i = 60; i < 63; ++i) c[1][static_cast<std::size_t>(i)] = true;    // 30 ms: no stance
+  for (Eigen::Index i = 150; i < n; ++i) c[1][static_cast<std::size_t>(i)] = true;    // strike 150, cut by the end
+  const auto ev = gait_events(c, t, rate);
+  ASSERT_EQ(ev.size(), 4u);
+  EXPECT_EQ(ev[0].label, "Foot Off");
+  EXPECT_EQ(ev[0].index, 40);
+  EXPECT_EQ(ev[1].label, "Foot Strike");
+  EXPECT_EQ(ev[1].index, 100);
+  EXPECT_EQ(ev[1].side, 0);
+  EXPECT_EQ(ev[2].index, 150);
+  EXPECT_EQ(ev[2].side, 1);
+  EXPECT_EQ(ev[3].label, "Foot Off");
+  EXPECT_EQ(ev[3].index, 170);
+  EXPECT_DOUBLE_EQ(ev[3].time_s, 1.7);
+}

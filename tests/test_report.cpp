@@ -14,6 +14,7 @@
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/markers/presets.hpp"
 #include "kin2grf/output/report.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
@@ -51,4 +52,36 @@ TEST(Report, RendersInHeadlessChromium) {
   const auto p = dom.find("data-points=\"");
   ASSERT_NE(p, std::string::npos);
   EXPECT_GT(std::stoi(dom.substr(p + 13)), 1000);
+}
+
+// estimate's report without plates (issue 30, item 8): per foot GRF, COP and joint torques, the
+// GRM, the gait events in a table; drawn by Chart.js in headless Chromium.
+TEST(Report, AnEstimateReportWithoutPlatesRendersWithItsGaitEvents) {
+  const char* candidates[] = {"/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"};
+  std::string browser;
+  for (const char* c : candidates)
+    if (std::filesystem::exists(c)) browser = c;
+  const SyntheticWalk w = make_synthetic_walk({});
+  const EstimateResult e = estimate(w.trial, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+  const auto events = gait_events({e.feet[0].contact, e.feet[1].contact}, e.time_s, e.motion.rate_hz);
+  ASSERT_FALSE(events.empty());
+  nlohmann::json j = {{"mass_kg", e.mass_kg}, {"marker_set", e.marker_set}, {"frames", {{"first", 1}, {"last", e.time_s.size()}}},
+                      {"progression", {{"speed_mps", 1.0}}}, {"settings", nlohmann::json::object()}, {"gait_events", nlohmann::json::array()}};
+  for (const auto& ev : events)
+    j["gait_events"].push_back({{"event", ev.label}, {"side", ev.side ? "left" : "right"}, {"frame", ev.index + 1}, {"time_s", ev.time_s}});
+  const std::string html = estimate_report_html("synthetic", e, j);
+  EXPECT_NE(html.find("Foot Strike"), std::string::npos);
+  if (browser.empty()) GTEST_SKIP() << "no Chromium found (scripts/setup.sh installs Debian's chromium)";
+  const auto dir = test::temp_dir("estimate-report");
+  const auto file = dir / "report.html";
+  write_file_text(file.string(), html);
+  const std::string cmd = browser + " --headless --no-sandbox --disable-gpu --user-data-dir=" + (dir / "profile").string() +
+                          " --dump-dom file://" + file.string() + " 2>/dev/null";
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  ASSERT_TRUE(pipe);
+  std::string dom;
+  char buf[4096];
+  while (std::size_t k = std::fread(buf, 1, sizeof buf, pipe.get())) dom.append(buf, k);
+  // 4 figures per foot (vertical, anterior, COP, joint torques) and the GRM.
+  EXPECT_NE(dom.find("data-charts-rendered=\"9\""), std::string::npos) << dom.substr(0, 400);
 }

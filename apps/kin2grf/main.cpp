@@ -43,7 +43,7 @@ int run_info(const std::string& file, bool json, double threshold, const std::st
 struct EstimateArgs : kin2grf::Settings {
   std::string opensim_dir;
   std::vector<std::string> opensim_bodies;
-  std::string out_mot, out_csv, out_json;
+  std::string out_mot, out_csv, out_json, out_events, out_report;
 };
 
 void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
@@ -52,6 +52,8 @@ void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
   c->add_option("-o,--output", a.out_mot, "OpenSim GRF .mot output");
   c->add_option("--csv", a.out_csv, "Per-frame CSV output (sagittal frame)");
   c->add_option("--json", a.out_json, "JSON summary output");
+  c->add_option("--events", a.out_events, "Gait events (foot strike, foot off per side, from the estimated contact) as CSV");
+  c->add_option("--report", a.out_report, "Self-contained HTML report with plots (no plates needed)");
   c->add_option("--opensim", a.opensim_dir,
                 "Write FOLDER/TRIAL_grf.mot (whole trial), TRIAL_markers.trc and TRIAL_external_loads.xml in OpenSim's frame "
                 "(Y up, X forward), ready for the ID tool");
@@ -76,7 +78,8 @@ void check_outputs(const std::vector<std::string>& outputs, const std::vector<st
 
 int run_estimate(const EstimateArgs& a) {
   {
-    std::vector<std::string> out = {a.out_mot, a.out_csv, a.out_json}, names = {"-o", "--csv", "--json"};
+    std::vector<std::string> out = {a.out_mot, a.out_csv, a.out_json, a.out_events, a.out_report},
+                             names = {"-o", "--csv", "--json", "--events", "--report"};
     if (!a.opensim_dir.empty()) {
       const auto f = kin2grf::opensim_export_paths(a.opensim_dir, std::filesystem::path(a.trial).stem().string());
       out.insert(out.end(), {f.grf_mot, f.markers_trc, f.external_loads_xml});
@@ -95,16 +98,22 @@ int run_estimate(const EstimateArgs& a) {
   options.progress = kin2grf::solve_progress(stderr);
   // The outputs need neither what validation reads nor, unless the OpenSim export writes them,
   // the markers: a long trial's memory (issue 10).
-  options.keep_all_series = false;
+  options.keep_all_series = !a.out_report.empty();  // the report plots the GRM
   const auto r = a.opensim_dir.empty() ? kin2grf::estimate_trial(a, options, std::move(files.trial), files.static_trial)
                                        : kin2grf::estimate_trial(a, options, trial, files.static_trial);
   print_messages(r);
   const std::string settings_line = kin2grf::settings_json(a, options).dump();
   if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r, settings_line);
   if (!a.out_csv.empty()) kin2grf::write_results_csv(a.out_csv, r);
-  if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(kin2grf::results_summary(r, kin2grf::settings_json(a, options))));
+  if (!a.out_json.empty() || !a.out_report.empty()) {
+    const auto summary = kin2grf::results_summary(r, kin2grf::settings_json(a, options));
+    if (!a.out_json.empty()) kin2grf::write_file_text(a.out_json, kin2grf::json_text(summary));
+    if (!a.out_report.empty()) kin2grf::write_file_text(a.out_report, kin2grf::estimate_report_html(a.trial, r, summary));
+  }
+  if (!a.out_events.empty()) kin2grf::write_file_text(a.out_events, kin2grf::gait_events_csv(r));
   std::cout << kin2grf::format_results_text(r);
-  for (const auto& [file, what] : {std::pair{a.out_mot, "OpenSim GRF"}, {a.out_csv, "per-frame CSV"}, {a.out_json, "JSON summary"}})
+  for (const auto& [file, what] : {std::pair{a.out_mot, "OpenSim GRF"}, {a.out_csv, "per-frame CSV"}, {a.out_json, "JSON summary"},
+                                   {a.out_events, "gait events CSV"}, {a.out_report, "HTML report"}})
     if (!file.empty()) std::cout << "wrote " << file << " (" << what << ")\n";
   if (!a.opensim_dir.empty()) {
     kin2grf::OpenSimExportOptions eo;
@@ -114,7 +123,7 @@ int run_estimate(const EstimateArgs& a) {
     std::cout << "wrote " << f.grf_mot << ", " << f.markers_trc << " and " << f.external_loads_xml
               << " (OpenSim: Y up, X forward; sagittal model: no mediolateral force or free moment)\n";
   }
-  if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty() && a.opensim_dir.empty())
+  if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty() && a.out_events.empty() && a.out_report.empty() && a.opensim_dir.empty())
     std::cout << "(-o GRF.mot, --csv FILE and --json FILE write the per-frame results and the full summary)\n";
   return 0;
 }

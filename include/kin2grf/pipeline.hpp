@@ -168,6 +168,21 @@ void check_options(const EstimateOptions& options);
 /// None when there is no complete stance (a standing trial, a single stance cut by the window).
 std::optional<double> median_stance_s(const std::array<std::vector<bool>, 2>& contact, double rate_hz);
 
+/// A gait event from the estimate's contact states (C3D's and Vicon's names): "Foot Strike" at
+/// the first frame of a stance, "Foot Off" at the first frame after it. Stances are the runs of
+/// contact with flickers under 20 ms bridged and runs under 50 ms left out (as median_stance_s
+/// takes them); a run that begins
+/// at the window's first frame has no strike in it, one that ends at its last frame no foot off
+/// (the window cut them).
+struct GaitEvent {
+  std::string label;    ///< "Foot Strike" or "Foot Off"
+  int side = 0;         ///< 0 right, 1 left
+  Eigen::Index index = 0;  ///< frame in the window (EstimateResult::first_frame_number + index in the file)
+  double time_s = 0.0;
+};
+/// Every foot's events, in time order (at one frame: the right foot first).
+std::vector<GaitEvent> gait_events(const std::array<std::vector<bool>, 2>& contact, const Eigen::VectorXd& time_s, double rate_hz);
+
 /// A walking double support: frames [first, last] where both feet are in contact, the trailing
 /// foot alone in contact on the frame before and the leading foot alone on the frame after.
 struct DoubleSupport {

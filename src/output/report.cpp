@@ -1,8 +1,11 @@
 #include "kin2grf/output/report.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+
+#include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
 
@@ -188,6 +191,63 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
     m.series.push_back({"force plates", time, to_vec(v.total->grm_measured_Nm), true});
     m.series.push_back({"kin2grf estimate", time, to_vec(v.total->grm_estimated_Nm), false});
     rep.figures.push_back(m);
+  }
+  rep.sections_html.push_back("<h2>Settings</h2><pre>" + html_escape(j["settings"].dump(2)) + "</pre>");
+  return render_report_html(rep);
+}
+
+std::string estimate_report_html(const std::string& trial, const EstimateResult& e, const nlohmann::json& j) {
+  Report rep;
+  rep.title = "kin2grf estimate: " + trial;
+  std::ostringstream t;
+  t << "<h2>Estimate</h2>\n<p>Ground reaction forces, centre of pressure and joint torques from the markers alone "
+       "(no plates compared). Body mass " << fmt(j["mass_kg"]) << " kg, marker set " << html_escape(j["marker_set"].get<std::string>())
+    << ", frames " << j["frames"]["first"] << "-" << j["frames"]["last"] << ", progression speed "
+    << fmt(j["progression"]["speed_mps"], "%.2f") << " m/s. Shaded: each foot's stances.</p>\n";
+  t << "<h3>Gait events</h3>\n<table><tr><th class=l>side</th><th class=l>event</th><th>frame</th><th>time s</th></tr>\n";
+  for (const auto& ev : j["gait_events"])
+    t << "<tr><td class=l>" << ev["side"].get<std::string>() << "</td><td class=l>" << ev["event"].get<std::string>() << "</td><td>"
+      << ev["frame"] << "</td><td>" << fmt(ev["time_s"], "%.3f") << "</td></tr>\n";
+  t << "</table>\n";
+  if (!e.messages.empty()) {
+    t << "<h3>Messages</h3><ul>\n";
+    for (const auto& m : e.messages) t << "<li>" << html_escape(m) << "</li>\n";
+    t << "</ul>\n";
+  }
+  rep.sections_html.push_back(t.str());
+  const std::vector<double> time = to_vec(e.time_s);
+  std::array<std::vector<std::pair<double, double>>, 2> stances;
+  for (int f = 0; f < 2; ++f) {
+    const auto& c = e.feet[static_cast<std::size_t>(f)].contact;
+    for (const IndexRun& run : runs_where(static_cast<Eigen::Index>(c.size()), [&](Eigen::Index i) { return c[static_cast<std::size_t>(i)]; }))
+      stances[static_cast<std::size_t>(f)].emplace_back(e.time_s[run.first], e.time_s[run.last]);
+  }
+  const auto figure = [&](const std::string& title, const std::string& unit, int foot, std::vector<ReportSeries> series) {
+    ReportFigure g;
+    g.title = title;
+    g.x_label = "time (s)";
+    g.y_label = unit;
+    if (foot >= 0) g.shaded = stances[static_cast<std::size_t>(foot)];
+    g.series = std::move(series);
+    rep.figures.push_back(std::move(g));
+  };
+  for (int f = 0; f < 2; ++f) {
+    const std::string foot = f ? "left" : "right";
+    const auto& fe = e.feet[static_cast<std::size_t>(f)];
+    figure(foot + " foot: vertical GRF", "N", f, {{"kin2grf estimate", time, to_vec(fe.force_N.col(1)), false}});
+    figure(foot + " foot: anterior GRF", "N", f, {{"kin2grf estimate", time, to_vec(fe.force_N.col(0)), false}});
+    figure(foot + " foot: COP along progression", "m", f, {{"kin2grf estimate", time, to_vec(fe.cop_x_m), false}});
+    std::vector<ReportSeries> torques;
+    for (int k = 0; k < 3; ++k) {  // hip, knee, ankle of this side (joint_torque_Nm: per side hip, knee, ankle, MTP)
+      static const char* const kJoint[] = {"hip", "knee", "ankle"};
+      torques.push_back({kJoint[k], time, to_vec(e.joint_torque_Nm.col(4 * f + k)), false});
+    }
+    figure(foot + " leg: joint torques", "N m", f, std::move(torques));
+  }
+  if (e.grm_Nm.size() == e.time_s.size()) {
+    char b[96];
+    std::snprintf(b, sizeof b, "sagittal GRM about x = %.3f m, y = %.3f m", e.grm_reference_m.x(), e.grm_reference_m.y());
+    figure(b, "N m", -1, {{"kin2grf estimate", time, to_vec(e.grm_Nm), false}});
   }
   rep.sections_html.push_back("<h2>Settings</h2><pre>" + html_escape(j["settings"].dump(2)) + "</pre>");
   return render_report_html(rep);

@@ -182,6 +182,10 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
     contacts[s ? "left" : "right"] = iv;
   }
   j["contact_intervals"] = contacts;
+  json events = json::array();
+  for (const GaitEvent& e : gait_events({r.feet[0].contact, r.feet[1].contact}, r.time_s, r.motion.rate_hz))
+    events.push_back({{"event", e.label}, {"side", e.side ? "left" : "right"}, {"frame", r.first_frame_number + e.index}, {"time_s", e.time_s}});
+  j["gait_events"] = events;
   double mean_it = 0;
   int max_it = 0;
   for (int it : r.iterations) { mean_it += it; max_it = std::max(max_it, it); }
@@ -204,6 +208,17 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
     seg.push_back({{"segment", segment_name(s)}, {"length_m", r.model.bodies[s].length_m}, {"mass_kg", r.model.bodies[s].mass_kg}});
   j["segments"] = seg;
   return j;
+}
+
+std::string gait_events_csv(const EstimateResult& r) {
+  std::ostringstream os;
+  os << "side,event,frame,time_s\n";
+  for (const GaitEvent& e : gait_events({r.feet[0].contact, r.feet[1].contact}, r.time_s, r.motion.rate_hz)) {
+    char b[32];
+    const auto end = std::to_chars(b, b + sizeof b, e.time_s).ptr;  // the shortest text that reads back the same
+    os << (e.side ? "left" : "right") << ',' << e.label << ',' << r.first_frame_number + e.index << ',' << std::string_view(b, end - b) << '\n';
+  }
+  return os.str();
 }
 
 std::string format_results_text(const EstimateResult& r) {

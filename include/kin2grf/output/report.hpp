@@ -49,6 +49,11 @@ std::string html_escape(const std::string& s);
 std::string validation_report_html(const std::string& trial, const EstimateResult& e, const ValidationResult& v,
                                    const nlohmann::json& validation);
 
+/// estimate's report, without plates: per foot the vertical and anterior GRF and the COP, the
+/// sagittal GRM (where the result holds it) and the joint torques over time, each foot's stances
+/// shaded; the gait events, the messages and the settings (`summary`: results_summary's JSON).
+std::string estimate_report_html(const std::string& trial, const EstimateResult& r, const nlohmann::json& summary);
+
 /// study's report: per activity, mean rRMSE of each component against the setting.
 std::string study_report_html(const StudyResult& study);
 

@@ -38,4 +38,8 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
 /// vertical force (what `estimate` prints).
 std::string format_results_text(const EstimateResult& r);
 
+/// The gait events (gait_events: foot strike, foot off per side) as CSV: side,event,frame,time_s
+/// (frame: the file's frame number).
+std::string gait_events_csv(const EstimateResult& r);
+
 }  // namespace kin2grf
