@@ -8,8 +8,11 @@
 
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
+
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/output/opensim_export.hpp"
 #include "kin2grf/output/results.hpp"
 #include "kin2grf/validation/validate.hpp"
 #include "kin2grf/workflow/batch.hpp"
@@ -43,17 +46,26 @@ py::dict estimate_dict(const kin2grf::Settings& s, const kin2grf::EstimateOption
   return d;
 }
 
-py::dict estimate(const std::string& trial, const std::vector<std::string>& words) {
+py::dict estimate(const std::string& trial, const std::vector<std::string>& words, const std::string& opensim_dir) {
   const auto s = settings_from(trial, words);
   kin2grf::EstimateResult r;
   kin2grf::EstimateOptions o;
+  std::string written;
   {
     py::gil_scoped_release nogil;
     const auto files = kin2grf::load_trial_and_static(s, kin2grf::estimate_load_options());
     o = kin2grf::to_options(s);
     r = kin2grf::estimate_trial(s, o, files.trial, files.static_trial);
+    if (!opensim_dir.empty()) {
+      // The OpenSim set, as `estimate --opensim DIR` writes it (the files named after the trial).
+      kin2grf::OpenSimExportOptions eo;
+      eo.settings = kin2grf::settings_json(s, o).dump();
+      written = kin2grf::write_opensim_export(opensim_dir, std::filesystem::path(s.trial).stem().string(), files.trial, r, eo).grf_mot;
+    }
   }
-  return estimate_dict(s, o, r);
+  py::dict d = estimate_dict(s, o, r);
+  if (!written.empty()) d["opensim_grf_mot"] = written;
+  return d;
 }
 
 py::dict validate(const std::string& trial, const std::vector<std::string>& words, const std::string& plates,
@@ -115,7 +127,7 @@ PYBIND11_MODULE(_kin2grf, m) {
   m.attr("__version__") = KIN2GRF_VERSION;
   // Bad input raises kin2grf.InputError (a ValueError) with the library's own message.
   py::register_exception<kin2grf::InputError>(m, "InputError", PyExc_ValueError);
-  m.def("estimate", &estimate, py::arg("trial"), py::arg("words"));
+  m.def("estimate", &estimate, py::arg("trial"), py::arg("words"), py::arg("opensim_dir") = std::string());
   m.def("validate", &validate, py::arg("trial"), py::arg("words"), py::arg("plates"), py::arg("threshold_N"),
         py::arg("zero_offset"), py::arg("sync"));
   m.def("batch_lines", &batch_lines, py::arg("lines"), py::arg("jobs"), py::arg("out_dir"));

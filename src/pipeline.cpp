@@ -257,9 +257,9 @@ void lag_torso_stage(const EstimateOptions& o, ModelMotion& motion, EstimateResu
   lag_torso_fore_aft(motion, added);
 }
 
-/// Which frames take the running COP function, and the rest of the trial's calibration: the belt
-/// velocity (always, on a treadmill, from every frame's contact points), the progression speed
-/// and the speed gate.
+/// Which frames take the running COP function, the rest of the trial's calibration (the belt
+/// velocity, always, on a treadmill, from every frame's contact points; the progression speed and
+/// the speed gate) and, with the touchdown rule, each foot's landing frames (landing_frames).
 struct ContactPlan {
   std::vector<bool> running;                  ///< frames that take the running COP function
   std::array<std::vector<bool>, 2> landing;   ///< per side, frames where the foot is still landing (landing_frames)
@@ -294,14 +294,19 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
     MotionFrame f;
     FrameContacts fc;
     if (touchdown)
-      for (int side = 0; side < 2; ++side) gap[side].resize(n), rate[side].resize(n), speed[side].resize(n), lowest[side].resize(static_cast<std::size_t>(n));
+      for (int side = 0; side < 2; ++side) {
+        gap[side].resize(n), rate[side].resize(n), speed[side].resize(n);
+        lowest[side].resize(static_cast<std::size_t>(n));
+      }
     for (Eigen::Index i = 0; i < n; ++i) {
       motion.frame(i, f);
       contact_frame(model, cal.contact, co, is_running_frame(running, i), f, fc);
       if (r.frame.treadmill) samples.add(fc);
       if (touchdown)
-        for (int side = 0; side < 2; ++side)
-          gap[side][i] = fc.lowest_gap_m[side], rate[side][i] = fc.lowest_gap_rate_mps[side], speed[side][i] = fc.lowest_velocity_x_mps[side], lowest[side][static_cast<std::size_t>(i)] = fc.lowest_point[side];
+        for (int side = 0; side < 2; ++side) {
+          gap[side][i] = fc.lowest_gap_m[side], rate[side][i] = fc.lowest_gap_rate_mps[side];
+          speed[side][i] = fc.lowest_velocity_x_mps[side], lowest[side][static_cast<std::size_t>(i)] = fc.lowest_point[side];
+        }
     }
     if (const auto belt = r.frame.treadmill ? samples.median_mps() : std::nullopt) {
       cal.belt_velocity_mps = *belt;
@@ -396,7 +401,7 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
         progress(static_cast<long>(static_cast<double>(k) / static_cast<double>(end) * static_cast<double>(n)), static_cast<long>(n));
       motion.frame(i, f);
       contact_frame(r.model, r.calibration.contact, o.contact, is_running_frame(running, i), f, fc);
-      for (int side = 0; side < 2; ++side) fc.landing[side] = is_running_frame(landing[side], i);
+      for (int side = 0; side < 2; ++side) fc.landing[side] = flag_at(landing[side], i);
       const FrameSolution s = solver.solve(f.q, f.qdd, fc);
       for (Eigen::Index j = 0; j < np; ++j) {
         const ContactPoint& p = fc.points[static_cast<std::size_t>(j)];

@@ -313,8 +313,12 @@ TEST(CliBatch, RunsEveryTrialPastAFailureAndTheTableDoesNotDependOnJobs) {
   EXPECT_TRUE(j["trials"][2]["ok"].get<bool>());
   EXPECT_FALSE(j["trials"][2]["validated"].get<bool>());  // a TRC has no plates
   EXPECT_TRUE(j["trials"][2]["vertical_rrmse_percent"].is_null());
-  for (const char* f : {"with-plates.csv", "with-plates_grf.mot", "with-plates.json", "markers-only.csv"})
+  for (const char* f : {"with-plates.csv", "with-plates_grf.mot", "with-plates.json", "with-plates_markers.trc",
+                        "with-plates_external_loads.xml", "markers-only.csv"})
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / f)) << f;
+  // The batch's GRF is the OpenSim set's (one convention everywhere).
+  EXPECT_NE(kin2grf::read_file_text((dir / "out" / "with-plates_grf.mot").string()).find("kin2grf_frame=OpenSim ground"),
+            std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "missing.csv"));
 }
 
@@ -363,15 +367,16 @@ TEST(CliExample, ItsOpenSimMarkerAndForceFilesAreYUpAndValidateLikeItsCaptureFil
   EXPECT_EQ(first_three(a), first_three(b)) << a << "\n" << b;
 }
 
-// kin2grf's own GRF .mot from a Z-up C3D is in that lab's frame (OpenSim's convention is Y up).
-// Read back as plates, its vertical is found from the forces (a ground reaction is mostly
+// kin2grf's GRF .mot from a Z-up C3D in that lab's frame (-o --lab-frame; OpenSim's convention is
+// Y up). Read back as plates, its vertical is found from the forces (a ground reaction is mostly
 // vertical), with a warning, and the estimate compared with itself is exact. Taken as Y up, its
 // COPs were all dropped as unloaded and nothing could be compared.
 TEST(CliExample, AGrfMotWrittenInAZUpFrameIsReadBackWithItsVertical) {
   const auto dir = example_dir();
   const std::string c3d = (dir / "example_walk.c3d").string(), mot = (dir / "roundtrip_grf.mot").string();
-  const CliRun e = run("estimate " + c3d + " -o " + mot);
+  const CliRun e = run("estimate " + c3d + " -o " + mot + " --lab-frame");
   ASSERT_EQ(e.status, 0) << e.out;
+  EXPECT_NE(kin2grf::read_file_text(mot).find("kin2grf_frame=lab"), std::string::npos);
   const CliRun info = run("info " + mot);
   EXPECT_NE(info.out.find("the forces are largest along Z"), std::string::npos) << info.out;
   const CliRun v = run("validate " + c3d + " --plates " + mot);
@@ -689,4 +694,27 @@ TEST(CliExample, TheBundledRecordedWalkValidatesAsTheReadmeSays) {
   EXPECT_NEAR(anterior, 7.6, 0.15) << v.out;
   EXPECT_NEAR(cop, 6.3, 0.15) << v.out;
   EXPECT_NE(v.out.find("left foot is partly off the plate"), std::string::npos) << v.out;
+}
+
+// One GRF convention (issue 30, item 2): -o writes what --opensim's STEM_grf.mot holds (OpenSim's
+// frame, Y up, every frame of the trial) and its header names the frame; --lab-frame is asked for.
+TEST(CliExample, TheGrfMotIsInOpenSimsFrameLikeTheOpenSimSet) {
+  KIN2GRF_REQUIRE_CLI();
+  const auto dir = kin2grf::test::temp_dir("cli_one_convention");
+  const std::string c3d = (example_dir() / "example_walk.c3d").string(), mot = (dir / "o.mot").string();
+  const CliRun e = run("estimate " + c3d + " -o " + mot + " --opensim " + (dir / "set").string());
+  ASSERT_EQ(e.status, 0) << e.out;
+  const std::string o = kin2grf::read_file_text(mot), set = kin2grf::read_file_text((dir / "set" / "example_walk_grf.mot").string());
+  EXPECT_NE(o.find("kin2grf_frame=OpenSim ground"), std::string::npos);
+  // The same data rows (the header's name line differs: each file is named after itself).
+  EXPECT_EQ(o.substr(o.find("endheader")), set.substr(set.find("endheader")));
+  // Y up: the vertical force is in ground_force_vy, and the rows cover the trial's every frame.
+  const auto table = kin2grf::read_sto(mot);
+  const int vy = table.column("ground_force_vy"), vz = table.column("ground_force_vz");
+  ASSERT_GE(vy, 0);
+  ASSERT_GE(vz, 0);
+  EXPECT_GT(table.data.col(vy).maxCoeff(), 500.0);
+  EXPECT_LT(table.data.col(vz).cwiseAbs().maxCoeff(), 1e-9);  // the sagittal model: no mediolateral force
+  const kin2grf::Trial t = kin2grf::load_trial(c3d);
+  EXPECT_EQ(table.data.rows(), t.markers.frames());
 }

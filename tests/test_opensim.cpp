@@ -227,6 +227,7 @@ TEST(Outputs, StreamedWritersWriteWhatTheWholeTablesWould) {
   t.header["DataType"] = "double";
   t.header["kin2grf_version"] = KIN2GRF_VERSION;
   t.header["kin2grf_settings"] = "{\"a\":1}";
+  t.header["kin2grf_frame"] = kLabFrameHeader;
   const std::string mot_text = read_file_text(mot);
   EXPECT_GT(mot_text.size(), std::size_t{1} << 16);
   EXPECT_EQ(mot_text, format_sto(t));

@@ -44,12 +44,15 @@ struct EstimateArgs : kin2grf::Settings {
   std::string opensim_dir;
   std::vector<std::string> opensim_bodies;
   std::string out_mot, out_csv, out_json, out_events, out_report;
+  bool lab_frame = false;
 };
 
 void add_estimate_options(CLI::App* c, EstimateArgs& a, bool outputs = true) {
   kin2grf::add_settings_options(c, a);
   if (!outputs) return;
-  c->add_option("-o,--output", a.out_mot, "OpenSim GRF .mot output");
+  c->add_option("-o,--output", a.out_mot,
+                "GRF .mot output in OpenSim's convention (X forward, Y up, every frame of the trial), as --opensim writes it");
+  c->add_flag("--lab-frame", a.lab_frame, "-o in the input's lab frame (its up axis) over the processed window instead");
   c->add_option("--csv", a.out_csv, "Per-frame CSV output (sagittal frame)");
   c->add_option("--json", a.out_json, "JSON summary output");
   c->add_option("--events", a.out_events, "Gait events (foot strike, foot off per side, from the estimated contact) as CSV");
@@ -99,11 +102,15 @@ int run_estimate(const EstimateArgs& a) {
   // The outputs need neither what validation reads nor, unless the OpenSim export writes them,
   // the markers: a long trial's memory (issue 10).
   options.keep_all_series = !a.out_report.empty();  // the report plots the GRM
+  const Eigen::VectorXd trial_time_s = trial.markers.time_s;  // -o's rows: every frame of the trial
   const auto r = a.opensim_dir.empty() ? kin2grf::estimate_trial(a, options, std::move(files.trial), files.static_trial)
                                        : kin2grf::estimate_trial(a, options, trial, files.static_trial);
   print_messages(r);
   const std::string settings_line = kin2grf::settings_json(a, options).dump();
-  if (!a.out_mot.empty()) kin2grf::write_grf_mot(a.out_mot, r, settings_line);
+  if (!a.out_mot.empty()) {
+    if (a.lab_frame) kin2grf::write_grf_mot(a.out_mot, r, settings_line);
+    else kin2grf::write_opensim_grf_mot(a.out_mot, trial_time_s, r, settings_line);
+  }
   if (!a.out_csv.empty()) kin2grf::write_results_csv(a.out_csv, r);
   if (!a.out_json.empty() || !a.out_report.empty()) {
     const auto summary = kin2grf::results_summary(r, kin2grf::settings_json(a, options));
@@ -112,7 +119,7 @@ int run_estimate(const EstimateArgs& a) {
   }
   if (!a.out_events.empty()) kin2grf::write_file_text(a.out_events, kin2grf::gait_events_csv(r));
   std::cout << kin2grf::format_results_text(r);
-  for (const auto& [file, what] : {std::pair{a.out_mot, "OpenSim GRF"}, {a.out_csv, "per-frame CSV"}, {a.out_json, "JSON summary"},
+  for (const auto& [file, what] : {std::pair{a.out_mot, a.lab_frame ? "GRF, lab frame" : "GRF, OpenSim's frame"}, {a.out_csv, "per-frame CSV"}, {a.out_json, "JSON summary"},
                                    {a.out_events, "gait events CSV"}, {a.out_report, "HTML report"}})
     if (!file.empty()) std::cout << "wrote " << file << " (" << what << ")\n";
   if (!a.opensim_dir.empty()) {

@@ -112,9 +112,11 @@ class Estimate:
         return f"<kin2grf.Estimate {self.values.shape[0]} frames, mass {self.summary.get('mass_kg')} kg>"
 
 
-def estimate(trial: str | os.PathLike, **settings) -> Estimate:
-    """Estimate GRF, COP, GRM and joint torques of `trial` (C3D or TRC), as `kin2grf estimate`."""
-    return Estimate(_kin2grf.estimate(os.fspath(trial), _words(settings)))
+def estimate(trial: str | os.PathLike, opensim: str | os.PathLike | None = None, **settings) -> Estimate:
+    """Estimate GRF, COP, GRM and joint torques of `trial` (C3D or TRC), as `kin2grf estimate`.
+    `opensim`: a folder to write the OpenSim set into, as ``--opensim DIR`` does (TRIAL_grf.mot in
+    OpenSim's frame, TRIAL_markers.trc, TRIAL_external_loads.xml)."""
+    return Estimate(_kin2grf.estimate(os.fspath(trial), _words(settings), os.fspath(opensim) if opensim else ""))
 
 
 def validate(trial: str | os.PathLike, plates: str | os.PathLike | None = None, threshold: float = 20.0,

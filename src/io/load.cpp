@@ -104,6 +104,12 @@ Trial load_by_extension(const std::string& path, const LoadOptions& options) {
     t.encoding = "text";
     const Table table = read_sto(path);
     t.warnings.insert(t.warnings.end(), table.warnings.begin(), table.warnings.end());
+    // kin2grf's own GRF in OpenSim's frame lines up with the markers of the same --opensim set,
+    // not with the capture file's lab frame (unless its axes are OpenSim's).
+    if (const auto frame = table.header.find("kin2grf_frame");
+        frame != table.header.end() && frame->second.rfind("OpenSim", 0) == 0)
+      t.warnings.push_back(path + ": written by kin2grf in OpenSim's frame (X the walker's progression, Y up): it lines up with "
+                                  "the TRC of the same --opensim set; to compare it with the capture file, write it with -o --lab-frame");
     t.plates = grf_from_table(table, path, options.cop_threshold_N, t.warnings);
     if (!t.plates) t.warnings.push_back("no ground_force columns: not a GRF file (" +
                                         std::to_string(table.labels.size()) + " columns)");

@@ -11,6 +11,17 @@
 
 namespace kin2grf {
 
+namespace {
+/// Lab -> OpenSim: rows forward, up, right.
+Eigen::Matrix3d lab_to_opensim(const EstimateResult& r) {
+  Eigen::Matrix3d R;
+  R.row(0) = r.frame.forward.transpose();
+  R.row(1) = r.frame.up.transpose();
+  R.row(2) = r.frame.forward.cross(r.frame.up).transpose();
+  return R;
+}
+}  // namespace
+
 std::string external_loads_xml(const std::string& mot, const OpenSimExportOptions& o) {
   std::ostringstream os;
   os << "<?xml version=\"1.0\" encoding=\"UTF-8\" ?>\n"
@@ -43,16 +54,9 @@ OpenSimExportFiles opensim_export_paths(const std::string& dir, const std::strin
           (fs::path(dir) / (stem + "_external_loads.xml")).string()};
 }
 
-OpenSimExportFiles write_opensim_export(const std::string& dir, const std::string& stem, const Trial& trial,
-                                        const EstimateResult& r, const OpenSimExportOptions& o) {
-  namespace fs = std::filesystem;
-  ensure_output_folder(dir);
-  // Lab -> OpenSim: rows forward, up, right.
-  Eigen::Matrix3d R;
-  R.row(0) = r.frame.forward.transpose();
-  R.row(1) = r.frame.up.transpose();
-  R.row(2) = r.frame.forward.cross(r.frame.up).transpose();
-  const Eigen::Index N = trial.markers.frames(), n = r.time_s.size();
+Table opensim_grf_table(const Eigen::VectorXd& trial_time_s, const EstimateResult& r, const std::string& settings) {
+  const Eigen::Matrix3d R = lab_to_opensim(r);
+  const Eigen::Index N = trial_time_s.size(), n = r.time_s.size();
   const auto plates = as_lab_plates(r);
 
   // The GRF over the whole trial.
@@ -83,11 +87,27 @@ OpenSimExportFiles write_opensim_export(const std::string& dir, const std::strin
       else f.cop_m.row(k).setZero();  // a foot that never touches the ground
     }
   }
-  Table t = grf_table(trial.markers.time_s, feet[0], feet[1]);
-  t.name = stem + "_grf";
+  Table t = grf_table(trial_time_s, feet[0], feet[1]);
   t.header["DataType"] = "double";
   t.header["kin2grf_version"] = KIN2GRF_VERSION;
-  if (!o.settings.empty()) t.header["kin2grf_settings"] = o.settings;
+  t.header["kin2grf_frame"] = kOpenSimFrameHeader;
+  if (!settings.empty()) t.header["kin2grf_settings"] = settings;
+  return t;
+}
+
+void write_opensim_grf_mot(const std::string& path, const Eigen::VectorXd& trial_time_s, const EstimateResult& r,
+                           const std::string& settings) {
+  Table t = opensim_grf_table(trial_time_s, r, settings);
+  t.name = std::filesystem::path(path).stem().string();
+  write_file_text(path, format_sto(t));
+}
+
+OpenSimExportFiles write_opensim_export(const std::string& dir, const std::string& stem, const Trial& trial,
+                                        const EstimateResult& r, const OpenSimExportOptions& o) {
+  ensure_output_folder(dir);
+  const Eigen::Matrix3d R = lab_to_opensim(r);
+  Table t = opensim_grf_table(trial.markers.time_s, r, o.settings);
+  t.name = stem + "_grf";
   const OpenSimExportFiles out = opensim_export_paths(dir, stem);
   write_file_text(out.grf_mot, format_sto(t));
 

@@ -35,6 +35,7 @@ void write_grf_mot(const std::string& path, const EstimateResult& r, const std::
   t.labels = grf_labels();
   t.header["DataType"] = "double";
   t.header["kin2grf_version"] = KIN2GRF_VERSION;
+  t.header["kin2grf_frame"] = kLabFrameHeader;
   if (!settings.empty()) t.header["kin2grf_settings"] = settings;
   const Eigen::Index n = r.time_s.size();
   AtomicFile file(path);

@@ -17,6 +17,7 @@
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/output_file.hpp"
+#include "kin2grf/output/opensim_export.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/output/results.hpp"
 #include "kin2grf/io/json.hpp"
@@ -63,6 +64,8 @@ ValidationRun validate_trial(const Settings& s, const std::string& plates_file, 
   ValidationRun run;
   run.estimate = estimate_trial(s, options, trial, files.static_trial);
   run.validation = validate(run.estimate, *source.plates, vo);
+  if (measured)  // what the plates file's reader noticed (the trial's own warnings are the estimate's)
+    for (const auto& w : measured->warnings) run.validation.notes.push_back("plates file: " + w);
   run.settings = settings_json(s, options);
   run.settings["plates"] = source.path;
   run.settings["threshold_N"] = vo.threshold_N;
@@ -90,7 +93,8 @@ void parse_sync(const std::string& text, ValidationOptions& vo) {
 
 std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir) {
   const auto base = (std::filesystem::path(out_dir) / file_stem(entry.name)).string();
-  return {base + ".csv", base + "_grf.mot", base + ".json"};
+  const auto opensim = opensim_export_paths(out_dir, file_stem(entry.name));
+  return {base + ".csv", opensim.grf_mot, base + ".json", opensim.markers_trc, opensim.external_loads_xml};
 }
 
 BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& options) {
@@ -119,10 +123,14 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
       // The trial's files are placed together, with the batch's, or not at all.
       OutputTransaction outputs;
       const auto written = batch_trial_outputs(entry, options.out_dir);
-      const std::string &csv = written[0], &mot = written[1], &json = written[2];
+      const std::string &csv = written[0], &json = written[2];
       write_results_csv(csv, r);
       auto settings = settings_json(entry.settings, estimate_options);
-      write_grf_mot(mot, r, settings.dump());
+      // The OpenSim set, as `estimate --opensim` writes it: the GRF in OpenSim's frame over the
+      // whole trial, the markers, the ExternalLoads file.
+      OpenSimExportOptions eo;
+      eo.settings = settings.dump();
+      write_opensim_export(options.out_dir, file_stem(entry.name), trial, r, eo);
       write_file_text(json, json_text(v ? validation_json(entry.name, r, *v, settings) : results_summary(r, settings)));
       outputs.commit();
       row.outputs = written;

@@ -5,6 +5,7 @@ import csv
 import math
 import os
 import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
@@ -64,6 +65,14 @@ def test_estimate_equals_the_cli_csv_on_a_shared_trial(tmp_path):
     if not trial.exists():
         pytest.skip(f"shared recordings not found at {DATA} (set KIN2GRF_DATA_DIR)")
     assert_same_as_cli(kin2grf.estimate(trial, mass=64.9), cli_csv(trial, "--mass", "64.9", tmp=tmp_path))
+
+
+def test_estimate_writes_the_opensim_set(example, tmp_path):
+    r = kin2grf.estimate(example / "example_walk.c3d", opensim=tmp_path / "set")
+    for f in ("example_walk_grf.mot", "example_walk_markers.trc", "example_walk_external_loads.xml"):
+        assert (tmp_path / "set" / f).exists(), f
+    assert "kin2grf_frame=OpenSim ground" in (tmp_path / "set" / "example_walk_grf.mot").read_text()
+    assert r.summary["mass_kg"] == 70.0
 
 
 def test_table_and_columns(example):
@@ -152,3 +161,19 @@ def test_batch_locally_and_on_a_dask_cluster(example, tmp_path):
         remote = kin2grf.batch(lines, client=client)
     assert isinstance(remote, pd.DataFrame)
     assert without_timing(remote.to_dict("records")) == without_timing(local.to_dict("records"))
+
+
+def test_the_readme_example_runs_as_written(tmp_path):
+    """The README's first Python example, verbatim, from a copy of the repository's root layout
+    (its bundled walk) so that its output folder lands in tmp_path."""
+    root = Path(__file__).resolve().parents[2]
+    text = (root / "README.md").read_text()
+    start = text.index("```python\n") + len("```python\n")
+    code = text[start:text.index("```", start)]
+    (tmp_path / "data").mkdir()
+    os.symlink(root / "data" / "example", tmp_path / "data" / "example")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "grf_vertical_r_N" in done.stdout
+    assert (tmp_path / "out" / "python-opensim" / "walking2_grf.mot").exists()

@@ -159,10 +159,12 @@ std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, cons
 void contact_frame(const Model& model, const ContactCalibration& soles, const ContactModelOptions& options, bool running,
                    MotionFrame& frame, FrameContacts& fc);
 
-/// Whether frame i takes the running COP function (`running`: flight_frames' flags; empty, none).
-inline bool is_running_frame(const std::vector<bool>& running, Eigen::Index i) {
-  return static_cast<Eigen::Index>(running.size()) > i && running[static_cast<std::size_t>(i)];
+/// Frame i's flag of a per-frame flag vector; an empty (or short) vector: false.
+inline bool flag_at(const std::vector<bool>& flags, Eigen::Index i) {
+  return static_cast<Eigen::Index>(flags.size()) > i && flags[static_cast<std::size_t>(i)];
 }
+/// Whether frame i takes the running COP function (`running`: flight_frames' flags; empty, none).
+inline bool is_running_frame(const std::vector<bool>& running, Eigen::Index i) { return flag_at(running, i); }
 
 /// contact_frame over the whole trial, D* kept in motion.dstar and its derivatives (for tests
 /// and benchmarks that look at every frame's contacts). `running`

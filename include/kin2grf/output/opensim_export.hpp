@@ -21,6 +21,7 @@
 
 #include <string>
 
+#include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/trial.hpp"
 #include "kin2grf/pipeline.hpp"
 
@@ -43,6 +44,17 @@ OpenSimExportFiles opensim_export_paths(const std::string& dir, const std::strin
 /// Write the three files into `dir` (created if needed), names starting with `stem`.
 OpenSimExportFiles write_opensim_export(const std::string& dir, const std::string& stem, const Trial& trial,
                                         const EstimateResult& estimate, const OpenSimExportOptions& options = {});
+
+/// What the header of an OpenSim-convention GRF .mot says of its frame (key kin2grf_frame).
+inline constexpr const char* kOpenSimFrameHeader =
+    "OpenSim ground: X forward (the walker's progression), Y up, Z to the right; every frame of the trial";
+
+/// STEM_grf.mot's table: the GRF in OpenSim's frame over the trial's `trial_time_s` (every marker
+/// frame; zero force outside contact and the processed window), with its header.
+Table opensim_grf_table(const Eigen::VectorXd& trial_time_s, const EstimateResult& estimate, const std::string& settings = "");
+/// That table as a .mot file at `path` (estimate -o, batch, Python).
+void write_opensim_grf_mot(const std::string& path, const Eigen::VectorXd& trial_time_s, const EstimateResult& estimate,
+                           const std::string& settings = "");
 
 /// The ExternalLoads XML text for a .mot file name (exposed for tests).
 std::string external_loads_xml(const std::string& mot_file_name, const OpenSimExportOptions& options);

@@ -17,6 +17,9 @@ namespace kin2grf {
 /// `settings`: the run's settings as one line (compact JSON), written to the header with the
 /// version (kin2grf_version=, kin2grf_settings=). Written row by row as it is made (AtomicFile).
 void write_grf_mot(const std::string& path, const EstimateResult& r, const std::string& settings = "");
+/// What write_grf_mot's header says of its frame (key kin2grf_frame).
+inline constexpr const char* kLabFrameHeader =
+    "lab: the input file's axes (its up axis up, not OpenSim's Y unless the input's is); the processed window";
 /// The per-frame results as one table (sagittal frame; units in the column names): what the CSV
 /// writes and the Python module returns. NaN where a value does not exist (COP without contact).
 struct ResultsTable {
