@@ -46,25 +46,33 @@ py::dict estimate_dict(const kin2grf::Settings& s, const kin2grf::EstimateOption
   return d;
 }
 
-py::dict estimate(const std::string& trial, const std::vector<std::string>& words, const std::string& opensim_dir) {
+py::dict estimate(const std::string& trial, const std::vector<std::string>& words, const std::string& opensim_dir,
+                  const std::string& mot_path, bool lab_frame) {
   const auto s = settings_from(trial, words);
   kin2grf::EstimateResult r;
   kin2grf::EstimateOptions o;
-  std::string written;
+  std::vector<std::string> written;
   {
     py::gil_scoped_release nogil;
     const auto files = kin2grf::load_trial_and_static(s, kin2grf::estimate_load_options());
     o = kin2grf::to_options(s);
     r = kin2grf::estimate_trial(s, o, files.trial, files.static_trial);
+    const std::string stem = std::filesystem::path(s.trial).stem().string(), settings = kin2grf::settings_json(s, o).dump();
     if (!opensim_dir.empty()) {
       // The OpenSim set, as `estimate --opensim DIR` writes it (the files named after the trial).
       kin2grf::OpenSimExportOptions eo;
-      eo.settings = kin2grf::settings_json(s, o).dump();
-      written = kin2grf::write_opensim_export(opensim_dir, std::filesystem::path(s.trial).stem().string(), files.trial, r, eo).grf_mot;
+      eo.settings = settings;
+      const auto f = kin2grf::write_opensim_export(opensim_dir, stem, files.trial, r, eo);
+      written = {f.grf_mot, f.markers_trc, f.external_loads_xml};
+    }
+    if (!mot_path.empty()) {  // as `estimate -o` (with --lab-frame)
+      if (lab_frame) kin2grf::write_grf_mot(mot_path, r, settings);
+      else kin2grf::write_opensim_grf_mot(mot_path, stem, files.trial.markers.time_s, r, settings);
+      written.push_back(mot_path);
     }
   }
   py::dict d = estimate_dict(s, o, r);
-  if (!written.empty()) d["opensim_grf_mot"] = written;
+  d["written"] = written;
   return d;
 }
 
@@ -127,7 +135,8 @@ PYBIND11_MODULE(_kin2grf, m) {
   m.attr("__version__") = KIN2GRF_VERSION;
   // Bad input raises kin2grf.InputError (a ValueError) with the library's own message.
   py::register_exception<kin2grf::InputError>(m, "InputError", PyExc_ValueError);
-  m.def("estimate", &estimate, py::arg("trial"), py::arg("words"), py::arg("opensim_dir") = std::string());
+  m.def("estimate", &estimate, py::arg("trial"), py::arg("words"), py::arg("opensim_dir") = std::string(),
+        py::arg("mot_path") = std::string(), py::arg("lab_frame") = false);
   m.def("validate", &validate, py::arg("trial"), py::arg("words"), py::arg("plates"), py::arg("threshold_N"),
         py::arg("zero_offset"), py::arg("sync"));
   m.def("batch_lines", &batch_lines, py::arg("lines"), py::arg("jobs"), py::arg("out_dir"));

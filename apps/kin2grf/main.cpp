@@ -109,7 +109,7 @@ int run_estimate(const EstimateArgs& a) {
   const std::string settings_line = kin2grf::settings_json(a, options).dump();
   if (!a.out_mot.empty()) {
     if (a.lab_frame) kin2grf::write_grf_mot(a.out_mot, r, settings_line);
-    else kin2grf::write_opensim_grf_mot(a.out_mot, trial_time_s, r, settings_line);
+    else kin2grf::write_opensim_grf_mot(a.out_mot, std::filesystem::path(a.trial).stem().string(), trial_time_s, r, settings_line);
   }
   if (!a.out_csv.empty()) kin2grf::write_results_csv(a.out_csv, r);
   if (!a.out_json.empty() || !a.out_report.empty()) {

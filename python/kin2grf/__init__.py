@@ -95,11 +95,24 @@ class Estimate:
     of arrays without pandas). summary: the ``--json`` document. messages: what the method noted.
     """
 
-    def __init__(self, d: dict):
+    def __init__(self, d: dict, trial: str = "", words: list[str] | None = None):
         self.columns: list[str] = list(d["columns"])
         self.values: np.ndarray = np.asarray(d["values"])
         self.summary: dict = d["summary"]
         self.messages: list[str] = list(d["messages"])
+        self._trial, self._words = trial, list(words or [])
+
+    def write_opensim(self, folder: str | os.PathLike) -> list[str]:
+        """Write the OpenSim set into `folder`, as ``kin2grf estimate --opensim`` does: TRIAL_grf.mot
+        (OpenSim's frame, every frame of the trial), TRIAL_markers.trc, TRIAL_external_loads.xml.
+        The estimate is made again from the same trial and settings (it is deterministic)."""
+        return list(_kin2grf.estimate(self._trial, self._words, os.fspath(folder))["written"])
+
+    def write_mot(self, path: str | os.PathLike, lab_frame: bool = False) -> str:
+        """Write the GRF .mot, as ``kin2grf estimate -o`` does: OpenSim's frame over every frame of
+        the trial (the OpenSim set's TRIAL_grf.mot), or with `lab_frame` the input's lab frame over the
+        processed window."""
+        return _kin2grf.estimate(self._trial, self._words, "", os.fspath(path), bool(lab_frame))["written"][-1]
 
     @property
     def table(self):
@@ -116,7 +129,8 @@ def estimate(trial: str | os.PathLike, opensim: str | os.PathLike | None = None,
     """Estimate GRF, COP, GRM and joint torques of `trial` (C3D or TRC), as `kin2grf estimate`.
     `opensim`: a folder to write the OpenSim set into, as ``--opensim DIR`` does (TRIAL_grf.mot in
     OpenSim's frame, TRIAL_markers.trc, TRIAL_external_loads.xml)."""
-    return Estimate(_kin2grf.estimate(os.fspath(trial), _words(settings), os.fspath(opensim) if opensim else ""))
+    words = _words(settings)
+    return Estimate(_kin2grf.estimate(os.fspath(trial), words, os.fspath(opensim) if opensim else ""), os.fspath(trial), words)
 
 
 def validate(trial: str | os.PathLike, plates: str | os.PathLike | None = None, threshold: float = 20.0,
@@ -128,7 +142,7 @@ def validate(trial: str | os.PathLike, plates: str | os.PathLike | None = None, 
     d = _kin2grf.validate(os.fspath(trial), _words(settings), os.fspath(plates) if plates else "", float(threshold), zero_offset,
                           _text(sync))
     out = d["validation"]
-    out["estimate"] = Estimate(d["estimate"])
+    out["estimate"] = Estimate(d["estimate"], os.fspath(trial), _words(settings))
     return out
 
 

@@ -95,10 +95,10 @@ Table opensim_grf_table(const Eigen::VectorXd& trial_time_s, const EstimateResul
   return t;
 }
 
-void write_opensim_grf_mot(const std::string& path, const Eigen::VectorXd& trial_time_s, const EstimateResult& r,
-                           const std::string& settings) {
+void write_opensim_grf_mot(const std::string& path, const std::string& stem, const Eigen::VectorXd& trial_time_s,
+                           const EstimateResult& r, const std::string& settings) {
   Table t = opensim_grf_table(trial_time_s, r, settings);
-  t.name = std::filesystem::path(path).stem().string();
+  t.name = stem + "_grf";  // as the OpenSim set's TRIAL_grf.mot: the same file
   write_file_text(path, format_sto(t));
 }
 

@@ -73,6 +73,12 @@ def test_estimate_writes_the_opensim_set(example, tmp_path):
         assert (tmp_path / "set" / f).exists(), f
     assert "kin2grf_frame=OpenSim ground" in (tmp_path / "set" / "example_walk_grf.mot").read_text()
     assert r.summary["mass_kg"] == 70.0
+    # The result writes the same files, and the -o .mot is the set's .mot.
+    written = r.write_opensim(tmp_path / "again")
+    assert [Path(p).name for p in written] == ["example_walk_grf.mot", "example_walk_markers.trc", "example_walk_external_loads.xml"]
+    mot = r.write_mot(tmp_path / "o.mot")
+    assert Path(mot).read_text() == (tmp_path / "set" / "example_walk_grf.mot").read_text()
+    assert "kin2grf_frame=lab" in Path(r.write_mot(tmp_path / "lab.mot", lab_frame=True)).read_text()
 
 
 def test_table_and_columns(example):
@@ -177,3 +183,4 @@ def test_the_readme_example_runs_as_written(tmp_path):
     assert done.returncode == 0, done.stderr[-2000:]
     assert "grf_vertical_r_N" in done.stdout
     assert (tmp_path / "out" / "python-opensim" / "walking2_grf.mot").exists()
+    assert (tmp_path / "out" / "python-grf.mot").read_text() == (tmp_path / "out" / "python-opensim" / "walking2_grf.mot").read_text()

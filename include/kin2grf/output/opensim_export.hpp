@@ -52,9 +52,10 @@ inline constexpr const char* kOpenSimFrameHeader =
 /// STEM_grf.mot's table: the GRF in OpenSim's frame over the trial's `trial_time_s` (every marker
 /// frame; zero force outside contact and the processed window), with its header.
 Table opensim_grf_table(const Eigen::VectorXd& trial_time_s, const EstimateResult& estimate, const std::string& settings = "");
-/// That table as a .mot file at `path` (estimate -o, batch, Python).
-void write_opensim_grf_mot(const std::string& path, const Eigen::VectorXd& trial_time_s, const EstimateResult& estimate,
-                           const std::string& settings = "");
+/// That table as a .mot file at `path`, named STEM_grf as the OpenSim set's (estimate -o, Python):
+/// the same bytes as write_opensim_export's STEM_grf.mot.
+void write_opensim_grf_mot(const std::string& path, const std::string& stem, const Eigen::VectorXd& trial_time_s,
+                           const EstimateResult& estimate, const std::string& settings = "");
 
 /// The ExternalLoads XML text for a .mot file name (exposed for tests).
 std::string external_loads_xml(const std::string& mot_file_name, const OpenSimExportOptions& options);
