@@ -89,7 +89,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
   } else if (kind == "speed-gate-ratio") {
     s.push_back({"fixed 1.50 m/s", 0, [](EstimateOptions& o) { o.solver.speed_gate_ratio = 0, o.solver.speed_gate_mps = 1.5; }});
     for (double floor : {0.5, 0.75})
-      for (double k : {1.0, 1.5, 2.0, 3.0}) {
+      for (double k : {0.5, 0.7, 1.0, 1.5, 2.0, 3.0}) {
         std::snprintf(b, sizeof b, "%.1f x speed, >= %.2f", k, floor);
         s.push_back({b, k, [k, floor](EstimateOptions& o) { o.solver.speed_gate_ratio = k, o.solver.speed_gate_floor_mps = floor; }});
       }

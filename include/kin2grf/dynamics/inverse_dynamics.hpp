@@ -65,7 +65,11 @@ struct SolverOptions {
   /// those data cannot tell them apart, holding no slow walk and no sprint. It is the default for
   /// its physical reason and for the two held-out failures of the fixed gate (issue 9: a 0.4 m/s
   /// walk's swing foot took load; a 3.3 m/s run did better with 2 m/s); 2 x v let a fast walker's
-  /// landing foot in 60-90 ms early (docs/METHOD-NOTES.md).
+  /// landing foot in 60-90 ms early (docs/METHOD-NOTES.md). With 0.5 and 0.7 x v among the
+  /// candidates (session 18), 0.7 (at least 0.75) wins the criterion on all trials (8.53 against
+  /// 8.59 %), but held out it moves walking from 6.6 / 7.8 / 6.1 to 6.3 / 7.9 / 6.3 (the same
+  /// mean), running from 5.0 / 9.3 / 4.3 to 4.9 / 9.3 / 4.3, and costs the drop jump 13.6 ->
+  /// 15.3 % (its lab's choice without it: 0.5, at least 0.5): no held-out gain, the default stays.
   double speed_gate_ratio = 1.0;
   double speed_gate_floor_mps = 0.75;
   /// Feet side by side: when both feet are in contact and all their active points lie within
