@@ -511,7 +511,7 @@ std::array<std::vector<bool>, 2> foot_contact_states(const RawSolve& raw, Eigen:
 }
 
 /// Stances near the window's ends: the zero-lag filters see data on one side only there.
-/// Measured by cutting development walks short (session 15): the total vertical force is 12-53 %
+/// Measured by cutting development walks short: the total vertical force is 12-53 %
 /// body weight RMS off at the cut, 4-10 % 40 ms in and 1-4 % by 60 ms, at a 6 Hz kinematic
 /// cut-off; half a period of that cut-off (83 ms at 6 Hz) covers it and scales with the filter.
 void window_edge_messages(const std::array<std::vector<bool>, 2>& contact, double rate_hz, double cutoff_hz, EstimateResult& r) {
@@ -757,7 +757,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   r.seconds_dynamics = seconds_dynamics;
   feet_stage(o, r, motion.rate_hz, raw);
   // What only the per-foot results needed is freed before the totals take their arrays: a long
-  // trial's peak memory (issue 10).
+  // trial's peak memory.
   raw = RawSolve();
   r.motion = std::move(motion);
   r.grm_reference_m = o.grm_reference_m;

@@ -100,7 +100,7 @@ int run_estimate(const EstimateArgs& a) {
   auto options = kin2grf::to_options(a);
   options.progress = kin2grf::solve_progress(stderr);
   // The outputs need neither what validation reads nor, unless the OpenSim export writes them,
-  // the markers: a long trial's memory (issue 10).
+  // the markers: a long trial's memory.
   options.keep_all_series = !a.out_report.empty();  // the report plots the GRM
   const Eigen::VectorXd trial_time_s = trial.markers.time_s;  // -o's rows: every frame of the trial
   const auto r = a.opensim_dir.empty() ? kin2grf::estimate_trial(a, options, std::move(files.trial), files.static_trial)

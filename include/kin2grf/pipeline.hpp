@@ -82,7 +82,7 @@ struct EstimateOptions {
   SolverOptions solver;
   LandmarkOptions landmarks;
   /// Whether the result holds every per-frame series. false (a long trial's memory when only the
-  /// outputs are wanted, issue 10): what only validation and COP fitting read is left out (the
+  /// outputs are wanted): what only validation and COP fitting read is left out (the
   /// window's landmarks are released once the motion is made, r.landmarks keeping its rate and
   /// times; FootResult::sole_m and kinematic_total stay empty), and so are the per-frame totals
   /// (grm_Nm, residual, joint_force_N), which frame_totals() remakes from the motion as the
@@ -207,7 +207,7 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
                         const EstimateOptions& options);
 /// The same, taking the trial: its marker samples are released as soon as the landmarks are made
 /// (its path, warnings and everything else are kept), so that a long trial's markers and its
-/// results are never held together (issue 10's memory). The results are the same.
+/// results are never held together (the memory of long trials). The results are the same.
 EstimateResult estimate(Trial&& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& options);
 
 /// One foot's result at one processed frame in the lab frame of the input: force on the body (N)

@@ -707,7 +707,7 @@ Trial read_c3d_bytes(const std::vector<std::uint8_t>& bytes, const std::string& 
 
 Trial read_c3d(const std::string& path, const C3dReadOptions& options) {
   // Mapped, not read into memory: the frames are read front to back and each block's bytes are
-  // released behind (issue 10's memory: a 10-minute capture is 0.5 GB, mostly analog samples).
+  // released behind (memory: a 10-minute capture is 0.5 GB, mostly analog samples).
   const MappedFile file(path, /*populate=*/false);
   return file.read([&] {
     return read_c3d_span(file.bytes(), path, options, [&](std::size_t begin, std::size_t end) { file.release(begin, end); });

@@ -54,7 +54,7 @@ int Table::column(const std::string& label) const {
 }
 
 MarkerTrajectories read_trc(const std::string& path, std::vector<std::string>* warnings) {
-  // The rows' text is released as they are parsed (issue 10's memory: a long trial's text and its
+  // The rows' text is released as they are parsed (memory: a long trial's text and its
   // markers are not held whole together).
   const MappedFile file(path, /*populate=*/false);
   return file.read([&] {

@@ -70,7 +70,7 @@ BodyGeometry measure_geometry(const SagittalLandmarks& lm) {
 Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm) {
   const Eigen::Index n = lm.frames();
   Eigen::MatrixXd x(n, 12);
-  // The absolute angles first, in x itself (a long trial's memory, issue 10): the torso's in
+  // The absolute angles first, in x itself (a long trial's memory): the torso's in
   // column 2, each joint's child segment's in column 3 + j.
   for (Eigen::Index i = 0; i < n; ++i) {
     auto P = [&](int k) { return Eigen::Vector2d(lm.p[k].row(i).transpose()); };
@@ -288,7 +288,7 @@ double measured_torso_lag_s(const ModelMotion& m) {
 
 double noise_limited_cutoff(const SagittalLandmarks& lm, double upper_hz) {
   // residual_analysis_cutoff reads at most a minute of frames: only those are gathered (a long
-  // trial's memory, issue 10).
+  // trial's memory).
   const Eigen::Index n = std::min<Eigen::Index>(lm.frames(), static_cast<Eigen::Index>(60 * lm.rate_hz));
   Eigen::MatrixXd xy(n, 2 * kLandmarkCount);
   for (int k = 0; k < kLandmarkCount; ++k) xy.middleCols(2 * k, 2) = lm.p[static_cast<std::size_t>(k)].topRows(n);

@@ -699,7 +699,7 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
   s.rate_hz = m.rate_hz;
   s.time_s = m.time_s.segment(best_a, best_len);
   // Each 3D landmark is released once projected (the heels and MT heads once the feet's lateral
-  // places are taken too): a long trial's memory (issue 10).
+  // places are taken too): a long trial's memory.
   const auto lateral_needs = [](int id) {
     for (int side = 0; side < 2; ++side)
       if (id == landmark(side, kHeel) || id == landmark(side, kMt)) return true;

@@ -17,7 +17,7 @@ namespace kin2grf {
 namespace {
 
 /// Rows are gathered into a buffer and written out every so often: the file is written as it is
-/// made, never held whole (issue 10).
+/// made, never held whole.
 constexpr std::size_t kFlushBytes = std::size_t{1} << 16;
 
 void flush_if_full(std::string& buf, std::ostream& os, bool force = false) {

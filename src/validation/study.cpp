@@ -97,7 +97,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
       return std::tuple(o.solver.speed_gate_ratio, o.solver.speed_gate_mps, o.solver.speed_gate_floor_mps);
     });
   } else if (kind == "trunk-ablation") {
-    // What the estimate owes to the trunk and arm markers (issue 29): every trial as recorded,
+    // What the estimate owes to the trunk and arm markers: every trial as recorded,
     // and with the model torso above the pelvis instead (without_trunk_markers).
     s.push_back({"intact", 0, [](EstimateOptions&) {}, 0.0, true});
     s.push_back({"trunk markers removed", 1, [](EstimateOptions&) {}, 0.0, false, true});
@@ -117,7 +117,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
     }
     mark_default(s, [](const EstimateOptions& o) { return o.contact.touchdown_fraction; });
   } else if (kind == "noise") {
-    // Robustness to what real capture does (issue 10): 0, 1, 2, 3 mm of Gaussian noise on every
+    // Robustness to what real capture does: 0, 1, 2, 3 mm of Gaussian noise on every
     // marker coordinate, kNoiseRealizations seeded draws per level (the same draws for every run),
     // their stances pooled; the estimate otherwise unchanged.
     for (double mm : {0.0, 1.0, 2.0, 3.0}) {
@@ -145,7 +145,7 @@ std::vector<Setting> settings_for(const std::string& kind) {
     mark_default(s, [](const EstimateOptions& o) { return o.torso_length; });
   } else if (kind == "double-support-sta") {
     // Up to 0.2: above it a 1 cm error of the ground level moves a walk by 0.3-0.4 points of
-    // vertical (PiG_Motion3 at 0.3 and 0.4; issue 10's limit is 0.2, docs/ROBUSTNESS.md): the
+    // vertical (PiG_Motion3 at 0.3 and 0.4; the robustness limit is 0.2, docs/ROBUSTNESS.md): the
     // double supports' ends move with the ground, and the prior's timing with them.
     for (double w : {0.0, 0.1, 0.2}) {
       std::snprintf(b, sizeof b, w > 0 ? "%.1f" : "off", w);

@@ -63,10 +63,10 @@ struct SolverOptions {
   /// with the fixed 1.5 m/s (leave-one-lab-out criterion 12.04 against 12.02 %; walking 9.4 %
   /// vertical for both, running anterior 10.2 against 10.6 %, drop jump 13.6 against 13.9 %):
   /// those data cannot tell them apart, holding no slow walk and no sprint. It is the default for
-  /// its physical reason and for the two held-out failures of the fixed gate (issue 9: a 0.4 m/s
+  /// its physical reason and for the two held-out failures of the fixed gate (a 0.4 m/s
   /// walk's swing foot took load; a 3.3 m/s run did better with 2 m/s); 2 x v let a fast walker's
   /// landing foot in 60-90 ms early (docs/METHOD-NOTES.md). With 0.5 and 0.7 x v among the
-  /// candidates (session 18), 0.7 (at least 0.75) wins the criterion on all trials (8.53 against
+  /// candidates, 0.7 (at least 0.75) wins the criterion on all trials (8.53 against
   /// 8.59 %), but held out it moves walking from 6.6 / 7.8 / 6.1 to 6.3 / 7.9 / 6.3 (the same
   /// mean), running from 5.0 / 9.3 / 4.3 to 4.9 / 9.3 / 4.3, and costs the drop jump 13.6 ->
   /// 15.3 % (its lab's choice without it: 0.5, at least 0.5): no held-out gain, the default stays.

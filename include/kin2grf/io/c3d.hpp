@@ -36,7 +36,7 @@ struct C3dReadOptions {
   /// false: the plates keep their geometry, type and rate but no samples (ForcePlateRecording::
   /// samples() is 0), and the analog samples are not read. For `estimate`, which needs the plates
   /// only to tell the lab's up axis: their force, moment and COP in doubles take 4 (float) to 8
-  /// (integer) times the plates' analog data in the file, at 1-2 kHz (issue 10's memory).
+  /// (integer) times the plates' analog data in the file, at 1-2 kHz (the memory of long trials).
   bool plate_samples = true;
 };
 

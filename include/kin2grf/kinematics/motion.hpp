@@ -63,7 +63,7 @@ struct MotionFrame {
 /// frame, prepare_contacts keeps it for every frame.
 /// q, qd, qdd of a frame are rebuilt by frame(i), the same forward kinematics for every caller,
 /// bit for bit. Why not N x 63 matrices: three of them were 1.5 KB a frame, 44 % of a long
-/// trial's peak memory (issue 10); rebuilding each frame where it is used (the contact stage,
+/// trial's peak memory; rebuilding each frame where it is used (the contact stage,
 /// the solve, the totals) costs the pipeline about 5 % (scripts/speed-compare.sh).
 struct ModelMotion {
   double rate_hz = 0.0;
@@ -73,7 +73,7 @@ struct ModelMotion {
   /// x's first and second time derivatives: stored (reconstruct_motion), or, when empty, x's
   /// central differences (central_difference, second_difference) taken per frame by
   /// derivatives_at(). compute_motion keeps x only: the derivatives were two thirds of a long
-  /// trial's motion (issue 10's memory), and a frame's differences cost a few operations. The
+  /// trial's motion (the memory of long trials), and a frame's differences cost a few operations. The
   /// same numbers either way, bit for bit.
   Eigen::MatrixXd xd, xdd;
   Eigen::VectorXd torso_ax_mps2;       ///< N: the HAT COM's fore-aft acceleration (lag_torso_fore_aft)
@@ -133,7 +133,7 @@ ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, doub
 /// paper Eq. 5's M qdd) is replaced by itself delayed by tau:
 ///   a(t) = a_x(t - tau), linearly interpolated between frames; a_x(0) before the first frame.
 /// A delay, as what the trunk markers already lag the hip by is measured (measured_torso_lag_s,
-/// a cross-correlation peak); until session 11 this was a first-order lag of time constant tau,
+/// a cross-correlation peak); a first-order lag of time constant tau was tried before it,
 /// which also attenuated (docs/METHOD-NOTES.md compares them). Its position and velocity, its
 /// vertical and angular accelerations and every other segment are unchanged (torso_ax_mps2 is
 /// the one series it writes). tau_s = 0 leaves the motion as it is (the paper).

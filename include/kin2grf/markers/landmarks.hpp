@@ -162,7 +162,7 @@ std::size_t remove_marker_outliers(MarkerTrajectories& markers, const std::vecto
 /// `release`: `motion` itself, when the caller has no further use for its samples: each
 /// marker's samples are released (left 0 x 3) after the last landmark that reads them, and those
 /// of markers no landmark reads at once, so that a long trial's markers and landmarks are not
-/// held whole together (issue 10's memory). The names, times and rate stay.
+/// held whole together (the memory of long trials). The names, times and rate stay.
 Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& motion,
                               const MarkerTrajectories* static_trial, const LandmarkOptions& options,
                               const std::string& path,

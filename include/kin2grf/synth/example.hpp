@@ -81,7 +81,7 @@ Trial make_example_walk(const SyntheticWalkOptions& options = {});
 /// whose signals are the method's own estimate), `seconds` long (1-600). Returns what was written,
 /// a line per example. `rate_hz`: the markers' rate (50-2000 Hz); `analog_rate_hz`: the walk's
 /// plates' rate, an integer multiple of it (0: the marker rate), their signals interpolated
-/// linearly between frames: a capture's size and shape for the memory benchmark (issue 10: 2 kHz
+/// linearly between frames: a capture's size and shape for the memory benchmark (2 kHz
 /// markers, 10 kHz analog). The squat's plates are at the marker rate. `marker_noise_m`: Gaussian
 /// noise (SD, m; 0-0.01, seeded, the same every time) on the walk's marker coordinates, as real
 /// capture has: the trial the noise rule and its stance floor act on (min_kinematic_cycles).

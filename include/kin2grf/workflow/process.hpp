@@ -10,7 +10,7 @@ namespace kin2grf {
 /// than unmapping them, and has threads share that heap. A 510-frame estimate then takes 200
 /// page faults, not 900. Blocks of 1 MB or more are mapped on their own and returned when freed
 /// once they no longer fit in the heap's free top: kept in the heap they left holes that a long
-/// trial's peak memory carried (issue 10: 0.97 -> 0.59 GB on a 557 MB capture). Call it first in
+/// trial's peak memory carried (0.97 -> 0.59 GB on a 557 MB capture). Call it first in
 /// main(), before anything is allocated.
 void tune_allocator_for_a_short_run();
 /// A long run's time is its frames', not its page faults', and a huge page is resident whole from

@@ -90,7 +90,7 @@ LoadOptions estimate_load_options();
 /// set's recognition goes into the result's messages.
 EstimateResult estimate_trial(const Settings& s, EstimateOptions options, const Trial& trial, const std::optional<Trial>& st);
 /// The same, giving up the trial: its marker samples are released once the landmarks are made
-/// (estimate(Trial&&), issue 10's memory).
+/// (estimate(Trial&&), the memory of long trials).
 EstimateResult estimate_trial(const Settings& s, EstimateOptions options, Trial&& trial, const std::optional<Trial>& st);
 
 }  // namespace kin2grf
