@@ -365,8 +365,8 @@ TEST(RepeatedLabels, AMappingFileNamesEachOccurrenceAndAPresetTakesTheLateralOne
     // The mapping: each centre the mean of its medial and lateral marker, all four named.
     MarkerSet mapping = *example;
     mapping.preset = false;
-    mapping.rules[2] = LandmarkRule{"mean", {"RKNE#1", "RKNE#2"}, {}, {}, 0.0, 0.0};
-    mapping.rules[3] = LandmarkRule{"mean", {"RANK#1", "RANK#2"}, {}, {}, 0.0, 0.0};
+    mapping.rules[2] = LandmarkRule{RuleKind::Mean, {"RKNE#1", "RKNE#2"}, {}, {}, 0.0, 0.0};
+    mapping.rules[3] = LandmarkRule{RuleKind::Mean, {"RANK#1", "RANK#2"}, {}, {}, 0.0, 0.0};
     ASSERT_EQ(landmark_name(2), std::string("knee_r"));
     ASSERT_EQ(landmark_name(3), std::string("ankle_r"));
     const EstimateResult r = estimate(t, nullptr, mapping, o);
@@ -375,8 +375,8 @@ TEST(RepeatedLabels, AMappingFileNamesEachOccurrenceAndAPresetTakesTheLateralOne
     // A mapping naming the bare label is refused, naming both occurrences.
     MarkerSet bare = *example;
     bare.preset = false;
-    bare.rules[2] = LandmarkRule{"marker", {"RKNE"}, {}, {}, 0.0, 0.0};
-    bare.rules[3] = LandmarkRule{"mean", {"RANK#1", "RANK#2"}, {}, {}, 0.0, 0.0};
+    bare.rules[2] = LandmarkRule{RuleKind::Marker, {"RKNE"}, {}, {}, 0.0, 0.0};
+    bare.rules[3] = LandmarkRule{RuleKind::Mean, {"RANK#1", "RANK#2"}, {}, {}, 0.0, 0.0};
     try {
       (void)estimate(t, nullptr, bare, o);
       ADD_FAILURE() << "a repeated label taken silently";
@@ -386,7 +386,7 @@ TEST(RepeatedLabels, AMappingFileNamesEachOccurrenceAndAPresetTakesTheLateralOne
     // A preset naming the bare label takes the lateral one (5 cm out) and says which.
     MarkerSet preset = bare;
     preset.preset = true;
-    preset.rules[3] = LandmarkRule{"marker", {"RANK"}, {}, {}, 0.0, 0.0};
+    preset.rules[3] = LandmarkRule{RuleKind::Marker, {"RANK"}, {}, {}, 0.0, 0.0};
     std::vector<std::string> messages;
     const auto chosen = choose_repeated_markers(preset, t.markers, messages);
     ASSERT_TRUE(chosen);
@@ -507,7 +507,7 @@ TEST(Landmarks, WithoutTrunkMarkersTheTorsoStandsOnTheHipCentre) {
   std::string why;
   const auto ablated = without_trunk_markers(set, why);
   ASSERT_TRUE(ablated.has_value()) << why;
-  EXPECT_EQ(ablated->rules[kShoulder].kind, "pelvis_up");
+  EXPECT_EQ(ablated->rules[kShoulder].kind, RuleKind::PelvisUp);
   const auto needed = ablated->motion_markers();
   EXPECT_EQ(std::count(needed.begin(), needed.end(), "RSHO"), 0);
   Trial t = make_synthetic_trial({});
@@ -524,7 +524,7 @@ TEST(Landmarks, WithoutTrunkMarkersTheTorsoStandsOnTheHipCentre) {
   const Eigen::Index i = r.landmarks.frames() / 2;
   EXPECT_NEAR(r.landmarks.p[kShoulder](i, 1) - r.landmarks.p[kHip](i, 1), 0.5, 1e-9);
   MarkerSet functional_hip = set;
-  functional_hip.rules[kHip].kind = "functional";
+  functional_hip.rules[kHip].kind = RuleKind::Functional;
   EXPECT_FALSE(without_trunk_markers(functional_hip, why).has_value());
   EXPECT_NE(why.find("'functional'"), std::string::npos);
 }

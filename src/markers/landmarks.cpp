@@ -273,21 +273,34 @@ std::optional<MarkerSet> choose_repeated_markers(const MarkerSet& set, const Mar
   return out;
 }
 
+const char* rule_kind_name(RuleKind kind) {
+  switch (kind) {
+    case RuleKind::Marker: return "marker";
+    case RuleKind::Mean: return "mean";
+    case RuleKind::Harrington: return "harrington";
+    case RuleKind::Static: return "static";
+    case RuleKind::Functional: return "functional";
+    case RuleKind::PelvisUp: return "pelvis_up";
+    case RuleKind::VirtualHallux: return "virtual_hallux";
+  }
+  return "?";
+}
+
 std::optional<MarkerSet> without_trunk_markers(const MarkerSet& set, std::string& why) {
   const LandmarkRule& shoulder = set.rules[kShoulder];
-  if (shoulder.kind == "pelvis_up") return set;
+  if (shoulder.kind == RuleKind::PelvisUp) return set;
   const LandmarkRule& hip = set.rules[kHip];
-  const bool from_pelvis = hip.kind == "harrington" && !hip.pelvis.empty();
-  const bool from_markers = (hip.kind == "mean" || hip.kind == "marker") && !hip.markers.empty();
+  const bool from_pelvis = hip.kind == RuleKind::Harrington && !hip.pelvis.empty();
+  const bool from_markers = (hip.kind == RuleKind::Mean || hip.kind == RuleKind::Marker) && !hip.markers.empty();
   if (!from_pelvis && !from_markers) {
-    why = set.name + ": the hip centre is made by a '" + hip.kind + "' rule, above which kin2grf puts no model torso";
+    why = set.name + ": the hip centre is made by a '" + rule_kind_name(hip.kind) + "' rule, above which kin2grf puts no model torso";
     return std::nullopt;
   }
   MarkerSet out = set;
   out.name = set.name + " without trunk markers";
   LandmarkRule& r = out.rules[kShoulder];
   r = LandmarkRule{};
-  r.kind = "pelvis_up";
+  r.kind = RuleKind::PelvisUp;
   r.value = 0.5;  // the presets' model torso (plug-in-gait-lower and the others)
   r.sway_gain = kTrunkSwayGain;
   if (from_pelvis) r.pelvis = hip.pelvis;
@@ -298,9 +311,9 @@ std::optional<MarkerSet> without_trunk_markers(const MarkerSet& set, std::string
 std::vector<std::string> MarkerSet::motion_markers() const {
   std::vector<std::string> out;
   for (const auto& r : rules) {
-    if (r.kind == "marker" || r.kind == "mean" || r.kind == "pelvis_up") out.insert(out.end(), r.markers.begin(), r.markers.end());
-    if (r.kind == "static") out.insert(out.end(), r.cluster.begin(), r.cluster.end());
-    if (r.kind == "functional") {
+    if (r.kind == RuleKind::Marker || r.kind == RuleKind::Mean || r.kind == RuleKind::PelvisUp) out.insert(out.end(), r.markers.begin(), r.markers.end());
+    if (r.kind == RuleKind::Static) out.insert(out.end(), r.cluster.begin(), r.cluster.end());
+    if (r.kind == RuleKind::Functional) {
       out.insert(out.end(), r.cluster.begin(), r.cluster.end());
       out.insert(out.end(), r.markers.begin(), r.markers.end());
     }
@@ -419,15 +432,15 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
     const LandmarkRule& r = set.rules[static_cast<std::size_t>(id)];
     const std::string what = std::string("landmark ") + kNames[id];
     Eigen::MatrixX3d P = Eigen::MatrixX3d::Constant(n, 3, kNaN);
-    if (r.kind == "marker" || r.kind == "mean") {
+    if (r.kind == RuleKind::Marker || r.kind == RuleKind::Mean) {
       P = mean_of(m, r.markers, path, what);
-    } else if (r.kind == "harrington") {
+    } else if (r.kind == RuleKind::Harrington) {
       const Pelvis pv = pelvis(m, r.pelvis, path);
       for (Eigen::Index i = 0; i < n; ++i) {
         const double ax = -0.24 * pv.depth[i] - 0.0099, ay = -0.30 * pv.width[i] - 0.0109;
         P.row(i) = pv.origin.row(i) + ax * pv.x.row(i) + ay * pv.y.row(i);
       }
-    } else if (r.kind == "pelvis_up" && r.pelvis.empty()) {
+    } else if (r.kind == RuleKind::PelvisUp && r.pelvis.empty()) {
       // The model torso above a hip centre made of markers (without_trunk_markers on a set whose
       // hip rule is a mean): upright above their mean.
       Eigen::Vector3d up = Eigen::Vector3d::Zero();
@@ -437,7 +450,7 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
       out.messages.push_back("shoulder: the torso is an upright segment of " + std::to_string(r.value).substr(0, 4) +
                              " m above the hip centre, its top swaying by " + std::to_string(r.sway_gain).substr(0, 4) +
                              " x the hip's fore-aft oscillation (trunk markers not used)");
-    } else if (r.kind == "pelvis_up") {
+    } else if (r.kind == RuleKind::PelvisUp) {
       const Pelvis pv = pelvis(m, r.pelvis, path);
       // Without upper-body markers the torso is an upright segment above the hip centre: the
       // pelvis's tilt (10-15 deg forward) and its oscillations are not the trunk's, and a torso
@@ -454,7 +467,7 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
       out.messages.push_back("shoulder: no upper-body markers; the torso is an upright segment of " +
                              std::to_string(r.value).substr(0, 4) + " m above the hip centre, its top swaying by " +
                              std::to_string(r.sway_gain).substr(0, 4) + " x the hip's fore-aft oscillation, an approximation");
-    } else if (r.kind == "functional") {
+    } else if (r.kind == RuleKind::Functional) {
       std::vector<Eigen::MatrixX3d> prox, dist;
       for (const auto& c : r.cluster) prox.push_back(marker(m, c, path, what));
       for (const auto& c : r.markers) dist.push_back(marker(m, c, path, what));
@@ -462,7 +475,7 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
       P = functional_joint_centre(prox, dist, msg);
       if (P.rows() == 0) throw InputError(path + ": landmark " + kNames[id] + ": " + msg);
       out.messages.push_back(std::string(kNames[id]) + ": " + msg);
-    } else if (r.kind == "static") {
+    } else if (r.kind == RuleKind::Static) {
       if (!st) {
         throw InputError(path + ": landmark " + kNames[id] + " of marker set '" + set.name +
                          "' is a virtual point calibrated on a static trial: give --static STATIC (it needs markers " +
@@ -639,7 +652,7 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
   // Fill short gaps (cubic Catmull-Rom between the valid neighbours; linear with one neighbour pair).
   std::vector<bool> ok(static_cast<std::size_t>(n), true);
   for (int id = 0; id < kLandmarkCount; ++id) {
-    if (set.rules[static_cast<std::size_t>(id)].kind == "virtual_hallux") continue;
+    if (set.rules[static_cast<std::size_t>(id)].kind == RuleKind::VirtualHallux) continue;
     auto& P = p[static_cast<std::size_t>(id)];
     Eigen::Index i = 0;
     while (i < n) {
@@ -681,7 +694,7 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
   if (best_len < 10) {
     std::string which;
     for (int id = 0; id < kLandmarkCount; ++id) {
-      if (set.rules[static_cast<std::size_t>(id)].kind == "virtual_hallux") continue;
+      if (set.rules[static_cast<std::size_t>(id)].kind == RuleKind::VirtualHallux) continue;
       Eigen::Index bad = 0;
       for (Eigen::Index i = 0; i < n; ++i) bad += !p[static_cast<std::size_t>(id)].row(i).allFinite();
       if (bad) which += std::string(" ") + kNames[id] + " (" + std::to_string(bad) + " frames)";
@@ -742,7 +755,7 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
         T(i, 1) = M(i, 1) + L * std::sin(th_t);
       }
     };
-    if (r.kind == "virtual_hallux") {
+    if (r.kind == RuleKind::VirtualHallux) {
       virtual_toes(r.value);
       w.messages.push_back(std::string("hallux_") + (side ? "l" : "r") + ": no hallux marker; virtual toes of " +
                            std::to_string(r.value) + " x ankle-MT length");
@@ -771,7 +784,7 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
   // fore-aft accelerations is measured (kTrunkSwayGain); its vertical motion is the hip's (a
   // gain of 0.97-1.03 on the same trials), so only x changes.
   const LandmarkRule& sr = set.rules[kShoulder];
-  if (sr.kind == "pelvis_up" && sr.sway_gain != 1.0) {
+  if (sr.kind == RuleKind::PelvisUp && sr.sway_gain != 1.0) {
     auto& S = s.p[kShoulder];
     const Eigen::VectorXd hx = s.p[kHip].col(0);
     const Eigen::VectorXd trend = butterworth_filtfilt(hx, s.rate_hz, kTrunkTrendCutoffHz);

@@ -63,24 +63,24 @@ MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
       const auto& r = lm.at(landmark_name(id));
       check_one_rule(r, source + ": landmark '" + landmark_name(id) + "'");
       LandmarkRule rule;
-      if (r.contains("marker")) { rule.kind = "marker"; rule.markers = {r["marker"].get<std::string>()}; }
-      else if (r.contains("mean")) { rule.kind = "mean"; rule.markers = r["mean"].get<std::vector<std::string>>(); }
-      else if (r.contains("harrington")) { rule.kind = "harrington"; rule.pelvis = r["harrington"].get<std::map<std::string, std::string>>(); }
+      if (r.contains("marker")) { rule.kind = RuleKind::Marker; rule.markers = {r["marker"].get<std::string>()}; }
+      else if (r.contains("mean")) { rule.kind = RuleKind::Mean; rule.markers = r["mean"].get<std::vector<std::string>>(); }
+      else if (r.contains("harrington")) { rule.kind = RuleKind::Harrington; rule.pelvis = r["harrington"].get<std::map<std::string, std::string>>(); }
       else if (r.contains("static")) {
-        rule.kind = "static";
+        rule.kind = RuleKind::Static;
         rule.markers = r["static"].get<std::vector<std::string>>();
         rule.cluster = r.at("cluster").get<std::vector<std::string>>();
         if (rule.cluster.size() < 3) throw InputError(source + ": landmark '" + landmark_name(id) + "': a cluster needs 3 or more markers");
       } else if (r.contains("functional")) {
         // A joint centre from the motion itself (SCoRE): the point fixed in both segments.
-        rule.kind = "functional";
+        rule.kind = RuleKind::Functional;
         const auto& f = r["functional"];
         rule.cluster = f.at("proximal").get<std::vector<std::string>>();
         rule.markers = f.at("distal").get<std::vector<std::string>>();
         if (rule.cluster.size() < 3 || rule.markers.size() < 3)
           throw InputError(source + ": landmark '" + landmark_name(id) + "': a functional joint needs 3 or more markers on each segment");
       } else if (r.contains("pelvis_up")) {
-        rule.kind = "pelvis_up";
+        rule.kind = RuleKind::PelvisUp;
         rule.value = r["pelvis_up"].get<double>();
         rule.sway_gain = r.value("sway_gain", kTrunkSwayGain);
         if (!(rule.sway_gain >= 0.0 && rule.sway_gain <= 1.5))
@@ -92,14 +92,14 @@ MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
           throw InputError(source + ": landmark '" + landmark_name(id) + "': pelvis_up " + std::to_string(rule.value) +
                            " m is not a torso length (0.2-1.0 m above the hip centre)");
       } else if (r.contains("virtual_hallux")) {
-        rule.kind = "virtual_hallux";
+        rule.kind = RuleKind::VirtualHallux;
         rule.value = r["virtual_hallux"].get<double>();
       } else {
         throw InputError(source + ": landmark '" + landmark_name(id) + "': unknown rule " + json_excerpt(r) +
                          " (a rule is one of: marker, mean, harrington, static, functional, pelvis_up, virtual_hallux)");
       }
       check_distinct_pelvis_markers(rule.pelvis, source + ": landmark '" + landmark_name(id) + "'");
-      if ((rule.kind == "marker" || rule.kind == "mean" || rule.kind == "static") && rule.markers.empty())
+      if ((rule.kind == RuleKind::Marker || rule.kind == RuleKind::Mean || rule.kind == RuleKind::Static) && rule.markers.empty())
         throw InputError(source + ": landmark '" + landmark_name(id) + "' names no marker");
       s.rules[static_cast<std::size_t>(id)] = rule;
     }

@@ -42,8 +42,14 @@
 
 namespace kin2grf {
 
+/// How a landmark is made from markers (the mapping file's rule names: rule_kind_name).
+enum class RuleKind { Marker, Mean, Harrington, Static, Functional, PelvisUp, VirtualHallux };
+/// The mapping file's name of a rule kind ("marker", "mean", "harrington", "static", "functional",
+/// "pelvis_up", "virtual_hallux").
+const char* rule_kind_name(RuleKind kind);
+
 struct LandmarkRule {
-  std::string kind;                  ///< marker, mean, harrington, static, functional, pelvis_up, virtual_hallux
+  RuleKind kind = RuleKind::Marker;
   std::vector<std::string> markers;  ///< marker / mean / static markers; functional: the distal cluster; pelvis_up without pelvis: hip centres
   std::vector<std::string> cluster;  ///< static: tracking cluster; functional: the proximal cluster
   std::map<std::string, std::string> pelvis;  ///< harrington / pelvis_up: rasis, lasis, rpsis, lpsis | sacrum
