@@ -171,9 +171,8 @@ std::optional<double> median_stance_s(const std::array<std::vector<bool>, 2>& co
 /// A gait event from the estimate's contact states (C3D's and Vicon's names): "Foot Strike" at
 /// the first frame of a stance, "Foot Off" at the first frame after it. Stances are the runs of
 /// contact with flickers under 20 ms bridged and runs under 50 ms left out (as median_stance_s
-/// takes them); a run that begins
-/// at the window's first frame has no strike in it, one that ends at its last frame no foot off
-/// (the window cut them).
+/// takes them); a run that begins at the window's first frame has no strike in it, one that ends
+/// at its last frame no foot off (the window cut them).
 struct GaitEvent {
   std::string label;    ///< "Foot Strike" or "Foot Off"
   int side = 0;         ///< 0 right, 1 left

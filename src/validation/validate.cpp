@@ -558,7 +558,7 @@ std::optional<SyncEstimate> estimate_sync(const EstimateResult& e, const Validat
   s.error_at_offset_N = at(best);
   s.error_as_recorded_N = at(kmax);
   s.frames = frames;
-  // Half-width of the shifts within 10 % of the least RMSE (linear between frames).
+  // Half-width of the shifts within 10 % of the least median error (linear between frames).
   const double level = 1.1 * at(best);
   double lo = -kmax, hi = kmax;
   for (int k = best; k > 0; --k)

@@ -161,8 +161,8 @@ struct ValidationResult {
   /// Per-frame measured per-foot series (sum of the foot's kept stances; NaN elsewhere).
   std::array<Eigen::MatrixX2d, 2> measured_force_N;
   std::array<Eigen::VectorXd, 2> measured_cop_x_m;
-  /// Step 6, from the plates as recorded (none without a total window of 10 frames, or when the
-  /// best shift lies at the search's limit).
+  /// Step 6, from the plates as recorded (none with fewer than 10 loaded frames clear of the
+  /// recording's ends by the search's reach, or when the best shift lies at the search's limit).
   std::optional<SyncEstimate> sync;
   double plate_shift_s = 0.0;  ///< the shift the comparison above was made with (0 unless Sync::Auto or Fixed)
 };
