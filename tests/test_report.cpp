@@ -27,11 +27,28 @@
 using namespace kin2grf;
 using kin2grf::test::synthetic_with_exact_plates;
 
+namespace {
+/// The first Chromium found, or "" (the tests that need one skip without it).
+std::string chromium() {
+  for (const char* c : {"/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"})
+    if (std::filesystem::exists(c)) return c;
+  return "";
+}
+/// The DOM that headless `browser` makes of the HTML file `html` (a profile folder in `dir`).
+std::string rendered_dom(const std::string& browser, const std::filesystem::path& dir, const std::filesystem::path& html) {
+  const std::string cmd = browser + " --headless --no-sandbox --disable-gpu --user-data-dir=" + (dir / "profile").string() +
+                          " --dump-dom file://" + html.string() + " 2>/dev/null";
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  std::string dom;
+  if (!pipe) return dom;
+  char buf[4096];
+  while (std::size_t k = std::fread(buf, 1, sizeof buf, pipe.get())) dom.append(buf, k);
+  return dom;
+}
+}  // namespace
+
 TEST(Report, RendersInHeadlessChromium) {
-  const char* candidates[] = {"/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"};
-  std::string browser;
-  for (const char* c : candidates)
-    if (std::filesystem::exists(c)) browser = c;
+  const std::string browser = chromium();
   if (browser.empty()) GTEST_SKIP() << "no Chromium found (scripts/setup.sh installs Debian's chromium)";
   const auto s = synthetic_with_exact_plates();
   const auto v = validate(s.estimate, s.plates);
@@ -39,13 +56,8 @@ TEST(Report, RendersInHeadlessChromium) {
   const auto dir = test::temp_dir("report");
   const auto html = dir / "report.html";
   write_file_text(html.string(), validation_report_html("synthetic", s.estimate, v, j));
-  const std::string cmd = browser + " --headless --no-sandbox --disable-gpu --user-data-dir=" + (dir / "profile").string() +
-                          " --dump-dom file://" + html.string() + " 2>/dev/null";
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-  ASSERT_TRUE(pipe);
-  std::string dom;
-  char buf[4096];
-  while (std::size_t k = std::fread(buf, 1, sizeof buf, pipe.get())) dom.append(buf, k);
+  const std::string dom = rendered_dom(browser, dir, html);
+  ASSERT_FALSE(dom.empty());
   // 3 figures per foot and 2 totals, each drawn by Chart.js (the script sets the attribute
   // only after every chart was constructed).
   EXPECT_NE(dom.find("data-charts-rendered=\"8\""), std::string::npos) << dom.substr(0, 400);
@@ -57,10 +69,7 @@ TEST(Report, RendersInHeadlessChromium) {
 // estimate's report without plates (issue 30, item 8): per foot GRF, COP and joint torques, the
 // GRM, the gait events in a table; drawn by Chart.js in headless Chromium.
 TEST(Report, AnEstimateReportWithoutPlatesRendersWithItsGaitEvents) {
-  const char* candidates[] = {"/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"};
-  std::string browser;
-  for (const char* c : candidates)
-    if (std::filesystem::exists(c)) browser = c;
+  const std::string browser = chromium();
   const SyntheticWalk w = make_synthetic_walk({});
   const EstimateResult e = estimate(w.trial, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
   const auto events = gait_events({e.feet[0].contact, e.feet[1].contact}, e.time_s, e.motion.rate_hz);
@@ -75,13 +84,8 @@ TEST(Report, AnEstimateReportWithoutPlatesRendersWithItsGaitEvents) {
   const auto dir = test::temp_dir("estimate-report");
   const auto file = dir / "report.html";
   write_file_text(file.string(), html);
-  const std::string cmd = browser + " --headless --no-sandbox --disable-gpu --user-data-dir=" + (dir / "profile").string() +
-                          " --dump-dom file://" + file.string() + " 2>/dev/null";
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-  ASSERT_TRUE(pipe);
-  std::string dom;
-  char buf[4096];
-  while (std::size_t k = std::fread(buf, 1, sizeof buf, pipe.get())) dom.append(buf, k);
+  const std::string dom = rendered_dom(browser, dir, file);
+  ASSERT_FALSE(dom.empty());
   // 4 figures per foot (vertical, anterior, COP, joint torques) and the GRM.
   EXPECT_NE(dom.find("data-charts-rendered=\"9\""), std::string::npos) << dom.substr(0, 400);
 }

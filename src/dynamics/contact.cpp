@@ -101,8 +101,9 @@ void contact_frame(const Model& model, const ContactCalibration& soles, const Co
     const double theta = f.cop_foot_angle_rad[static_cast<std::size_t>(side)];
     fc.foot_inclination_rad[side] =
         -((std::isnan(theta) ? f.q(coord::theta(foot)) : theta) - soles.feet[static_cast<std::size_t>(side)].flat_angle_rad);
-    {
-      // The lowest sole point and its vertical velocity (A, B on the foot, C on the toes).
+    if (o.touchdown_fraction > 0) {
+      // The lowest sole point and its velocity (A, B on the foot, C on the toes): only the
+      // touchdown rule reads them, so the per-frame solve does not pay for them otherwise.
       const std::size_t k = sp[0].y() <= sp[1].y() && sp[0].y() <= sp[2].y() ? 0 : sp[1].y() <= sp[2].y() ? 1 : 2;
       fc.lowest_gap_m[static_cast<std::size_t>(side)] = sp[k].y() - ground;
       fc.lowest_point[static_cast<std::size_t>(side)] = static_cast<int>(k);

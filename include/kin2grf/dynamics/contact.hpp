@@ -126,7 +126,8 @@ struct FrameContacts {
   std::array<double, 2> cop_fraction{};          ///< model 2: s = F(theta_A)
   std::array<std::array<Eigen::Vector2d, 3>, 2> sole{};  ///< sole points A, B, C per side (sole_points)
   /// Per side, the lowest sole point's gap to the ground (m) and its rate (m/s, the material
-  /// point's vertical velocity; negative descending): what landing_frames() reads.
+  /// point's vertical velocity; negative descending): what landing_frames() reads. Filled only
+  /// with the touchdown rule on (ContactModelOptions::touchdown_fraction > 0).
   std::array<double, 2> lowest_gap_m{}, lowest_gap_rate_mps{}, lowest_velocity_x_mps{};
   std::array<int, 2> lowest_point{};  ///< per side, which sole point is lowest: 0 A, 1 B, 2 C
   /// Per side, the foot is still landing this frame (landing_frames()): none of its points may be
