@@ -123,9 +123,9 @@ void BM_ContactSolvePerFrame(benchmark::State& state) {
     return;
   }
   const auto r = kin2grf::estimate(w.trial, nullptr, *w.set, w.options);
-  kin2grf::ModelMotion motion = kin2grf::compute_motion(r.model, r.landmarks, w.options.kinematic_cutoff_hz, w.options.torso_length);
-  const auto contacts = kin2grf::prepare_contacts(r.model, r.calibration.contact, w.options.contact, motion);
-  kin2grf::ContactSolver solver(r.model, r.calibration, w.options.solver);
+  kin2grf::ModelMotion motion = kin2grf::compute_motion(r.model(), r.landmarks, w.options.kinematic_cutoff_hz, w.options.torso_length);
+  const auto contacts = kin2grf::prepare_contacts(r.model(), r.calibration.contact, w.options.contact, motion);
+  kin2grf::ContactSolver solver(r.model(), r.calibration, w.options.solver);
   const Eigen::Index n = motion.frames();
   // Each frame's q and qdd rebuilt once, outside the timing (the pipeline rebuilds them per frame).
   std::vector<kin2grf::MotionFrame> frame(static_cast<std::size_t>(n));

@@ -4,7 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <limits>
+#include <memory>
+#include <tuple>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/kinematics/filter.hpp"
@@ -150,11 +153,28 @@ double resolve_mass(const Trial& trial, const EstimateOptions& o) {
   return m;
 }
 
-/// markers -> landmarks -> the sagittal frame and window (r.frame, r.landmarks, r.time_s...).
-/// `release` (the trial, when the caller gave it up): its marker samples are released once the
-/// landmarks are made, the last use of them.
-void sagittal_stage(const Trial& trial, Trial* release, const Trial* static_trial, const MarkerSet& given_set,
-                    const EstimateOptions& o, EstimateResult& r) {
+using Messages = std::vector<std::string>;
+
+void append(Messages& to, Messages&& from) {
+  to.insert(to.end(), std::make_move_iterator(from.begin()), std::make_move_iterator(from.end()));
+}
+
+/// What the sagittal stage makes of the markers: the frame, the processed window's landmarks and
+/// where that window lies in the trial.
+struct SagittalStage {
+  SagittalFrame frame;
+  SagittalLandmarks landmarks;
+  Eigen::Index first_index = 0;
+  int first_frame_number = 1;
+  std::array<Eigen::VectorXd, 2> foot_lateral_m;
+  Messages messages;
+};
+
+/// markers -> landmarks -> the sagittal frame and window. `release` (the trial, when the caller
+/// gave it up): its marker samples are released once the landmarks are made, the last use of them.
+SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* static_trial, const MarkerSet& given_set,
+                             const EstimateOptions& o) {
+  SagittalStage out;
   std::vector<std::string> repeated;
   const std::optional<MarkerSet> chosen = given_set.preset ? choose_repeated_markers(given_set, trial.markers, repeated) : std::nullopt;
   const MarkerSet& set = chosen ? *chosen : given_set;
@@ -177,20 +197,21 @@ void sagittal_stage(const Trial& trial, Trial* release, const Trial* static_tria
   const MarkerTrajectories& markers = trial.markers;
   // What the readers noticed (duplicate labels, rows cut short, an up axis corrected...) goes with
   // the results, so that estimate's and validate's outputs say it too.
-  for (const auto& w : trial.warnings) r.messages.push_back("input: " + w);
+  Messages& msg = out.messages;
+  for (const auto& w : trial.warnings) msg.push_back("input: " + w);
   if (static_trial)
-    for (const auto& w : static_trial->warnings) r.messages.push_back("static trial: " + w);
-  r.messages.insert(r.messages.end(), repeated.begin(), repeated.end());
-  r.messages.insert(r.messages.end(), cleaning.begin(), cleaning.end());
-  r.messages.insert(r.messages.end(), lm3.messages.begin(), lm3.messages.end());
-  r.frame = detect_sagittal_frame(lm3, markers, o.landmarks);
-  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, r.frame, markers, o.landmarks, trial.path);
-  r.messages.insert(r.messages.end(), win.messages.begin(), win.messages.end());
-  r.first_index = win.first;
-  r.first_frame_number = trial.markers.first_frame + static_cast<int>(win.first);
-  r.foot_lateral_m = std::move(win.foot_lateral_m);
-  r.landmarks = std::move(win.landmarks);
-  const SagittalLandmarks& lm = r.landmarks;
+    for (const auto& w : static_trial->warnings) msg.push_back("static trial: " + w);
+  append(msg, std::move(repeated));
+  append(msg, std::move(cleaning));
+  append(msg, std::move(lm3.messages));
+  out.frame = detect_sagittal_frame(lm3, markers, o.landmarks);
+  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, out.frame, markers, o.landmarks, trial.path);
+  append(msg, std::move(win.messages));
+  out.first_index = win.first;
+  out.first_frame_number = trial.markers.first_frame + static_cast<int>(win.first);
+  out.foot_lateral_m = std::move(win.foot_lateral_m);
+  out.landmarks = std::move(win.landmarks);
+  const SagittalLandmarks& lm = out.landmarks;
   // The zero-lag filter's single pass runs at cut-off / 0.802 (Winter's correction), which must
   // be below the Nyquist frequency.
   const double limit = max_zero_lag_cutoff_hz(lm.rate_hz);
@@ -200,61 +221,83 @@ void sagittal_stage(const Trial& trial, Trial* release, const Trial* static_tria
       throw InputError(trial.path + ": the " + name + " of " + format_number(value) + " Hz is too high for the marker rate of " +
                        format_number(lm.rate_hz) + " Hz: a zero-lag Butterworth filter takes cut-offs below " + format_number(limit) +
                        " Hz (half the rate times Winter's two-pass correction 0.802)");
-  r.time_s = lm.time_s;
+  return out;
 }
 
 /// The model (fixed segment lengths, the medians over the window, and anthropometry) and the
 /// trial's floor and soles (ground level, contact calibration).
-std::pair<Model, ContactCalibration> model_stage(const EstimateOptions& o, EstimateResult& r) {
-  const SagittalLandmarks& lm = r.landmarks;
+struct ModelStage {
+  std::shared_ptr<const Model> model;
+  /// The floor the contacts and the results take: the measured (or given) ground plus
+  /// ContactModelOptions::ground_shift_m, applied here only, after the soles are measured, so
+  /// that every later stage (the contacts, the flight test, the totals, the lab-frame COP) sees
+  /// one floor.
+  ContactCalibration soles;
+  Messages messages;
+};
+ModelStage model_stage(const EstimateOptions& o, const SagittalLandmarks& lm, double mass_kg) {
+  ModelStage out;
   const GroundLevel ground = o.ground_level_m ? GroundLevel{*o.ground_level_m, ""} : estimate_ground_level(lm);
-  if (!ground.message.empty()) r.messages.push_back(ground.message);
-  ContactCalibration soles = calibrate_contact(lm, ground.level_m);
-  if (!soles.message.empty()) r.messages.push_back(soles.message);
+  if (!ground.message.empty()) out.messages.push_back(ground.message);
+  out.soles = calibrate_contact(lm, ground.level_m);
+  if (!out.soles.message.empty()) out.messages.push_back(out.soles.message);
   for (int s = 0; s < 2; ++s)
-    if (soles.flat_frames[static_cast<std::size_t>(s)] < 3)
-      r.messages.push_back(std::string(s ? "left" : "right") + " foot: only " + std::to_string(soles.flat_frames[static_cast<std::size_t>(s)]) +
-                           " foot-flat frames for the contact calibration");
-  return {build_model(measure_geometry(lm), r.mass_kg, anthropometric_table(o.anthropometry)), std::move(soles)};
+    if (out.soles.flat_frames[static_cast<std::size_t>(s)] < 3)
+      out.messages.push_back(std::string(s ? "left" : "right") + " foot: only " +
+                             std::to_string(out.soles.flat_frames[static_cast<std::size_t>(s)]) +
+                             " foot-flat frames for the contact calibration");
+  out.soles.ground_level_m += o.contact.ground_shift_m;
+  out.model = std::make_shared<const Model>(build_model(measure_geometry(lm), mass_kg, anthropometric_table(o.anthropometry)));
+  return out;
 }
 
-/// Model coordinates and their derivatives, filtered at the kinematic cut-off. Where the noise
-/// lowered it and the stance floor may raise it again (min_kinematic_cycles), the unfiltered
-/// coordinates are kept in `unfiltered` for the second pass (half the landmarks' size).
-ModelMotion kinematics_stage(const EstimateOptions& o, const Model& model, EstimateResult& r, Eigen::MatrixXd& unfiltered) {
-  const SagittalLandmarks& lm = r.landmarks;
+/// Model coordinates and their derivatives, filtered at the kinematic cut-off.
+struct KinematicsStage {
+  ModelMotion motion;
+  double kinematic_cutoff_hz = 0.0;  ///< the dynamics' (the user's, or lowered by the markers' noise)
+  double position_cutoff_hz = 0.0;   ///< the residual analysis' (the COP function's foot angle)
+  /// The unfiltered coordinates, kept only where the noise lowered the cut-off and the stance
+  /// floor (min_kinematic_cycles) may raise it again in a second pass (half the landmarks' size).
+  Eigen::MatrixXd unfiltered;
+  Messages messages;
+};
+KinematicsStage kinematics_stage(const EstimateOptions& o, const std::shared_ptr<const Model>& model, const SagittalLandmarks& lm) {
+  KinematicsStage out;
   // The kinematic cut-off: the user's (6 Hz), lowered where the markers' own noise needs it
   // (Winter's residual analysis on the landmarks, noise_limited_cutoff).
-  r.kinematic_cutoff_hz = o.kinematic_cutoff_hz;
+  out.kinematic_cutoff_hz = o.kinematic_cutoff_hz;
   if (o.cutoff_from_noise) {
     const double fc = noise_limited_cutoff(lm, o.kinematic_cutoff_hz);
     if (fc < o.kinematic_cutoff_hz) {
-      r.kinematic_cutoff_hz = fc;
+      out.kinematic_cutoff_hz = fc;
       char b[200];
       std::snprintf(b, sizeof b, "kinematic cut-off lowered from %.1f to %.2f Hz: the markers' noise (residual analysis)",
                     o.kinematic_cutoff_hz, fc);
-      r.messages.emplace_back(b);
+      out.messages.emplace_back(b);
     }
   }
-  r.position_cutoff_hz = r.kinematic_cutoff_hz;
+  out.position_cutoff_hz = out.kinematic_cutoff_hz;
   Eigen::MatrixXd x = model_coordinates(lm, o.torso_length);
-  if (o.min_kinematic_cycles > 0 && r.kinematic_cutoff_hz < o.kinematic_cutoff_hz) unfiltered = x;
-  return motion_from_coordinates(model, std::move(x), lm.rate_hz, lm.time_s, r.kinematic_cutoff_hz);
+  if (o.min_kinematic_cycles > 0 && out.kinematic_cutoff_hz < o.kinematic_cutoff_hz) out.unfiltered = x;
+  out.motion = motion_from_coordinates(model, std::move(x), lm.rate_hz, lm.time_s, out.kinematic_cutoff_hz);
+  return out;
 }
 
 /// The upper body's fore-aft lag: what the trunk markers do not already show of it
-/// (lag_torso_fore_aft, measured_torso_lag_s).
-void lag_torso_stage(const EstimateOptions& o, ModelMotion& motion, EstimateResult& r) {
-  if (!(o.torso_lag_s > 0)) return;
+/// (lag_torso_fore_aft, measured_torso_lag_s). The motion is changed in place.
+Messages lag_torso_stage(const EstimateOptions& o, ModelMotion& motion) {
+  Messages out;
+  if (!(o.torso_lag_s > 0)) return out;
   const double measured = measured_torso_lag_s(motion);
   const double added = std::clamp(o.torso_lag_s - measured, 0.0, o.torso_lag_s);
   if (added < o.torso_lag_s) {
     char b[200];
     std::snprintf(b, sizeof b, "torso lag: the trunk markers already lag the hip by %.0f ms; %.0f of the %.0f ms added",
                   1000 * measured, 1000 * added, 1000 * o.torso_lag_s);
-    r.messages.emplace_back(b);
+    out.emplace_back(b);
   }
   lag_torso_fore_aft(motion, added);
+  return out;
 }
 
 /// Which frames take the running COP function, the rest of the trial's calibration (the belt
@@ -264,30 +307,31 @@ struct ContactPlan {
   std::vector<bool> running;                  ///< frames that take the running COP function
   std::array<std::vector<bool>, 2> landing;   ///< per side, frames where the foot is still landing (landing_frames)
   TrialCalibration calibration;
+  Messages messages;
 };
-ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactCalibration soles, EstimateResult& r,
-                          const ModelMotion& motion, std::optional<double> progression_speed_mps = std::nullopt) {
-  const SagittalLandmarks& lm = r.landmarks;
+/// `hip_speed_mps`: the overground progression speed (progression_speed of the landmarks); a
+/// treadmill's is its belt's.
+ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactCalibration soles, bool treadmill, double hip_speed_mps,
+                          const ModelMotion& motion) {
+  ContactPlan plan;
   const ContactModelOptions& co = o.contact;
-  std::vector<bool> running;
   if (co.foot_model == FootModel::Cop && co.running_cop) {
-    running = flight_frames(model, motion, soles);
-    const auto nrun = std::count(running.begin(), running.end(), true);
+    plan.running = flight_frames(model, motion, soles);
+    const auto nrun = std::count(plan.running.begin(), plan.running.end(), true);
     if (nrun > 0) {
       char b[160];
       std::snprintf(b, sizeof b, "running: %ld of %ld frames are near a flight phase and take the running COP function",
-                    static_cast<long>(nrun), static_cast<long>(running.size()));
-      r.messages.push_back(b);
+                    static_cast<long>(nrun), static_cast<long>(plan.running.size()));
+      plan.messages.push_back(b);
     }
   }
-  TrialCalibration cal;
+  TrialCalibration& cal = plan.calibration;
   cal.contact = std::move(soles);
-  std::array<std::vector<bool>, 2> landing;
   const bool touchdown = co.touchdown_fraction > 0;
   const Eigen::Index n = motion.frames();
   std::array<std::vector<int>, 2> lowest;
   std::array<Eigen::VectorXd, 2> gap, rate, speed;  // per side, the lowest sole point's (touchdown rule)
-  if (r.frame.treadmill || touchdown) {
+  if (treadmill || touchdown) {
     // The belt: measured on every treadmill trial, whatever the solver's settings (validation's
     // still-foot rule takes it too). The lowest sole points' descents, for the touchdown rule.
     BeltVelocitySamples samples;
@@ -300,32 +344,30 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
       }
     for (Eigen::Index i = 0; i < n; ++i) {
       motion.frame(i, f);
-      contact_frame(model, cal.contact, co, is_running_frame(running, i), f, fc);
-      if (r.frame.treadmill) samples.add(fc);
+      contact_frame(model, cal.contact, co, is_running_frame(plan.running, i), f, fc);
+      if (treadmill) samples.add(fc);
       if (touchdown)
         for (int side = 0; side < 2; ++side) {
           gap[side][i] = fc.lowest_gap_m[side], rate[side][i] = fc.lowest_gap_rate_mps[side];
           speed[side][i] = fc.lowest_velocity_x_mps[side], lowest[side][static_cast<std::size_t>(i)] = fc.lowest_point[side];
         }
     }
-    if (const auto belt = r.frame.treadmill ? samples.median_mps() : std::nullopt) {
+    if (const auto belt = treadmill ? samples.median_mps() : std::nullopt) {
       cal.belt_velocity_mps = *belt;
       char b[128];
       std::snprintf(b, sizeof b, std::abs(*belt) < 0.05 ? "no progression (stationary trial): ground velocity %.2f m/s"
                                                         : "treadmill: belt velocity %.3f m/s",
                     *belt);
-      r.messages.push_back(b);
+      plan.messages.push_back(b);
     }
   }
-  // Overground, from the hip's landmark (or a first pass's, the landmarks then gone).
-  cal.progression_speed_mps =
-      r.frame.treadmill ? std::abs(cal.belt_velocity_mps) : progression_speed_mps ? *progression_speed_mps : progression_speed(lm);
+  cal.progression_speed_mps = treadmill ? std::abs(cal.belt_velocity_mps) : hip_speed_mps;
   cal.speed_gate_mps = speed_gate_for(o.solver, cal.progression_speed_mps);
   if (o.solver.speed_gate_ratio > 0) {
     char b[160];
     std::snprintf(b, sizeof b, "contact speed gate %.2f m/s (%.2f x the progression speed %.2f m/s, at least %.2f)", cal.speed_gate_mps,
                   o.solver.speed_gate_ratio, cal.progression_speed_mps, o.solver.speed_gate_floor_mps);
-    r.messages.push_back(b);
+    plan.messages.push_back(b);
   }
   if (touchdown) {
     LandingRule rule;
@@ -334,10 +376,10 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
     rule.swing_speed_mps = cal.speed_gate_mps;
     for (int side = 0; side < 2; ++side) {
       speed[side] = (speed[side].array() - cal.belt_velocity_mps).abs().matrix();
-      landing[side] = landing_frames(gap[side], rate[side], speed[side], lowest[side], rule);
+      plan.landing[side] = landing_frames(gap[side], rate[side], speed[side], lowest[side], rule);
     }
   }
-  return {std::move(running), std::move(landing), std::move(cal)};
+  return plan;
 }
 
 /// The per-frame solve's raw results (before the post-filter).
@@ -355,19 +397,23 @@ struct RawSolve {
   // x np, column-major). Only those frames: a long walk holds a fifth of its frames' worth.
   std::vector<Eigen::Index> both_feet_frames;
   std::vector<double> both_feet_torque_map;
+  std::vector<int> iterations;  ///< semi-smooth Newton iterations per frame
+  int cycled_frames = 0, capped_frames = 0;
 };
 
-/// Eqs. 5-10 on every frame (least squares, activation, semi-smooth iterations).
-RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResult& r, const ModelMotion& motion,
-                     const std::vector<bool>& running, const std::array<std::vector<bool>, 2>& landing,
-                     const std::function<void(long, long)>& progress) {
+/// Eqs. 5-10 on every frame (least squares, activation, semi-smooth iterations). `path` and
+/// `first_frame_number` name a frame the solve could not make finite.
+RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCalibration& calibration, const ModelMotion& motion,
+                     const ContactPlan& plan, const std::function<void(long, long)>& progress, const std::string& path,
+                     int first_frame_number) {
   const Eigen::Index n = motion.frames();
+  const std::vector<bool>& running = plan.running;
   RawSolve raw;
   {
     MotionFrame f;
     FrameContacts fc;
     motion.frame(0, f);
-    contact_frame(r.model, r.calibration.contact, o.contact, is_running_frame(running, 0), f, fc);
+    contact_frame(model, calibration.contact, o.contact, is_running_frame(running, 0), f, fc);
     for (const auto& p : fc.points) raw.point_side.push_back(p.side);
   }
   const auto np = static_cast<Eigen::Index>(raw.point_side.size());
@@ -380,7 +426,7 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
     raw.inclination_rad[side].resize(n);
     if (o.keep_all_series) raw.sole_m[side].resize(n, 6);
   }
-  r.iterations.resize(static_cast<std::size_t>(n));
+  raw.iterations.resize(static_cast<std::size_t>(n));
   std::vector<char> cycled(static_cast<std::size_t>(n)), capped(static_cast<std::size_t>(n));
   // Frames are independent: each chunk of frames (about 10 us each) has its own solver
   // (workspace) and writes only its own rows. The first chunk, on the calling thread, reports
@@ -391,7 +437,7 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
   std::vector<std::pair<std::vector<Eigen::Index>, std::vector<double>>> chunk_maps(
       keep_torque_map ? static_cast<std::size_t>(std::max(1, thread_count())) : 0);
   for_chunks(static_cast<std::size_t>(n), min_chunk_for(10e-6), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
-    ContactSolver solver(r.model, r.calibration, o.solver);
+    ContactSolver solver(model, calibration, o.solver);
     MotionFrame f;
     FrameContacts fc;
     const auto step = std::max<std::size_t>(1, (end - begin) / 100);
@@ -400,8 +446,8 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
       if (chunk == 0 && progress && (k - begin) % step == 0)
         progress(static_cast<long>(static_cast<double>(k) / static_cast<double>(end) * static_cast<double>(n)), static_cast<long>(n));
       motion.frame(i, f);
-      contact_frame(r.model, r.calibration.contact, o.contact, is_running_frame(running, i), f, fc);
-      for (int side = 0; side < 2; ++side) fc.landing[side] = flag_at(landing[side], i);
+      contact_frame(model, calibration.contact, o.contact, is_running_frame(running, i), f, fc);
+      for (int side = 0; side < 2; ++side) fc.landing[side] = flag_at(plan.landing[side], i);
       const FrameSolution s = solver.solve(f.q, f.qdd, fc);
       for (Eigen::Index j = 0; j < np; ++j) {
         const ContactPoint& p = fc.points[static_cast<std::size_t>(j)];
@@ -427,7 +473,7 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
       raw.lambda.row(i) = s.contact_lambda.transpose();
       raw.torque.row(i) = s.joint_torque_Nm.transpose();
       raw.active[k] = s.contact_active;
-      r.iterations[k] = s.iterations;
+      raw.iterations[k] = s.iterations;
       cycled[k] = s.cycled;
       capped[k] = s.capped;
     }
@@ -444,17 +490,38 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
       std::vector<double>().swap(v);
     }
   }
-  r.cycled_frames += static_cast<int>(std::count(cycled.begin(), cycled.end(), 1));
-  r.capped_frames += static_cast<int>(std::count(capped.begin(), capped.end(), 1));
-  const Eigen::MatrixXd& lam = raw.lambda;
-  const Eigen::MatrixXd& torque = raw.torque;
+  raw.cycled_frames = static_cast<int>(std::count(cycled.begin(), cycled.end(), 1));
+  raw.capped_frames = static_cast<int>(std::count(capped.begin(), capped.end(), 1));
   if (progress) progress(static_cast<long>(n), static_cast<long>(n));
   // No NaN leaves the library: a frame the solve could not make finite is named, not written.
   for (Eigen::Index i = 0; i < n; ++i)
-    if (!lam.row(i).allFinite() || !torque.row(i).allFinite())
-      throw InputError(trial.path + ": the contact solve gave a non-finite force at frame " +
-                       std::to_string(r.first_frame_number + static_cast<int>(i)) + " (check the markers there)");
+    if (!raw.lambda.row(i).allFinite() || !raw.torque.row(i).allFinite())
+      throw InputError(path + ": the contact solve gave a non-finite force at frame " +
+                       std::to_string(first_frame_number + static_cast<int>(i)) + " (check the markers there)");
   return raw;
+}
+
+/// One pass of the dynamics on a motion: the torso lag (the motion is changed in place), the
+/// contact plan and the solve. The stance floor's second pass is a second call.
+struct DynamicsPass {
+  ContactPlan plan;  ///< its messages: the torso lag's first, then the contact stage's
+  RawSolve raw;
+  double seconds_kinematics = 0, seconds_dynamics = 0;
+};
+DynamicsPass dynamics_pass(const EstimateOptions& o, const Model& model, const ContactCalibration& soles, bool treadmill,
+                           double hip_speed_mps, ModelMotion& motion, const std::function<void(long, long)>& progress,
+                           const std::string& path, int first_frame_number) {
+  using clock = std::chrono::steady_clock;
+  const auto ta = clock::now();
+  DynamicsPass pass;
+  Messages lag = lag_torso_stage(o, motion);
+  pass.plan = contact_stage(o, model, soles, treadmill, hip_speed_mps, motion);
+  pass.plan.messages.insert(pass.plan.messages.begin(), std::make_move_iterator(lag.begin()), std::make_move_iterator(lag.end()));
+  const auto tb = clock::now();
+  pass.raw = solve_stage(o, model, pass.plan.calibration, motion, pass.plan, progress, path, first_frame_number);
+  pass.seconds_kinematics = std::chrono::duration<double>(tb - ta).count();
+  pass.seconds_dynamics = std::chrono::duration<double>(clock::now() - tb).count();
+  return pass;
 }
 
 /// The double-support transition (EstimateOptions::double_support_sta_weight) on the
@@ -463,8 +530,8 @@ RawSolve solve_stage(const Trial& trial, const EstimateOptions& o, EstimateResul
 /// normal multipliers are scaled to their new total (a foot's COP does not move), the sum is
 /// kept, and the joint torques move with the multipliers (the solve's torque_per_normal, linear
 /// in them). The tangential multipliers are left as solved.
-void double_support_transition(double w, const std::array<std::vector<bool>, 2>& contact, double stance_s, double rate_hz,
-                               const RawSolve& raw, Eigen::MatrixXd& lamf, EstimateResult& r) {
+Messages double_support_transition(double w, const std::array<std::vector<bool>, 2>& contact, double stance_s, double rate_hz,
+                                   const RawSolve& raw, Eigen::MatrixXd& lamf, Eigen::MatrixXd& joint_torque_Nm) {
   const auto max_frames = static_cast<Eigen::Index>(0.5 * stance_s * rate_hz);
   const int np = static_cast<int>(raw.point_side.size());
   const auto supports = walking_double_supports(contact, max_frames);
@@ -489,15 +556,17 @@ void double_support_transition(double w, const std::array<std::vector<bool>, 2>&
       for (int j = 0; j < np; ++j) {
         const double d = (factor[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] - 1) * lamf(k, 2 * j);
         lamf(k, 2 * j) += d;
-        for (int q = 0; q < kJointCount; ++q) r.joint_torque_Nm(k, q) += d * G[j * kJointCount + q];
+        for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += d * G[j * kJointCount + q];
       }
     }
   }
+  Messages out;
   if (!supports.empty()) {
     char b[200];
     std::snprintf(b, sizeof b, "double support: %zu handovers blended (weight %g) towards a smooth transition", supports.size(), w);
-    r.messages.emplace_back(b);
+    out.emplace_back(b);
   }
+  return out;
 }
 
 /// Each foot's contact state per frame from the solve: any of its points active.
@@ -514,8 +583,9 @@ std::array<std::vector<bool>, 2> foot_contact_states(const RawSolve& raw, Eigen:
 /// Measured by cutting development walks short: the total vertical force is 12-53 %
 /// body weight RMS off at the cut, 4-10 % 40 ms in and 1-4 % by 60 ms, at a 6 Hz kinematic
 /// cut-off; half a period of that cut-off (83 ms at 6 Hz) covers it and scales with the filter.
-void window_edge_messages(const std::array<std::vector<bool>, 2>& contact, double rate_hz, double cutoff_hz, EstimateResult& r) {
-  if (!(rate_hz > 0) || !(cutoff_hz > 0)) return;
+Messages window_edge_messages(const std::array<std::vector<bool>, 2>& contact, double rate_hz, double cutoff_hz, int first_frame_number) {
+  Messages out;
+  if (!(rate_hz > 0) || !(cutoff_hz > 0)) return out;
   const double settle_s = 0.5 / cutoff_hz;
   const auto reach = static_cast<Eigen::Index>(std::ceil(settle_s * rate_hz));
   for (int side = 0; side < 2; ++side) {
@@ -528,123 +598,158 @@ void window_edge_messages(const std::array<std::vector<bool>, 2>& contact, doubl
       std::snprintf(b, sizeof b,
                     "%s foot: the stance at frames %ld-%ld %s within %.0f ms of the window's %s (half a period of the %.1f Hz "
                     "kinematic cut-off): the filters see one side of it there, so its forces near that edge are less certain",
-                    side ? "left" : "right", static_cast<long>(r.first_frame_number + run.first),
-                    static_cast<long>(r.first_frame_number + run.last), at_start && at_end ? "lies" : at_start ? "begins" : "ends",
+                    side ? "left" : "right", static_cast<long>(first_frame_number + run.first),
+                    static_cast<long>(first_frame_number + run.last), at_start && at_end ? "lies" : at_start ? "begins" : "ends",
                     1000 * settle_s, at_start && at_end ? "ends" : at_start ? "start" : "end", cutoff_hz);
-      r.messages.emplace_back(b);
+      out.emplace_back(b);
     }
   }
+  return out;
 }
 
-/// The post-filter (Sect. 2.6) and each foot's force, COP, contact state, gap and sole.
-void feet_stage(const EstimateOptions& o, EstimateResult& r, double rate_hz, RawSolve& raw) {
+/// The post-filter's cut-off (Sect. 2.6): post_cutoff_cycles over the median stance, at least the
+/// floor (post_cutoff_floor_ratio x the kinematic cut-off), within what the rate allows; or the
+/// fixed post_cutoff_hz. With the message that says which.
+std::pair<double, std::string> post_cutoff(const EstimateOptions& o, std::optional<double> stance, double rate_hz,
+                                           double kinematic_cutoff_hz) {
+  if (!(o.post_cutoff_cycles > 0)) return {o.post_cutoff_hz, ""};
+  char b[200];
+  double hz = o.post_cutoff_hz;
+  if (stance) {
+    const double per_stance = o.post_cutoff_cycles / *stance, floor_hz = o.post_cutoff_floor_ratio * kinematic_cutoff_hz;
+    hz = std::min(std::max(per_stance, floor_hz), 0.4 * rate_hz);
+    if (per_stance >= floor_hz)
+      std::snprintf(b, sizeof b, "post-filter cut-off %.1f Hz: %g cycles over the median stance of %.3f s", hz, o.post_cutoff_cycles,
+                    *stance);
+    else
+      std::snprintf(b, sizeof b,
+                    "post-filter cut-off %.1f Hz: %g x the kinematic cut-off, above %g cycles over the median stance of %.3f s "
+                    "(%.1f Hz)",
+                    hz, o.post_cutoff_floor_ratio, o.post_cutoff_cycles, *stance, per_stance);
+  } else {
+    std::snprintf(b, sizeof b, "post-filter cut-off %g Hz (fixed): no complete stance to scale it to", o.post_cutoff_hz);
+  }
+  return {hz, b};
+}
+
+/// What the feet stage makes of the solve: the post-filtered per-foot results and joint torques.
+struct FeetStage {
+  std::array<FootResult, 2> feet;
+  Eigen::MatrixXd joint_torque_Nm;
+  double post_cutoff_hz = 0.0;
+  Messages messages;
+};
+
+/// One foot's force, COP, contact state, gap and sole from the post-filtered multipliers `lamf`
+/// and the raw ones; the raw solve's per-side series are taken.
+FootResult foot_result(int side, const std::vector<bool>& contact, const Eigen::MatrixXd& lamf, RawSolve& raw) {
   const Eigen::Index n = raw.lambda.rows();
   const int np = static_cast<int>(raw.point_side.size());
   const Eigen::MatrixXd& lam = raw.lambda;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  FootResult f;
+  f.force_N = Eigen::MatrixX2d::Zero(n, 2);
+  f.raw_force_N = Eigen::MatrixX2d::Zero(n, 2);
+  f.cop_x_m = Eigen::VectorXd::Constant(n, nan);
+  f.contact = contact;
+  f.inclination_rad = std::move(raw.inclination_rad[side]);
+  f.gap_m = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
+  f.sole_m = std::move(raw.sole_m[side]);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double mx = 0;
+    for (int j = 0; j < np; ++j) {
+      if (raw.point_side[static_cast<std::size_t>(j)] != side) continue;
+      f.gap_m[i] = std::min(f.gap_m[i], raw.point_gap_m(i, j));
+      f.force_N(i, 0) += lamf(i, 2 * j + 1);
+      f.force_N(i, 1) += lamf(i, 2 * j);
+      f.raw_force_N(i, 0) += lam(i, 2 * j + 1);
+      f.raw_force_N(i, 1) += lam(i, 2 * j);
+      mx += lamf(i, 2 * j) * raw.point_x_m(i, j);
+    }
+    if (f.contact[static_cast<std::size_t>(i)]) {
+      if (np == 2) f.cop_x_m[i] = raw.point_x_m(i, side);
+      else if (std::abs(f.force_N(i, 1)) > 1e-6) f.cop_x_m[i] = mx / f.force_N(i, 1);
+    }
+  }
+  return f;
+}
+
+/// The post-filter (Sect. 2.6), the double-support transition and each foot's result.
+FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, double kinematic_cutoff_hz, int first_frame_number,
+                     double ground_level_m) {
+  FeetStage out;
+  const Eigen::Index n = raw.lambda.rows();
+  const int np = static_cast<int>(raw.point_side.size());
   const std::array<std::vector<bool>, 2> contact = foot_contact_states(raw, n);
-  window_edge_messages(contact, rate_hz, r.kinematic_cutoff_hz, r);
+  out.messages = window_edge_messages(contact, rate_hz, kinematic_cutoff_hz, first_frame_number);
   const std::optional<double> stance = median_stance_s(contact, rate_hz);
   // Final filtering (Sect. 2.6): all multipliers at the post-filter cut-off, then inactive ones
-  // back to zero. The cut-off follows the trial's stance duration (post_cutoff_cycles), within
-  // what the marker rate allows.
-  r.post_cutoff_hz = o.post_cutoff_hz;
-  if (o.post_cutoff_cycles > 0) {
-    char b[200];
-    if (stance) {
-      const double per_stance = o.post_cutoff_cycles / *stance, floor_hz = o.post_cutoff_floor_ratio * r.kinematic_cutoff_hz;
-      r.post_cutoff_hz = std::min(std::max(per_stance, floor_hz), 0.4 * rate_hz);
-      if (per_stance >= floor_hz)
-        std::snprintf(b, sizeof b, "post-filter cut-off %.1f Hz: %g cycles over the median stance of %.3f s", r.post_cutoff_hz,
-                      o.post_cutoff_cycles, *stance);
-      else
-        std::snprintf(b, sizeof b,
-                      "post-filter cut-off %.1f Hz: %g x the kinematic cut-off, above %g cycles over the median stance of %.3f s "
-                      "(%.1f Hz)",
-                      r.post_cutoff_hz, o.post_cutoff_floor_ratio, o.post_cutoff_cycles, *stance, per_stance);
-    } else {
-      std::snprintf(b, sizeof b, "post-filter cut-off %g Hz (fixed): no complete stance to scale it to", o.post_cutoff_hz);
-    }
-    r.messages.emplace_back(b);
-  }
-  const double post = r.post_cutoff_hz;
-  Eigen::MatrixXd lamf = post > 0 ? butterworth_filtfilt(lam, rate_hz, post) : lam;
+  // back to zero.
+  std::string why;
+  std::tie(out.post_cutoff_hz, why) = post_cutoff(o, stance, rate_hz, kinematic_cutoff_hz);
+  if (!why.empty()) out.messages.push_back(std::move(why));
+  const double post = out.post_cutoff_hz;
+  Eigen::MatrixXd lamf = post > 0 ? butterworth_filtfilt(raw.lambda, rate_hz, post) : raw.lambda;
   // In place (nothing below reads the raw torques): a long trial holds them once.
-  r.joint_torque_Nm = post > 0 ? butterworth_filtfilt(std::move(raw.torque), rate_hz, post) : std::move(raw.torque);
+  out.joint_torque_Nm = post > 0 ? butterworth_filtfilt(std::move(raw.torque), rate_hz, post) : std::move(raw.torque);
   for (Eigen::Index i = 0; i < n; ++i)
     for (int j = 0; j < np; ++j)
       if (!raw.active[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;
   if (o.double_support_sta_weight > 0 && stance)
-    double_support_transition(o.double_support_sta_weight, contact, *stance, rate_hz, raw, lamf, r);
-
-  const double nan = std::numeric_limits<double>::quiet_NaN();
+    append(out.messages,
+           double_support_transition(o.double_support_sta_weight, contact, *stance, rate_hz, raw, lamf, out.joint_torque_Nm));
+  bool any = false;
   for (int side = 0; side < 2; ++side) {
-    FootResult& f = r.feet[side];
-    f.force_N = Eigen::MatrixX2d::Zero(n, 2);
-    f.raw_force_N = Eigen::MatrixX2d::Zero(n, 2);
-    f.cop_x_m = Eigen::VectorXd::Constant(n, nan);
-    f.contact = contact[static_cast<std::size_t>(side)];
-    f.inclination_rad = std::move(raw.inclination_rad[side]);
-    f.gap_m = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
-    f.sole_m = std::move(raw.sole_m[side]);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      double mx = 0;
-      for (int j = 0; j < np; ++j) {
-        if (raw.point_side[static_cast<std::size_t>(j)] != side) continue;
-        f.gap_m[i] = std::min(f.gap_m[i], raw.point_gap_m(i, j));
-        f.force_N(i, 0) += lamf(i, 2 * j + 1);
-        f.force_N(i, 1) += lamf(i, 2 * j);
-        f.raw_force_N(i, 0) += lam(i, 2 * j + 1);
-        f.raw_force_N(i, 1) += lam(i, 2 * j);
-        mx += lamf(i, 2 * j) * raw.point_x_m(i, j);
-      }
-      if (f.contact[static_cast<std::size_t>(i)]) {
-        if (np == 2) f.cop_x_m[i] = raw.point_x_m(i, side);
-        else if (std::abs(f.force_N(i, 1)) > 1e-6) f.cop_x_m[i] = mx / f.force_N(i, 1);
-      }
-    }
+    out.feet[side] = foot_result(side, contact[static_cast<std::size_t>(side)], lamf, raw);
+    for (bool c : out.feet[side].contact) any = any || c;
   }
-  {
-    bool any = false;
-    for (int side = 0; side < 2; ++side)
-      for (bool c : r.feet[side].contact) any = any || c;
-    if (!any) {
-      char b[200];
-      std::snprintf(b, sizeof b, "no stance: neither foot touches the ground (%.3f m) in the processed window; the GRF is zero "
-                                 "throughout (check --ground-level)", r.ground_level_m());
-      r.messages.push_back(b);
-    }
+  if (!any) {
+    char b[200];
+    std::snprintf(b, sizeof b, "no stance: neither foot touches the ground (%.3f m) in the processed window; the GRF is zero "
+                               "throughout (check --ground-level)", ground_level_m);
+    out.messages.push_back(b);
   }
+  return out;
 }
 
-/// Whole-body totals from the kinematics alone, the GRM, the dynamic residual and joint forces,
-/// for every frame (frame_totals), unless the result is not to hold them (keep_all_series).
-void totals_stage(const EstimateOptions& o, EstimateResult& r) {
-  if (!o.keep_all_series) return;
-  const Eigen::Index n = r.motion.frames();
-  r.grm_Nm = Eigen::VectorXd::Zero(n);
-  r.residual = Eigen::MatrixX3d::Zero(n, 3);
-  r.kinematic_total = Eigen::MatrixX3d::Zero(n, 3);
-  r.joint_force_N = Eigen::MatrixXd::Zero(n, 2 * kJointCount);
+/// Every frame's totals (frame_totals), unless the result is not to hold them (keep_all_series).
+struct TotalsStage {
+  Eigen::VectorXd grm_Nm;
+  Eigen::MatrixX3d residual, kinematic_total;
+  Eigen::MatrixXd joint_force_N;
+};
+TotalsStage totals_stage(const EstimateOptions& o, const ModelMotion& motion, const std::array<FootResult, 2>& feet,
+                         double ground_level_m) {
+  TotalsStage out;
+  if (!o.keep_all_series) return out;
+  const Eigen::Index n = motion.frames();
+  out.grm_Nm = Eigen::VectorXd::Zero(n);
+  out.residual = Eigen::MatrixX3d::Zero(n, 3);
+  out.kinematic_total = Eigen::MatrixX3d::Zero(n, 3);
+  out.joint_force_N = Eigen::MatrixXd::Zero(n, 2 * kJointCount);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const FrameTotals t = frame_totals(r, i);
-    r.grm_Nm[i] = t.grm_Nm;
-    r.residual.row(i) = t.residual.transpose();
-    r.kinematic_total.row(i) = t.kinematic_total.transpose();
-    for (int j = 0; j < 2 * kJointCount; ++j) r.joint_force_N(i, j) = t.joint_force_N[static_cast<std::size_t>(j)];
+    const FrameTotals t = frame_totals(motion, feet, ground_level_m, o.grm_reference_m, i);
+    out.grm_Nm[i] = t.grm_Nm;
+    out.residual.row(i) = t.residual.transpose();
+    out.kinematic_total.row(i) = t.kinematic_total.transpose();
+    for (int j = 0; j < 2 * kJointCount; ++j) out.joint_force_N(i, j) = t.joint_force_N[static_cast<std::size_t>(j)];
   }
+  return out;
 }
 
 }  // namespace
 
-FrameTotals frame_totals(const EstimateResult& r, Eigen::Index i) {
+FrameTotals frame_totals(const ModelMotion& motion, const std::array<FootResult, 2>& feet, double ground_level_m,
+                         const Eigen::Vector2d& grm_reference_m, Eigen::Index i) {
   FrameTotals t;
-  const double g = r.model.gravity_mps2;
+  const Model& model = *motion.model;
+  const double g = model.gravity_mps2;
   MotionFrame m;
-  r.motion.frame(i, m);
+  motion.frame(i, m);
   Eigen::Vector3d kin = Eigen::Vector3d::Zero();  // sum m(a+g), sum of moments about the origin
   std::array<Eigen::Vector2d, kSegmentCount> seg_force;
   for (int s = 0; s < kSegmentCount; ++s) {
-    const Body& b = r.model.bodies[s];
+    const Body& b = model.bodies[s];
     const Eigen::Vector2d pos = m.q.segment<2>(coord::com_x(s));
     const Eigen::Vector2d F = b.mass_kg * Eigen::Vector2d(m.qdd(coord::com_x(s)), m.qdd(coord::com_x(s) + 1) + g);
     seg_force[static_cast<std::size_t>(s)] = F;
@@ -652,11 +757,11 @@ FrameTotals frame_totals(const EstimateResult& r, Eigen::Index i) {
   }
   Eigen::Vector3d ext = Eigen::Vector3d::Zero();
   for (int side = 0; side < 2; ++side) {
-    const auto& f = r.feet[static_cast<std::size_t>(side)];
+    const auto& f = feet[static_cast<std::size_t>(side)];
     if (!f.contact[static_cast<std::size_t>(i)]) continue;
-    const double x = f.cop_x_m[i], y = r.ground_level_m();
+    const double x = f.cop_x_m[i], y = ground_level_m;
     const double fx = f.force_N(i, 0), fy = f.force_N(i, 1);
-    t.grm_Nm += sagittal_moment(x - r.grm_reference_m.x(), y - r.grm_reference_m.y(), fx, fy);
+    t.grm_Nm += sagittal_moment(x - grm_reference_m.x(), y - grm_reference_m.y(), fx, fy);
     ext += Eigen::Vector3d(fx, fy, sagittal_moment(x, y, fx, fy));
   }
   t.residual = kin - ext;
@@ -665,103 +770,121 @@ FrameTotals frame_totals(const EstimateResult& r, Eigen::Index i) {
     const int side = j / 4, depth = j % 4;
     Eigen::Vector2d F = Eigen::Vector2d::Zero();
     for (int k = depth; k < 4; ++k) F += seg_force[static_cast<std::size_t>(segment(side, static_cast<LegSegment>(k)))];
-    if (depth <= 2 && r.feet[static_cast<std::size_t>(side)].contact[static_cast<std::size_t>(i)])
-      F -= r.feet[static_cast<std::size_t>(side)].force_N.row(i).transpose();
+    if (depth <= 2 && feet[static_cast<std::size_t>(side)].contact[static_cast<std::size_t>(i)])
+      F -= feet[static_cast<std::size_t>(side)].force_N.row(i).transpose();
     t.joint_force_N[static_cast<std::size_t>(2 * j)] = F.x();
     t.joint_force_N[static_cast<std::size_t>(2 * j + 1)] = F.y();
   }
   return t;
 }
 
+FrameTotals frame_totals(const EstimateResult& r, Eigen::Index i) {
+  return frame_totals(r.motion, r.feet, r.ground_level_m(), r.grm_reference_m, i);
+}
+
 namespace {
 
+/// The stance floor (EstimateOptions::min_kinematic_cycles): the dynamics' kinematic cut-off
+/// raised to that many cycles over the first solve's median stance, when that is above the
+/// noise-lowered one; none otherwise.
+std::optional<double> stance_floor_hz(const EstimateOptions& o, const KinematicsStage& kin, const RawSolve& first,
+                                      double rate_hz, std::string& message) {
+  if (kin.unfiltered.size() == 0) return std::nullopt;
+  const auto stance = median_stance_s(foot_contact_states(first, first.lambda.rows()), rate_hz);
+  if (!stance) return std::nullopt;
+  const double floor_hz = std::min(o.kinematic_cutoff_hz, o.min_kinematic_cycles / *stance);
+  if (!(floor_hz > kin.kinematic_cutoff_hz)) return std::nullopt;
+  char b[240];
+  std::snprintf(b, sizeof b,
+                "kinematic cut-off for the dynamics raised to %.2f Hz: %g cycles over the median stance of %.3f s (the COP "
+                "function's foot angle keeps %.2f Hz)",
+                floor_hz, o.min_kinematic_cycles, *stance, kin.position_cutoff_hz);
+  message = b;
+  return floor_hz;
+}
+
 /// estimate(); `release` (the trial itself, when the caller gave it up) loses its marker samples
-/// once the landmarks are made.
+/// once the landmarks are made. The stages in order, each taking what it reads and returning
+/// what it makes; the result is assembled at the end.
 EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* static_trial, const MarkerSet& set,
                              const EstimateOptions& o) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   check_options(o);
-  EstimateResult r;
-  r.marker_set = set.name;
-  r.mass_kg = resolve_mass(trial, o);
-  sagittal_stage(trial, release, static_trial, set, o, r);
-  // Not a structured binding: the lambda below captures the soles (clang before 16 refuses a
-  // captured binding).
-  std::pair<Model, ContactCalibration> model_and_soles = model_stage(o, r);
-  r.model = std::move(model_and_soles.first);
-  const ContactCalibration soles = std::move(model_and_soles.second);
-  Eigen::MatrixXd unfiltered;  // for a second pass (min_kinematic_cycles): only where the noise lowered the cut-off
-  ModelMotion motion = kinematics_stage(o, r.model, r, unfiltered);
-  const std::size_t first_pass_messages = r.messages.size();
-  double seconds_kinematics = 0, seconds_dynamics = 0;
-  std::vector<bool> running;
-  std::array<std::vector<bool>, 2> landing;
-  RawSolve raw;
+  const double mass_kg = resolve_mass(trial, o);
+  SagittalStage sag = sagittal_stage(trial, release, static_trial, set, o);
+  ModelStage mod = model_stage(o, sag.landmarks, mass_kg);
+  KinematicsStage kin = kinematics_stage(o, mod.model, sag.landmarks);
+  const double hip_speed_mps = sag.frame.treadmill ? 0.0 : progression_speed(sag.landmarks);
+  if (!o.keep_all_series) sag.landmarks.p = {};  // the hip's speed was the last use of them
   // The solve's progress over both passes when a second may follow: the first reports the first
   // half, the second the rest (or the first completes it), so a progress line never restarts.
-  const bool two_pass_progress = unfiltered.size() > 0 && o.progress;
-  std::function<void(long, long)> progress = o.progress;
-  const auto set_pass = [&](long pass) {
-    if (two_pass_progress) progress = [&o, pass](long done, long n) { o.progress(pass * n + done, 2 * n); };
+  const bool two_pass_progress = kin.unfiltered.size() > 0 && o.progress;
+  const auto pass_progress = [&](long pass) -> std::function<void(long, long)> {
+    if (!two_pass_progress) return o.progress;
+    return [&o, pass](long done, long n) { o.progress(pass * n + done, 2 * n); };
   };
-  // The torso lag, the contact calibration and the solve (Eqs. 5-10) on `motion`.
-  const auto dynamics = [&](std::optional<double> progression_speed_mps) {
-    const auto ta = clock::now();
-    lag_torso_stage(o, motion, r);
-    ContactPlan plan = contact_stage(o, r.model, soles, r, motion, progression_speed_mps);
-    running = std::move(plan.running);
-    landing = std::move(plan.landing);
-    r.calibration = std::move(plan.calibration);
-    if (!o.keep_all_series) r.landmarks.p = {};  // the last to read them is contact_stage (the hip's speed)
-    const auto tb = clock::now();
-    r.cycled_frames = r.capped_frames = 0;  // solve_stage counts into them
-    raw = solve_stage(trial, o, r, motion, running, landing, progress);
-    seconds_kinematics += std::chrono::duration<double>(tb - ta).count();
-    seconds_dynamics += std::chrono::duration<double>(clock::now() - tb).count();
+  double seconds_kinematics = std::chrono::duration<double>(clock::now() - t0).count();
+  const auto pass = [&](ModelMotion& motion, long index) {
+    DynamicsPass p = dynamics_pass(o, *mod.model, mod.soles, sag.frame.treadmill, hip_speed_mps, motion, pass_progress(index), trial.path,
+                                   sag.first_frame_number);
+    seconds_kinematics += p.seconds_kinematics;
+    return p;
   };
-  seconds_kinematics = std::chrono::duration<double>(clock::now() - t0).count();
-  set_pass(0);
-  dynamics(std::nullopt);
-  bool raised = false;
-  // The stance floor (min_kinematic_cycles): the dynamics' kinematics not below that many cycles
-  // per stance, the stance from this first solve's contacts (as the post-filter takes it).
-  if (unfiltered.size() > 0) {
-    if (const auto stance = median_stance_s(foot_contact_states(raw, motion.frames()), motion.rate_hz)) {
-      const double floor_hz = std::min(o.kinematic_cutoff_hz, o.min_kinematic_cycles / *stance);
-      if (floor_hz > r.kinematic_cutoff_hz) {
-        const auto tk = clock::now();
-        r.messages.resize(first_pass_messages);  // the second pass says its own
-        r.kinematic_cutoff_hz = floor_hz;
-        char b[240];
-        std::snprintf(b, sizeof b,
-                      "kinematic cut-off for the dynamics raised to %.2f Hz: %g cycles over the median stance of %.3f s (the COP "
-                      "function's foot angle keeps %.2f Hz)",
-                      floor_hz, o.min_kinematic_cycles, *stance, r.position_cutoff_hz);
-        r.messages.emplace_back(b);
-        const double rate_hz = motion.rate_hz, speed_mps = r.calibration.progression_speed_mps;
-        Eigen::VectorXd time_s = std::move(motion.time_s);
-        motion = ModelMotion();
-        raw = RawSolve();
-        motion = motion_from_coordinates(r.model, std::move(unfiltered), rate_hz, std::move(time_s), floor_hz, r.position_cutoff_hz);
-        seconds_kinematics += std::chrono::duration<double>(clock::now() - tk).count();
-        set_pass(1);
-        dynamics(speed_mps);
-        raised = true;
-      }
-    }
-    unfiltered = Eigen::MatrixXd();
-    if (two_pass_progress && !raised) o.progress(2 * motion.frames(), 2 * motion.frames());  // one pass was enough: done
+  DynamicsPass dyn = pass(kin.motion, 0);
+  double seconds_dynamics = dyn.seconds_dynamics;
+  std::string raised;
+  if (const auto floor_hz = stance_floor_hz(o, kin, dyn.raw, kin.motion.rate_hz, raised)) {
+    // The second pass: the same stages on the coordinates filtered at the raised cut-off; the
+    // first pass's contact plan and solve are dropped (their messages with them).
+    const auto tk = clock::now();
+    const double rate_hz = kin.motion.rate_hz;
+    Eigen::VectorXd time_s = std::move(kin.motion.time_s);
+    kin.motion = ModelMotion();
+    dyn = DynamicsPass();
+    kin.motion = motion_from_coordinates(mod.model, std::move(kin.unfiltered), rate_hz, std::move(time_s), *floor_hz, kin.position_cutoff_hz);
+    kin.kinematic_cutoff_hz = *floor_hz;
+    kin.messages.push_back(std::move(raised));
+    seconds_kinematics += std::chrono::duration<double>(clock::now() - tk).count();
+    dyn = pass(kin.motion, 1);
+    seconds_dynamics += dyn.seconds_dynamics;
+  } else if (two_pass_progress) {
+    o.progress(2 * kin.motion.frames(), 2 * kin.motion.frames());  // one pass was enough: done
   }
+  kin.unfiltered = Eigen::MatrixXd();
+  const std::vector<int> iterations = std::move(dyn.raw.iterations);
+  const int cycled_frames = dyn.raw.cycled_frames, capped_frames = dyn.raw.capped_frames;
+  const double ground_level_m = dyn.plan.calibration.contact.ground_level_m;
+  FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m);
+  TotalsStage totals = totals_stage(o, kin.motion, feet.feet, ground_level_m);
+
+  EstimateResult r;
+  r.marker_set = set.name;
+  r.mass_kg = mass_kg;
+  r.frame = std::move(sag.frame);
+  r.kinematic_cutoff_hz = kin.kinematic_cutoff_hz;
+  r.position_cutoff_hz = kin.position_cutoff_hz;
+  r.post_cutoff_hz = feet.post_cutoff_hz;
+  r.calibration = std::move(dyn.plan.calibration);
+  r.time_s = sag.landmarks.time_s;
+  r.first_index = sag.first_index;
+  r.first_frame_number = sag.first_frame_number;
+  r.feet = std::move(feet.feet);
+  r.grm_Nm = std::move(totals.grm_Nm);
+  r.joint_torque_Nm = std::move(feet.joint_torque_Nm);
+  r.joint_force_N = std::move(totals.joint_force_N);
+  r.residual = std::move(totals.residual);
+  r.iterations = iterations;
+  r.cycled_frames = cycled_frames;
+  r.capped_frames = capped_frames;
+  r.foot_lateral_m = std::move(sag.foot_lateral_m);
+  r.motion = std::move(kin.motion);
+  r.grm_reference_m = o.grm_reference_m;
+  r.landmarks = std::move(sag.landmarks);
+  r.kinematic_total = std::move(totals.kinematic_total);
+  for (Messages* m : {&sag.messages, &mod.messages, &kin.messages, &dyn.plan.messages, &feet.messages}) append(r.messages, std::move(*m));
   r.seconds_kinematics = seconds_kinematics;
   r.seconds_dynamics = seconds_dynamics;
-  feet_stage(o, r, motion.rate_hz, raw);
-  // What only the per-foot results needed is freed before the totals take their arrays: a long
-  // trial's peak memory.
-  raw = RawSolve();
-  r.motion = std::move(motion);
-  r.grm_reference_m = o.grm_reference_m;
-  totals_stage(o, r);
   return r;
 }
 

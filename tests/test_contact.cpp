@@ -30,8 +30,8 @@ TEST(Contact, FlightFramesAreFoundFromTheKinematicsAlone) {
   so.flight_height_m = 0.3;  // flight 1.253-1.747 s
   const Trial t = make_synthetic_trial(so);
   const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
-  ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
-  const auto run = flight_frames(r.model, mm, r.calibration.contact);
+  ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
+  const auto run = flight_frames(r.model(), mm, r.calibration.contact);
   ASSERT_EQ(run.size(), static_cast<std::size_t>(mm.frames()));
   for (Eigen::Index i = 0; i < mm.frames(); ++i) {
     const double time = mm.time_s[i];
@@ -46,8 +46,8 @@ TEST(Contact, FlightFramesAreFoundFromTheKinematicsAlone) {
     sq.squat_depth = depth;
     const Trial ts = make_synthetic_trial(sq);
     const auto rs = estimate(ts, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
-    ModelMotion ms = compute_motion(rs.model, synthetic_landmarks(ts), 6.0);
-    const auto none = flight_frames(rs.model, ms, rs.calibration.contact);
+    ModelMotion ms = compute_motion(rs.model(), synthetic_landmarks(ts), 6.0);
+    const auto none = flight_frames(rs.model(), ms, rs.calibration.contact);
     EXPECT_EQ(std::count(none.begin(), none.end(), true), 0) << depth;
   }
 }
@@ -62,10 +62,10 @@ TEST(Contact, ADeepDipWithAFootOnTheGroundIsNotAFlight) {
   so.squat_period_s = 0.4;
   const Trial t = make_synthetic_trial(so);
   const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
-  ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
-  const auto by_force_alone = flight_frames(r.model, mm, r.calibration.contact, 0.2, 0.4, -1e9);
+  ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
+  const auto by_force_alone = flight_frames(r.model(), mm, r.calibration.contact, 0.2, 0.4, -1e9);
   ASSERT_GT(std::count(by_force_alone.begin(), by_force_alone.end(), true), 0) << "the bounce must dip below 0.2 body weight";
-  const auto run = flight_frames(r.model, mm, r.calibration.contact);
+  const auto run = flight_frames(r.model(), mm, r.calibration.contact);
   EXPECT_EQ(std::count(run.begin(), run.end(), true), 0);
 }
 
@@ -148,14 +148,14 @@ TEST(Contact, EachFramesContactsAreTheWholeTrialsBitForBit) {
   for (FootModel model : {FootModel::Cop, FootModel::ThreePoint}) {
     ContactModelOptions co;
     co.foot_model = model;
-    ModelMotion whole = compute_motion(r.model, synthetic_landmarks(t), 6.0);
+    ModelMotion whole = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
     const ModelMotion bare = whole;
-    const auto all = prepare_contacts(r.model, r.calibration.contact, co, whole);
+    const auto all = prepare_contacts(r.model(), r.calibration.contact, co, whole);
     FrameContacts fc;
     MotionFrame f;
     for (Eigen::Index i = 0; i < bare.frames(); i += 7) {
       bare.frame(i, f);
-      contact_frame(r.model, r.calibration.contact, co, false, f, fc);
+      contact_frame(r.model(), r.calibration.contact, co, false, f, fc);
       const FrameContacts& ref = all[static_cast<std::size_t>(i)];
       ASSERT_EQ(fc.points.size(), ref.points.size()) << i;
       ASSERT_EQ(fc.points.size(), model == FootModel::Cop ? 2u : 6u);

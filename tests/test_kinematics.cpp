@@ -26,9 +26,9 @@ TEST(Kinematics, ReconstructionSatisfiesTheBilateralConstraints) {
   const auto r = run(so);
   // Rebuild the motion and check Phi(q) ~ 0 via Phi_q qd = 0 and finite differences of q.
   const SagittalLandmarks lm = synthetic_landmarks(t);
-  ModelMotion mm = compute_motion(r.model, lm, 6.0);
-  (void)prepare_contacts(r.model, r.calibration.contact, ContactModelOptions{}, mm);
-  ContactSolver solver(r.model, r.calibration, {});
+  ModelMotion mm = compute_motion(r.model(), lm, 6.0);
+  (void)prepare_contacts(r.model(), r.calibration.contact, ContactModelOptions{}, mm);
+  ContactSolver solver(r.model(), r.calibration, {});
   for (Eigen::Index i = 5; i < mm.frames(); i += 37) {
     const MotionFrame f = mm.frame(i);
     const Eigen::MatrixXd Phi = solver.bilateral_jacobian(f.q);
@@ -44,11 +44,11 @@ TEST(Kinematics, ReconstructedPositionsKeepTheSegmentLengths) {
   so.left_leg_raised_rad = 0.3;
   const Trial t = make_synthetic_trial(so);
   const auto r = run(so);
-  const ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
+  const ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
   // Position level: every landmark attached to a body stays at its body-fixed place, so the
   // distance to the proximal landmark is the same in every frame (fixed-length model).
   for (int s = 0; s < kSegmentCount; ++s) {
-    const Body& b = r.model.bodies[s];
+    const Body& b = r.model().bodies[s];
     for (int k = 0; k < 2; ++k) {
       if (b.points[k] < 0) continue;
       const double L = b.points_local[k].norm();
@@ -71,9 +71,9 @@ TEST(Kinematics, MeasuredTorsoLengthIsFollowedAndDifferentiated) {
   const Eigen::ArrayXd bob = 0.02 * (2.0 * M_PI * 1.5 * t.markers.time_s.array()).sin();
   for (const char* s : {"RSHO", "LSHO"}) t.markers.positions_m[static_cast<std::size_t>(t.markers.find(s))].col(2).array() += bob;
   const SagittalLandmarks lm = synthetic_landmarks(t);
-  const ModelMotion measured = compute_motion(r.model, lm, 6.0, TorsoLength::Measured);
-  const ModelMotion fixed = compute_motion(r.model, lm, 6.0, TorsoLength::Fixed);
-  const double dt = 1.0 / lm.rate_hz, L0 = r.model.bodies[kTorso].length_m;
+  const ModelMotion measured = compute_motion(r.model(), lm, 6.0, TorsoLength::Measured);
+  const ModelMotion fixed = compute_motion(r.model(), lm, 6.0, TorsoLength::Fixed);
+  const double dt = 1.0 / lm.rate_hz, L0 = r.model().bodies[kTorso].length_m;
   auto point = [](const ModelMotion& m, int col, Eigen::Index i) { return Eigen::Vector2d(m.frame(i).q.segment<2>(col)); };
   double worst_len = 0, worst_acc = 0, fixed_spread = 0, acc_scale = 0;
   const int sh = coord::point_x(kShoulder), hip = coord::point_x(kHip), com = coord::com_x(kTorso);
@@ -101,7 +101,7 @@ TEST(Kinematics, MeasuredTorsoLengthIsFollowedAndDifferentiated) {
 TEST(Kinematics, TorsoLagDelaysOnlyTheTorsosForeAftAcceleration) {
   const Trial t = make_synthetic_trial({});
   const auto r = run({});
-  const ModelMotion base = compute_motion(r.model, synthetic_landmarks(t), 6.0);
+  const ModelMotion base = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
   const int c = coord::com_x(kTorso);
   ModelMotion step = base;
   const Eigen::Index i0 = 100;
@@ -151,7 +151,7 @@ TEST(Kinematics, TorsoLagDelaysOnlyTheTorsosForeAftAcceleration) {
 // torso lag adds only the rest (the pipeline's lag_torso_stage).
 TEST(Kinematics, TheTrunksOwnLagBehindTheHipIsMeasured) {
   const auto r = run({});
-  ModelMotion m = compute_motion(r.model, synthetic_landmarks(make_synthetic_trial({})), 6.0);
+  ModelMotion m = compute_motion(r.model(), synthetic_landmarks(make_synthetic_trial({})), 6.0);
   auto with_delay = [&](double delay_s) {
     ModelMotion d = m;
     d.xd = Eigen::MatrixXd::Zero(d.frames(), d.x.cols());  // stored derivatives, set below
@@ -182,7 +182,7 @@ TEST(Kinematics, TheTrunksOwnLagBehindTheHipIsMeasured) {
 // and every frame() is rebuilt the same, however often it is asked for.
 TEST(Kinematics, TheMotionHoldsFewNumbersAFrameAndRebuildsEachFrameAlike) {
   const auto r = run({});
-  const ModelMotion m = compute_motion(r.model, synthetic_landmarks(make_synthetic_trial({})), 6.0);
+  const ModelMotion m = compute_motion(r.model(), synthetic_landmarks(make_synthetic_trial({})), 6.0);
   const Eigen::Index n = m.frames();
   ASSERT_GT(n, 100);
   const auto held = m.x.size() + m.xd.size() + m.xdd.size() + m.torso_ax_mps2.size() + m.dstar.size() + m.dstar_d.size() +
@@ -230,9 +230,9 @@ TEST(Kinematics, TheCopsFootAngleAtItsOwnCutoffIsTheFootsThetaFilteredThere) {
   const Trial t = make_synthetic_trial({});
   const auto r = run(SyntheticOptions{});
   const SagittalLandmarks lm = synthetic_landmarks(t);
-  const ModelMotion at4 = compute_motion(r.model, lm, 4.0);
-  const ModelMotion mixed = compute_motion(r.model, lm, 6.0, TorsoLength::Measured, 4.0);
-  const ModelMotion plain = compute_motion(r.model, lm, 6.0);
+  const ModelMotion at4 = compute_motion(r.model(), lm, 4.0);
+  const ModelMotion mixed = compute_motion(r.model(), lm, 6.0, TorsoLength::Measured, 4.0);
+  const ModelMotion plain = compute_motion(r.model(), lm, 6.0);
   ASSERT_EQ(mixed.cop_foot_angle_rad.rows(), lm.frames());
   EXPECT_EQ(plain.cop_foot_angle_rad.size(), 0);
   MotionFrame f4, fm, fp;

@@ -24,9 +24,9 @@ using kin2grf::test::synthetic_landmarks;
 TEST(Model, MassMatrixSumsToBodyMass) {
   const auto r = run({});
   double m = 0;
-  for (const auto& b : r.model.bodies) m += b.mass_kg;
+  for (const auto& b : r.model().bodies) m += b.mass_kg;
   EXPECT_NEAR(m, 70.0 * (0.678 + 2 * (0.100 + 0.0465 + 0.0145)), 1e-9);
-  EXPECT_NEAR(r.model.mass_diagonal().sum(), 2 * m + [&] { double s = 0; for (auto& b : r.model.bodies) s += b.inertia_kgm2; return s; }(), 1e-9);
+  EXPECT_NEAR(r.model().mass_diagonal().sum(), 2 * m + [&] { double s = 0; for (auto& b : r.model().bodies) s += b.inertia_kgm2; return s; }(), 1e-9);
 }
 
 // The anthropometric tables: the 9 bodies' mass fractions add up to the whole body, each

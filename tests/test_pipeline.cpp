@@ -36,6 +36,21 @@ TEST(Estimate, QuietStandingCarriesBodyWeightUnderTheCentreOfMass) {
   }
 }
 
+// The ground shift (the paper's robustness study) is one floor for every stage: the contacts'
+// gaps, the calibration the result reports, and the COP's height in the lab frame.
+TEST(Estimate, AGroundShiftIsTheFloorOfEveryStage) {
+  SyntheticOptions so;
+  so.squat_depth = 0.0;
+  EstimateOptions shifted;
+  shifted.contact.ground_shift_m = -0.005;
+  const auto r0 = run(so), rs = run(so, shifted);
+  EXPECT_NEAR(rs.ground_level_m(), r0.ground_level_m() - 0.005, 1e-12);
+  const Eigen::Index i = r0.time_s.size() / 2;
+  ASSERT_TRUE(r0.feet[0].contact[static_cast<std::size_t>(i)] && rs.feet[0].contact[static_cast<std::size_t>(i)]);
+  const double h0 = r0.frame.up.dot(lab_foot_frame(r0, 0, i).cop_m), hs = rs.frame.up.dot(lab_foot_frame(rs, 0, i).cop_m);
+  EXPECT_NEAR(hs - h0, -0.005, 1e-9);
+}
+
 TEST(Estimate, SquatTotalVerticalForceMatchesTheSegmentAccelerations) {
   const auto r = run({});
   for (Eigen::Index i = 10; i < r.time_s.size() - 10; ++i) {
@@ -147,8 +162,8 @@ TEST(Estimate, PrescribedSingleSupportRecoversTheExactContactForce) {
   }
 
   // One frame, forward dynamics: [M -A^T; A 0] [qdd; mu] = [f; c].
-  ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
-  auto contacts = prepare_contacts(r.model, r.calibration.contact, ContactModelOptions{}, mm);
+  ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
+  auto contacts = prepare_contacts(r.model(), r.calibration.contact, ContactModelOptions{}, mm);
   const Eigen::Index i = 120;
   const FrameContacts& fc = contacts[static_cast<std::size_t>(i)];
   ASSERT_EQ(fc.points.size(), 2u);
@@ -156,21 +171,21 @@ TEST(Estimate, PrescribedSingleSupportRecoversTheExactContactForce) {
   const Eigen::VectorXd q = mm.frame(i).q;
   SolverOptions sopt;
   sopt.r_N_per_m = 1e5;
-  ContactSolver solver(r.model, r.calibration, sopt);  // no speed gate (eo's)
+  ContactSolver solver(r.model(), r.calibration, sopt);  // no speed gate (eo's)
   const Eigen::MatrixXd Phi = solver.bilateral_jacobian(q);
   Eigen::MatrixXd A(kBilateralCount + 2, coord::kCount);
   A << Phi, fc.points[0].jac_normal.dense().transpose(), fc.points[0].jac_tangent.dense().transpose();
   Eigen::VectorXd c = Eigen::VectorXd::Zero(kBilateralCount + 2);
   const double phidd[kJointCount] = {0.8, -1.5, 2.0, 0.3, -0.4, 0.9, 0.0, -0.2};  // rad/s^2 (qd = 0)
   for (int j = 0; j < kJointCount; ++j) c[48 + j] = phidd[j];
-  const Eigen::VectorXd Mdiag = r.model.mass_diagonal();
+  const Eigen::VectorXd Mdiag = r.model().mass_diagonal();
   const int n = coord::kCount, m = kBilateralCount + 2;
   Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n + m, n + m);
   K.topLeftCorner(n, n) = Mdiag.asDiagonal();
   K.topRightCorner(n, m) = -A.transpose();
   K.bottomLeftCorner(m, n) = A;
   Eigen::VectorXd rhs(n + m);
-  rhs << r.model.gravity_force(), c;
+  rhs << r.model().gravity_force(), c;
   const Eigen::VectorXd sol = K.fullPivLu().solve(rhs);
   ASSERT_LT((K * sol - rhs).norm(), 1e-8);
   const Eigen::VectorXd qdd = sol.head(n);

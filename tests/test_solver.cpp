@@ -29,11 +29,11 @@ TEST(Solver, StructuredAndDenseFactorisationsAgree) {
     so.left_leg_raised_rad = raised;
     const Trial t = make_synthetic_trial(so);
     const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), {});
-    ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
-    const auto contacts = prepare_contacts(r.model, r.calibration.contact, ContactModelOptions{}, mm);
+    ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
+    const auto contacts = prepare_contacts(r.model(), r.calibration.contact, ContactModelOptions{}, mm);
     SolverOptions structured_opt, dense_opt;
     dense_opt.dense_factorisation = true;
-    ContactSolver structured(r.model, r.calibration, structured_opt), dense(r.model, r.calibration, dense_opt);
+    ContactSolver structured(r.model(), r.calibration, structured_opt), dense(r.model(), r.calibration, dense_opt);
     for (Eigen::Index i = 0; i < mm.frames(); i += 11) {
       const MotionFrame f = mm.frame(i);
       const Eigen::VectorXd q = f.q, qdd = f.qdd;
@@ -57,8 +57,8 @@ TEST(Solver, SlowWalkSwingFootCarriesNothing) {
   const Trial t = make_synthetic_trial(so);
   EstimateOptions eo;
   const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
-  ModelMotion mm = compute_motion(r.model, synthetic_landmarks(t), 6.0);
-  auto contacts = prepare_contacts(r.model, r.calibration.contact, ContactModelOptions{}, mm);
+  ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
+  auto contacts = prepare_contacts(r.model(), r.calibration.contact, ContactModelOptions{}, mm);
   const Eigen::Index i = 120;
   FrameContacts fc = contacts[static_cast<std::size_t>(i)];
   ASSERT_EQ(fc.points.size(), 2u);
@@ -72,14 +72,14 @@ TEST(Solver, SlowWalkSwingFootCarriesNothing) {
 
   TrialCalibration fixed = r.calibration;  // the old fixed gate
   fixed.speed_gate_mps = 1.5;
-  const FrameSolution before = ContactSolver(r.model, fixed, SolverOptions{}).solve(q, qdd, fc);
+  const FrameSolution before = ContactSolver(r.model(), fixed, SolverOptions{}).solve(q, qdd, fc);
   ASSERT_TRUE(test::foot_active(before, fc, 1)) << "the failure this test guards: the fixed gate lets the swing foot in";
   ASSERT_GT(test::foot_force(before, fc, 1).y(), 20.0);
 
   TrialCalibration rule = r.calibration;  // the defaults: the progression speed, at least 0.75 m/s
   rule.speed_gate_mps = speed_gate_for(SolverOptions{}, 0.4);
   EXPECT_NEAR(rule.speed_gate_mps, 0.75, 1e-12);
-  const FrameSolution after = ContactSolver(r.model, rule, SolverOptions{}).solve(q, qdd, fc);
+  const FrameSolution after = ContactSolver(r.model(), rule, SolverOptions{}).solve(q, qdd, fc);
   EXPECT_FALSE(test::foot_active(after, fc, 1));
   EXPECT_EQ(test::foot_force(after, fc, 1).y(), 0.0);
   EXPECT_EQ(test::foot_force(after, fc, 1).x(), 0.0);

@@ -114,9 +114,11 @@ struct EstimateResult {
   /// COP function's foot angle takes; kinematic_cutoff_hz when the stance floor did not raise it.
   double position_cutoff_hz = 0.0;
   double post_cutoff_hz = 0.0;       ///< the post-filter cut-off used (EstimateOptions::post_cutoff_cycles)
-  Model model;
-  /// The floor, the soles, the belt velocity, the progression speed and the speed gate the trial
-  /// was solved with (measured once, model_stage and contact_stage).
+  /// The model the trial was solved with (one home: the motion's).
+  [[nodiscard]] const Model& model() const { return *motion.model; }
+  /// The floor (with EstimateOptions::contact.ground_shift_m applied), the soles, the belt
+  /// velocity, the progression speed and the speed gate the trial was solved with (measured once,
+  /// model_stage and contact_stage).
   TrialCalibration calibration;
   [[nodiscard]] double ground_level_m() const { return calibration.contact.ground_level_m; }
   Eigen::VectorXd time_s;
@@ -154,6 +156,10 @@ struct FrameTotals {
   std::array<double, 2 * kJointCount> joint_force_N{};
 };
 FrameTotals frame_totals(const EstimateResult& r, Eigen::Index i);
+/// The same from its parts: the motion (and its model), the feet's results, the floor the COPs
+/// stand on and the GRM's reference point.
+FrameTotals frame_totals(const ModelMotion& motion, const std::array<FootResult, 2>& feet, double ground_level_m,
+                         const Eigen::Vector2d& grm_reference_m, Eigen::Index i);
 
 /// Plausible adult and child body masses (kg): outside, estimate() refuses unless allowed.
 inline constexpr double kMassRangeKg[2] = {20.0, 300.0};

@@ -29,7 +29,7 @@ PointKinematics place(const PointKinematics& proximal, double th, double w, doub
 /// The torso's length scale k = L(t) / L0 and its derivatives at frame i (1, 0, 0 without column 11).
 std::array<double, 3> torso_scale(const ModelMotion& m, Eigen::Index i, const double* xd_i, const double* xdd_i) {
   if (m.x.cols() <= 11) return {1.0, 0.0, 0.0};
-  const double L0 = m.model.bodies[kTorso].length_m;
+  const double L0 = m.model->bodies[kTorso].length_m;
   return {m.x(i, 11) / L0, xd_i[11] / L0, xdd_i[11] / L0};
 }
 
@@ -142,7 +142,7 @@ void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
   // e = R(theta) rho, so d' = k' e + k e' and d'' = k'' e + 2 k' e' + k e''.
   const auto [ks, ksd, ksdd] = torso_scale(*this, i, d1.data(), d2.data());
   for (int s : order) {
-    const Body& b = model.bodies[s];
+    const Body& b = model->bodies[s];
     const bool scaled = s == kTorso;
     const double k0 = scaled ? ks : 1.0, k1 = scaled ? ksd : 0.0, k2 = scaled ? ksdd : 0.0;
     for (int k = 0; k < 2; ++k)
@@ -180,20 +180,20 @@ void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
   }
 }
 
-ModelMotion reconstruct_motion(const Model& model, Eigen::MatrixXd x, Eigen::MatrixXd xd, Eigen::MatrixXd xdd, double rate_hz,
-                               Eigen::VectorXd time_s) {
+ModelMotion reconstruct_motion(std::shared_ptr<const Model> model, Eigen::MatrixXd x, Eigen::MatrixXd xd, Eigen::MatrixXd xdd,
+                               double rate_hz, Eigen::VectorXd time_s) {
   const Eigen::Index n = x.rows();
   ModelMotion mm;
   mm.rate_hz = rate_hz;
   mm.time_s = std::move(time_s);
-  mm.model = model;
+  mm.model = std::move(model);
   mm.x = std::move(x);
   mm.xd = std::move(xd);
   mm.xdd = std::move(xdd);
   // The HAT COM's fore-aft acceleration as the chain gives it (as frame() places it), the series
   // the torso lag delays.
   Eigen::VectorXd ax(n);
-  const Eigen::Vector2d& rho = model.bodies[kTorso].com_local;
+  const Eigen::Vector2d& rho = mm.model->bodies[kTorso].com_local;
   std::array<double, kMaxIndependent> d1{}, d2{};
   for (Eigen::Index i = 0; i < n; ++i) {
     mm.derivatives_at(i, d1.data(), d2.data());
@@ -212,8 +212,8 @@ Eigen::MatrixXd model_coordinates(const SagittalLandmarks& lm, TorsoLength torso
   return x;
 }
 
-ModelMotion motion_from_coordinates(const Model& model, Eigen::MatrixXd x, double rate_hz, Eigen::VectorXd time_s, double cutoff_hz,
-                                    double cop_angle_cutoff_hz) {
+ModelMotion motion_from_coordinates(std::shared_ptr<const Model> model, Eigen::MatrixXd x, double rate_hz, Eigen::VectorXd time_s,
+                                    double cutoff_hz, double cop_angle_cutoff_hz) {
   // The feet's absolute angles at the COP's own cut-off: the sum of the chain's columns (torso,
   // hip, knee, ankle), the foot's theta as frame() builds it, filtered (a linear filter, so the
   // sum of the filtered columns).
@@ -225,13 +225,14 @@ ModelMotion motion_from_coordinates(const Model& model, Eigen::MatrixXd x, doubl
   }
   if (cutoff_hz > 0) x = butterworth_filtfilt(std::move(x), rate_hz, cutoff_hz);
   // Empty derivatives: each frame takes x's central differences (ModelMotion::derivatives_at).
-  ModelMotion m = reconstruct_motion(model, std::move(x), Eigen::MatrixXd(), Eigen::MatrixXd(), rate_hz, std::move(time_s));
+  ModelMotion m = reconstruct_motion(std::move(model), std::move(x), Eigen::MatrixXd(), Eigen::MatrixXd(), rate_hz, std::move(time_s));
   m.cop_foot_angle_rad = std::move(cop_angle);
   return m;
 }
 
-ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz, TorsoLength torso, double cop_angle_cutoff_hz) {
-  return motion_from_coordinates(model, model_coordinates(lm, torso), lm.rate_hz, lm.time_s, cutoff_hz, cop_angle_cutoff_hz);
+ModelMotion compute_motion(std::shared_ptr<const Model> model, const SagittalLandmarks& lm, double cutoff_hz, TorsoLength torso,
+                           double cop_angle_cutoff_hz) {
+  return motion_from_coordinates(std::move(model), model_coordinates(lm, torso), lm.rate_hz, lm.time_s, cutoff_hz, cop_angle_cutoff_hz);
 }
 
 void lag_torso_fore_aft(ModelMotion& m, double tau_s) {

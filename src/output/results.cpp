@@ -206,7 +206,7 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
   j["messages"] = r.messages;
   json seg = json::array();
   for (int s = 0; s < kSegmentCount; ++s)
-    seg.push_back({{"segment", segment_name(s)}, {"length_m", r.model.bodies[s].length_m}, {"mass_kg", r.model.bodies[s].mass_kg}});
+    seg.push_back({{"segment", segment_name(s)}, {"length_m", r.model().bodies[s].length_m}, {"mass_kg", r.model().bodies[s].mass_kg}});
   j["segments"] = seg;
   return j;
 }
@@ -233,7 +233,7 @@ std::string format_results_text(const EstimateResult& r) {
   std::snprintf(b, sizeof b, "progression: %s, speed %.2f m/s, contact speed gate %.2f m/s\n", r.frame.how.c_str(),
                 r.calibration.progression_speed_mps, r.calibration.speed_gate_mps);
   os << b;
-  const double bw = r.mass_kg * r.model.gravity_mps2;
+  const double bw = r.mass_kg * r.model().gravity_mps2;
   for (int s = 0; s < 2; ++s) {
     const auto& f = r.feet[static_cast<std::size_t>(s)];
     std::snprintf(b, sizeof b, "%-5s foot: %zu contact interval(s), peak vertical %.0f N (%.2f body weights)\n", s ? "left" : "right",

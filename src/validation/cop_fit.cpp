@@ -34,7 +34,7 @@ Eigen::Vector4d weights(const CopFunction& f, double th) {
 }  // namespace
 
 void collect_cop_samples(const EstimateResult& e, const ValidationResult& v, double min_force_fraction, CopSamples& out) {
-  const double bw = e.mass_kg * e.model.gravity_mps2;
+  const double bw = e.mass_kg * e.model().gravity_mps2;
   for (const auto& s : v.stances) {
     if (s.cop_reference_suspect) continue;  // the plate's COP is not where the foot is
     const FootResult& f = e.feet[static_cast<std::size_t>(s.foot)];

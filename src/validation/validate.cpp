@@ -290,7 +290,7 @@ std::optional<double> vertical_lag_ms(const Eigen::VectorXd& ev, const Eigen::Ve
 /// beyond the foot's heel-toe landmark span along x; NaN without such frames.
 double cop_beyond_foot_m(const EstimateResult& e, const Candidate& c, const Eigen::VectorXd& mv, const Eigen::VectorXd& mc,
                          Eigen::Index a) {
-  const double bw = e.mass_kg * e.model.gravity_mps2;
+  const double bw = e.mass_kg * e.model().gravity_mps2;
   const int heel = c.foot ? kHeelL : kHeelR, toe = c.foot ? kHalluxL : kHalluxR;
   std::vector<double> beyond;
   for (Eigen::Index i = 0; i < mv.size(); ++i) {
@@ -305,7 +305,7 @@ double cop_beyond_foot_m(const EstimateResult& e, const Candidate& c, const Eige
 /// v's per-foot series.
 StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, const Candidate& c, const ValidationOptions& o) {
   const Eigen::Index n = e.time_s.size();
-  const double bw = e.mass_kg * e.model.gravity_mps2, rate = e.landmarks.rate_hz, ground = e.ground_level_m();
+  const double bw = e.mass_kg * e.model().gravity_mps2, rate = e.landmarks.rate_hz, ground = e.ground_level_m();
   const Eigen::Index search = static_cast<Eigen::Index>(std::lround(0.2 * rate));
   const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(c.plate)];
   const FootResult& fe = e.feet[static_cast<std::size_t>(c.foot)];
@@ -383,7 +383,7 @@ std::pair<std::vector<Eigen::Index>, std::vector<unsigned>> total_frames(const E
                                                                          const std::vector<Candidate>& cands,
                                                                          const ValidationOptions& o) {
   const Eigen::Index n = e.time_s.size();
-  const double bw = e.mass_kg * e.model.gravity_mps2;
+  const double bw = e.mass_kg * e.model().gravity_mps2;
   const int np = static_cast<int>(v.plates.size());
   // Total: every loaded plate in a kept stance, and the plates carrying the whole body.
   std::vector<unsigned> mask(static_cast<std::size_t>(n), 0u);
@@ -691,7 +691,7 @@ nlohmann::json component_json(const ComponentMetrics& c, double bw) {
 
 nlohmann::json validation_json(const std::string& trial, const EstimateResult& e, const ValidationResult& v,
                                const nlohmann::json& settings) {
-  const double bw = v.mass_kg * e.model.gravity_mps2;
+  const double bw = v.mass_kg * e.model().gravity_mps2;
   nlohmann::json j;
   j["trial"] = trial;
   j["kin2grf_version"] = KIN2GRF_VERSION;

@@ -20,6 +20,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -68,7 +69,9 @@ struct MotionFrame {
 struct ModelMotion {
   double rate_hz = 0.0;
   Eigen::VectorXd time_s;
-  Model model;                         ///< the bodies frame() places (a copy: the motion stands alone)
+  /// The bodies frame() places: shared, not copied, with whoever else holds the model (an
+  /// estimate's result reads its model from here).
+  std::shared_ptr<const Model> model;
   Eigen::MatrixXd x;                   ///< independent coordinates (independent_coordinates' columns)
   /// x's first and second time derivatives: stored (reconstruct_motion), or, when empty, x's
   /// central differences (central_difference, second_difference) taken per frame by
@@ -102,8 +105,13 @@ struct ModelMotion {
 /// Forward kinematics of the chain from the independent coordinates and their first and second
 /// time derivatives (N x 11: fixed lengths; N x 12: the torso takes column 11's length). xd and
 /// xdd empty: x's central differences, per frame (ModelMotion::derivatives_at).
-ModelMotion reconstruct_motion(const Model& model, Eigen::MatrixXd x, Eigen::MatrixXd xd, Eigen::MatrixXd xdd, double rate_hz,
-                               Eigen::VectorXd time_s);
+ModelMotion reconstruct_motion(std::shared_ptr<const Model> model, Eigen::MatrixXd x, Eigen::MatrixXd xd, Eigen::MatrixXd xdd,
+                               double rate_hz, Eigen::VectorXd time_s);
+/// The same with a copy of `model` (a test's or a benchmark's own model).
+inline ModelMotion reconstruct_motion(const Model& model, Eigen::MatrixXd x, Eigen::MatrixXd xd, Eigen::MatrixXd xdd, double rate_hz,
+                                      Eigen::VectorXd time_s) {
+  return reconstruct_motion(std::make_shared<const Model>(model), std::move(x), std::move(xd), std::move(xdd), rate_hz, std::move(time_s));
+}
 
 enum class TorsoLength {
   Measured,  ///< the filtered hip-shoulder distance of each frame (kin2grf's default)
@@ -115,14 +123,19 @@ enum class TorsoLength {
 Eigen::MatrixXd model_coordinates(const SagittalLandmarks& lm, TorsoLength torso);
 
 /// compute_motion from model_coordinates' columns (unfiltered), their rate and times.
-ModelMotion motion_from_coordinates(const Model& model, Eigen::MatrixXd x, double rate_hz, Eigen::VectorXd time_s, double cutoff_hz,
-                                    double cop_angle_cutoff_hz = 0.0);
+ModelMotion motion_from_coordinates(std::shared_ptr<const Model> model, Eigen::MatrixXd x, double rate_hz, Eigen::VectorXd time_s,
+                                    double cutoff_hz, double cop_angle_cutoff_hz = 0.0);
 
 /// The whole kinematic step: independent coordinates, filter at cutoff_hz, differentiate,
 /// reconstruct. cop_angle_cutoff_hz > 0 (and not cutoff_hz): the COP function's foot angles
 /// are filtered at it instead (ModelMotion::cop_foot_angle_rad).
-ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz,
+ModelMotion compute_motion(std::shared_ptr<const Model> model, const SagittalLandmarks& lm, double cutoff_hz,
                            TorsoLength torso = TorsoLength::Measured, double cop_angle_cutoff_hz = 0.0);
+/// The same with a copy of `model`.
+inline ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz,
+                                  TorsoLength torso = TorsoLength::Measured, double cop_angle_cutoff_hz = 0.0) {
+  return compute_motion(std::make_shared<const Model>(model), lm, cutoff_hz, torso, cop_angle_cutoff_hz);
+}
 
 /// The upper body's fore-aft lag (kin2grf, not in the paper). The HAT is one rigid segment whose
 /// COM follows the hip and shoulder landmarks, but most of its mass (viscera, arms, head, soft
