@@ -119,12 +119,12 @@ void check_options(const EstimateOptions& o) {
     require(finite(*o.ground_level_m) && std::abs(*o.ground_level_m) <= 10.0, "ground level (m)", *o.ground_level_m, "between -10 and 10");
   require(o.landmarks.max_gap_frames >= 0 && o.landmarks.max_gap_frames <= 100000, "longest gap filled (frames)",
           o.landmarks.max_gap_frames, "between 0 and 100000");
-  require(finite(o.solver.speed_gate_mps) && o.solver.speed_gate_mps >= 0 && o.solver.speed_gate_mps <= 20, "speed gate (m/s)",
-          o.solver.speed_gate_mps, "between 0 (none) and 20");
-  require(finite(o.solver.speed_gate_ratio) && o.solver.speed_gate_ratio >= 0 && o.solver.speed_gate_ratio <= 20,
-          "speed gate ratio", o.solver.speed_gate_ratio, "between 0 (a fixed gate) and 20");
-  require(finite(o.solver.speed_gate_floor_mps) && o.solver.speed_gate_floor_mps >= 0 && o.solver.speed_gate_floor_mps <= 20,
-          "speed gate floor (m/s)", o.solver.speed_gate_floor_mps, "between 0 and 20");
+  require(finite(o.contact.speed_gate.fixed_mps) && o.contact.speed_gate.fixed_mps >= 0 && o.contact.speed_gate.fixed_mps <= 20, "speed gate (m/s)",
+          o.contact.speed_gate.fixed_mps, "between 0 (none) and 20");
+  require(finite(o.contact.speed_gate.ratio) && o.contact.speed_gate.ratio >= 0 && o.contact.speed_gate.ratio <= 20,
+          "speed gate ratio", o.contact.speed_gate.ratio, "between 0 (a fixed gate) and 20");
+  require(finite(o.contact.speed_gate.floor_mps) && o.contact.speed_gate.floor_mps >= 0 && o.contact.speed_gate.floor_mps <= 20,
+          "speed gate floor (m/s)", o.contact.speed_gate.floor_mps, "between 0 and 20");
   require(finite(o.solver.min_split_distance_m) && o.solver.min_split_distance_m >= 0 && o.solver.min_split_distance_m <= 1,
           "split distance (m)", o.solver.min_split_distance_m, "between 0 (none) and 1");
   require(finite(o.torso_lag_s) && o.torso_lag_s >= 0 && o.torso_lag_s <= 0.2, "torso lag (s)", o.torso_lag_s,
@@ -362,11 +362,11 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
     }
   }
   cal.progression_speed_mps = treadmill ? std::abs(cal.belt_velocity_mps) : hip_speed_mps;
-  cal.speed_gate_mps = speed_gate_for(o.solver, cal.progression_speed_mps);
-  if (o.solver.speed_gate_ratio > 0) {
+  cal.speed_gate_mps = speed_gate_for(o.contact.speed_gate, cal.progression_speed_mps);
+  if (o.contact.speed_gate.ratio > 0) {
     char b[160];
     std::snprintf(b, sizeof b, "contact speed gate %.2f m/s (%.2f x the progression speed %.2f m/s, at least %.2f)", cal.speed_gate_mps,
-                  o.solver.speed_gate_ratio, cal.progression_speed_mps, o.solver.speed_gate_floor_mps);
+                  o.contact.speed_gate.ratio, cal.progression_speed_mps, o.contact.speed_gate.floor_mps);
     plan.messages.push_back(b);
   }
   if (touchdown) {

@@ -148,8 +148,8 @@ TEST(Estimate, PrescribedSingleSupportRecoversTheExactContactForce) {
   so.left_leg_raised_rad = 0.6;
   const Trial t = make_synthetic_trial(so);
   EstimateOptions eo;
-  eo.solver.speed_gate_mps = 0.0;
-  eo.solver.speed_gate_ratio = 0.0;
+  eo.contact.speed_gate.fixed_mps = 0.0;
+  eo.contact.speed_gate.ratio = 0.0;
   const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
   // All the load on the right foot, none on the lifted left one.
   for (Eigen::Index i = 10; i < r.time_s.size() - 10; i += 7) {

@@ -77,7 +77,7 @@ TEST(Solver, SlowWalkSwingFootCarriesNothing) {
   ASSERT_GT(test::foot_force(before, fc, 1).y(), 20.0);
 
   TrialCalibration rule = r.calibration;  // the defaults: the progression speed, at least 0.75 m/s
-  rule.speed_gate_mps = speed_gate_for(SolverOptions{}, 0.4);
+  rule.speed_gate_mps = speed_gate_for(SpeedGateRule{}, 0.4);
   EXPECT_NEAR(rule.speed_gate_mps, 0.75, 1e-12);
   const FrameSolution after = ContactSolver(r.model(), rule, SolverOptions{}).solve(q, qdd, fc);
   EXPECT_FALSE(test::foot_active(after, fc, 1));
@@ -88,14 +88,14 @@ TEST(Solver, SlowWalkSwingFootCarriesNothing) {
 }
 
 TEST(Solver, SpeedGateScalesWithTheProgressionSpeed) {
-  SolverOptions o;  // defaults
+  SpeedGateRule o;  // defaults
   EXPECT_NEAR(speed_gate_for(o, 0.0), 0.75, 1e-12);   // standing, squatting: the floor
   EXPECT_NEAR(speed_gate_for(o, 0.4), 0.75, 1e-12);   // a slow walk: the floor
   EXPECT_NEAR(speed_gate_for(o, 1.3), 1.3, 1e-12);    // walking
   EXPECT_NEAR(speed_gate_for(o, 9.0), 9.0, 1e-12);    // sprinting: the landing foot is not cut
   EXPECT_NEAR(speed_gate_for(o, -3.5), 3.5, 1e-12);   // a treadmill belt's sign does not matter
-  o.speed_gate_ratio = 0;
-  o.speed_gate_mps = 1.5;
+  o.ratio = 0;
+  o.fixed_mps = 1.5;
   EXPECT_NEAR(speed_gate_for(o, 9.0), 1.5, 1e-12);    // a fixed gate stays fixed
   // The hip's progression speed, through a step's oscillation (+-0.1 m/s at 2 Hz).
   SagittalLandmarks lm;

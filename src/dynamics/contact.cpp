@@ -8,6 +8,12 @@
 #include <string>
 
 namespace kin2grf {
+
+double speed_gate_for(const SpeedGateRule& rule, double v) {
+  if (rule.ratio <= 0) return std::max(0.0, rule.fixed_mps);
+  return std::max(rule.floor_mps, rule.ratio * std::abs(v));
+}
+
 namespace {
 
 double half_cosine(double a, double b, double u) { return a + (b - a) * 0.5 * (1.0 - std::cos(M_PI * u)); }
@@ -228,6 +234,7 @@ std::optional<double> BeltVelocitySamples::median_mps() const {
 }  // namespace kin2grf
 
 namespace kin2grf {
+
 namespace {
 double percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());

@@ -12,10 +12,6 @@
 
 namespace kin2grf {
 
-double speed_gate_for(const SolverOptions& o, double v) {
-  if (o.speed_gate_ratio <= 0) return std::max(0.0, o.speed_gate_mps);
-  return std::max(o.speed_gate_floor_mps, o.speed_gate_ratio * std::abs(v));
-}
 namespace {
 
 /// The (x, y) pairs of q: the landmark points, the segments' COMs and D*. k-th pair's x column.

@@ -83,18 +83,18 @@ std::vector<Setting> settings_for(const std::string& kind) {
   } else if (kind == "speed-gate") {
     for (double v : {0.0, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0}) {
       std::snprintf(b, sizeof b, v > 0 ? "%.2f m/s" : "off", v);
-      s.push_back({b, v, [v](EstimateOptions& o) { o.solver.speed_gate_ratio = 0, o.solver.speed_gate_mps = v; }});
+      s.push_back({b, v, [v](EstimateOptions& o) { o.contact.speed_gate.ratio = 0, o.contact.speed_gate.fixed_mps = v; }});
     }
-    mark_default(s, [](const EstimateOptions& o) { return std::tuple(o.solver.speed_gate_ratio, o.solver.speed_gate_mps); });
+    mark_default(s, [](const EstimateOptions& o) { return std::tuple(o.contact.speed_gate.ratio, o.contact.speed_gate.fixed_mps); });
   } else if (kind == "speed-gate-ratio") {
-    s.push_back({"fixed 1.50 m/s", 0, [](EstimateOptions& o) { o.solver.speed_gate_ratio = 0, o.solver.speed_gate_mps = 1.5; }});
+    s.push_back({"fixed 1.50 m/s", 0, [](EstimateOptions& o) { o.contact.speed_gate.ratio = 0, o.contact.speed_gate.fixed_mps = 1.5; }});
     for (double floor : {0.5, 0.75})
       for (double k : {0.5, 0.7, 1.0, 1.5, 2.0, 3.0}) {
         std::snprintf(b, sizeof b, "%.1f x speed, >= %.2f", k, floor);
-        s.push_back({b, k, [k, floor](EstimateOptions& o) { o.solver.speed_gate_ratio = k, o.solver.speed_gate_floor_mps = floor; }});
+        s.push_back({b, k, [k, floor](EstimateOptions& o) { o.contact.speed_gate.ratio = k, o.contact.speed_gate.floor_mps = floor; }});
       }
     mark_default(s, [](const EstimateOptions& o) {
-      return std::tuple(o.solver.speed_gate_ratio, o.solver.speed_gate_mps, o.solver.speed_gate_floor_mps);
+      return std::tuple(o.contact.speed_gate.ratio, o.contact.speed_gate.fixed_mps, o.contact.speed_gate.floor_mps);
     });
   } else if (kind == "trunk-ablation") {
     // What the estimate owes to the trunk and arm markers: every trial as recorded,

@@ -149,9 +149,9 @@ EstimateOptions to_options(const Settings& a) {
   else if (a.running_cop != "builtin") o.contact.running_cop = read_cop_function(a.running_cop);
   o.solver.r_N_per_m = (a.paper && !a.r_given) ? 1e4 : a.r;
   o.solver.norm = (a.paper || a.norm == "paper") ? MultiplierNorm::Paper : MultiplierNorm::TorqueScaled;
-  o.solver.speed_gate_mps = a.paper ? 0.0 : a.speed_gate;
-  o.solver.speed_gate_ratio = a.paper ? 0.0 : a.speed_gate_ratio;
-  o.solver.speed_gate_floor_mps = a.speed_gate_floor;
+  o.contact.speed_gate.fixed_mps = a.paper ? 0.0 : a.speed_gate;
+  o.contact.speed_gate.ratio = a.paper ? 0.0 : a.speed_gate_ratio;
+  o.contact.speed_gate.floor_mps = a.speed_gate_floor;
   o.contact.touchdown_fraction = a.paper ? 0.0 : a.touchdown_fraction;
   o.solver.min_split_distance_m = a.paper ? 0.0 : a.split_distance;
   o.torso_length = (a.paper || a.torso_length == "fixed") ? TorsoLength::Fixed : TorsoLength::Measured;
@@ -179,9 +179,9 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
                                        : nlohmann::json(nullptr)},
           {"r_N_per_m", o.solver.r_N_per_m},
           {"norm", o.solver.norm == MultiplierNorm::Paper ? "paper" : "torque-scaled"},
-          {"speed_gate_mps", o.solver.speed_gate_mps},
-          {"speed_gate_ratio", o.solver.speed_gate_ratio},
-          {"speed_gate_floor_mps", o.solver.speed_gate_floor_mps},
+          {"speed_gate_mps", o.contact.speed_gate.fixed_mps},
+          {"speed_gate_ratio", o.contact.speed_gate.ratio},
+          {"speed_gate_floor_mps", o.contact.speed_gate.floor_mps},
           {"touchdown_fraction", o.contact.touchdown_fraction},
           {"min_split_distance_m", o.solver.min_split_distance_m},
           {"torso_length", torso_length_name(o.torso_length)},

@@ -48,30 +48,6 @@ struct SolverOptions {
   int max_iterations = 20;
   MultiplierNorm norm = MultiplierNorm::TorqueScaled;  ///< kin2grf's default; the paper: Paper
   double torque_length_m = 0.9;
-  /// A contact point may be active only while its horizontal speed relative to the ground
-  /// (or belt) is below this (m/s); <= 0 disables the gate (the paper). kin2grf's default: 1.5
-  /// (`kin2grf study speed-gate`: walking flat from 0.5 to 3 m/s, running best at 1-1.5 m/s).
-  double speed_gate_mps = 1.5;
-  /// The gate relative to the subject's progression speed v (overground: the hip's; treadmill:
-  /// the belt's): when > 0 the trial's gate is max(speed_gate_floor_mps, speed_gate_ratio x v)
-  /// and speed_gate_mps is not used. Why: a stance contact point stays (nearly) still on the
-  /// ground at any speed, while a swing foot moves at 2-3 v; a fixed 1.5 m/s lets a 0.4 m/s
-  /// walker's swing foot (about 1 m/s, 8-12 mm above the floor) take the load, and cuts a
-  /// sprinter's landing. The floor keeps standing and squatting trials (v ~ 0) gated only
-  /// against feet that really slide. See speed_gate_for() and `kin2grf study speed-gate-ratio`.
-  /// kin2grf's default 1 x v, at least 0.75 m/s. On the 14 development trials (8 labs) it ties
-  /// with the fixed 1.5 m/s (leave-one-lab-out criterion 12.04 against 12.02 %; walking 9.4 %
-  /// vertical for both, running anterior 10.2 against 10.6 %, drop jump 13.6 against 13.9 %):
-  /// those data cannot tell them apart, holding no slow walk and no sprint. It is the default for
-  /// its physical reason and for the two held-out failures of the fixed gate (a 0.4 m/s
-  /// walk's swing foot took load; a 3.3 m/s run did better with 2 m/s); 2 x v let a fast walker's
-  /// landing foot in 60-90 ms early (docs/METHOD-NOTES.md). With 0.5 and 0.7 x v among the
-  /// candidates, 0.7 (at least 0.75) wins the criterion on all trials (8.53 against
-  /// 8.59 %), but held out it moves walking from 6.6 / 7.8 / 6.1 to 6.3 / 7.9 / 6.3 (the same
-  /// mean), running from 5.0 / 9.3 / 4.3 to 4.9 / 9.3 / 4.3, and costs the drop jump 13.6 ->
-  /// 15.3 % (its lab's choice without it: 0.5, at least 0.5): no held-out gain, the default stays.
-  double speed_gate_ratio = 1.0;
-  double speed_gate_floor_mps = 0.75;
   /// Feet side by side: when both feet are in contact and all their active points lie within
   /// this distance along progression (m), the sagittal moment equation cannot tell how the load
   /// is split between them (F_R x_R + F_L x_L = M with x_R ~ x_L), and fitting it anyway hands one
@@ -87,10 +63,6 @@ struct SolverOptions {
   /// of the normal equations vanishes; selectable to cross-check them).
   bool dense_factorisation = false;
 };
-
-/// The trial's speed gate (m/s) for a progression speed v (m/s): speed_gate_mps, or with a ratio
-/// max(speed_gate_floor_mps, speed_gate_ratio x |v|); 0 = no gate.
-double speed_gate_for(const SolverOptions& options, double progression_speed_mps);
 
 struct FrameSolution {
   Eigen::Matrix<double, kJointCount, 1> joint_torque_Nm = Eigen::Matrix<double, kJointCount, 1>::Zero();

@@ -29,9 +29,9 @@ struct Settings {
               cop_function, running_cop = "builtin", torso_length = "measured",
               kinematic_cutoff_rule = "noise";
   double r = SolverOptions{}.r_N_per_m, kinematic_cutoff = EstimateOptions{}.kinematic_cutoff_hz,
-         post_cutoff_cycles = EstimateOptions{}.post_cutoff_cycles, ground_shift = 0, speed_gate = SolverOptions{}.speed_gate_mps,
-         split_distance = SolverOptions{}.min_split_distance_m, speed_gate_ratio = SolverOptions{}.speed_gate_ratio,
-         speed_gate_floor = SolverOptions{}.speed_gate_floor_mps, torso_lag = EstimateOptions{}.torso_lag_s,
+         post_cutoff_cycles = EstimateOptions{}.post_cutoff_cycles, ground_shift = 0, speed_gate = SpeedGateRule{}.fixed_mps,
+         split_distance = SolverOptions{}.min_split_distance_m, speed_gate_ratio = SpeedGateRule{}.ratio,
+         speed_gate_floor = SpeedGateRule{}.floor_mps, torso_lag = EstimateOptions{}.torso_lag_s,
          double_support_sta = EstimateOptions{}.double_support_sta_weight,
          min_kinematic_cycles = EstimateOptions{}.min_kinematic_cycles,
          touchdown_fraction = ContactModelOptions{}.touchdown_fraction,
