@@ -16,7 +16,7 @@
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 
 // Every heap allocation of the process is counted (the per-frame solve must make none): malloc,
 // calloc and realloc are interposed and passed to glibc's own (operator new and Eigen allocate
@@ -124,12 +124,17 @@ void BM_ContactSolvePerFrame(benchmark::State& state) {
   }
   const auto r = kin2grf::estimate(w.trial, nullptr, *w.set, w.options);
   kin2grf::ModelMotion motion = kin2grf::compute_motion(r.model(), r.landmarks, w.options.kinematic_cutoff_hz, w.options.torso_length);
-  const auto contacts = kin2grf::prepare_contacts(r.model(), r.calibration.contact, w.options.contact, motion);
   kin2grf::ContactSolver solver(r.model(), r.calibration, w.options.solver);
   const Eigen::Index n = motion.frames();
-  // Each frame's q and qdd rebuilt once, outside the timing (the pipeline rebuilds them per frame).
+  // Each frame's q, qdd and contacts made once, outside the timing (the pipeline makes them per
+  // frame as it solves it).
   std::vector<kin2grf::MotionFrame> frame(static_cast<std::size_t>(n));
-  for (Eigen::Index i = 0; i < n; ++i) motion.frame(i, frame[static_cast<std::size_t>(i)]);
+  std::vector<kin2grf::FrameContacts> contacts(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    motion.frame(i, frame[k]);
+    kin2grf::contact_frame(r.model(), r.calibration.contact, w.options.contact, false, frame[k], contacts[k]);
+  }
   long frames = 0, allocations = 0;
   for (auto _ : state) {
     const long before = g_allocations.load();

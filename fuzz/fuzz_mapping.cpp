@@ -5,7 +5,7 @@
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/json.hpp"
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {

@@ -22,7 +22,7 @@
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/summary.hpp"
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 #include "test_support.hpp"
 
 using namespace kin2grf;

@@ -11,7 +11,7 @@
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/numeric.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
@@ -139,24 +139,23 @@ TEST(Contact, GroundLevelIsTheLabFloorUnlessTheFeetSayOtherwise) {
   EXPECT_NEAR(estimate_ground_level(lifted(-0.30)).level_m, -0.30 + lowest, 0.01) << "the origin above the floor";
 }
 
-// The pipeline makes each frame's contacts as it solves the frame (contact_frame, issue 10's
-// memory): they are the whole-trial prepare_contacts' to the bit, the reused FrameContacts keeps
-// no point of the frame before, and D* goes into the frame as prepare_contacts keeps it.
-TEST(Contact, EachFramesContactsAreTheWholeTrialsBitForBit) {
+// The pipeline makes each frame's contacts as it solves the frame, reusing one FrameContacts and
+// one MotionFrame: they are a fresh frame's to the bit (the reused FrameContacts keeps no point
+// of the frame before), and D* goes into the reused frame as into a fresh one.
+TEST(Contact, EachFramesContactsAreAFreshFramesBitForBit) {
   const Trial t = make_synthetic_trial({});
   const auto r = run({});
   for (FootModel model : {FootModel::Cop, FootModel::ThreePoint}) {
     ContactModelOptions co;
     co.foot_model = model;
-    ModelMotion whole = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
-    const ModelMotion bare = whole;
-    const auto all = prepare_contacts(r.model(), r.calibration.contact, co, whole);
+    const ModelMotion motion = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
+    const auto all = test::contact_frames(r.model(), r.calibration.contact, co, motion);  // fresh per frame
     FrameContacts fc;
     MotionFrame f;
-    for (Eigen::Index i = 0; i < bare.frames(); i += 7) {
-      bare.frame(i, f);
+    for (Eigen::Index i = 0; i < motion.frames(); i += 7) {
+      motion.frame(i, f);
       contact_frame(r.model(), r.calibration.contact, co, false, f, fc);
-      const FrameContacts& ref = all[static_cast<std::size_t>(i)];
+      const FrameContacts& ref = all.contacts[static_cast<std::size_t>(i)];
       ASSERT_EQ(fc.points.size(), ref.points.size()) << i;
       ASSERT_EQ(fc.points.size(), model == FootModel::Cop ? 2u : 6u);
       for (std::size_t j = 0; j < fc.points.size(); ++j) {
@@ -166,7 +165,7 @@ TEST(Contact, EachFramesContactsAreTheWholeTrialsBitForBit) {
         EXPECT_EQ(fc.points[j].gap_m, ref.points[j].gap_m);
       }
       EXPECT_EQ(fc.foot_inclination_rad, ref.foot_inclination_rad);
-      const MotionFrame kept = whole.frame(i);
+      const MotionFrame& kept = all.frames[static_cast<std::size_t>(i)];
       EXPECT_EQ(f.q, kept.q) << i;
       EXPECT_EQ(f.qdd, kept.qdd) << i;
     }

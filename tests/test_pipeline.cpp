@@ -11,7 +11,7 @@
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/numeric.hpp"
 #include "kin2grf/output/results.hpp"
 #include "kin2grf/pipeline.hpp"
@@ -162,13 +162,13 @@ TEST(Estimate, PrescribedSingleSupportRecoversTheExactContactForce) {
   }
 
   // One frame, forward dynamics: [M -A^T; A 0] [qdd; mu] = [f; c].
-  ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
-  auto contacts = prepare_contacts(r.model(), r.calibration.contact, ContactModelOptions{}, mm);
-  const Eigen::Index i = 120;
-  const FrameContacts& fc = contacts[static_cast<std::size_t>(i)];
+  const ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
+  const auto tc = test::contact_frames(r.model(), r.calibration.contact, ContactModelOptions{}, mm);
+  const std::size_t i = 120;
+  const FrameContacts& fc = tc.contacts[i];
   ASSERT_EQ(fc.points.size(), 2u);
   ASSERT_GT(fc.points[1].gap_m, 0.05) << "the left foot is lifted";
-  const Eigen::VectorXd q = mm.frame(i).q;
+  const Eigen::VectorXd q = tc.frames[i].q;
   SolverOptions sopt;
   sopt.r_N_per_m = 1e5;
   ContactSolver solver(r.model(), r.calibration, sopt);  // no speed gate (eo's)

@@ -11,7 +11,7 @@
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
 #include "test_support.hpp"
@@ -29,13 +29,14 @@ TEST(Solver, StructuredAndDenseFactorisationsAgree) {
     so.left_leg_raised_rad = raised;
     const Trial t = make_synthetic_trial(so);
     const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), {});
-    ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
-    const auto contacts = prepare_contacts(r.model(), r.calibration.contact, ContactModelOptions{}, mm);
+    const ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
+    const auto tc = test::contact_frames(r.model(), r.calibration.contact, ContactModelOptions{}, mm);
+    const auto& contacts = tc.contacts;
     SolverOptions structured_opt, dense_opt;
     dense_opt.dense_factorisation = true;
     ContactSolver structured(r.model(), r.calibration, structured_opt), dense(r.model(), r.calibration, dense_opt);
     for (Eigen::Index i = 0; i < mm.frames(); i += 11) {
-      const MotionFrame f = mm.frame(i);
+      const MotionFrame& f = tc.frames[static_cast<std::size_t>(i)];
       const Eigen::VectorXd q = f.q, qdd = f.qdd;
       const auto a = structured.solve(q, qdd, contacts[static_cast<std::size_t>(i)]);
       const auto b = dense.solve(q, qdd, contacts[static_cast<std::size_t>(i)]);
@@ -57,15 +58,15 @@ TEST(Solver, SlowWalkSwingFootCarriesNothing) {
   const Trial t = make_synthetic_trial(so);
   EstimateOptions eo;
   const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
-  ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
-  auto contacts = prepare_contacts(r.model(), r.calibration.contact, ContactModelOptions{}, mm);
-  const Eigen::Index i = 120;
-  FrameContacts fc = contacts[static_cast<std::size_t>(i)];
+  const ModelMotion mm = compute_motion(r.model(), synthetic_landmarks(t), 6.0);
+  const auto tc = test::contact_frames(r.model(), r.calibration.contact, ContactModelOptions{}, mm);
+  const std::size_t i = 120;
+  FrameContacts fc = tc.contacts[i];
   ASSERT_EQ(fc.points.size(), 2u);
   fc.points[0].velocity.setZero();                 // the stance foot's D* is still
   fc.points[1].gap_m = 0.008;                      // low swing clearance
   fc.points[1].velocity = Eigen::Vector2d(1.0, 0);  // a slow walker's swing foot
-  const MotionFrame f = mm.frame(i);
+  const MotionFrame& f = tc.frames[i];
   const Eigen::VectorXd q = f.q;
   Eigen::VectorXd qdd = f.qdd;
   qdd[coord::theta(kTorso)] += 20.0;  // rad/s^2: about 30 N m that no single contact point balances

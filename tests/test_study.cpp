@@ -15,7 +15,7 @@
 #include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/text.hpp"
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/output/report.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"

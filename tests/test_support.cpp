@@ -1,5 +1,5 @@
 #include "test_support.hpp"
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 
 #include <cmath>
 #include <cstdlib>
@@ -87,6 +87,19 @@ bool foot_active(const FrameSolution& s, const FrameContacts& fc, int side) {
   for (std::size_t j = 0; j < fc.points.size(); ++j)
     if (fc.points[j].side == side && s.contact_active[j]) return true;
   return false;
+}
+
+TrialContacts contact_frames(const Model& model, const ContactCalibration& soles, const ContactModelOptions& options,
+                             const ModelMotion& motion) {
+  TrialContacts out;
+  const auto n = static_cast<std::size_t>(motion.frames());
+  out.frames.resize(n);
+  out.contacts.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    motion.frame(static_cast<Eigen::Index>(i), out.frames[i]);
+    contact_frame(model, soles, options, false, out.frames[i], out.contacts[i]);
+  }
+  return out;
 }
 
 }  // namespace kin2grf::test

@@ -29,6 +29,15 @@ std::filesystem::path temp_dir(const std::string& name);
 SagittalLandmarks synthetic_landmarks(const Trial& t);
 /// estimate() on a synthetic trial with the example marker set.
 EstimateResult run(const SyntheticOptions& so, EstimateOptions eo = {});
+
+/// contact_frame on every frame of a motion, as the pipeline does frame by frame: each frame's
+/// q, qd, qdd (D* filled in) and its contact points, for tests that look at many frames.
+struct TrialContacts {
+  std::vector<MotionFrame> frames;
+  std::vector<FrameContacts> contacts;
+};
+TrialContacts contact_frames(const Model& model, const ContactCalibration& soles, const ContactModelOptions& options,
+                             const ModelMotion& motion);
 /// A squat whose "plates" are the estimate's own forces, unloaded for 10 frames at each end so
 /// that the stances begin and end inside the trial.
 struct SyntheticWithPlates {

@@ -11,7 +11,7 @@
 
 #include "kin2grf/dynamics/contact.hpp"
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/markers/landmarks.hpp"
 #include "kin2grf/model/model.hpp"

@@ -16,8 +16,6 @@ double speed_gate_for(const SpeedGateRule& rule, double v) {
 
 namespace {
 
-double half_cosine(double a, double b, double u) { return a + (b - a) * 0.5 * (1.0 - std::cos(M_PI * u)); }
-
 /// Material point of body s at lab position X this frame: its velocity, acceleration and the
 /// Jacobian rows of its x and y with respect to q (through the proximal landmark and theta_s).
 struct MaterialPoint {
@@ -43,14 +41,6 @@ MaterialPoint material_point(const Model& model, const MotionFrame& m, int s, co
 }
 
 }  // namespace
-
-double CopFunction::fraction(double th) const {
-  if (th <= delta_hs) return s_hs;
-  if (th <= delta_ho) return half_cosine(s_hs, s_ho, (th - delta_hs) / (delta_ho - delta_hs));
-  if (th <= delta_mo) return half_cosine(s_ho, s_mo, (th - delta_ho) / (delta_mo - delta_ho));
-  if (th <= delta_to) return s_mo + (s_to - s_mo) * (th - delta_mo) / (delta_to - delta_mo);
-  return s_to;
-}
 
 std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, const MotionFrame& m, int side) {
   const int foot = segment(side, kFoot), toes = segment(side, kToes);
@@ -201,22 +191,6 @@ std::vector<bool> landing_frames(const Eigen::VectorXd& gap, const Eigen::Vector
     for (Eigen::Index i = run.first; i < landed; ++i) out[static_cast<std::size_t>(i)] = true;
     away = false;
     seen = landed;
-  }
-  return out;
-}
-
-std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCalibration& soles, const ContactModelOptions& o,
-                                            ModelMotion& m, const std::vector<bool>& running) {
-  const Eigen::Index n = m.frames();
-  std::vector<FrameContacts> out(static_cast<std::size_t>(n));
-  m.dstar = m.dstar_d = m.dstar_dd = Eigen::MatrixX4d::Zero(n, 4);
-  MotionFrame f;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    m.frame(i, f);
-    contact_frame(model, soles, o, is_running_frame(running, i), f, out[static_cast<std::size_t>(i)]);
-    m.dstar.row(i) = f.q.segment<4>(coord::dstar_x(0)).transpose();
-    m.dstar_d.row(i) = f.qd.segment<4>(coord::dstar_x(0)).transpose();
-    m.dstar_dd.row(i) = f.qdd.segment<4>(coord::dstar_x(0)).transpose();
   }
   return out;
 }

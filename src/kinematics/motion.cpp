@@ -169,15 +169,10 @@ void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
   for (int s = 0; s < 2; ++s)
     f.cop_foot_angle_rad[static_cast<std::size_t>(s)] =
         cop_foot_angle_rad.rows() > i ? cop_foot_angle_rad(i, s) : std::numeric_limits<double>::quiet_NaN();
-  if (dstar.rows() > i) {
-    f.q.segment<4>(coord::dstar_x(0)) = dstar.row(i).transpose();
-    f.qd.segment<4>(coord::dstar_x(0)) = dstar_d.row(i).transpose();
-    f.qdd.segment<4>(coord::dstar_x(0)) = dstar_dd.row(i).transpose();
-  } else {
-    f.q.segment<4>(coord::dstar_x(0)).setZero();
-    f.qd.segment<4>(coord::dstar_x(0)).setZero();
-    f.qdd.segment<4>(coord::dstar_x(0)).setZero();
-  }
+  // D* (Sect. 2.3) is the contact stage's: contact_frame fills it in as the frame is solved.
+  f.q.segment<4>(coord::dstar_x(0)).setZero();
+  f.qd.segment<4>(coord::dstar_x(0)).setZero();
+  f.qdd.segment<4>(coord::dstar_x(0)).setZero();
 }
 
 ModelMotion reconstruct_motion(std::shared_ptr<const Model> model, Eigen::MatrixXd x, Eigen::MatrixXd xd, Eigen::MatrixXd xdd,

@@ -11,7 +11,6 @@
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/numeric.hpp"
-#include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 
 namespace kin2grf {

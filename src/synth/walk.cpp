@@ -31,7 +31,7 @@
 #include "kin2grf/markers/landmarks.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 
 namespace kin2grf {
 

@@ -8,9 +8,9 @@
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/cop_function.hpp"
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 #include "kin2grf/io/text.hpp"
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/parallel.hpp"
 
 namespace kin2grf {

@@ -3,7 +3,7 @@
 
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 
 int main() {
   const kin2grf::Trial walk = kin2grf::make_example_walk();

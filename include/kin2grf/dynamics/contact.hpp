@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/model/foot_model.hpp"
 #include "kin2grf/model/model.hpp"
 
 namespace kin2grf {
@@ -59,33 +60,6 @@ struct TrialCalibration {
   /// belt's speed.
   double progression_speed_mps = 0.0;
   double speed_gate_mps = 0.0;  ///< the trial's contact speed gate (speed_gate_for); 0: none
-};
-
-enum class FootModel { Cop, ThreePoint };
-
-/// x_D = F(theta_A) of the paper: event angles (rad) and the COP's arc fraction at each event
-/// (0 at A, 1 at C; up to 1.25 extends the sole beyond C along B -> C: the hallux landmark is a
-/// marker on the toe and the COP rolls on to the toe tip).
-///
-/// The defaults are kin2grf's fit to the plate COPs of the 7 development walking trials
-/// (932 frames of 13 plate stances loaded above 20 % body weight; event angles and positions
-/// both fitted; RMS of F - s 0.060 against 0.098 with the paper's angles; leave-one-trial-out
-/// COP rRMSE 6.3 % against 9.7 %). Provenance and the command that remakes it:
-/// data/cop-function/walking-fitted.json and docs/METHOD-NOTES.md. paper() keeps the paper's
-/// event angles (-0.3, 0, 0.15, 1 rad) with positions fitted for them (--paper).
-struct CopFunction {
-  double delta_hs = -0.20, delta_ho = -0.06, delta_mo = 0.08, delta_to = 1.08;
-  double s_hs = 0.138, s_ho = 0.260, s_mo = 0.761, s_to = 1.012;
-  [[nodiscard]] double fraction(double theta_a) const;
-  /// The paper's event angles; positions fitted with those angles fixed (same data).
-  static CopFunction paper() { return {-0.3, 0.0, 0.15, 1.0, 0.052, 0.453, 0.837, 0.944}; }
-  /// Running (frames near a flight phase, see flight_frames()): the paper's event angles with
-  /// positions fitted to the plate COPs of the development running trials (3 trials, 2 labs,
-  /// 5869 frames; data/cop-function/running-fitted.json). A runner's COP stays on the forefoot
-  /// from mid-stance on (s_HO 0.71 against walking's 0.26) and a forefoot strike lands there.
-  /// Leave-one-lab-out COP rRMSE 9.1 / 6.4 / 6.3 % against 11.5 / 9.7 / 7.7 % with the paper's
-  /// positions (docs/METHOD-NOTES.md). Event angles not fitted: fitting them overfits two labs.
-  static CopFunction running() { return {-0.3, 0.0, 0.15, 1.0, 0.000, 0.709, 0.840, 1.078}; }
 };
 
 /// One row of a contact point's Jacobian, d(y)/dq or d(x)/dq (63 wide), by its non-zeros: a
@@ -171,7 +145,7 @@ double speed_gate_for(const SpeedGateRule& rule, double progression_speed_mps);
 struct ContactModelOptions {
   FootModel foot_model = FootModel::Cop;
   CopFunction cop;
-  /// Model 2's function on running frames (prepare_contacts' `running`); none: `cop` everywhere
+  /// Model 2's function on running frames (contact_frame's `running`, from flight_frames); none: `cop` everywhere
   /// (the paper, or a user's own function).
   std::optional<CopFunction> running_cop = CopFunction::running();
   double ground_shift_m = 0.0;  ///< added to the measured ground (the paper's robustness study)
@@ -200,13 +174,6 @@ inline bool flag_at(const std::vector<bool>& flags, Eigen::Index i) {
 }
 /// Whether frame i takes the running COP function (`running`: flight_frames' flags; empty, none).
 inline bool is_running_frame(const std::vector<bool>& running, Eigen::Index i) { return flag_at(running, i); }
-
-/// contact_frame over the whole trial, D* kept in motion.dstar and its derivatives (for tests
-/// and benchmarks that look at every frame's contacts). `running`
-/// (empty, or one flag per frame): frames that take options.running_cop.
-std::vector<FrameContacts> prepare_contacts(const Model& model, const ContactCalibration& soles, const ContactModelOptions& options,
-                                            ModelMotion& motion,
-                                            const std::vector<bool>& running = {});
 
 /// The touchdown rule's values (landing_frames).
 struct LandingRule {

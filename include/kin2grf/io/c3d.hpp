@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "kin2grf/io/force_plate.hpp"
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 
 namespace kin2grf {
 

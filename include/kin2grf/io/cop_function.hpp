@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "kin2grf/dynamics/contact.hpp"
+#include "kin2grf/model/foot_model.hpp"
 
 namespace kin2grf {
 

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 
 namespace kin2grf {
 

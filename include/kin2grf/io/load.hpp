@@ -5,7 +5,7 @@
 #include <string>
 
 #include "kin2grf/io/c3d.hpp"
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 
 namespace kin2grf {
 

@@ -18,7 +18,7 @@
 #include <string_view>
 #include <vector>
 
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 
 namespace kin2grf {
 

@@ -16,7 +16,7 @@
 #include <string>
 
 #include "kin2grf/io/load.hpp"
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 
 namespace kin2grf {
 

@@ -61,7 +61,7 @@ struct MotionFrame {
 /// The model's motion over a trial, held as what determines it: the independent coordinates and
 /// their derivatives (N x 11 or 12 each) and the HAT COM's fore-aft acceleration as used (N: the
 /// torso lag replaces it). D* (zero here) is the contact model's: contact_frame puts it into a
-/// frame, prepare_contacts keeps it for every frame.
+/// frame as that frame is solved.
 /// q, qd, qdd of a frame are rebuilt by frame(i), the same forward kinematics for every caller,
 /// bit for bit. Why not N x 63 matrices: three of them were 1.5 KB a frame, 44 % of a long
 /// trial's peak memory; rebuilding each frame where it is used (the contact stage,
@@ -85,9 +85,6 @@ struct ModelMotion {
   /// cop_angle_cutoff_hz). The COP function maps an angle to a place: a position, whose noise
   /// the residual analysis judges, not an acceleration.
   Eigen::MatrixX2d cop_foot_angle_rad;
-  /// N x 4: D* and its derivatives (coord::dstar_x); empty (zero in a frame) unless
-  /// prepare_contacts kept them.
-  Eigen::MatrixX4d dstar, dstar_d, dstar_dd;
   [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
   /// Row i of xd and xdd into xd_i and xdd_i (x.cols() numbers each).
   void derivatives_at(Eigen::Index i, double* xd_i, double* xdd_i) const;

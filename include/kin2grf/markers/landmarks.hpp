@@ -36,7 +36,7 @@
 #include <string>
 #include <vector>
 
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/model/model.hpp"
 

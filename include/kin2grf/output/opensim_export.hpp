@@ -22,7 +22,7 @@
 #include <string>
 
 #include "kin2grf/io/opensim.hpp"
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 #include "kin2grf/pipeline.hpp"
 
 namespace kin2grf {

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 #include "kin2grf/markers/landmarks.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/validation/validate.hpp"

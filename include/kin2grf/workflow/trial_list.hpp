@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 #include "kin2grf/markers/landmarks.hpp"
 #include "kin2grf/validation/study.hpp"
 #include "kin2grf/workflow/settings.hpp"

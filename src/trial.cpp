@@ -1,4 +1,4 @@
-#include "kin2grf/io/trial.hpp"
+#include "kin2grf/trial.hpp"
 
 #include <algorithm>
 #include <random>

@@ -1,7 +1,7 @@
 // Marker-set presets: the JSON files of data/presets (embedded at build time) and users' mapping
 // files, read into MarkerSets, and the recognition of a trial's set. An adapter around the core:
 // the core's landmark computation takes a MarkerSet and knows no file format.
-#include "kin2grf/markers/presets.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 
 #include <algorithm>
 #include <map>
