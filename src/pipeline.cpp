@@ -9,6 +9,7 @@
 #include <memory>
 #include <tuple>
 
+#include "kin2grf/dynamics/mediolateral.hpp"
 #include "kin2grf/error.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
@@ -167,6 +168,8 @@ struct SagittalStage {
   Eigen::Index first_index = 0;
   int first_frame_number = 1;
   std::array<Eigen::VectorXd, 2> foot_lateral_m;
+  std::array<Eigen::MatrixX3d, kLandmarkCount> landmark_lab_m;  ///< with EstimateOptions::mediolateral
+  Eigen::MatrixX3d lateral_axis;                                ///< likewise, per frame
   Messages messages;
 };
 
@@ -205,7 +208,9 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   append(msg, std::move(cleaning));
   append(msg, std::move(lm3.messages));
   out.frame = detect_sagittal_frame(lm3, markers, o.landmarks);
-  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, out.frame, markers, o.landmarks, trial.path);
+  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, out.frame, markers, o.landmarks, trial.path, o.mediolateral);
+  out.landmark_lab_m = std::move(win.lab_m);
+  out.lateral_axis = std::move(win.lateral_axis);
   append(msg, std::move(win.messages));
   out.first_index = win.first;
   out.first_frame_number = trial.markers.first_frame + static_cast<int>(win.first);
@@ -712,6 +717,15 @@ FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, dou
   return out;
 }
 
+/// The mediolateral force (EstimateOptions::mediolateral) into each foot's result.
+void mediolateral_stage(const ModelMotion& motion, const SagittalStage& sag, double cutoff_hz, std::array<FootResult, 2>& feet) {
+  std::array<Eigen::VectorXd, 2> vertical{feet[0].force_N.col(1), feet[1].force_N.col(1)};
+  std::array<FootLoad, 2> loads;
+  for (int k = 0; k < 2; ++k) loads[k] = {&vertical[k], &feet[k].contact};
+  MediolateralForces ml = mediolateral_forces(motion, sag.landmark_lab_m, sag.lateral_axis, cutoff_hz, loads);
+  for (int k = 0; k < 2; ++k) feet[k].force_lateral_N = std::move(ml.foot_N[k]);
+}
+
 /// Every frame's totals (frame_totals), unless the result is not to hold them (keep_all_series).
 struct TotalsStage {
   Eigen::VectorXd grm_Nm;
@@ -856,6 +870,9 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   const int cycled_frames = dyn.raw.cycled_frames, capped_frames = dyn.raw.capped_frames;
   const double ground_level_m = dyn.plan.calibration.contact.ground_level_m;
   FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m);
+  if (o.mediolateral) mediolateral_stage(kin.motion, sag, kin.kinematic_cutoff_hz, feet.feet);
+  sag.landmark_lab_m = {};
+  sag.lateral_axis = Eigen::MatrixX3d();
   TotalsStage totals = totals_stage(o, kin.motion, feet.feet, ground_level_m);
 
   EstimateResult r;
@@ -919,6 +936,7 @@ LabFootFrame lab_foot_frame(const EstimateResult& r, int side, Eigen::Index i) {
   const Eigen::Index k = r.first_index + i;  // the trial frame (a turning frame's heading)
   LabFootFrame out;
   out.force_N = f.force_N(i, 0) * r.frame.forward_at(k) + f.force_N(i, 1) * r.frame.up;
+  if (f.force_lateral_N.size() > i) out.force_N += f.force_lateral_N[i] * r.frame.lateral_at(k);
   if (std::isfinite(f.cop_x_m[i]))
     out.cop_m = r.frame.to_lab(f.cop_x_m[i], r.ground_level_m(), r.foot_lateral_m[static_cast<std::size_t>(side)][i], k);
   else

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
+#include "kin2grf/dynamics/mediolateral.hpp"
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/text.hpp"
@@ -621,4 +622,77 @@ TEST(Pipeline, GaitEventsAreTheStancesEndsInsideTheWindow) {
   EXPECT_EQ(ev[3].label, "Foot Off");
   EXPECT_EQ(ev[3].index, 170);
   EXPECT_DOUBLE_EQ(ev[3].time_s, 1.7);
+}
+
+// The mediolateral force (dynamics/mediolateral.hpp): the whole body's lateral acceleration,
+// carried by the feet in proportion to their vertical loads.
+TEST(Mediolateral, TheFeetCarryTheBodysLateralAccelerationSharedByLoad) {
+  const auto r = run({});  // a squat: both feet on the ground throughout
+  const Eigen::Index n = r.time_s.size();
+  const double A = 0.03, w = 2 * M_PI * 1.0;  // a 3 cm sway at 1 Hz, every landmark alike
+  std::array<Eigen::MatrixX3d, kLandmarkCount> lab;
+  for (auto& p : lab) {
+    p = Eigen::MatrixX3d::Zero(n, 3);
+    for (Eigen::Index i = 0; i < n; ++i) p(i, 1) = A * std::sin(w * r.time_s[i]);
+  }
+  const Eigen::MatrixX3d lateral = Eigen::RowVector3d(0, 1, 0).replicate(n, 1);
+  std::array<Eigen::VectorXd, 2> fy{r.feet[0].force_N.col(1), r.feet[1].force_N.col(1)};
+  const std::array<FootLoad, 2> loads{FootLoad{&fy[0], &r.feet[0].contact}, FootLoad{&fy[1], &r.feet[1].contact}};
+  const MediolateralForces ml = mediolateral_forces(r.motion, lab, lateral, 6.0, loads);
+  double mass = 0;
+  for (const Body& b : r.model().bodies) mass += b.mass_kg;
+  const double peak = mass * A * w * w;  // 83 N for 70 kg
+  for (Eigen::Index i = n / 4; i < 3 * n / 4; ++i) {
+    EXPECT_NEAR(ml.total_N[i], -peak * std::sin(w * r.time_s[i]), 0.01 * peak) << "frame " << i;
+    EXPECT_NEAR(ml.foot_N[0][i] + ml.foot_N[1][i], ml.total_N[i], 1e-9 * peak);
+    EXPECT_NEAR(ml.foot_N[0][i], ml.total_N[i] * fy[0][i] / (fy[0][i] + fy[1][i]), 1e-9 * peak);
+  }
+  // A foot off the ground carries none of it, the other all.
+  std::vector<bool> off(static_cast<std::size_t>(n), false);
+  const std::array<FootLoad, 2> one{FootLoad{&fy[0], &r.feet[0].contact}, FootLoad{&fy[1], &off}};
+  const MediolateralForces single = mediolateral_forces(r.motion, lab, lateral, 6.0, one);
+  EXPECT_EQ(single.foot_N[1].cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LT((single.foot_N[0] - single.total_N).cwiseAbs().maxCoeff(), 1e-9 * peak);
+}
+
+// A turning walk's lateral axis rotates: a body moving straight at constant speed in the lab has
+// no lateral acceleration, whatever the axis does (differentiating the projected coordinate
+// instead would read x(t) times the turn as a force).
+TEST(Mediolateral, ARotatingFrameAddsNoForce) {
+  const auto r = run({});
+  const Eigen::Index n = r.time_s.size();
+  std::array<Eigen::MatrixX3d, kLandmarkCount> lab;
+  Eigen::MatrixX3d lateral(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = r.time_s[i], phi = 0.3 * t;  // turning at 0.3 rad/s
+    lateral.row(i) = Eigen::RowVector3d(-std::sin(phi), std::cos(phi), 0);
+  }
+  for (auto& p : lab) {
+    p = Eigen::MatrixX3d::Zero(n, 3);
+    for (Eigen::Index i = 0; i < n; ++i) p(i, 0) = 5.0 + 1.2 * r.time_s[i];  // 5 m from the origin, 1.2 m/s
+  }
+  std::array<Eigen::VectorXd, 2> fy{r.feet[0].force_N.col(1), r.feet[1].force_N.col(1)};
+  const std::array<FootLoad, 2> loads{FootLoad{&fy[0], &r.feet[0].contact}, FootLoad{&fy[1], &r.feet[1].contact}};
+  const MediolateralForces ml = mediolateral_forces(r.motion, lab, lateral, 6.0, loads);
+  EXPECT_LT(ml.total_N.segment(n / 4, n / 2).cwiseAbs().maxCoeff(), 0.5);
+}
+
+// --mediolateral adds the lateral force and changes nothing else; without lateral motion (the
+// synthetic squat) it is near zero, and the lab-frame outputs carry it.
+TEST(Mediolateral, TheOptionChangesNoSagittalResult) {
+  EstimateOptions with;
+  with.mediolateral = true;
+  const auto r0 = run({}), r1 = run({}, with);
+  const Eigen::Index n = r0.time_s.size();
+  EXPECT_EQ(r0.feet[0].force_lateral_N.size(), 0);
+  ASSERT_EQ(r1.feet[0].force_lateral_N.size(), n);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(r0.feet[k].force_N, r1.feet[k].force_N);
+    const Eigen::ArrayXd c0 = r0.feet[k].cop_x_m.array(), c1 = r1.feet[k].cop_x_m.array();
+    EXPECT_TRUE((c0.isNaN() == c1.isNaN()).all());
+    EXPECT_TRUE((c0.isNaN() || c0 == c1).all());
+    EXPECT_LT(r1.feet[k].force_lateral_N.cwiseAbs().maxCoeff(), 0.01 * 70 * 9.81);
+  }
+  const Eigen::Index i = n / 2;
+  EXPECT_NEAR(r1.frame.lateral_at(r1.first_index + i).dot(lab_foot_frame(r1, 0, i).force_N), r1.feet[0].force_lateral_N[i], 1e-9);
 }

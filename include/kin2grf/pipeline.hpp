@@ -90,6 +90,10 @@ struct EstimateOptions {
   bool keep_all_series = true;
   /// GRM reference point in the sagittal frame (x along progression, y up), m.
   Eigen::Vector2d grm_reference_m = Eigen::Vector2d::Zero();
+  /// The mediolateral force (kin2grf; dynamics/mediolateral.hpp): each foot's force along the
+  /// sagittal frame's lateral axis, from the whole body's lateral acceleration split by the
+  /// inverted-pendulum rule. Off: the sagittal model's outputs, with a zero lateral force.
+  bool mediolateral = false;
   /// Called with (frames solved, frames in all) every 1 % of the contact solve; empty: none.
   /// The core prints nothing itself: the front end decides what to show.
   std::function<void(long, long)> progress;
@@ -103,6 +107,9 @@ struct FootResult {
   Eigen::VectorXd inclination_rad;  ///< theta_A, the paper's foot inclination (contact.hpp)
   Eigen::VectorXd gap_m;            ///< normal gap g_n of the foot's lowest contact point
   Eigen::MatrixXd sole_m;           ///< N x 6: sole points A, B, C (x, y) in the sagittal frame (keep_all_series)
+  /// Along the sagittal frame's lateral axis (forward x up), N; zero when inactive; empty unless
+  /// EstimateOptions::mediolateral.
+  Eigen::VectorXd force_lateral_N;
 };
 
 struct EstimateResult {

@@ -644,7 +644,7 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
 }
 
 SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const SagittalFrame& fr,
-                                  const MarkerTrajectories& m, const LandmarkOptions& o, const std::string& path) {
+                                  const MarkerTrajectories& m, const LandmarkOptions& o, const std::string& path, bool keep_lateral) {
   SagittalWindow w;
   const Eigen::Index n = m.frames();
   std::array<Eigen::MatrixX3d, kLandmarkCount>& p = lm3.p;
@@ -717,13 +717,28 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
       if (id == landmark(side, kHeel) || id == landmark(side, kMt)) return true;
     return false;
   };
+  if (keep_lateral) {
+    w.lateral_axis.resize(best_len, 3);
+    for (Eigen::Index i = 0; i < best_len; ++i) w.lateral_axis.row(i) = fr.lateral_at(best_a + i).transpose();
+  }
   for (int id = 0; id < kLandmarkCount; ++id) {
     s.p[static_cast<std::size_t>(id)].resize(best_len, 2);
+    if (keep_lateral && p[static_cast<std::size_t>(id)].rows() >= best_a + best_len)
+      w.lab_m[static_cast<std::size_t>(id)] = p[static_cast<std::size_t>(id)].middleRows(best_a, best_len);
     for (Eigen::Index i = 0; i < best_len; ++i)
       s.p[static_cast<std::size_t>(id)].row(i) =
           fr.to_sagittal(p[static_cast<std::size_t>(id)].row(best_a + i).transpose(), best_a + i).transpose();
     if (!lateral_needs(id)) p[static_cast<std::size_t>(id)].resize(0, 3);
   }
+  // A virtual hallux has no 3D place: the toes take the MT head's.
+  if (keep_lateral)
+    for (int side = 0; side < 2; ++side) {
+      auto& H = w.lab_m[static_cast<std::size_t>(landmark(side, kHallux))];
+      const auto& M = w.lab_m[static_cast<std::size_t>(landmark(side, kMt))];
+      if (H.rows() != best_len) H = M;
+      for (Eigen::Index i = 0; i < best_len; ++i)
+        if (!H.row(i).allFinite()) H.row(i) = M.row(i);
+    }
   for (int side = 0; side < 2; ++side) {
     w.foot_lateral_m[side].resize(best_len);
     for (Eigen::Index i = 0; i < best_len; ++i)

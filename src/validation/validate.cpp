@@ -57,6 +57,7 @@ std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const
     m.side_hint = p.side_hint;
     m.has_geometry = p.has_geometry;
     m.force_N = Eigen::MatrixX2d::Constant(n, 2, kNaN);
+    m.force_lateral_N = Eigen::VectorXd::Constant(n, kNaN);
     m.moment_origin_Nm = Eigen::VectorXd::Constant(n, kNaN);
     m.cop_x_m = Eigen::VectorXd::Constant(n, kNaN);
     m.cop_lateral_m = Eigen::VectorXd::Constant(n, kNaN);
@@ -130,6 +131,7 @@ std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const
       const double fx = Fs.dot(fr.forward_at(first_index + i)), fy = Fs.dot(fr.up);
       m.force_N(i, 0) = fx;
       m.force_N(i, 1) = fy;
+      m.force_lateral_N[i] = Fs.dot(fr.lateral_at(first_index + i));
       // x = p . f + offset: the offset's share of x F_y (zero without turns).
       m.moment_origin_Nm[i] = Ms.dot(fr.lateral_at(first_index + i)) + fr.x_offset_at(first_index + i) * fy;
       if (fy > cop_threshold_N) {
@@ -316,9 +318,11 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
   s.first = c.run.first;
   s.last = c.run.last;
   s.assign_distance_m = c.distance;
+  s.body_weight_N = bw;
   const Eigen::VectorXd mv = mp.force_N.col(1).segment(a, len), ma = mp.force_N.col(0).segment(a, len);
   s.metrics.vertical = compare_series(fe.force_N.col(1).segment(a, len), mv);
   s.metrics.anterior = compare_series(fe.force_N.col(0).segment(a, len), ma);
+  if (fe.force_lateral_N.size() == n) s.metrics.lateral = compare_series(fe.force_lateral_N.segment(a, len), mp.force_lateral_N.segment(a, len));
   Eigen::VectorXd mc = mp.cop_x_m.segment(a, len);
   for (Eigen::Index i = 0; i < len; ++i)
     if (!(mv[i] > o.cop_min_force_fraction * bw)) mc[i] = kNaN;
@@ -634,19 +638,25 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
 
 MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   MeanMetrics mm;
-  std::array<std::vector<double>, 4> vals;
+  std::array<std::vector<double>, 5> vals;
+  std::vector<double> lateral_rmse;
   for (const auto& s : stances) {
     if (foot >= 0 && s.foot != foot) continue;
-    const std::array<const std::optional<SeriesMetrics>*, 4> c = {&s.metrics.vertical, &s.metrics.anterior, &s.metrics.cop,
-                                                                   &s.metrics.moment};
-    for (std::size_t k = 0; k < 4; ++k)
-      if (*c[k] && std::isfinite((*c[k])->rrmse_percent) && !(k >= 2 && s.cop_reference_suspect))
+    const std::array<const std::optional<SeriesMetrics>*, 5> c = {&s.metrics.vertical, &s.metrics.anterior, &s.metrics.cop,
+                                                                   &s.metrics.moment, &s.metrics.lateral};
+    for (std::size_t k = 0; k < 5; ++k)
+      if (*c[k] && std::isfinite((*c[k])->rrmse_percent) && !((k == 2 || k == 3) && s.cop_reference_suspect))
         vals[k].push_back((*c[k])->rrmse_percent);
+    if (s.metrics.lateral && std::isfinite(s.metrics.lateral->rmse) && s.body_weight_N > 0)
+      lateral_rmse.push_back(100 * s.metrics.lateral->rmse / s.body_weight_N);
     ++mm.n;
   }
-  std::array<double*, 4> mean = {&mm.vertical, &mm.anterior, &mm.cop, &mm.moment};
-  std::array<double*, 4> sd = {&mm.vertical_sd, &mm.anterior_sd, &mm.cop_sd, &mm.moment_sd};
-  for (std::size_t k = 0; k < 4; ++k) {
+  double lateral_sum = 0;
+  for (double x : lateral_rmse) lateral_sum += x;
+  mm.lateral_rmse_percent_bw = lateral_rmse.empty() ? kNaN : lateral_sum / static_cast<double>(lateral_rmse.size());
+  std::array<double*, 5> mean = {&mm.vertical, &mm.anterior, &mm.cop, &mm.moment, &mm.lateral};
+  std::array<double*, 5> sd = {&mm.vertical_sd, &mm.anterior_sd, &mm.cop_sd, &mm.moment_sd, &mm.lateral_sd};
+  for (std::size_t k = 0; k < 5; ++k) {
     const auto& x = vals[k];
     if (x.empty()) {
       *mean[k] = *sd[k] = kNaN;
@@ -684,6 +694,13 @@ nlohmann::json component_json(const ComponentMetrics& c, double bw) {
             {"moment", field(c.moment, pr)}};
   j["peak_difference"] = {{"vertical_N", field(c.vertical, pk)}, {"anterior_N", field(c.anterior, pk)},
                           {"moment_Nm", field(c.moment, pk)}};
+  if (c.lateral) {  // with --mediolateral only: the sagittal model's JSON is unchanged
+    j["rrmse_percent"]["lateral"] = num(c.lateral->rrmse_percent);
+    j["rmse"]["lateral_N"] = num(c.lateral->rmse);
+    j["rmse_percent_bw"]["lateral"] = num(100 * c.lateral->rmse / bw);
+    j["r"]["lateral"] = num(c.lateral->pearson_r);
+    j["peak_difference"]["lateral_N"] = num(c.lateral->peak_difference);
+  }
   return j;
 }
 
@@ -726,6 +743,10 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     const MeanMetrics m = mean_rrmse(v.stances, f);
     means[f < 0 ? "all" : side_name(f)] = {{"stances", m.n},         {"vertical", num(m.vertical)}, {"anterior", num(m.anterior)},
                                             {"cop", num(m.cop)},      {"moment", num(m.moment)}};
+    if (std::isfinite(m.lateral_rmse_percent_bw)) {
+      means[f < 0 ? "all" : side_name(f)]["lateral"] = num(m.lateral);
+      means[f < 0 ? "all" : side_name(f)]["lateral_rmse_percent_bw"] = num(m.lateral_rmse_percent_bw);
+    }
   }
   j["mean_rrmse_percent"] = means;
   if (v.sync)
@@ -791,6 +812,18 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
   if (m.n > 0)
     os << label("per foot, mean (SD), n = " + std::to_string(m.n)) << msd(m.vertical, m.vertical_sd)
        << msd(m.anterior, m.anterior_sd) << msd(m.cop, m.cop_sd) << msd(m.moment, m.moment_sd) << "\n";
+  if (std::isfinite(m.lateral_rmse_percent_bw)) {
+    os << label("mediolateral force") << text("rRMSE %") << text("RMSE %BW") << text("r") << "\n";
+    for (const auto& s : v.stances) {
+      if (!s.metrics.lateral) continue;
+      char pct[40], r[40];
+      std::snprintf(pct, sizeof pct, "%.1f", 100 * s.metrics.lateral->rmse / s.body_weight_N);
+      std::snprintf(r, sizeof r, "%.2f", s.metrics.lateral->pearson_r);
+      os << label(side_name(s.foot) + " foot on " + s.plate) << cell(s.metrics.lateral) << text(pct) << text(r) << "\n";
+    }
+    std::snprintf(buf, sizeof buf, "%.1f", m.lateral_rmse_percent_bw);
+    os << label("per foot, mean (SD)") << msd(m.lateral, m.lateral_sd) << text(buf) << "\n";
+  }
   if (v.total)
     os << label("total, GRM (" + std::to_string(v.total->frames.size()) + " frames)") << cell(v.total->metrics.vertical)
        << cell(v.total->metrics.anterior) << text("-") << cell(v.total->metrics.moment) << "\n";

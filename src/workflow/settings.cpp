@@ -25,6 +25,9 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("--markers", a.markers, "Marker-set preset name or mapping file (JSON); default: recognised");
   c->add_option("--mass", a.mass, "Body mass, kg (default: the C3D's PROCESSING:Bodymass or SUBJECT(S):WEIGHT); 20-300");
   c->add_flag("--force-mass", a.force_mass, "Accept a body mass outside 20-300 kg");
+  c->add_flag("--mediolateral", a.mediolateral,
+              "Estimate each foot's mediolateral force too (the whole body's lateral acceleration, split between the feet by "
+              "the inverted-pendulum rule; docs/METHOD-NOTES.md); off: the sagittal model's zero lateral force");
   c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
       ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
   c->add_option_function<double>(
@@ -127,6 +130,7 @@ EstimateOptions to_options(const Settings& a) {
   EstimateOptions o;
   o.mass_kg = a.mass;  // any given value, checked by the library (a negative one is refused, not ignored)
   o.allow_unusual_mass = a.force_mass;
+  o.mediolateral = a.mediolateral;
   o.anthropometry = (a.paper && !a.anthropometry_given) ? "winter" : a.anthropometry;
   o.kinematic_cutoff_hz = a.kinematic_cutoff;
   if (a.post_cutoff && a.post_cutoff_cycles_given)
@@ -183,6 +187,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"speed_gate_ratio", o.contact.speed_gate.ratio},
           {"speed_gate_floor_mps", o.contact.speed_gate.floor_mps},
           {"touchdown_fraction", o.contact.touchdown_fraction},
+          {"mediolateral", o.mediolateral},
           {"min_split_distance_m", o.solver.min_split_distance_m},
           {"torso_length", torso_length_name(o.torso_length)},
           {"torso_lag_s", o.torso_lag_s},

@@ -181,6 +181,11 @@ struct SagittalWindow {
   SagittalLandmarks landmarks;  ///< only the processed window
   Eigen::Index first = 0;       ///< index of its first frame in the trial
   std::array<Eigen::VectorXd, 2> foot_lateral_m;  ///< per side: lateral coordinate of the foot
+  /// When asked (the mediolateral force): every landmark's lab position (m), N x 3 each, with the
+  /// virtual hallux at the MT head, and each frame's lateral axis (SagittalFrame::lateral_at),
+  /// N x 3. Empty otherwise.
+  std::array<Eigen::MatrixX3d, kLandmarkCount> lab_m;
+  Eigen::MatrixX3d lateral_axis;
   std::vector<std::string> messages;
 };
 
@@ -189,6 +194,6 @@ struct SagittalWindow {
 /// not copied. Of `m` only the frame count, numbers, times and rate are read.
 SagittalWindow sagittal_landmarks(Landmarks3D lm, const MarkerSet& set, const SagittalFrame& frame,
                                   const MarkerTrajectories& motion, const LandmarkOptions& options,
-                                  const std::string& path);
+                                  const std::string& path, bool keep_lateral = false);
 
 }  // namespace kin2grf

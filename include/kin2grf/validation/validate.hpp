@@ -59,6 +59,7 @@ struct MeasuredPlate {
   Side side_hint = Side::General;
   bool has_geometry = false;
   Eigen::MatrixX2d force_N;        ///< (anterior, vertical); NaN outside the plate recording
+  Eigen::VectorXd force_lateral_N; ///< along the sagittal frame's lateral axis; NaN outside
   Eigen::VectorXd moment_origin_Nm;///< sagittal moment about the lab origin
   Eigen::VectorXd cop_x_m;         ///< NaN where the vertical force is below cop_threshold_N
   Eigen::VectorXd cop_lateral_m;
@@ -114,6 +115,8 @@ struct SyncEstimate {
 
 struct ComponentMetrics {
   std::optional<SeriesMetrics> vertical, anterior, cop, moment;
+  /// The mediolateral force, when the estimate has one (EstimateOptions::mediolateral).
+  std::optional<SeriesMetrics> lateral;
 };
 
 struct StanceValidation {
@@ -121,6 +124,7 @@ struct StanceValidation {
   std::string plate;
   Eigen::Index first = 0, last = 0;  ///< frames in the estimate's window (inclusive)
   double assign_distance_m = 0.0;
+  double body_weight_N = 0.0;  ///< the estimate's (for errors in % body weight)
   /// Step 4's registration check: median over the frames above half the body weight of the plate
   /// COP's distance beyond the foot's heel-toe landmark span (0: inside); NaN without such frames.
   double cop_beyond_foot_m = 0.0;
@@ -173,8 +177,11 @@ ValidationResult validate(const EstimateResult& estimate, const ForcePlateRecord
 /// Mean (and SD) over the stances of each component's rRMSE, per foot or all.
 struct MeanMetrics {
   int n = 0;
-  double vertical = 0, anterior = 0, cop = 0, moment = 0;
-  double vertical_sd = 0, anterior_sd = 0, cop_sd = 0, moment_sd = 0;
+  double vertical = 0, anterior = 0, cop = 0, moment = 0, lateral = 0;
+  double vertical_sd = 0, anterior_sd = 0, cop_sd = 0, moment_sd = 0, lateral_sd = 0;
+  /// Mean mediolateral force RMSE, % body weight (NaN without --mediolateral): its rRMSE divides
+  /// by a range of 10-15 % body weight, so a few newtons read large.
+  double lateral_rmse_percent_bw = 0;
 };
 MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot = -1);
 

@@ -24,7 +24,7 @@ namespace kin2grf {
 struct Settings {
   std::string trial, static_trial, markers;
   std::optional<double> mass;
-  bool force_mass = false;
+  bool force_mass = false, mediolateral = false;
   std::string foot_model = "cop", norm = "torque-scaled", anthropometry = EstimateOptions{}.anthropometry, up_axis,
               cop_function, running_cop = "builtin", torso_length = "measured",
               kinematic_cutoff_rule = "noise";

@@ -1,0 +1,51 @@
+// kin2grf dynamics: the mediolateral ground reaction force (kin2grf, not the paper: its authors'
+// "GRF along the lateral axis" future work; issue 28's first step). The sagittal model's
+// multipliers are unchanged; this adds a force along the sagittal frame's lateral axis
+// (SagittalFrame::lateral = forward x up) to each foot.
+//
+// Total (Newton's second law across the plane; gravity has no lateral part):
+//   F_z(t) = M a_Gz(t),  z_G = sum_s m_s z_s / M,
+// with each segment's COM on the line between its proximal and distal landmarks at its
+// anthropometric fraction (the model's com_local); the COM's lab position is filtered at the
+// dynamics' kinematic cut-off, differentiated twice (central differences) and projected on each
+// frame's lateral axis.
+//
+// Split between the feet in contact (k = right, left) by their vertical forces F_y,k (the
+// sagittal solve's, post-filtered):
+//   F_z,k = F_z F_y,k / sum_j F_y,j,
+// so that a foot alone carries F_z and a double support shares it as it shares the weight; zero
+// where a foot is not in contact, and in flight. An inverted-pendulum split (each foot's reaction
+// pointing from its COP to the COM, F_y,k (z_G - z_k) / (y_G - y_ground), which gives the feet
+// opposite signs in double support) was measured and lost on every development lab's walks
+// (per-foot rRMSE 24-53 % against 14-33 %; docs/METHOD-NOTES.md).
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <vector>
+
+#include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/model/model.hpp"
+
+namespace kin2grf {
+
+/// What the split needs of one foot: its vertical force (N) and contact state, per frame.
+struct FootLoad {
+  const Eigen::VectorXd* vertical_N = nullptr;
+  const std::vector<bool>* contact = nullptr;
+};
+
+struct MediolateralForces {
+  Eigen::VectorXd total_N;                  ///< M a_Gz, per frame
+  Eigen::VectorXd com_lateral_m;            ///< z_G, filtered
+  std::array<Eigen::VectorXd, 2> foot_N;    ///< per foot (right, left), zero without contact
+};
+
+/// `landmark_lab_m`: each landmark's lab position (unfiltered), N x 3; `lateral_axis`: each
+/// frame's lateral axis, N x 3 (a turning walk's rotates: the acceleration is taken in the lab and
+/// projected, so the frame's rotation adds nothing); `motion`: the sagittal motion (its model's
+/// masses, its rate and frames); `cutoff_hz`: the dynamics' kinematic cut-off.
+MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
+                                       const Eigen::MatrixX3d& lateral_axis, double cutoff_hz, const std::array<FootLoad, 2>& feet);
+
+}  // namespace kin2grf
