@@ -17,9 +17,10 @@ rm -rf "$OUT" && mkdir -p "$OUT"
 mapfile -t TRIALS < <(grep -v '^#' scripts/trials.txt | grep . | sed "s#DATA#$DATA#g")
 for row in "${TRIALS[@]}"; do
   IFS='|' read -r activity lab name args <<<"$row"
-  for config in defaults paper; do
+  for config in defaults paper mediolateral; do
     extra=""
     [ "$config" = paper ] && extra="--paper"
+    [ "$config" = mediolateral ] && extra="--mediolateral"
     # shellcheck disable=SC2086
     if ! $BIN validate $args $extra --json "$OUT/$name.$config.json" >"$OUT/$name.$config.txt" 2>"$OUT/$name.$config.log"; then
       echo "validate-all: $name ($config) failed:" >&2; cat "$OUT/$name.$config.log" >&2; exit 1
