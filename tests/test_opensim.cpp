@@ -370,6 +370,106 @@ namespace {
 }
 }  // namespace
 
+// The .mot/.sto files kin2grf writes, read by OpenSim's own rules (opensim-core,
+// OpenSim/Common/DelimFileAdapter.h, DelimFileAdapter::extendRead, with STOFileAdapter's
+// delimiters; FileAdapter picks STOFileAdapter for both .sto and .mot), restated here rather than
+// through kin2grf's reader:
+// - header lines up to one that is "endheader" alone (spaces or tabs around it; a trailing \r
+//   removed); a header line "key=value" with both non-empty is metadata, and a DataType key must
+//   say "double";
+// - then lines are split on the tab alone (STOFileAdapter: "\t"), a run of tabs being one, and a
+//   line with no token is skipped;
+// - the first such line is the labels, the first of which must be "time";
+// - every row has as many values as labels (else RowLengthMismatch), each read by std::stod;
+// - TimeSeriesTable takes rows in strictly increasing time only.
+// `labels` receives the labels after "time".
+namespace {
+::testing::AssertionResult opensim_reads_sto(const std::string& text, std::vector<std::string>* labels_out = nullptr,
+                                             std::vector<std::vector<double>>* rows_out = nullptr) {
+  auto tokenize = [](const std::string& line) {
+    std::vector<std::string> tokens;
+    std::string cur;
+    for (const char c : line) {
+      if (c == '\t') {
+        if (!cur.empty()) tokens.push_back(cur), cur.clear();
+      } else {
+        cur += c;
+      }
+    }
+    if (!cur.empty()) tokens.push_back(cur);
+    return tokens;
+  };
+  std::istringstream in(text);
+  std::string line;
+  bool ended = false;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const auto a = line.find_first_not_of(" \t"), b = line.find_last_not_of(" \t");
+    if (a != std::string::npos && line.substr(a, b - a + 1) == "endheader") {
+      ended = true;
+      break;
+    }
+    const auto eq = line.rfind('=');
+    if (eq != std::string::npos && eq > 0 && eq + 1 < line.size()) {
+      std::string key = line.substr(0, eq);
+      key = key.substr(key.find_first_not_of(' '));
+      key = key.substr(0, key.find_last_not_of(' ') + 1);
+      if (key == "DataType" && line.substr(eq + 1) != "double") return ::testing::AssertionFailure() << "DataTypeMismatch";
+    }
+  }
+  if (!ended) return ::testing::AssertionFailure() << "no endheader line";
+  auto next = [&] {
+    while (std::getline(in, line)) {
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      auto t = tokenize(line);
+      if (!t.empty()) return t;
+    }
+    return std::vector<std::string>{};
+  };
+  auto labels = next();
+  if (labels.empty()) return ::testing::AssertionFailure() << "No column labels detected";
+  if (labels[0] != "time") return ::testing::AssertionFailure() << "UnexpectedColumnLabel " << labels[0] << " (expected time)";
+  labels.erase(labels.begin());
+  double last_time = -std::numeric_limits<double>::infinity();
+  std::size_t rows = 0;
+  for (auto row = next(); !row.empty(); row = next(), ++rows) {
+    if (row.size() != labels.size() + 1)
+      return ::testing::AssertionFailure() << "RowLengthMismatch at data row " << rows + 1 << ": " << row.size() - 1 << " values for "
+                                           << labels.size() << " labels";
+    std::vector<double> values;
+    for (const auto& t : row) {
+      std::size_t used = 0;
+      values.push_back(std::stod(t, &used));
+      if (used != t.size()) return ::testing::AssertionFailure() << "not a number: " << t;
+    }
+    if (!(values[0] > last_time)) return ::testing::AssertionFailure() << "time not increasing at data row " << rows + 1;
+    last_time = values[0];
+    if (rows_out) rows_out->push_back(std::move(values));
+  }
+  if (rows == 0) return ::testing::AssertionFailure() << "no data rows";
+  if (labels_out) *labels_out = labels;
+  return ::testing::AssertionSuccess();
+}
+
+/// The ExternalLoads file's identifiers (force_identifier, point_identifier, torque_identifier,
+/// each + x, y, z as ExternalForce reads them) among the .mot's labels.
+::testing::AssertionResult external_loads_columns_exist(const std::string& xml, const std::vector<std::string>& labels) {
+  for (const std::string tag : {"force_identifier", "point_identifier", "torque_identifier"}) {
+    int found = 0;
+    for (std::size_t p = 0; (p = xml.find("<" + tag + ">", p)) != std::string::npos; ++found) {
+      const auto a = p + tag.size() + 2, b = xml.find("</" + tag + ">", a);
+      const std::string id = xml.substr(a, b - a);
+      for (const char c : std::string("xyz"))
+        if (std::find(labels.begin(), labels.end(), id + c) == labels.end())
+          return ::testing::AssertionFailure() << tag << " " << id << ": no column " << id + c;
+      p = b;
+    }
+    if (found != 2) return ::testing::AssertionFailure() << found << " " << tag << " (two feet expected)";
+  }
+  return ::testing::AssertionSuccess();
+}
+}  // namespace
+
 // A trial with gaps, the last marker's among them (the trailing empty fields OpenSim dropped:
 // walking2.c3d's export had 835 of 1249 rows short), is read by OpenSim's rules and, by
 // kin2grf's reader, back with the same gaps.
@@ -406,10 +506,67 @@ TEST(SharedOpenSim, EveryExportsTrcIsReadByOpenSimsRules) {
     const auto out = dir / std::to_string(trials++);
     const std::string cmd = std::string(KIN2GRF_CLI) + " estimate " + args + " --opensim " + out.string() + " >/dev/null 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-    for (const auto& e : std::filesystem::directory_iterator(out))
+    std::vector<std::string> labels;
+    std::string xml;
+    for (const auto& e : std::filesystem::directory_iterator(out)) {
       if (e.path().extension() == ".trc") {
         EXPECT_TRUE(opensim_reads_trc(read_file_text(e.path().string()))) << line;
       }
+      if (e.path().extension() == ".mot") {
+        EXPECT_TRUE(opensim_reads_sto(read_file_text(e.path().string()), &labels)) << line;
+      }
+      if (e.path().extension() == ".xml") xml = read_file_text(e.path().string());
+    }
+    EXPECT_TRUE(external_loads_columns_exist(xml, labels)) << line;
   }
   EXPECT_GE(trials, 10);
+}
+
+// The mediolateral force reaches OpenSim: the bundled recorded walk's export with --mediolateral
+// carries it in the .mot's Z columns (OpenSim's lateral axis), read by OpenSim's rules; without
+// it they are zero, as the sagittal model's lateral force is.
+TEST(OpenSimExport, TheMediolateralForceIsInTheGrfMotsZColumns) {
+  KIN2GRF_REQUIRE_CLI();
+  const auto dir = test::temp_dir("opensim_ml");
+  const std::string walk = std::string(KIN2GRF_SOURCE_DIR) + "/data/example/walking2.c3d";
+  double largest[2] = {0, 0};
+  for (int with = 0; with < 2; ++with) {
+    const auto out = dir / std::to_string(with);
+    const std::string cmd = std::string(KIN2GRF_CLI) + " estimate " + walk + " --mass 64.9" + (with ? " --mediolateral" : "") +
+                            " --opensim " + out.string() + " >/dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    std::vector<std::string> labels;
+    std::vector<std::vector<double>> rows;
+    ASSERT_TRUE(opensim_reads_sto(read_file_text((out / "walking2_grf.mot").string()), &labels, &rows));
+    for (const std::string name : {"ground_force_vz", "1_ground_force_vz"}) {
+      const auto col = std::find(labels.begin(), labels.end(), name) - labels.begin() + 1;  // after time
+      ASSERT_LT(static_cast<std::size_t>(col), labels.size() + 1) << name;
+      for (const auto& r : rows) largest[with] = std::max(largest[with], std::abs(r[static_cast<std::size_t>(col)]));
+    }
+  }
+  EXPECT_EQ(largest[0], 0.0);
+  EXPECT_GT(largest[1], 10.0);                // N: a walk's lateral force peaks at 5-10 % body weight
+  EXPECT_LT(largest[1], 0.3 * 64.9 * 9.81);
+}
+
+// The -o file and the plates' .mot kin2grf reads are also read by OpenSim's rules.
+TEST(OpenSimExport, TheGrfMotOfEstimateIsReadByOpenSimsRules) {
+  KIN2GRF_REQUIRE_CLI();
+  const auto dir = test::temp_dir("opensim_o");
+  const std::string walk = std::string(KIN2GRF_SOURCE_DIR) + "/data/example/walking2.c3d";
+  for (const std::string extra : {"", " --lab-frame"}) {
+    const auto mot = dir / ("grf" + std::to_string(extra.size()) + ".mot");
+    const std::string cmd =
+        std::string(KIN2GRF_CLI) + " estimate " + walk + " --mass 64.9 -o " + mot.string() + extra + " >/dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    std::vector<std::string> labels;
+    EXPECT_TRUE(opensim_reads_sto(read_file_text(mot.string()), &labels)) << extra;
+    EXPECT_EQ(labels.size(), 18u) << extra;
+  }
+  // The rules restated above refuse what OpenSim refuses.
+  EXPECT_FALSE(opensim_reads_sto("endheader\ntime x\n0 1\n"));             // spaces: one label, not "time"
+  EXPECT_FALSE(opensim_reads_sto("endheader\ntime\tx\n0\t1\n0\t2\n"));  // time not increasing
+  EXPECT_FALSE(opensim_reads_sto("endheader\ntime\tx\ty\n0\t1\n"));      // a row short
+  EXPECT_FALSE(opensim_reads_sto("DataType=Vec3\nendheader\ntime\tx\n0\t1\n"));
+  EXPECT_TRUE(opensim_reads_sto("nRows=1\n endheader \r\n\ntime\tx\n0\t1\n"));
 }
