@@ -328,6 +328,14 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
     if (!(mv[i] > o.cop_min_force_fraction * bw)) mc[i] = kNaN;
   s.metrics.cop = compare_series(fe.cop_x_m.segment(a, len), mc);
   s.cop_beyond_foot_m = cop_beyond_foot_m(e, c, mv, mc, a);
+  if (fe.force_lateral_N.size() == n) {
+    // The COP's lateral place (the heel-MT markers' midpoint, EstimateResult::foot_lateral_m),
+    // scored with the mediolateral force, the first pieces of the 3D model.
+    Eigen::VectorXd ml = mp.cop_lateral_m.segment(a, len);
+    for (Eigen::Index i = 0; i < len; ++i)
+      if (!(mv[i] > o.cop_min_force_fraction * bw)) ml[i] = kNaN;
+    s.metrics.cop_lateral = compare_series(e.foot_lateral_m[static_cast<std::size_t>(c.foot)].segment(a, len), ml);
+  }
   {
     // The foot's sole length (heel point A to toe point C) over the stance, for the COP error
     // in % of foot length: an rRMSE divides by the COP's range, 5-6 cm over a walking stance
@@ -639,7 +647,7 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
 MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   MeanMetrics mm;
   std::array<std::vector<double>, 5> vals;
-  std::vector<double> lateral_rmse;
+  std::vector<double> lateral_rmse, cop_lateral_rmse;
   for (const auto& s : stances) {
     if (foot >= 0 && s.foot != foot) continue;
     const std::array<const std::optional<SeriesMetrics>*, 5> c = {&s.metrics.vertical, &s.metrics.anterior, &s.metrics.cop,
@@ -647,10 +655,15 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
     for (std::size_t k = 0; k < 5; ++k)
       if (*c[k] && std::isfinite((*c[k])->rrmse_percent) && !((k == 2 || k == 3) && s.cop_reference_suspect))
         vals[k].push_back((*c[k])->rrmse_percent);
+    if (s.metrics.cop_lateral && std::isfinite(s.metrics.cop_lateral->rmse) && !s.cop_reference_suspect)
+      cop_lateral_rmse.push_back(1000 * s.metrics.cop_lateral->rmse);
     if (s.metrics.lateral && std::isfinite(s.metrics.lateral->rmse) && s.body_weight_N > 0)
       lateral_rmse.push_back(100 * s.metrics.lateral->rmse / s.body_weight_N);
     ++mm.n;
   }
+  double cop_lateral_sum = 0;
+  for (double x : cop_lateral_rmse) cop_lateral_sum += x;
+  mm.cop_lateral_rmse_mm = cop_lateral_rmse.empty() ? kNaN : cop_lateral_sum / static_cast<double>(cop_lateral_rmse.size());
   double lateral_sum = 0;
   for (double x : lateral_rmse) lateral_sum += x;
   mm.lateral_rmse_percent_bw = lateral_rmse.empty() ? kNaN : lateral_sum / static_cast<double>(lateral_rmse.size());
@@ -701,6 +714,7 @@ nlohmann::json component_json(const ComponentMetrics& c, double bw) {
     j["r"]["lateral"] = num(c.lateral->pearson_r);
     j["peak_difference"]["lateral_N"] = num(c.lateral->peak_difference);
   }
+  if (c.cop_lateral) j["rmse"]["cop_lateral_mm"] = num(1000 * c.cop_lateral->rmse);
   return j;
 }
 
@@ -746,6 +760,7 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     if (std::isfinite(m.lateral_rmse_percent_bw)) {
       means[f < 0 ? "all" : side_name(f)]["lateral"] = num(m.lateral);
       means[f < 0 ? "all" : side_name(f)]["lateral_rmse_percent_bw"] = num(m.lateral_rmse_percent_bw);
+      means[f < 0 ? "all" : side_name(f)]["cop_lateral_rmse_mm"] = num(m.cop_lateral_rmse_mm);
     }
   }
   j["mean_rrmse_percent"] = means;
@@ -813,16 +828,20 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
     os << label("per foot, mean (SD), n = " + std::to_string(m.n)) << msd(m.vertical, m.vertical_sd)
        << msd(m.anterior, m.anterior_sd) << msd(m.cop, m.cop_sd) << msd(m.moment, m.moment_sd) << "\n";
   if (std::isfinite(m.lateral_rmse_percent_bw)) {
-    os << label("mediolateral force") << text("rRMSE %") << text("RMSE %BW") << text("r") << "\n";
+    os << label("mediolateral force") << text("rRMSE %") << text("RMSE %BW") << text("r") << text("COP mm") << "\n";
     for (const auto& s : v.stances) {
       if (!s.metrics.lateral) continue;
       char pct[40], r[40];
       std::snprintf(pct, sizeof pct, "%.1f", 100 * s.metrics.lateral->rmse / s.body_weight_N);
       std::snprintf(r, sizeof r, "%.2f", s.metrics.lateral->pearson_r);
-      os << label(side_name(s.foot) + " foot on " + s.plate) << cell(s.metrics.lateral) << text(pct) << text(r) << "\n";
+      char cop[40] = "-";
+      if (s.metrics.cop_lateral) std::snprintf(cop, sizeof cop, "%.0f", 1000 * s.metrics.cop_lateral->rmse);
+      os << label(side_name(s.foot) + " foot on " + s.plate) << cell(s.metrics.lateral) << text(pct) << text(r) << text(cop) << "\n";
     }
     std::snprintf(buf, sizeof buf, "%.1f", m.lateral_rmse_percent_bw);
-    os << label("per foot, mean (SD)") << msd(m.lateral, m.lateral_sd) << text(buf) << "\n";
+    os << label("per foot, mean (SD)") << msd(m.lateral, m.lateral_sd) << text(buf) << text("-");
+    std::snprintf(buf, sizeof buf, "%.0f", m.cop_lateral_rmse_mm);
+    os << text(buf) << "\n";
   }
   if (v.total)
     os << label("total, GRM (" + std::to_string(v.total->frames.size()) + " frames)") << cell(v.total->metrics.vertical)

@@ -115,8 +115,9 @@ struct SyncEstimate {
 
 struct ComponentMetrics {
   std::optional<SeriesMetrics> vertical, anterior, cop, moment;
-  /// The mediolateral force, when the estimate has one (EstimateOptions::mediolateral).
-  std::optional<SeriesMetrics> lateral;
+  /// The mediolateral force and the COP's lateral place (m), when the estimate has them
+  /// (EstimateOptions::mediolateral).
+  std::optional<SeriesMetrics> lateral, cop_lateral;
 };
 
 struct StanceValidation {
@@ -182,6 +183,7 @@ struct MeanMetrics {
   /// Mean mediolateral force RMSE, % body weight (NaN without --mediolateral): its rRMSE divides
   /// by a range of 10-15 % body weight, so a few newtons read large.
   double lateral_rmse_percent_bw = 0;
+  double cop_lateral_rmse_mm = 0;  ///< mean over the stances (NaN without --mediolateral)
 };
 MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot = -1);
 
