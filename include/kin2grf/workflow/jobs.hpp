@@ -1,0 +1,71 @@
+// kin2grf jobs: what each command of the command line does, from its arguments to its outputs
+// (load, resolve the settings, estimate, validate, write, report), in the library so that the
+// command line is only its flags. Each writes what it shows on `out` and its notes on `log`.
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "kin2grf/validation/validate.hpp"
+#include "kin2grf/workflow/settings.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace kin2grf {
+
+/// estimate: the settings (the library's names) and where the outputs go.
+struct EstimateJob : Settings {
+  std::string opensim_dir;
+  std::vector<std::string> opensim_bodies;
+  std::string out_mot, out_csv, out_json, out_events, out_report;
+  bool lab_frame = false;
+};
+
+struct ValidateJob {
+  EstimateJob est;
+  std::string plates, out_json, report, zero_offset = "unloaded";
+  ValidationOptions options;
+};
+
+struct StudyJob {
+  std::string kind, trial_list, out_json, report, cross_validate;
+  std::vector<std::string> trials;
+  EstimateJob est;
+  std::string plates;
+};
+
+struct FitCopJob {
+  std::string trial_list, activity = "walking", out;
+  double min_force = 0.2;
+  bool leave_one_out = false, fit_angles = false;
+};
+
+struct BatchJob {
+  std::string trial_list, out_csv, out_json, out_dir;
+  int jobs = 0;  ///< 0: every core
+};
+
+/// Registers estimate's settings and, with `outputs`, its output options on `app`.
+void add_estimate_options(CLI::App* app, EstimateJob& job, bool outputs = true);
+
+/// info: a recording described (text, or JSON with `json`).
+int info_job(const std::string& file, bool json, double threshold_N, const std::string& zero_offset, const std::string& up_axis,
+             std::ostream& out);
+/// estimate: one trial's GRF, COP, GRM and joint torques into the asked outputs.
+int estimate_job(const EstimateJob& job, std::ostream& out, std::ostream& log);
+/// validate: estimate, then compare with the trial's plates (or --plates).
+int validate_job(const ValidateJob& job, std::ostream& out, std::ostream& log);
+/// study: a parameter study over trials with plates, optionally cross-validated by lab.
+int study_job(const StudyJob& job, std::ostream& out, std::ostream& log);
+/// fit-cop: foot model 2's COP function fitted to a trial list's plate COPs.
+int fit_cop_job(const FitCopJob& job, std::ostream& out);
+/// batch: every trial of a list, on all cores, past failures, into one summary table (1 when
+/// any failed).
+int batch_job(const BatchJob& job, std::ostream& out, std::ostream& log);
+/// make-example: the bundled synthetic walk and squat written into `dir`.
+int make_example_job(const std::string& dir, double seconds, double rate_hz, double analog_rate_hz, double noise_mm, std::ostream& out);
+
+}  // namespace kin2grf
