@@ -406,6 +406,42 @@ struct RawSolve {
   int cycled_frames = 0, capped_frames = 0;
 };
 
+/// What the per-foot results take of one solved frame i: its contact points' places and gaps, each
+/// foot's inclination and sole, the multipliers, torques and active set.
+void record_frame(RawSolve& raw, Eigen::Index i, const FrameContacts& fc, const FrameSolution& s, bool keep_sole) {
+  const auto np = static_cast<Eigen::Index>(raw.point_side.size());
+  for (Eigen::Index j = 0; j < np; ++j) {
+    const ContactPoint& p = fc.points[static_cast<std::size_t>(j)];
+    raw.point_x_m(i, j) = p.position.x();
+    raw.point_gap_m(i, j) = p.gap_m;
+  }
+  for (int side = 0; side < 2; ++side) {
+    const auto s_ = static_cast<std::size_t>(side);
+    raw.inclination_rad[s_][i] = fc.foot_inclination_rad[s_];
+    if (keep_sole)
+      for (int c = 0; c < 3; ++c) raw.sole_m[s_].block<1, 2>(i, 2 * c) = fc.sole[s_][static_cast<std::size_t>(c)].transpose();
+  }
+  raw.lambda.row(i) = s.contact_lambda.transpose();
+  raw.torque.row(i) = s.joint_torque_Nm.transpose();
+  raw.active[static_cast<std::size_t>(i)] = s.contact_active;
+  raw.iterations[static_cast<std::size_t>(i)] = s.iterations;
+}
+
+/// The chunks' torque maps (frames with both feet active) joined in frame order, each chunk's let
+/// go once copied.
+void join_torque_maps(std::vector<std::pair<std::vector<Eigen::Index>, std::vector<double>>>& chunk_maps, RawSolve& raw) {
+  std::size_t frames = 0, values = 0;
+  for (const auto& [f, v] : chunk_maps) frames += f.size(), values += v.size();
+  raw.both_feet_frames.reserve(frames);
+  raw.both_feet_torque_map.reserve(values);
+  for (auto& [f, v] : chunk_maps) {
+    raw.both_feet_frames.insert(raw.both_feet_frames.end(), f.begin(), f.end());
+    raw.both_feet_torque_map.insert(raw.both_feet_torque_map.end(), v.begin(), v.end());
+    std::vector<Eigen::Index>().swap(f);
+    std::vector<double>().swap(v);
+  }
+}
+
 /// Eqs. 5-10 on every frame (least squares, activation, semi-smooth iterations). `path` and
 /// `first_frame_number` name a frame the solve could not make finite.
 RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCalibration& calibration, const ModelMotion& motion,
@@ -454,17 +490,7 @@ RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCa
       contact_frame(model, calibration.contact, o.contact, is_running_frame(running, i), f, fc);
       for (int side = 0; side < 2; ++side) fc.landing[side] = flag_at(plan.landing[side], i);
       const FrameSolution s = solver.solve(f.q, f.qdd, fc);
-      for (Eigen::Index j = 0; j < np; ++j) {
-        const ContactPoint& p = fc.points[static_cast<std::size_t>(j)];
-        raw.point_x_m(i, j) = p.position.x();
-        raw.point_gap_m(i, j) = p.gap_m;
-      }
-      for (int side = 0; side < 2; ++side) {
-        const auto s_ = static_cast<std::size_t>(side);
-        raw.inclination_rad[s_][i] = fc.foot_inclination_rad[s_];
-        if (o.keep_all_series)
-          for (int c = 0; c < 3; ++c) raw.sole_m[s_].block<1, 2>(i, 2 * c) = fc.sole[s_][static_cast<std::size_t>(c)].transpose();
-      }
+      record_frame(raw, i, fc, s, o.keep_all_series);
       if (keep_torque_map) {
         std::array<bool, 2> on{false, false};
         for (Eigen::Index j = 0; j < np; ++j)
@@ -475,26 +501,11 @@ RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCa
           values.insert(values.end(), s.torque_per_normal.data(), s.torque_per_normal.data() + s.torque_per_normal.size());
         }
       }
-      raw.lambda.row(i) = s.contact_lambda.transpose();
-      raw.torque.row(i) = s.joint_torque_Nm.transpose();
-      raw.active[k] = s.contact_active;
-      raw.iterations[k] = s.iterations;
       cycled[k] = s.cycled;
       capped[k] = s.capped;
     }
   });
-  {
-    std::size_t frames = 0, values = 0;
-    for (const auto& [f, v] : chunk_maps) frames += f.size(), values += v.size();
-    raw.both_feet_frames.reserve(frames);
-    raw.both_feet_torque_map.reserve(values);
-    for (auto& [f, v] : chunk_maps) {  // chunks in frame order; each let go once copied
-      raw.both_feet_frames.insert(raw.both_feet_frames.end(), f.begin(), f.end());
-      raw.both_feet_torque_map.insert(raw.both_feet_torque_map.end(), v.begin(), v.end());
-      std::vector<Eigen::Index>().swap(f);
-      std::vector<double>().swap(v);
-    }
-  }
+  join_torque_maps(chunk_maps, raw);
   raw.cycled_frames = static_cast<int>(std::count(cycled.begin(), cycled.end(), 1));
   raw.capped_frames = static_cast<int>(std::count(capped.begin(), capped.end(), 1));
   if (progress) progress(static_cast<long>(n), static_cast<long>(n));
@@ -817,6 +828,36 @@ std::optional<double> stance_floor_hz(const EstimateOptions& o, const Kinematics
   return floor_hz;
 }
 
+/// The result, assembled once from the stages' outputs (each moved in).
+EstimateResult assemble_result(const std::string& marker_set, double mass_kg, SagittalStage& sag, ModelStage& mod, KinematicsStage& kin,
+                               DynamicsPass& dyn, FeetStage& feet, TotalsStage& totals, const std::vector<int>& iterations,
+                               const EstimateOptions& o) {
+  EstimateResult r;
+  r.marker_set = marker_set;
+  r.mass_kg = mass_kg;
+  r.frame = std::move(sag.frame);
+  r.kinematic_cutoff_hz = kin.kinematic_cutoff_hz;
+  r.position_cutoff_hz = kin.position_cutoff_hz;
+  r.post_cutoff_hz = feet.post_cutoff_hz;
+  r.calibration = std::move(dyn.plan.calibration);
+  r.time_s = sag.landmarks.time_s;
+  r.first_index = sag.first_index;
+  r.first_frame_number = sag.first_frame_number;
+  r.feet = std::move(feet.feet);
+  r.grm_Nm = std::move(totals.grm_Nm);
+  r.joint_torque_Nm = std::move(feet.joint_torque_Nm);
+  r.joint_force_N = std::move(totals.joint_force_N);
+  r.residual = std::move(totals.residual);
+  r.iterations = iterations;
+  r.foot_lateral_m = std::move(sag.foot_lateral_m);
+  r.motion = std::move(kin.motion);
+  r.grm_reference_m = o.grm_reference_m;
+  r.landmarks = std::move(sag.landmarks);
+  r.kinematic_total = std::move(totals.kinematic_total);
+  for (Messages* m : {&sag.messages, &mod.messages, &kin.messages, &dyn.plan.messages, &feet.messages}) append(r.messages, std::move(*m));
+  return r;
+}
+
 /// estimate(); `release` (the trial itself, when the caller gave it up) loses its marker samples
 /// once the landmarks are made. The stages in order, each taking what it reads and returning
 /// what it makes; the result is assembled at the end.
@@ -875,31 +916,9 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   sag.lateral_axis = Eigen::MatrixX3d();
   TotalsStage totals = totals_stage(o, kin.motion, feet.feet, ground_level_m);
 
-  EstimateResult r;
-  r.marker_set = set.name;
-  r.mass_kg = mass_kg;
-  r.frame = std::move(sag.frame);
-  r.kinematic_cutoff_hz = kin.kinematic_cutoff_hz;
-  r.position_cutoff_hz = kin.position_cutoff_hz;
-  r.post_cutoff_hz = feet.post_cutoff_hz;
-  r.calibration = std::move(dyn.plan.calibration);
-  r.time_s = sag.landmarks.time_s;
-  r.first_index = sag.first_index;
-  r.first_frame_number = sag.first_frame_number;
-  r.feet = std::move(feet.feet);
-  r.grm_Nm = std::move(totals.grm_Nm);
-  r.joint_torque_Nm = std::move(feet.joint_torque_Nm);
-  r.joint_force_N = std::move(totals.joint_force_N);
-  r.residual = std::move(totals.residual);
-  r.iterations = iterations;
+  EstimateResult r = assemble_result(set.name, mass_kg, sag, mod, kin, dyn, feet, totals, iterations, o);
   r.cycled_frames = cycled_frames;
   r.capped_frames = capped_frames;
-  r.foot_lateral_m = std::move(sag.foot_lateral_m);
-  r.motion = std::move(kin.motion);
-  r.grm_reference_m = o.grm_reference_m;
-  r.landmarks = std::move(sag.landmarks);
-  r.kinematic_total = std::move(totals.kinematic_total);
-  for (Messages* m : {&sag.messages, &mod.messages, &kin.messages, &dyn.plan.messages, &feet.messages}) append(r.messages, std::move(*m));
   r.seconds_kinematics = seconds_kinematics;
   r.seconds_dynamics = seconds_dynamics;
   return r;

@@ -643,13 +643,13 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
   return f;
 }
 
-SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const SagittalFrame& fr,
-                                  const MarkerTrajectories& m, const LandmarkOptions& o, const std::string& path, bool keep_lateral) {
-  SagittalWindow w;
+namespace {
+
+/// Short gaps filled in place (cubic Hermite between the valid neighbours, tangents by central
+/// differences there), each named in `messages`; `ok` false on the frames of the gaps left.
+void fill_short_gaps(std::array<Eigen::MatrixX3d, kLandmarkCount>& p, const MarkerSet& set, const MarkerTrajectories& m,
+                     const LandmarkOptions& o, std::vector<bool>& ok, std::vector<std::string>& messages) {
   const Eigen::Index n = m.frames();
-  std::array<Eigen::MatrixX3d, kLandmarkCount>& p = lm3.p;
-  // Fill short gaps (cubic Catmull-Rom between the valid neighbours; linear with one neighbour pair).
-  std::vector<bool> ok(static_cast<std::size_t>(n), true);
   for (int id = 0; id < kLandmarkCount; ++id) {
     if (set.rules[static_cast<std::size_t>(id)].kind == RuleKind::VirtualHallux) continue;
     auto& P = p[static_cast<std::size_t>(id)];
@@ -660,7 +660,6 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
       while (j < n && !P.row(j).allFinite()) ++j;
       const Eigen::Index len = j - i;
       if (i > 0 && j < n && len <= o.max_gap_frames) {
-        // Cubic Hermite between the valid neighbours, tangents by central differences there.
         const Eigen::Index i0 = i - 1, i1 = j;
         const double span = static_cast<double>(i1 - i0);
         const Eigen::RowVector3d p1 = P.row(i0), p2 = P.row(i1);
@@ -673,15 +672,21 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
           P.row(k) = (2 * t3 - 3 * t2 + 1) * p1 + (t3 - 2 * t2 + t) * span * d1 + (-2 * t3 + 3 * t2) * p2 +
                      (t3 - t2) * span * d2;
         }
-        w.messages.push_back(std::string(kNames[id]) + ": filled a gap of " + std::to_string(len) + " frames at frames " +
-                             std::to_string(m.first_frame + i) + "-" + std::to_string(m.first_frame + j - 1));
+        messages.push_back(std::string(kNames[id]) + ": filled a gap of " + std::to_string(len) + " frames at frames " +
+                           std::to_string(m.first_frame + i) + "-" + std::to_string(m.first_frame + j - 1));
       } else {
         for (Eigen::Index k = i; k < j; ++k) ok[static_cast<std::size_t>(k)] = false;
       }
       i = j;
     }
   }
-  // The longest run of frames where every landmark is defined.
+}
+
+/// The longest run of frames where every landmark is defined (`ok`): its first frame and length;
+/// InputError naming the landmarks missing when it is under 10 frames.
+std::pair<Eigen::Index, Eigen::Index> longest_defined_window(const std::vector<bool>& ok, const std::array<Eigen::MatrixX3d, kLandmarkCount>& p,
+                                                             const MarkerSet& set, const std::string& path) {
+  const auto n = static_cast<Eigen::Index>(ok.size());
   Eigen::Index best_a = 0, best_len = 0;
   for (Eigen::Index i = 0; i < n;) {
     if (!ok[static_cast<std::size_t>(i)]) { ++i; continue; }
@@ -700,6 +705,70 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
     }
     throw InputError(path + ": no run of 10 frames where every landmark is defined; missing:" + which);
   }
+  return {best_a, best_len};
+}
+
+/// Virtual toes: straight along the foot (ankle A -> MT head M) for `share` of its length, held
+/// at the MT head's foot-flat height (they do not go through the floor).
+void place_virtual_toes(const Eigen::MatrixX2d& A, const Eigen::MatrixX2d& M, Eigen::MatrixX2d& T, double share) {
+  const Eigen::Index len = M.rows();
+  std::vector<double> hm;
+  for (Eigen::Index i = 0; i < len; ++i) hm.push_back(M(i, 1));
+  std::sort(hm.begin(), hm.end());
+  const double flat_h = hm[hm.size() / 10];
+  std::vector<double> flat_ang;
+  for (Eigen::Index i = 0; i < len; ++i)
+    if (M(i, 1) < flat_h + 0.01) flat_ang.push_back(std::atan2(M(i, 1) - A(i, 1), M(i, 0) - A(i, 0)));
+  const double th_flat = median(flat_ang);
+  for (Eigen::Index i = 0; i < len; ++i) {
+    const double L = share * (M.row(i) - A.row(i)).norm();
+    const double th_f = std::atan2(M(i, 1) - A(i, 1), M(i, 0) - A(i, 0));
+    const double limit = -std::asin(std::clamp((M(i, 1) - flat_h) / L, -1.0, 1.0));
+    const double th_t = std::max(th_f - th_flat, limit);
+    T(i, 0) = M(i, 0) + L * std::cos(th_t);
+    T(i, 1) = M(i, 1) + L * std::sin(th_t);
+  }
+}
+
+/// One foot's toes: virtual ones where the set has no hallux marker, or where its toe marker
+/// stands implausibly near the MT head (a toe segment under kMinToeShare of the ankle-MT length;
+/// the development trials' toe markers give 0.25-0.86, a held-out overground run's marker mapped
+/// as the toe about 0.08), which cannot carry the COP's roll to the toe tip.
+void check_toes(SagittalLandmarks& s, const MarkerSet& set, int side, std::vector<std::string>& messages) {
+  const LandmarkRule& r = set.rules[static_cast<std::size_t>(landmark(side, kHallux))];
+  const auto& A = s.p[landmark(side, kAnkle)];
+  const auto& M = s.p[landmark(side, kMt)];
+  auto& T = s.p[landmark(side, kHallux)];
+  if (r.kind == RuleKind::VirtualHallux) {
+    place_virtual_toes(A, M, T, r.value);
+    messages.push_back(std::string("hallux_") + (side ? "l" : "r") + ": no hallux marker; virtual toes of " + std::to_string(r.value) +
+                       " x ankle-MT length");
+    return;
+  }
+  std::vector<double> toe, foot;
+  for (Eigen::Index i = 0; i < M.rows(); ++i) toe.push_back((T.row(i) - M.row(i)).norm()), foot.push_back((M.row(i) - A.row(i)).norm());
+  const double toe_m = median(toe), foot_m = median(foot);
+  if (toe_m < kMinToeShare * foot_m) {
+    place_virtual_toes(A, M, T, kVirtualToeShare);
+    char b[300];
+    std::snprintf(b, sizeof b,
+                  "hallux_%s: the toe marker stands a median %.0f mm ahead of the MT head, under %.2f x the ankle-MT length "
+                  "(%.0f mm): too near for a toe; virtual toes of %.2f x ankle-MT length instead",
+                  side ? "l" : "r", 1000 * toe_m, kMinToeShare, 1000 * foot_m, kVirtualToeShare);
+    messages.emplace_back(b);
+  }
+}
+
+}  // namespace
+
+SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const SagittalFrame& fr,
+                                  const MarkerTrajectories& m, const LandmarkOptions& o, const std::string& path, bool keep_lateral) {
+  SagittalWindow w;
+  const Eigen::Index n = m.frames();
+  std::array<Eigen::MatrixX3d, kLandmarkCount>& p = lm3.p;
+  std::vector<bool> ok(static_cast<std::size_t>(n), true);
+  fill_short_gaps(p, set, m, o, ok, w.messages);
+  const auto [best_a, best_len] = longest_defined_window(ok, p, set, path);
   if (best_len < n) {
     w.messages.push_back("processing frames " + std::to_string(m.first_frame + best_a) + "-" +
                          std::to_string(m.first_frame + best_a + best_len - 1) + " of " + std::to_string(m.first_frame) + "-" +
@@ -746,51 +815,7 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
           0.5 * (p[landmark(side, kHeel)].row(best_a + i) + p[landmark(side, kMt)].row(best_a + i)).dot(fr.lateral_at(best_a + i).transpose());
     p[landmark(side, kHeel)].resize(0, 3);
     p[landmark(side, kMt)].resize(0, 3);
-    // Virtual hallux: toes straight along the foot, held at the MT head's foot-flat height.
-    const LandmarkRule& r = set.rules[static_cast<std::size_t>(landmark(side, kHallux))];
-    const auto& A = s.p[landmark(side, kAnkle)];
-    const auto& M = s.p[landmark(side, kMt)];
-    auto& T = s.p[landmark(side, kHallux)];
-    const auto virtual_toes = [&](double share) {
-      std::vector<double> hm;
-      for (Eigen::Index i = 0; i < best_len; ++i) hm.push_back(M(i, 1));
-      std::sort(hm.begin(), hm.end());
-      const double flat_h = hm[hm.size() / 10];
-      std::vector<double> flat_ang;
-      for (Eigen::Index i = 0; i < best_len; ++i)
-        if (M(i, 1) < flat_h + 0.01) flat_ang.push_back(std::atan2(M(i, 1) - A(i, 1), M(i, 0) - A(i, 0)));
-      const double th_flat = median(flat_ang);
-      for (Eigen::Index i = 0; i < best_len; ++i) {
-        const double L = share * (M.row(i) - A.row(i)).norm();
-        const double th_f = std::atan2(M(i, 1) - A(i, 1), M(i, 0) - A(i, 0));
-        const double limit = -std::asin(std::clamp((M(i, 1) - flat_h) / L, -1.0, 1.0));
-        const double th_t = std::max(th_f - th_flat, limit);
-        T(i, 0) = M(i, 0) + L * std::cos(th_t);
-        T(i, 1) = M(i, 1) + L * std::sin(th_t);
-      }
-    };
-    if (r.kind == RuleKind::VirtualHallux) {
-      virtual_toes(r.value);
-      w.messages.push_back(std::string("hallux_") + (side ? "l" : "r") + ": no hallux marker; virtual toes of " +
-                           std::to_string(r.value) + " x ankle-MT length");
-      continue;
-    }
-    // A toe marker implausibly near the MT head (a toe segment under kMinToeShare of the
-    // ankle-MT length; the development trials' toe markers give 0.25-0.86, a held-out overground
-    // run's marker mapped as the toe about 0.08) cannot carry the COP's roll to the toe tip:
-    // virtual toes replace it.
-    std::vector<double> toe, foot;
-    for (Eigen::Index i = 0; i < best_len; ++i) toe.push_back((T.row(i) - M.row(i)).norm()), foot.push_back((M.row(i) - A.row(i)).norm());
-    const double toe_m = median(toe), foot_m = median(foot);
-    if (toe_m < kMinToeShare * foot_m) {
-      virtual_toes(kVirtualToeShare);
-      char b[300];
-      std::snprintf(b, sizeof b,
-                    "hallux_%s: the toe marker stands a median %.0f mm ahead of the MT head, under %.2f x the ankle-MT length "
-                    "(%.0f mm): too near for a toe; virtual toes of %.2f x ankle-MT length instead",
-                    side ? "l" : "r", 1000 * toe_m, kMinToeShare, 1000 * foot_m, kVirtualToeShare);
-      w.messages.emplace_back(b);
-    }
+    check_toes(s, set, side, w.messages);
   }
   // Torso without trunk markers: the shoulder point sways fore-aft by sway_gain times the hip
   // centre's oscillation about its own slow progression (a 0.5 Hz zero-lag trend, below the
