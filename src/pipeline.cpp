@@ -248,7 +248,7 @@ ModelStage model_stage(const EstimateOptions& o, const SagittalLandmarks& lm, do
   if (!out.soles.message.empty()) out.messages.push_back(out.soles.message);
   for (int s = 0; s < 2; ++s)
     if (out.soles.flat_frames[static_cast<std::size_t>(s)] < 3)
-      out.messages.push_back(std::string(s ? "left" : "right") + " foot: only " +
+      out.messages.push_back(std::string(side_name(s)) + " foot: only " +
                              std::to_string(out.soles.flat_frames[static_cast<std::size_t>(s)]) +
                              " foot-flat frames for the contact calibration");
   out.soles.ground_level_m += o.contact.ground_shift_m;
@@ -614,7 +614,7 @@ Messages window_edge_messages(const std::array<std::vector<bool>, 2>& contact, d
       std::snprintf(b, sizeof b,
                     "%s foot: the stance at frames %ld-%ld %s within %.0f ms of the window's %s (half a period of the %.1f Hz "
                     "kinematic cut-off): the filters see one side of it there, so its forces near that edge are less certain",
-                    side ? "left" : "right", static_cast<long>(first_frame_number + run.first),
+                    side_name(side), static_cast<long>(first_frame_number + run.first),
                     static_cast<long>(first_frame_number + run.last), at_start && at_end ? "lies" : at_start ? "begins" : "ends",
                     1000 * settle_s, at_start && at_end ? "ends" : at_start ? "start" : "end", cutoff_hz);
       out.emplace_back(b);
@@ -968,7 +968,7 @@ std::array<ForcePlate, 2> as_lab_plates(const EstimateResult& r) {
   const Eigen::Index n = r.time_s.size();
   for (int side = 0; side < 2; ++side) {
     ForcePlate& p = out[static_cast<std::size_t>(side)];
-    p.name = side ? "left" : "right";
+    p.name = side_name(side);
     p.side_hint = side ? Side::Left : Side::Right;
     p.force_N.resize(n, 3);
     p.cop_m.resize(n, 3);

@@ -290,9 +290,9 @@ ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_
     const int other = 1 - side;
     if (heel_height[static_cast<std::size_t>(side)] > heel_height[static_cast<std::size_t>(other)] + 0.03) {
       cal.feet[static_cast<std::size_t>(side)] = cal.feet[static_cast<std::size_t>(other)];
-      cal.message = std::string(side ? "left" : "right") + " foot never stands on the floor (heel landmark " +
+      cal.message = std::string(side_name(side)) + " foot never stands on the floor (heel landmark " +
                     std::to_string(static_cast<int>(1000 * heel_height[static_cast<std::size_t>(side)])) +
-                    " mm above it at its lowest): its sole geometry is taken from the " + (side ? "right" : "left") + " foot";
+                    " mm above it at its lowest): its sole geometry is taken from the " + side_name(1 - side) + " foot";
     }
   }
   return cal;

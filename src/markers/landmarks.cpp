@@ -741,7 +741,7 @@ void check_toes(SagittalLandmarks& s, const MarkerSet& set, int side, std::vecto
   auto& T = s.p[landmark(side, kHallux)];
   if (r.kind == RuleKind::VirtualHallux) {
     place_virtual_toes(A, M, T, r.value);
-    messages.push_back(std::string("hallux_") + (side ? "l" : "r") + ": no hallux marker; virtual toes of " + std::to_string(r.value) +
+    messages.push_back(std::string("hallux_") + side_letter(side) + ": no hallux marker; virtual toes of " + std::to_string(r.value) +
                        " x ankle-MT length");
     return;
   }
@@ -754,7 +754,7 @@ void check_toes(SagittalLandmarks& s, const MarkerSet& set, int side, std::vecto
     std::snprintf(b, sizeof b,
                   "hallux_%s: the toe marker stands a median %.0f mm ahead of the MT head, under %.2f x the ankle-MT length "
                   "(%.0f mm): too near for a toe; virtual toes of %.2f x ankle-MT length instead",
-                  side ? "l" : "r", 1000 * toe_m, kMinToeShare, 1000 * foot_m, kVirtualToeShare);
+                  side_letter(side), 1000 * toe_m, kMinToeShare, 1000 * foot_m, kVirtualToeShare);
     messages.emplace_back(b);
   }
 }

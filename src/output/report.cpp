@@ -154,7 +154,7 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
 
   const std::vector<double> time = to_vec(e.time_s);
   for (int f = 0; f < 2; ++f) {
-    const std::string foot = f ? "left" : "right";
+    const std::string foot = side_name(f);
     std::vector<std::pair<double, double>> shaded;
     for (const auto& s : v.stances)
       if (s.foot == f) shaded.emplace_back(e.time_s[s.first], e.time_s[s.last]);
@@ -232,7 +232,7 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
     rep.figures.push_back(std::move(g));
   };
   for (int f = 0; f < 2; ++f) {
-    const std::string foot = f ? "left" : "right";
+    const std::string foot = side_name(f);
     const auto& fe = e.feet[static_cast<std::size_t>(f)];
     figure(foot + " foot: vertical GRF", "N", f, {{"kin2grf estimate", time, to_vec(fe.force_N.col(1)), false}});
     figure(foot + " foot: anterior GRF", "N", f, {{"kin2grf estimate", time, to_vec(fe.force_N.col(0)), false}});

@@ -180,12 +180,12 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
   for (int s = 0; s < 2; ++s) {
     json iv = json::array();
     for (const auto& run : contact_runs(r.feet[s].contact)) iv.push_back({{"start_s", r.time_s[run.first]}, {"end_s", r.time_s[run.last]}});
-    contacts[s ? "left" : "right"] = iv;
+    contacts[side_name(s)] = iv;
   }
   j["contact_intervals"] = contacts;
   json events = json::array();
   for (const GaitEvent& e : gait_events({r.feet[0].contact, r.feet[1].contact}, r.time_s, r.motion.rate_hz))
-    events.push_back({{"event", e.label}, {"side", e.side ? "left" : "right"}, {"frame", r.first_frame_number + e.index}, {"time_s", e.time_s}});
+    events.push_back({{"event", e.label}, {"side", side_name(e.side)}, {"frame", r.first_frame_number + e.index}, {"time_s", e.time_s}});
   j["gait_events"] = events;
   double mean_it = 0;
   int max_it = 0;
@@ -217,7 +217,7 @@ std::string gait_events_csv(const EstimateResult& r) {
   for (const GaitEvent& e : gait_events({r.feet[0].contact, r.feet[1].contact}, r.time_s, r.motion.rate_hz)) {
     char b[32];
     const auto end = std::to_chars(b, b + sizeof b, e.time_s).ptr;  // the shortest text that reads back the same
-    os << (e.side ? "left" : "right") << ',' << e.label << ',' << r.first_frame_number + e.index << ',' << std::string_view(b, end - b) << '\n';
+    os << side_name(e.side) << ',' << e.label << ',' << r.first_frame_number + e.index << ',' << std::string_view(b, end - b) << '\n';
   }
   return os.str();
 }
@@ -236,7 +236,7 @@ std::string format_results_text(const EstimateResult& r) {
   const double bw = r.mass_kg * r.model().gravity_mps2;
   for (int s = 0; s < 2; ++s) {
     const auto& f = r.feet[static_cast<std::size_t>(s)];
-    std::snprintf(b, sizeof b, "%-5s foot: %zu contact interval(s), peak vertical %.0f N (%.2f body weights)\n", s ? "left" : "right",
+    std::snprintf(b, sizeof b, "%-5s foot: %zu contact interval(s), peak vertical %.0f N (%.2f body weights)\n", side_name(s),
                   contact_runs(f.contact).size(), f.force_N.col(1).maxCoeff(), f.force_N.col(1).maxCoeff() / bw);
     os << b;
   }

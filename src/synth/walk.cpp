@@ -158,7 +158,7 @@ std::array<ForcePlate, 2> synthetic_walk_feet(const SyntheticWalk& w, const Esti
   std::array<ForcePlate, 2> feet;
   for (int side = 0; side < 2; ++side) {
     auto& p = feet[static_cast<std::size_t>(side)];
-    p.name = side ? "left" : "right";
+    p.name = side_name(side);
     p.force_N = Eigen::MatrixX3d::Zero(w.trial.markers.frames(), 3);
     p.cop_m = Eigen::MatrixX3d::Constant(w.trial.markers.frames(), 3, std::nan(""));
     p.free_moment_Nm = Eigen::MatrixX3d::Zero(w.trial.markers.frames(), 3);

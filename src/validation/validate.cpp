@@ -18,7 +18,6 @@ namespace {
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 
-std::string side_name(int foot) { return foot ? "left" : "right"; }
 
 std::string frames_text(const EstimateResult& e, Eigen::Index a, Eigen::Index b) {
   return "frames " + std::to_string(e.first_frame_number + a) + "-" + std::to_string(e.first_frame_number + b);
@@ -249,7 +248,7 @@ std::vector<Candidate> assign_stances(const EstimateResult& e, ValidationResult&
       if (ca.foot != cb.foot || ca.plate == cb.plate) continue;
       if (ca.run.last < cb.run.first || cb.run.last < ca.run.first) continue;
       if (ca.kept || cb.kept)
-        v.excluded.push_back("the " + side_name(ca.foot) + " foot stands on plates " + v.plates[static_cast<std::size_t>(ca.plate)].name +
+        v.excluded.push_back(std::string("the ") + side_name(ca.foot) + " foot stands on plates " + v.plates[static_cast<std::size_t>(ca.plate)].name +
                              " and " + v.plates[static_cast<std::size_t>(cb.plate)].name + " at once (" +
                              frames_text(e, std::max(ca.run.first, cb.run.first), std::min(ca.run.last, cb.run.last)) + ")");
       ca.kept = cb.kept = false;
@@ -354,7 +353,7 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
                   ": under more than half the body weight its COP lies a median %.0f mm beyond the %s foot's heel-toe "
                   "markers (limit %.0f mm): the plate does not seem registered with the markers; COP and moment are "
                   "shown but not scored",
-                  1000 * s.cop_beyond_foot_m, side_name(c.foot).c_str(), 1000 * o.max_cop_beyond_foot_m);
+                  1000 * s.cop_beyond_foot_m, side_name(c.foot), 1000 * o.max_cop_beyond_foot_m);
     v.notes.push_back("plate " + mp.name + " " + frames_text(e, c.run.first, c.run.last) + buf);
   }
   s.moment_reference_m = {mp.has_geometry ? mp.centre_m.x() : mean_finite(mc), mp.surface_y_m};
@@ -815,7 +814,7 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
   os << label("rRMSE % (paper's Eq. 12)") << text("vertical") << text("anterior") << text("COP") << text("moment")
      << "   frames\n";
   for (const auto& s : v.stances) {
-    os << label(side_name(s.foot) + " foot on " + s.plate) << cell(s.metrics.vertical) << cell(s.metrics.anterior)
+    os << label(std::string(side_name(s.foot)) + " foot on " + s.plate) << cell(s.metrics.vertical) << cell(s.metrics.anterior)
        << (s.cop_reference_suspect ? bracketed(s.metrics.cop) : cell(s.metrics.cop))
        << (s.cop_reference_suspect ? bracketed(s.metrics.moment) : cell(s.metrics.moment));
     std::snprintf(buf, sizeof buf, "   %ld-%ld\n", static_cast<long>(v.first_frame_number + s.first),
@@ -836,7 +835,7 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
       std::snprintf(r, sizeof r, "%.2f", s.metrics.lateral->pearson_r);
       char cop[40] = "-";
       if (s.metrics.cop_lateral) std::snprintf(cop, sizeof cop, "%.0f", 1000 * s.metrics.cop_lateral->rmse);
-      os << label(side_name(s.foot) + " foot on " + s.plate) << cell(s.metrics.lateral) << text(pct) << text(r) << text(cop) << "\n";
+      os << label(std::string(side_name(s.foot)) + " foot on " + s.plate) << cell(s.metrics.lateral) << text(pct) << text(r) << text(cop) << "\n";
     }
     std::snprintf(buf, sizeof buf, "%.1f", m.lateral_rmse_percent_bw);
     os << label("per foot, mean (SD)") << msd(m.lateral, m.lateral_sd) << text(buf) << text("-");

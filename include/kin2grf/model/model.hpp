@@ -36,7 +36,12 @@ enum SegmentId : int {
   kTorso = 0, kThighR = 1, kShankR = 2, kFootR = 3, kToesR = 4,
   kThighL = 5, kShankL = 6, kFootL = 7, kToesL = 8, kSegmentCount = 9
 };
+/// A foot: its index in every per-foot array (right 0, left 1).
 enum FootSide : int { kRight = 0, kLeft = 1 };
+/// A foot's name, "right" or "left", in every message and output; side_letter: "r" or "l" (landmark
+/// names, OpenSim's bodies).
+constexpr const char* side_name(int side) { return side == kLeft ? "left" : "right"; }
+constexpr const char* side_letter(int side) { return side == kLeft ? "l" : "r"; }
 
 /// A leg's landmarks and bodies, proximal to distal (the same order on both sides).
 enum LegLandmark : int { kKnee = 0, kAnkle = 1, kHeel = 2, kMt = 3, kHallux = 4 };
