@@ -695,4 +695,10 @@ TEST(Mediolateral, TheOptionChangesNoSagittalResult) {
   }
   const Eigen::Index i = n / 2;
   EXPECT_NEAR(r1.frame.lateral_at(r1.first_index + i).dot(lab_foot_frame(r1, 0, i).force_N), r1.feet[0].force_lateral_N[i], 1e-9);
+  // The per-frame table gains the two lateral columns, last; without the option it has none.
+  const ResultsTable t0 = results_table(r0), t1 = results_table(r1);
+  ASSERT_EQ(t1.columns.size(), t0.columns.size() + 2);
+  EXPECT_EQ(t1.columns.back(), "grf_lateral_l_N");
+  EXPECT_EQ(t1.values(i, t1.values.cols() - 2), r1.feet[0].force_lateral_N[i]);
+  EXPECT_EQ(t1.values.leftCols(t0.values.cols()).row(i), t0.values.row(i));
 }

@@ -56,7 +56,7 @@ void write_grf_mot(const std::string& path, const EstimateResult& r, const std::
   file.commit();
 }
 
-std::vector<std::string> results_columns() {
+std::vector<std::string> results_columns(bool mediolateral) {
   std::vector<std::string> c = {"frame", "time_s"};
   for (const char* s : {"r", "l"})
     for (const char* name : {"grf_anterior_%s_N", "grf_vertical_%s_N", "cop_x_%s_m", "contact_%s", "gap_%s_m",
@@ -72,6 +72,8 @@ std::vector<std::string> results_columns() {
     c.push_back(std::string("force_") + joint_name(j) + "_y_N");
   }
   for (const char* name : {"residual_x_N", "residual_y_N", "residual_moment_Nm", "iterations"}) c.emplace_back(name);
+  if (mediolateral)
+    for (const char* name : {"grf_lateral_r_N", "grf_lateral_l_N"}) c.emplace_back(name);
   return c;
 }
 
@@ -93,11 +95,13 @@ void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> v) {
   for (int j = 0; j < 2 * kJointCount; ++j) v[k++] = held ? r.joint_force_N(i, j) : t.joint_force_N[static_cast<std::size_t>(j)];
   for (int j = 0; j < 3; ++j) v[k++] = held ? r.residual(i, j) : t.residual[j];
   v[k++] = r.iterations[static_cast<std::size_t>(i)];
+  if (v.size() > k)
+    for (const auto& f : r.feet) v[k++] = f.force_lateral_N[i];
 }
 
 ResultsTable results_table(const EstimateResult& r) {
   ResultsTable t;
-  t.columns = results_columns();
+  t.columns = results_columns(r.feet[0].force_lateral_N.size() > 0);
   const Eigen::Index n = r.time_s.size();
   const auto nc = static_cast<Eigen::Index>(t.columns.size());
   t.values.resize(n, nc);
@@ -110,7 +114,7 @@ ResultsTable results_table(const EstimateResult& r) {
 }
 
 void write_results_csv(std::ostream& os, const EstimateResult& r) {
-  const std::vector<std::string> columns = results_columns();
+  const std::vector<std::string> columns = results_columns(r.feet[0].force_lateral_N.size() > 0);
   std::string buf;
   for (std::size_t k = 0; k < columns.size(); ++k) (buf += k ? "," : "") += columns[k];
   buf += '\n';

@@ -96,9 +96,17 @@ def test_table_and_columns(example):
     assert r.summary["mass_kg"] == 70.0
 
 
+def test_mediolateral_adds_the_lateral_columns(example):
+    r0 = kin2grf.estimate(example / "example_walk.c3d")
+    r1 = kin2grf.estimate(example / "example_walk.c3d", mediolateral=True)
+    assert r1.columns == r0.columns + ["grf_lateral_r_N", "grf_lateral_l_N"]
+    assert np.array_equal(r1["grf_vertical_r_N"], r0["grf_vertical_r_N"])
+    assert r1.summary["settings"]["mediolateral"] is True
+
+
 def test_help_lists_every_setting():
     for f in (kin2grf.estimate, kin2grf.validate):
-        for name in ("speed_gate_ratio", "mass", "touchdown_fraction", "post_cutoff_floor", "paper"):
+        for name in ("speed_gate_ratio", "mass", "touchdown_fraction", "post_cutoff_floor", "paper", "mediolateral"):
             assert f"    {name}" in f.__doc__, (f.__name__, name)
 
 

@@ -28,7 +28,9 @@ struct ResultsTable {
 };
 ResultsTable results_table(const EstimateResult& r);
 /// results_table's columns, and its row `i` into `out` (out.size() == the columns' count).
-std::vector<std::string> results_columns();
+/// The per-frame table's columns; `mediolateral` (EstimateOptions::mediolateral): and each foot's
+/// lateral force last, grf_lateral_r_N and grf_lateral_l_N.
+std::vector<std::string> results_columns(bool mediolateral = false);
 void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> out);
 /// results_table as CSV: counts (frame, contact, iterations) as integers, the rest to 6
 /// significant digits, NaN as an empty cell. Written row by row as made, never held whole; the
