@@ -702,3 +702,39 @@ TEST(Mediolateral, TheOptionChangesNoSagittalResult) {
   EXPECT_EQ(t1.values(i, t1.values.cols() - 2), r1.feet[0].force_lateral_N[i]);
   EXPECT_EQ(t1.values.leftCols(t0.values.cols()).row(i), t0.values.row(i));
 }
+
+// The same recorded walk turned about the vertical (the lab's axes no longer along the walkway, or
+// the walk the other way) gives the same forces in the walker's frame: each foot's anterior,
+// vertical and mediolateral forces (issue 28's frame test). A heading within 10 degrees of a lab
+// axis is snapped to it (detect_sagittal_frame), so the recorded walk (along X) and its 180-degree
+// turn share a snapped frame, and its 30- and 210-degree turns the walker's own heading: each pair
+// agrees to round-off, and across the pairs the forces differ only by the walker's few degrees off
+// the lab's axis (under 1 % body weight).
+TEST(Mediolateral, AWalkTurnedAboutTheVerticalGivesTheSameForces) {
+  const std::string path = std::string(KIN2GRF_SOURCE_DIR) + "/data/example/walking2.c3d";
+  const Trial walk = load_trial(path);
+  ASSERT_EQ(walk.markers.up_axis, Axis::Z);
+  EstimateOptions eo;
+  eo.mass_kg = 64.9;
+  eo.mediolateral = true;
+  const MarkerSet& set = *recognise_marker_set(walk.markers);
+  const double bw = 64.9 * 9.81;
+  const auto turned = [&](double deg) {
+    Trial t = walk;
+    t.markers = rotated(walk.markers, Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix(), Axis::Z);
+    return estimate(t, nullptr, set, eo);
+  };
+  const auto difference = [](const EstimateResult& a, const EstimateResult& b) {
+    double d = 0;
+    for (int k = 0; k < 2; ++k)
+      d = std::max({d, (a.feet[k].force_N - b.feet[k].force_N).cwiseAbs().maxCoeff(),
+                    (a.feet[k].force_lateral_N - b.feet[k].force_lateral_N).cwiseAbs().maxCoeff()});
+    return d;
+  };
+  const auto r0 = turned(0), r180 = turned(180), r30 = turned(30), r210 = turned(210);
+  ASSERT_EQ(r30.time_s.size(), r0.time_s.size());
+  EXPECT_LT(difference(r0, r180), 1e-3 * bw);
+  EXPECT_LT(difference(r30, r210), 1e-3 * bw);
+  EXPECT_LT(difference(r0, r30), 0.01 * bw);
+  EXPECT_GT(r0.feet[0].force_lateral_N.cwiseAbs().maxCoeff(), 10.0);  // the force compared is there
+}
