@@ -101,6 +101,11 @@ std::vector<Setting> settings_for(const std::string& kind) {
     // and with the model torso above the pelvis instead (without_trunk_markers).
     s.push_back({"intact", 0, [](EstimateOptions&) {}, 0.0, true});
     s.push_back({"trunk markers removed", 1, [](EstimateOptions&) {}, 0.0, false, true});
+  } else if (kind == "mediolateral-ablation") {
+    // The mediolateral force (--mediolateral) as recorded and without the trunk and arm markers:
+    // the trunk is most of the mass whose lateral acceleration the force is.
+    s.push_back({"intact", 0, [](EstimateOptions& o) { o.mediolateral = true; }, 0.0, true});
+    s.push_back({"trunk markers removed", 1, [](EstimateOptions& o) { o.mediolateral = true; }, 0.0, false, true});
   } else if (kind == "post-cutoff-floor") {
     // The post-filter's floor as a multiple of the dynamics' kinematic cut-off.
     for (double f : {0.0, 0.5, 0.75, 1.0, 1.5, 2.0}) {
@@ -191,7 +196,7 @@ StudyCell pool(const std::vector<StudyTrialResult>& trials, const std::string& a
 
 const std::vector<std::string>& study_kinds() {
   static const std::vector<std::string> kinds{"r",     "ground-shift",         "cutoff",         "post-cutoff-cycles", "kinematic-cutoff",
-                                              "speed-gate", "speed-gate-ratio", "touchdown-fraction", "post-cutoff-floor", "trunk-ablation", "noise",     "min-kinematic-cycles", "split-distance",
+                                              "speed-gate", "speed-gate-ratio", "touchdown-fraction", "post-cutoff-floor", "trunk-ablation", "mediolateral-ablation", "noise",     "min-kinematic-cycles", "split-distance",
                                               "torso-length", "torso-lag",      "double-support-sta", "foot-model"};
   return kinds;
 }
@@ -431,9 +436,16 @@ std::string format_study_table(const StudyResult& s) {
                     c.per_foot.cop, c.per_foot.moment);
       os << b;
       // No trial with a total window (validate says why): a dash, not "nan".
-      if (std::isfinite(c.total_grm)) std::snprintf(b, sizeof b, " %10.1f\n", c.total_grm);
-      else std::snprintf(b, sizeof b, " %10s\n", "-");
+      if (std::isfinite(c.total_grm)) std::snprintf(b, sizeof b, " %10.1f", c.total_grm);
+      else std::snprintf(b, sizeof b, " %10s", "-");
       os << b;
+      // With --mediolateral: its rRMSE and RMSE in % body weight, and the lateral COP's RMSE.
+      if (std::isfinite(c.per_foot.lateral_rmse_percent_bw)) {
+        std::snprintf(b, sizeof b, "   mediolateral %.1f %% (%.1f %% BW), lateral COP %.0f mm", c.per_foot.lateral,
+                      c.per_foot.lateral_rmse_percent_bw, c.per_foot.cop_lateral_rmse_mm);
+        os << b;
+      }
+      os << "\n";
     }
   }
   for (const auto& f : s.failures) os << "failed: " << f << "\n";
