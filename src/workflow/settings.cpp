@@ -17,6 +17,48 @@ namespace kin2grf {
 
 namespace {
 const char* torso_length_name(TorsoLength t) { return t == TorsoLength::Fixed ? "fixed" : "measured"; }
+
+/// A numeric setting that is one EstimateOptions field, declared once: its flag (range, default:
+/// the field's, help), its value under --paper (none: the user's) and its key in the settings
+/// JSON all come from its row. Adding one: a row here and the field with its use.
+struct NumericSetting {
+  const char* flag;  ///< without the dashes
+  const char* json_key;
+  double& (*field)(EstimateOptions&);
+  double lo, hi;  ///< the command line's range; lo > hi: none there (the library's check_options)
+  std::optional<double> paper;
+  const char* help;
+};
+const std::vector<NumericSetting>& numeric_settings() {
+  using O = EstimateOptions;
+  static const std::vector<NumericSetting> table = {
+      {"min-kinematic-cycles", "min_kinematic_cycles", [](O& o) -> double& { return o.min_kinematic_cycles; }, 0.0, 20.0, std::nullopt,
+       "Where the noise rule lowers the kinematic cut-off, the dynamics' cut-off stays at least this many cycles over the median "
+       "stance (the COP function's foot angle keeps the lowered one); 0 = no floor"},
+      {"post-cutoff-floor", "post_cutoff_floor_ratio", [](O& o) -> double& { return o.post_cutoff_floor_ratio; }, 0.0, 10.0, std::nullopt,
+       "The per-stance post-filter cut-off is not taken below this multiple of the dynamics' kinematic cut-off (0 = no floor, the "
+       "default)"},
+      {"ground-shift", "ground_shift_m", [](O& o) -> double& { return o.contact.ground_shift_m; }, 1.0, -1.0, std::nullopt,
+       "Shift the ground by this much, m (robustness study)"},
+      {"speed-gate-ratio", "speed_gate_ratio", [](O& o) -> double& { return o.contact.speed_gate.ratio; }, 0.0, 20.0, 0.0,
+       "The speed gate as this multiple of the progression speed (hip or belt), at least --speed-gate-floor; 0 = the fixed "
+       "--speed-gate"},
+      {"speed-gate-floor", "speed_gate_floor_mps", [](O& o) -> double& { return o.contact.speed_gate.floor_mps; }, 0.0, 20.0, std::nullopt,
+       "Lowest speed gate with --speed-gate-ratio, m/s"},
+      {"touchdown-fraction", "touchdown_fraction", [](O& o) -> double& { return o.contact.touchdown_fraction; }, 0.0, 1.0, 0.0,
+       "A landing foot takes no load before its descent speed, past the final approach's peak, has fallen to this fraction of the "
+       "peak (1: from the peak on; 0 = off, the default and the paper)"},
+      {"split-distance", "min_split_distance_m", [](O& o) -> double& { return o.solver.min_split_distance_m; }, 0.0, 1.0, 0.0,
+       "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)"},
+      {"torso-lag", "torso_lag_s", [](O& o) -> double& { return o.torso_lag_s; }, 0.0, 0.2, 0.0,
+       "The upper body's fore-aft lag behind the pelvis, s: the HAT's fore-aft inertial force is delayed by this time, less what "
+       "the trunk markers already lag the hip by (0 = none, the paper)"},
+      {"double-support-sta", "double_support_sta_weight", [](O& o) -> double& { return o.double_support_sta_weight; }, 0.0, 1.0, 0.0,
+       "Weight (0-1) of the smooth transition towards which each walking double support's split between the feet is blended "
+       "(0 = none, the paper)"},
+  };
+  return table;
+}
 }  // namespace
 
 void add_settings_options(CLI::App* c, Settings& a) {
@@ -37,53 +79,23 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("--kinematic-cutoff-rule", a.kinematic_cutoff_rule,
                 "noise: --kinematic-cutoff lowered where the markers' noise needs it (residual analysis); fixed: as given (--paper)")
       ->check(CLI::IsMember({"noise", "fixed"}))->capture_default_str();
-  c->add_option("--min-kinematic-cycles", a.min_kinematic_cycles,
-                "Where the noise rule lowers the kinematic cut-off, the dynamics' cut-off stays at least this many cycles "
-                "over the median stance (the COP function's foot angle keeps the lowered one); 0 = no floor")
-      ->check(CLI::Range(0.0, 20.0))->capture_default_str();
   c->add_option("--post-cutoff", a.post_cutoff,
                 "Multiplier post-filter at this fixed cut-off, Hz (the paper: 12; 0: none); replaces --post-cutoff-cycles");
   c->add_option_function<double>(
        "--post-cutoff-cycles", [&a](double v) { a.post_cutoff_cycles = v, a.post_cutoff_cycles_given = true; },
        "Multiplier post-filter cut-off as cycles per stance: this over the trial's median stance duration (default 4; "
        "0, --paper or a trial with no complete stance: 12 Hz)");
-  c->add_option("--post-cutoff-floor", a.post_cutoff_floor,
-                "The per-stance post-filter cut-off is not taken below this multiple of the dynamics' kinematic cut-off "
-                "(0 = no floor, the default)")
-      ->check(CLI::Range(0.0, 10.0))->capture_default_str();
   c->add_option("--ground-level", a.ground_level, "Floor height in the lab's up axis, m (default: estimated)");
   c->add_option("--grm-reference", a.grm_reference,
                  "GRM reference point in the sagittal frame: along progression and up from the lab origin, m (default 0 0)")
       ->expected(2);
-  c->add_option("--ground-shift", a.ground_shift, "Shift the ground by this much, m (robustness study)")->capture_default_str();
   c->add_option_function<double>(
-       "--speed-gate", [&a](double v) { a.speed_gate = v, a.speed_gate_ratio = 0; },
+       "--speed-gate", [&a](double v) { a.speed_gate = v, a.numeric.contact.speed_gate.ratio = 0; },
        "A fixed speed gate: contact allowed only below this sole speed, m/s (0 = off, the paper); replaces --speed-gate-ratio")
       ->check(CLI::Range(0.0, 20.0));
-  c->add_option("--speed-gate-ratio", a.speed_gate_ratio,
-                "The speed gate as this multiple of the progression speed (hip or belt), at least --speed-gate-floor; "
-                "0 = the fixed --speed-gate")
-      ->check(CLI::Range(0.0, 20.0))->capture_default_str();
-  c->add_option("--speed-gate-floor", a.speed_gate_floor, "Lowest speed gate with --speed-gate-ratio, m/s")
-      ->check(CLI::Range(0.0, 20.0))->capture_default_str();
-  c->add_option("--touchdown-fraction", a.touchdown_fraction,
-                "A landing foot takes no load before its descent speed, past the final approach's peak, has fallen to this "
-                "fraction of the peak (1: from the peak on; 0 = off, the default and the paper)")
-      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
-  c->add_option("--split-distance", a.split_distance,
-                "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)")
-      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   c->add_option("--torso-length", a.torso_length,
                 "measured (the hip-shoulder distance of each frame, filtered) or fixed (its median, the paper's rigid HAT)")
       ->check(CLI::IsMember({"measured", "fixed"}))->capture_default_str();
-  c->add_option("--torso-lag", a.torso_lag,
-                "The upper body's fore-aft lag behind the pelvis, s: the HAT's fore-aft inertial force is delayed by this "
-                "time, less what the trunk markers already lag the hip by (0 = none, the paper)")
-      ->check(CLI::Range(0.0, 0.2))->capture_default_str();
-  c->add_option("--double-support-sta", a.double_support_sta,
-                "Weight (0-1) of the smooth transition towards which each walking double support's split between the "
-                "feet is blended (0 = none, the paper)")
-      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
       ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
   c->add_option_function<std::string>(
@@ -98,6 +110,10 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
   c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length, no torso lag");
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
+  for (const NumericSetting& s : numeric_settings()) {
+    CLI::Option* opt = c->add_option(std::string("--") + s.flag, s.field(a.numeric), s.help)->capture_default_str();
+    if (s.lo <= s.hi) opt->check(CLI::Range(s.lo, s.hi));
+  }
 }
 
 void parse_settings(const std::vector<std::string>& words, Settings& s, const std::string& where) {
@@ -138,12 +154,9 @@ EstimateOptions to_options(const Settings& a) {
   if (a.post_cutoff) o.post_cutoff_hz = *a.post_cutoff;
   const bool fixed_post_cutoff = a.post_cutoff || (a.paper && !a.post_cutoff_cycles_given);
   o.post_cutoff_cycles = fixed_post_cutoff ? 0.0 : a.post_cutoff_cycles;
-  o.post_cutoff_floor_ratio = a.post_cutoff_floor;
   o.cutoff_from_noise = !a.paper && a.kinematic_cutoff_rule == "noise";
-  o.min_kinematic_cycles = a.min_kinematic_cycles;
   o.ground_level_m = a.ground_level;
   o.contact.foot_model = a.foot_model == "cop" ? FootModel::Cop : FootModel::ThreePoint;
-  o.contact.ground_shift_m = a.ground_shift;
   if (a.grm_reference.size() == 2) o.grm_reference_m = Eigen::Vector2d(a.grm_reference[0], a.grm_reference[1]);
   if (a.paper) o.contact.cop = CopFunction::paper();
   if (!a.cop_function.empty()) o.contact.cop = read_cop_function(a.cop_function);
@@ -154,15 +167,11 @@ EstimateOptions to_options(const Settings& a) {
   o.solver.r_N_per_m = (a.paper && !a.r_given) ? 1e4 : a.r;
   o.solver.norm = (a.paper || a.norm == "paper") ? MultiplierNorm::Paper : MultiplierNorm::TorqueScaled;
   o.contact.speed_gate.fixed_mps = a.paper ? 0.0 : a.speed_gate;
-  o.contact.speed_gate.ratio = a.paper ? 0.0 : a.speed_gate_ratio;
-  o.contact.speed_gate.floor_mps = a.speed_gate_floor;
-  o.contact.touchdown_fraction = a.paper ? 0.0 : a.touchdown_fraction;
-  o.solver.min_split_distance_m = a.paper ? 0.0 : a.split_distance;
   o.torso_length = (a.paper || a.torso_length == "fixed") ? TorsoLength::Fixed : TorsoLength::Measured;
-  o.torso_lag_s = a.paper ? 0.0 : a.torso_lag;
-  o.double_support_sta_weight = a.paper ? 0.0 : a.double_support_sta;
   o.landmarks.max_gap_frames = a.max_gap;
   o.landmarks.up_axis = parse_axis(a.up_axis);
+  EstimateOptions given = a.numeric;
+  for (const NumericSetting& s : numeric_settings()) s.field(o) = (a.paper && s.paper) ? *s.paper : s.field(given);
   return o;
 }
 
@@ -173,7 +182,7 @@ nlohmann::json cop_json(const CopFunction& c, const std::string& source) {
 }  // namespace
 
 nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
-  return {{"trial", a.trial},
+  nlohmann::json j = {{"trial", a.trial},
           {"static", a.static_trial},
           {"paper_configuration", a.paper},
           {"foot_model", a.foot_model},
@@ -184,25 +193,20 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"r_N_per_m", o.solver.r_N_per_m},
           {"norm", o.solver.norm == MultiplierNorm::Paper ? "paper" : "torque-scaled"},
           {"speed_gate_mps", o.contact.speed_gate.fixed_mps},
-          {"speed_gate_ratio", o.contact.speed_gate.ratio},
-          {"speed_gate_floor_mps", o.contact.speed_gate.floor_mps},
-          {"touchdown_fraction", o.contact.touchdown_fraction},
+
           {"mediolateral", o.mediolateral},
-          {"min_split_distance_m", o.solver.min_split_distance_m},
           {"torso_length", torso_length_name(o.torso_length)},
-          {"torso_lag_s", o.torso_lag_s},
-          {"double_support_sta_weight", o.double_support_sta_weight},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"kinematic_cutoff_rule", o.cutoff_from_noise ? "noise" : "fixed"},
-          {"min_kinematic_cycles", o.min_kinematic_cycles},
           {"post_cutoff_hz", o.post_cutoff_hz},
           {"post_cutoff_cycles", o.post_cutoff_cycles},
-          {"post_cutoff_floor_ratio", o.post_cutoff_floor_ratio},
           {"anthropometry", o.anthropometry},
           {"ground_level_m", o.ground_level_m ? nlohmann::json(*o.ground_level_m) : nlohmann::json("auto")},
-          {"ground_shift_m", o.contact.ground_shift_m},
           {"grm_reference_m", {o.grm_reference_m.x(), o.grm_reference_m.y()}},
           {"max_gap_frames", o.landmarks.max_gap_frames}};
+  EstimateOptions used = o;
+  for (const NumericSetting& s : numeric_settings()) j[s.json_key] = s.field(used);
+  return j;
 }
 
 const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, MarkerSet& custom, std::string* why) {

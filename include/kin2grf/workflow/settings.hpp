@@ -29,13 +29,10 @@ struct Settings {
               cop_function, running_cop = "builtin", torso_length = "measured",
               kinematic_cutoff_rule = "noise";
   double r = SolverOptions{}.r_N_per_m, kinematic_cutoff = EstimateOptions{}.kinematic_cutoff_hz,
-         post_cutoff_cycles = EstimateOptions{}.post_cutoff_cycles, ground_shift = 0, speed_gate = SpeedGateRule{}.fixed_mps,
-         split_distance = SolverOptions{}.min_split_distance_m, speed_gate_ratio = SpeedGateRule{}.ratio,
-         speed_gate_floor = SpeedGateRule{}.floor_mps, torso_lag = EstimateOptions{}.torso_lag_s,
-         double_support_sta = EstimateOptions{}.double_support_sta_weight,
-         min_kinematic_cycles = EstimateOptions{}.min_kinematic_cycles,
-         touchdown_fraction = ContactModelOptions{}.touchdown_fraction,
-         post_cutoff_floor = EstimateOptions{}.post_cutoff_floor_ratio;
+         post_cutoff_cycles = EstimateOptions{}.post_cutoff_cycles, speed_gate = SpeedGateRule{}.fixed_mps;
+  /// The numeric settings that are one option field each (settings.cpp's table: flag, range,
+  /// --paper value, JSON key), held in their own fields with the library's defaults.
+  EstimateOptions numeric;
   bool paper = false, r_given = false, anthropometry_given = false;
   std::optional<double> ground_level;
   std::optional<double> post_cutoff;  ///< given: the post-filter at this fixed cut-off, Hz
