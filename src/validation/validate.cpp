@@ -304,10 +304,39 @@ double cop_beyond_foot_m(const EstimateResult& e, const Candidate& c, const Eige
 
 /// One kept stance compared (per-foot metrics, timing, lag); its measured force and COP go into
 /// v's per-foot series.
+/// The foot's sole length (heel point A to toe point C), median over the stance, for the COP
+/// error in % of foot length: an rRMSE divides by the COP's range, 5-6 cm over a walking stance
+/// overground and 50-60 cm on a treadmill, so the same error reads 32 % or 4.5 %. NaN without
+/// the sole series.
+double stance_foot_length_m(const EstimateResult& e, const Candidate& c) {
+  const Eigen::MatrixXd& sole = e.feet[static_cast<std::size_t>(c.foot)].sole_m;
+  std::vector<double> sole_length;
+  if (sole.rows() == e.time_s.size())
+    for (Eigen::Index i = c.run.first; i <= c.run.last; ++i) sole_length.push_back((sole.block<1, 2>(i, 4) - sole.block<1, 2>(i, 0)).norm());
+  return sole_length.empty() ? kNaN : median(sole_length);
+}
+
+/// Contact timing: threshold crossings of the estimate near the plate's (+ = estimate late), and
+/// the vertical force's best time shift.
+void stance_timing(const EstimateResult& e, const MeasuredPlate& mp, const Candidate& c, const ValidationOptions& o, StanceValidation& s) {
+  const Eigen::Index n = e.time_s.size(), a = c.run.first;
+  const double rate = e.landmarks.rate_hz;
+  const Eigen::Index search = static_cast<Eigen::Index>(std::lround(0.2 * rate));
+  const Eigen::VectorXd ev = e.feet[static_cast<std::size_t>(c.foot)].force_N.col(1);
+  const Eigen::VectorXd pv = mp.force_N.col(1);
+  const auto m_on = rising_crossing(pv, e.time_s, o.threshold_N, a - 1, c.run.last);
+  const auto m_off = falling_crossing(pv, e.time_s, o.threshold_N, a, c.run.last + 1);
+  const Eigen::Index from = std::max<Eigen::Index>(0, a - search), to = std::min<Eigen::Index>(n - 1, c.run.last + search);
+  if (m_on && !(ev[from] > o.threshold_N))
+    if (const auto e_on = rising_crossing(ev, e.time_s, o.threshold_N, from, c.run.last)) s.onset_error_ms = 1000 * (*e_on - *m_on);
+  if (m_off && !(ev[to] > o.threshold_N))
+    if (const auto e_off = falling_crossing(ev, e.time_s, o.threshold_N, a, to)) s.offset_error_ms = 1000 * (*e_off - *m_off);
+  s.vertical_lag_ms = vertical_lag_ms(ev, pv, a, c.run.last, rate);
+}
+
 StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, const Candidate& c, const ValidationOptions& o) {
   const Eigen::Index n = e.time_s.size();
-  const double bw = e.mass_kg * e.model().gravity_mps2, rate = e.landmarks.rate_hz, ground = e.ground_level_m();
-  const Eigen::Index search = static_cast<Eigen::Index>(std::lround(0.2 * rate));
+  const double bw = e.mass_kg * e.model().gravity_mps2, ground = e.ground_level_m();
   const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(c.plate)];
   const FootResult& fe = e.feet[static_cast<std::size_t>(c.foot)];
   const Eigen::Index a = c.run.first, len = c.run.last - c.run.first + 1;
@@ -335,17 +364,7 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
       if (!(mv[i] > o.cop_min_force_fraction * bw)) ml[i] = kNaN;
     s.metrics.cop_lateral = compare_series(e.foot_lateral_m[static_cast<std::size_t>(c.foot)].segment(a, len), ml);
   }
-  {
-    // The foot's sole length (heel point A to toe point C) over the stance, for the COP error
-    // in % of foot length: an rRMSE divides by the COP's range, 5-6 cm over a walking stance
-    // overground and 50-60 cm on a treadmill, so the same error reads 32 % or 4.5 %.
-    const Eigen::MatrixXd& sole = e.feet[static_cast<std::size_t>(c.foot)].sole_m;
-    std::vector<double> sole_length;
-    if (sole.rows() == n)
-      for (Eigen::Index i = c.run.first; i <= c.run.last; ++i)
-        sole_length.push_back((sole.block<1, 2>(i, 4) - sole.block<1, 2>(i, 0)).norm());
-    s.foot_length_m = sole_length.empty() ? kNaN : median(sole_length);
-  }
+  s.foot_length_m = stance_foot_length_m(e, c);
   if (s.cop_beyond_foot_m > o.max_cop_beyond_foot_m) {
     s.cop_reference_suspect = true;
     char buf[320];
@@ -366,17 +385,7 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
     mm[i] = mp.moment_origin_Nm[k] - sagittal_moment(rx, ry, mp.force_N(k, 0), mp.force_N(k, 1));
   }
   s.metrics.moment = compare_series(me, mm);
-  // Contact timing: threshold crossings of the estimate near the plate's, + = estimate late.
-  const Eigen::VectorXd ev = fe.force_N.col(1);
-  const Eigen::VectorXd pv = mp.force_N.col(1);
-  const auto m_on = rising_crossing(pv, e.time_s, o.threshold_N, a - 1, c.run.last);
-  const auto m_off = falling_crossing(pv, e.time_s, o.threshold_N, a, c.run.last + 1);
-  const Eigen::Index from = std::max<Eigen::Index>(0, a - search), to = std::min<Eigen::Index>(n - 1, c.run.last + search);
-  if (m_on && !(ev[from] > o.threshold_N))
-    if (const auto e_on = rising_crossing(ev, e.time_s, o.threshold_N, from, c.run.last)) s.onset_error_ms = 1000 * (*e_on - *m_on);
-  if (m_off && !(ev[to] > o.threshold_N))
-    if (const auto e_off = falling_crossing(ev, e.time_s, o.threshold_N, a, to)) s.offset_error_ms = 1000 * (*e_off - *m_off);
-  s.vertical_lag_ms = vertical_lag_ms(ev, pv, a, c.run.last, rate);
+  stance_timing(e, mp, c, o, s);
   for (Eigen::Index i = 0; i < len; ++i) {
     auto& mf = v.measured_force_N[static_cast<std::size_t>(c.foot)];
     if (!std::isfinite(mf(a + i, 1))) mf.row(a + i).setZero();
