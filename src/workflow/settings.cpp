@@ -68,8 +68,8 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("--mass", a.mass, "Body mass, kg (default: the C3D's PROCESSING:Bodymass or SUBJECT(S):WEIGHT); 20-300");
   c->add_flag("--force-mass", a.force_mass, "Accept a body mass outside 20-300 kg");
   c->add_flag("--mediolateral", a.mediolateral,
-              "Estimate each foot's mediolateral force too (the whole body's lateral acceleration, split between the feet by "
-              "the inverted-pendulum rule; docs/METHOD-NOTES.md); off: the sagittal model's zero lateral force");
+              "Estimate each foot's mediolateral force too (the whole body's lateral acceleration, shared between the feet by "
+              "vertical load; docs/METHOD-NOTES.md); off: the sagittal model's zero lateral force");
   c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
       ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
   c->add_option_function<double>(
