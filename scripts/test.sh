@@ -9,9 +9,10 @@ cmake --preset ci >/dev/null
 cmake --build --preset ci
 ctest --preset ci -j2
 # The readers, outputs, filters, solver and parallel tests under ASan/UBSan, built with the
-# library the fuzzers use (one sanitizer build of it serves both), then the fuzz targets, 20 s each,
-# seeded with the project's own files; scripts/fuzz.sh 600 is the long run.
+# library the fuzzers use (one sanitizer build of it serves both; line tables only, which keep the
+# sanitizers' stack traces at a fraction of full debug information's compile time), then the fuzz
+# targets, 10 s each, seeded with the project's own files; scripts/fuzz.sh 600 is the long run.
 cmake --preset fuzz >/dev/null
 cmake --build --preset fuzz --target kin2grf_tests
 ctest --preset fuzz -j2 -R 'C3d|Trc|Sto|Corrupt|Fuzz|Solver|NoisyMarkers|SyntheticWalk|Parallel|Text|OutputFile|InputFile'
-bash scripts/fuzz.sh 20
+bash scripts/fuzz.sh 10
