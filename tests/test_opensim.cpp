@@ -314,20 +314,24 @@ TEST(Trc, ThousandsOfOneRepeatedLabelAreNamedAtOnce) {
 // - every data row has exactly 3 NumMarkers + 2 tokens (else RowLengthMismatch), each read by
 //   std::stod (which takes "NaN").
 namespace {
-::testing::AssertionResult opensim_reads_trc(const std::string& text) {
-  auto tokenize = [](const std::string& line, const std::string& delims) {
-    std::vector<std::string> tokens;
-    std::string cur;
-    for (const char c : line) {
-      if (delims.find(c) != std::string::npos) {
-        if (!cur.empty()) tokens.push_back(cur), cur.clear();
-      } else {
-        cur += c;
-      }
+/// OpenSim's FileAdapter::tokenize: `line` split on any of `delims`, a run of them one split, so
+/// an empty field is no token at all.
+std::vector<std::string> opensim_tokenize(const std::string& line, const std::string& delims) {
+  std::vector<std::string> tokens;
+  std::string cur;
+  for (const char c : line) {
+    if (delims.find(c) != std::string::npos) {
+      if (!cur.empty()) tokens.push_back(cur), cur.clear();
+    } else {
+      cur += c;
     }
-    if (!cur.empty()) tokens.push_back(cur);
-    return tokens;
-  };
+  }
+  if (!cur.empty()) tokens.push_back(cur);
+  return tokens;
+}
+
+::testing::AssertionResult opensim_reads_trc(const std::string& text) {
+  const auto tokenize = opensim_tokenize;
   std::istringstream in(text);
   std::string line;
   std::getline(in, line);
@@ -386,19 +390,7 @@ namespace {
 namespace {
 ::testing::AssertionResult opensim_reads_sto(const std::string& text, std::vector<std::string>* labels_out = nullptr,
                                              std::vector<std::vector<double>>* rows_out = nullptr) {
-  auto tokenize = [](const std::string& line) {
-    std::vector<std::string> tokens;
-    std::string cur;
-    for (const char c : line) {
-      if (c == '\t') {
-        if (!cur.empty()) tokens.push_back(cur), cur.clear();
-      } else {
-        cur += c;
-      }
-    }
-    if (!cur.empty()) tokens.push_back(cur);
-    return tokens;
-  };
+  const auto tokenize = [](const std::string& line) { return opensim_tokenize(line, "\t"); };  // STOFileAdapter's delimiter
   std::istringstream in(text);
   std::string line;
   bool ended = false;

@@ -1,7 +1,5 @@
 #include "kin2grf/dynamics/mediolateral.hpp"
 
-#include <cmath>
-
 #include "kin2grf/error.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 

@@ -1,6 +1,6 @@
 // kin2grf markers: marker sets (presets or a user mapping file) -> the model's 12 landmarks.
 //
-// A marker set is data (JSON, data/presets/*.json, read by markers/presets.hpp outside the core;
+// A marker set is data (JSON, data/presets/*.json, read by io/marker_presets.hpp outside the core;
 // format in docs/MARKERSETS.md): for each landmark a rule, one of
 //   {"marker": "RKNE"}                        one marker
 //   {"mean": ["RMT1", "RMT2"]}                the mean of several markers
