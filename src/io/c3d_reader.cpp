@@ -102,6 +102,68 @@ std::string processor_name(int p) {
 }
 
 /// Parameter section: groups and parameters, resolved to "GROUP:NAME" keys.
+/// One parameter's type, dimensions and data (C3D: type, dimension count, dimensions, data),
+/// starting at byte q of the entry that begins at byte p; every size checked against `end`,
+/// the parameter section's end.
+C3dParameter read_parameter(const Bytes& b, std::size_t p, std::size_t q, std::size_t end, const std::string& name) {
+  C3dParameter par;
+  par.type = b.i8(q, "parameter type");
+  const int ndims = b.u8(q + 1, "parameter dimension count");
+  if (par.type != -1 && par.type != 1 && par.type != 2 && par.type != 4) {
+    std::ostringstream os;
+    os << b.path() << ": parameter '" << name << "' at byte " << p << " has invalid type "
+       << par.type << " (expected -1, 1, 2 or 4)";
+    throw InputError(os.str());
+  }
+  std::size_t count = 1;
+  for (int d = 0; d < ndims; ++d) {
+    const int dim = b.u8(q + 2 + d, "parameter dimension");
+    par.dims.push_back(dim);
+    // Checked before it can wrap: 255^8 already exceeds 2^64, and a wrapped product of 0
+    // would pass the bounds check below.
+    if (dim != 0 && count > (end - std::min(end, q)) / static_cast<std::size_t>(dim)) {
+      std::ostringstream os;
+      os << b.path() << ": parameter '" << name << "' at byte " << p << " has dimensions whose product exceeds the "
+         << "parameter section";
+      throw InputError(os.str());
+    }
+    count *= static_cast<std::size_t>(dim);
+  }
+  q += 2 + static_cast<std::size_t>(ndims);
+  const std::size_t elem = static_cast<std::size_t>(std::abs(par.type));
+  const std::size_t nbytes = count * elem;
+  if (q + nbytes > end) {
+    std::ostringstream os;
+    os << b.path() << ": parameter '" << name << "' at byte " << p << " declares " << nbytes
+       << " data bytes, past the end of the parameter section (byte " << end << ")";
+    throw InputError(os.str());
+  }
+  if (par.type == -1) {
+    const std::size_t len = ndims == 0 ? 1 : static_cast<std::size_t>(par.dims[0]);
+    const std::size_t nstr = len == 0 ? 0 : count / len;
+    for (std::size_t s = 0; s < nstr; ++s) {
+      std::string str;
+      for (std::size_t c = 0; c < len; ++c) {
+        const char ch = static_cast<char>(b.u8(q + s * len + c, "parameter string"));
+        str.push_back(ch == '\0' ? ' ' : ch);
+      }
+      par.strings.push_back(rtrim(str));
+    }
+  } else {
+    par.numbers.reserve(count);
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t o = q + i * elem;
+      double v = 0.0;
+      if (par.type == 1) v = b.u8(o, "parameter byte");
+      else if (par.type == 2) v = b.i16(o, "parameter int16");
+      else v = b.f32(o, "parameter float");
+      par.numbers.push_back(v);
+    }
+  }
+  par.raw.assign(nbytes, 0);
+  return par;
+}
+
 void parse_parameters(const Bytes& b, std::size_t start, C3dFile& file) {
   const std::size_t nblocks = b.u8(start + 2, "parameter section header (block count)");
   std::size_t end = start + std::max<std::size_t>(nblocks, 1) * 512;
@@ -126,61 +188,7 @@ void parse_parameters(const Bytes& b, std::size_t start, C3dFile& file) {
     if (id < 0) {
       groups[-id] = name;
     } else {
-      C3dParameter par;
-      par.type = b.i8(q, "parameter type");
-      const int ndims = b.u8(q + 1, "parameter dimension count");
-      if (par.type != -1 && par.type != 1 && par.type != 2 && par.type != 4) {
-        std::ostringstream os;
-        os << b.path() << ": parameter '" << name << "' at byte " << p << " has invalid type "
-           << par.type << " (expected -1, 1, 2 or 4)";
-        throw InputError(os.str());
-      }
-      std::size_t count = 1;
-      for (int d = 0; d < ndims; ++d) {
-        const int dim = b.u8(q + 2 + d, "parameter dimension");
-        par.dims.push_back(dim);
-        // Checked before it can wrap: 255^8 already exceeds 2^64, and a wrapped product of 0
-        // would pass the bounds check below.
-        if (dim != 0 && count > (end - std::min(end, q)) / static_cast<std::size_t>(dim)) {
-          std::ostringstream os;
-          os << b.path() << ": parameter '" << name << "' at byte " << p << " has dimensions whose product exceeds the "
-             << "parameter section";
-          throw InputError(os.str());
-        }
-        count *= static_cast<std::size_t>(dim);
-      }
-      q += 2 + static_cast<std::size_t>(ndims);
-      const std::size_t elem = static_cast<std::size_t>(std::abs(par.type));
-      const std::size_t nbytes = count * elem;
-      if (q + nbytes > end) {
-        std::ostringstream os;
-        os << b.path() << ": parameter '" << name << "' at byte " << p << " declares " << nbytes
-           << " data bytes, past the end of the parameter section (byte " << end << ")";
-        throw InputError(os.str());
-      }
-      if (par.type == -1) {
-        const std::size_t len = ndims == 0 ? 1 : static_cast<std::size_t>(par.dims[0]);
-        const std::size_t nstr = len == 0 ? 0 : count / len;
-        for (std::size_t s = 0; s < nstr; ++s) {
-          std::string str;
-          for (std::size_t c = 0; c < len; ++c) {
-            const char ch = static_cast<char>(b.u8(q + s * len + c, "parameter string"));
-            str.push_back(ch == '\0' ? ' ' : ch);
-          }
-          par.strings.push_back(rtrim(str));
-        }
-      } else {
-        par.numbers.reserve(count);
-        for (std::size_t i = 0; i < count; ++i) {
-          const std::size_t o = q + i * elem;
-          double v = 0.0;
-          if (par.type == 1) v = b.u8(o, "parameter byte");
-          else if (par.type == 2) v = b.i16(o, "parameter int16");
-          else v = b.f32(o, "parameter float");
-          par.numbers.push_back(v);
-        }
-      }
-      par.raw.assign(nbytes, 0);
+      C3dParameter par = read_parameter(b, p, q, end, name);
       pending.push_back({id, name, std::move(par)});
     }
     if (offset <= 0) break;        // 0 marks the last entry; negative would loop

@@ -306,18 +306,13 @@ Table read_sto(const std::string& path) {
   return file.read([&] { return parse_sto(file.text(), path); });
 }
 
-Table parse_sto(std::string_view text, const std::string& path) {
-  const auto lines = lines_of(text);
-  Table t;
-  std::size_t li = 0;
-  bool found_end = false;
-  for (; li < lines.size(); ++li) {
+namespace {
+/// The header up to `endheader` into t (its name, its key=value or key value fields); the index
+/// of the line after it.
+std::size_t read_sto_header(const std::vector<std::string_view>& lines, Table& t, const std::string& path) {
+  for (std::size_t li = 0; li < lines.size(); ++li) {
     const std::string l = trim(lines[li]);
-    if (l == "endheader") {
-      found_end = true;
-      ++li;
-      break;
-    }
+    if (l == "endheader") return li + 1;
     if (li == 0 && l.find('=') == std::string::npos) {
       t.name = l.rfind("name ", 0) == 0 ? trim(l.substr(5)) : l;
       continue;
@@ -330,7 +325,27 @@ Table parse_sto(std::string_view text, const std::string& path) {
       if (sp != std::string::npos) t.header[l.substr(0, sp)] = trim(l.substr(sp + 1));
     }
   }
-  if (!found_end) throw InputError(path + ": not a MOT/STO file: no 'endheader' line");
+  throw InputError(path + ": not a MOT/STO file: no 'endheader' line");
+}
+
+/// A count the header declares under either key (OpenSim's and SIMM's names); -1 when absent.
+long header_count(const Table& t, const char* k1, const char* k2, const std::string& path) {
+  for (const char* k : {k1, k2}) {
+    auto it = t.header.find(k);
+    if (it == t.header.end()) continue;
+    double v;
+    if (!parse_double(it->second, v) || !std::isfinite(v) || v < 0 || v > 1e9 || v != std::floor(v))
+      throw InputError(path + ": header field " + std::string(k) + " = '" + it->second + "' is not a count");
+    return static_cast<long>(v);
+  }
+  return -1;
+}
+}  // namespace
+
+Table parse_sto(std::string_view text, const std::string& path) {
+  const auto lines = lines_of(text);
+  Table t;
+  std::size_t li = read_sto_header(lines, t, path);
   while (li < lines.size() && trim(lines[li]).empty()) ++li;
   if (li >= lines.size()) throw InputError(path + ": no column labels after 'endheader'");
   for (const auto& s : split(lines[li], "\t", false)) {
@@ -343,19 +358,8 @@ Table parse_sto(std::string_view text, const std::string& path) {
   }
   const std::size_t label_line = li;
   const std::size_t ncol = t.labels.size();
-  auto declared = [&](const char* k1, const char* k2) -> long {
-    for (const char* k : {k1, k2}) {
-      auto it = t.header.find(k);
-      if (it == t.header.end()) continue;
-      double v;
-      if (!parse_double(it->second, v) || !std::isfinite(v) || v < 0 || v > 1e9 || v != std::floor(v))
-        throw InputError(path + ": header field " + std::string(k) + " = '" + it->second + "' is not a count");
-      return static_cast<long>(v);
-    }
-    return -1;
-  };
-  const long ncol_decl = declared("nColumns", "datacolumns");
-  const long nrow_decl = declared("nRows", "datarows");
+  const long ncol_decl = header_count(t, "nColumns", "datacolumns", path);
+  const long nrow_decl = header_count(t, "nRows", "datarows", path);
   if (ncol_decl >= 0 && static_cast<std::size_t>(ncol_decl) != ncol) {
     throw InputError(where(path, label_line) + ": header says " + std::to_string(ncol_decl) +
                      " columns but " + std::to_string(ncol) + " labels follow");

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/option_table.hpp"
 
 namespace kin2grf {
 namespace {
@@ -44,135 +45,164 @@ std::tuple<double, double> post_filter_setting(const EstimateOptions& o) { retur
 /// single draw measures the seed as much as the method.
 constexpr int kNoiseRealizations = 8;
 
-std::vector<Setting> settings_for(const std::string& kind) {
+/// A study from its setting's row (option_table.hpp): the row's grid, labels and condition.
+std::vector<Setting> grid_settings(const NumericOption& row) {
   std::vector<Setting> s;
-  char b[32];
-  if (kind == "r") {
-    for (int e = 2; e <= 12; ++e) {
-      const double r = std::pow(10.0, 0.5 * e);
-      std::snprintf(b, sizeof b, "%.3g", r);
-      s.push_back({b, r, [r](EstimateOptions& o) { o.solver.r_N_per_m = r; }});
-    }
-    mark_default(s, [](const EstimateOptions& o) { return o.solver.r_N_per_m; });
-  } else if (kind == "ground-shift") {
-    for (double d : {-0.01, 0.0, 0.01}) {
-      std::snprintf(b, sizeof b, "%+.0f mm", 1000 * d);
-      s.push_back({b, d, [d](EstimateOptions& o) { o.contact.ground_shift_m = d; }});
-    }
-    mark_default(s, [](const EstimateOptions& o) { return o.contact.ground_shift_m; });
-  } else if (kind == "cutoff") {
-    for (double f : {4.0, 6.0, 8.0, 10.0, 12.0, 15.0, 20.0}) {
-      std::snprintf(b, sizeof b, "%.0f Hz", f);
-      s.push_back({b, f, [f](EstimateOptions& o) { o.post_cutoff_cycles = 0, o.post_cutoff_hz = f; }});
-    }
-    mark_default(s, post_filter_setting);
-  } else if (kind == "post-cutoff-cycles") {
-    // The post-filter per stance (EstimateOptions::post_cutoff_cycles) against the paper's fixed 12 Hz.
-    s.push_back({"fixed 12 Hz", 0, [](EstimateOptions& o) { o.post_cutoff_cycles = 0, o.post_cutoff_hz = 12; }});
-    for (double c : {3.0, 3.5, 4.0, 5.0, 6.0, 8.0}) {
-      std::snprintf(b, sizeof b, "%.1f cycles", c);
-      s.push_back({b, c, [c](EstimateOptions& o) { o.post_cutoff_cycles = c; }});
-    }
-    mark_default(s, post_filter_setting);
-  } else if (kind == "kinematic-cutoff") {
-    for (double f : {4.0, 5.0, 6.0, 8.0, 10.0, 12.0}) {
-      std::snprintf(b, sizeof b, "%.0f Hz", f);
-      s.push_back({b, f, [f](EstimateOptions& o) { o.kinematic_cutoff_hz = f; }});
-    }
-    mark_default(s, [](const EstimateOptions& o) { return o.kinematic_cutoff_hz; });
-  } else if (kind == "speed-gate") {
-    for (double v : {0.0, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0}) {
-      std::snprintf(b, sizeof b, v > 0 ? "%.2f m/s" : "off", v);
-      s.push_back({b, v, [v](EstimateOptions& o) { o.contact.speed_gate.ratio = 0, o.contact.speed_gate.fixed_mps = v; }});
-    }
-    mark_default(s, [](const EstimateOptions& o) { return std::tuple(o.contact.speed_gate.ratio, o.contact.speed_gate.fixed_mps); });
-  } else if (kind == "speed-gate-ratio") {
-    s.push_back({"fixed 1.50 m/s", 0, [](EstimateOptions& o) { o.contact.speed_gate.ratio = 0, o.contact.speed_gate.fixed_mps = 1.5; }});
-    for (double floor : {0.5, 0.75})
-      for (double k : {0.5, 0.7, 1.0, 1.5, 2.0, 3.0}) {
-        std::snprintf(b, sizeof b, "%.1f x speed, >= %.2f", k, floor);
-        s.push_back({b, k, [k, floor](EstimateOptions& o) { o.contact.speed_gate.ratio = k, o.contact.speed_gate.floor_mps = floor; }});
-      }
-    mark_default(s, [](const EstimateOptions& o) {
-      return std::tuple(o.contact.speed_gate.ratio, o.contact.speed_gate.fixed_mps, o.contact.speed_gate.floor_mps);
-    });
-  } else if (kind == "trunk-ablation") {
-    // What the estimate owes to the trunk and arm markers: every trial as recorded,
-    // and with the model torso above the pelvis instead (without_trunk_markers).
-    s.push_back({"intact", 0, [](EstimateOptions&) {}, 0.0, true});
-    s.push_back({"trunk markers removed", 1, [](EstimateOptions&) {}, 0.0, false, true});
-  } else if (kind == "mediolateral-ablation") {
-    // The mediolateral force (--mediolateral) as recorded and without the trunk and arm markers:
-    // the trunk is most of the mass whose lateral acceleration the force is.
-    s.push_back({"intact", 0, [](EstimateOptions& o) { o.mediolateral = true; }, 0.0, true});
-    s.push_back({"trunk markers removed", 1, [](EstimateOptions& o) { o.mediolateral = true; }, 0.0, false, true});
-  } else if (kind == "post-cutoff-floor") {
-    // The post-filter's floor as a multiple of the dynamics' kinematic cut-off.
-    for (double f : {0.0, 0.5, 0.75, 1.0, 1.5, 2.0}) {
-      std::snprintf(b, sizeof b, f > 0 ? "%.2f x kinematic" : "none", f);
-      s.push_back({b, f, [f](EstimateOptions& o) { o.post_cutoff_floor_ratio = f; }});
-    }
-    mark_default(s, [](const EstimateOptions& o) { return o.post_cutoff_floor_ratio; });
-  } else if (kind == "touchdown-fraction") {
-    // The touchdown rule (landing_frames): off, or a landing foot loaded from the frame its
-    // final approach's descent speed has fallen to this fraction of its peak.
-    for (double f : {0.0, 0.5, 0.7, 0.8, 0.9, 1.0}) {
-      std::snprintf(b, sizeof b, f > 0 ? "%.1f of the peak" : "off", f);
-      s.push_back({b, f, [f](EstimateOptions& o) { o.contact.touchdown_fraction = f; }});
-    }
-    mark_default(s, [](const EstimateOptions& o) { return o.contact.touchdown_fraction; });
-  } else if (kind == "noise") {
-    // Robustness to what real capture does: 0, 1, 2, 3 mm of Gaussian noise on every
-    // marker coordinate, kNoiseRealizations seeded draws per level (the same draws for every run),
-    // their stances pooled; the estimate otherwise unchanged.
-    for (double mm : {0.0, 1.0, 2.0, 3.0}) {
-      std::snprintf(b, sizeof b, "%.0f mm noise", mm);
-      s.push_back({b, mm, [](EstimateOptions&) {}, mm / 1000.0});
-    }
-  } else if (kind == "min-kinematic-cycles") {
-    // The stance floor of a noise-lowered kinematic cut-off (EstimateOptions::min_kinematic_cycles),
-    // measured where it acts: every setting with 2 mm of marker noise (as the `noise` study adds
-    // it). As recorded, no development trial's cut-off is lowered, so clean trials cannot choose.
-    for (double c : {0.0, 2.5, 3.0, 3.5, 4.0, 5.0}) {
-      std::snprintf(b, sizeof b, c > 0 ? "%.1f cycles, 2 mm" : "off, 2 mm", c);
-      s.push_back({b, c, [c](EstimateOptions& o) { o.min_kinematic_cycles = c; }, 0.002});
-    }
-    mark_default(s, [](const EstimateOptions& o) { return o.min_kinematic_cycles; });
-  } else if (kind == "split-distance") {
-    for (double d : {0.0, 0.05, 0.1, 0.15, 0.2}) {
-      std::snprintf(b, sizeof b, d > 0 ? "%.2f m" : "off", d);
-      s.push_back({b, d, [d](EstimateOptions& o) { o.solver.min_split_distance_m = d; }});
-    }
-    mark_default(s, [](const EstimateOptions& o) { return o.solver.min_split_distance_m; });
-  } else if (kind == "torso-length") {
-    s.push_back({"fixed (the paper)", 0, [](EstimateOptions& o) { o.torso_length = TorsoLength::Fixed; }});
-    s.push_back({"measured", 1, [](EstimateOptions& o) { o.torso_length = TorsoLength::Measured; }});
-    mark_default(s, [](const EstimateOptions& o) { return o.torso_length; });
-  } else if (kind == "double-support-sta") {
-    // Up to 0.2: above it a 1 cm error of the ground level moves a walk by 0.3-0.4 points of
-    // vertical (PiG_Motion3 at 0.3 and 0.4; the robustness limit is 0.2, docs/ROBUSTNESS.md): the
-    // double supports' ends move with the ground, and the prior's timing with them.
-    for (double w : {0.0, 0.1, 0.2}) {
-      std::snprintf(b, sizeof b, w > 0 ? "%.1f" : "off", w);
-      s.push_back({b, w, [w](EstimateOptions& o) { o.double_support_sta_weight = w; }});
-    }
-    mark_default(s, [](const EstimateOptions& o) { return o.double_support_sta_weight; });
-  } else if (kind == "torso-lag") {
-    for (double t : {0.0, 0.01, 0.02, 0.025, 0.03, 0.035, 0.04, 0.05}) {
-      std::snprintf(b, sizeof b, t > 0 ? "%.0f ms" : "off", 1000 * t);
-      s.push_back({b, t, [t](EstimateOptions& o) { o.torso_lag_s = t; }});
-    }
-    mark_default(s, [](const EstimateOptions& o) { return o.torso_lag_s; });
-  } else if (kind == "foot-model") {
-    s.push_back({"three-point (model 1)", 1, [](EstimateOptions& o) { o.contact.foot_model = FootModel::ThreePoint; }});
-    s.push_back({"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }});
-    mark_default(s, [](const EstimateOptions& o) { return o.contact.foot_model; });
-  } else {
-    std::string kinds;
-    for (const auto& k : study_kinds()) kinds += (kinds.empty() ? "" : ", ") + k;
-    throw InputError("unknown study '" + kind + "' (" + kinds + ")");
+  char b[48];
+  for (double v : row.grid) {
+    if (v == 0 && row.zero_label) std::snprintf(b, sizeof b, "%s", row.zero_label);
+    else std::snprintf(b, sizeof b, row.label_format, row.label_scale * v);
+    auto* field = row.field;
+    s.push_back({b, v, [field, v](EstimateOptions& o) { field(o) = v; }, row.study_marker_noise_m});
+  }
+  EstimateOptions defaults;
+  for (Setting& c : s) {
+    EstimateOptions o;
+    c.apply(o);
+    c.is_default = row.field(o) == row.field(defaults);
   }
   return s;
+}
+
+/// Settings over a list of values, labelled by `format` (`zero`: the label of 0 when given).
+template <class Apply>
+std::vector<Setting> value_settings(std::initializer_list<double> values, const char* format, double scale, const char* zero,
+                                    Apply apply) {
+  std::vector<Setting> s;
+  char b[48];
+  for (double v : values) {
+    if (v == 0 && zero) std::snprintf(b, sizeof b, "%s", zero);
+    else std::snprintf(b, sizeof b, format, scale * v);
+    s.push_back({b, v, [apply, v](EstimateOptions& o) { apply(o, v); }});
+  }
+  return s;
+}
+
+std::vector<Setting> r_settings() {
+  std::vector<Setting> s;
+  char b[32];
+  for (int e = 2; e <= 12; ++e) {
+    const double r = std::pow(10.0, 0.5 * e);
+    std::snprintf(b, sizeof b, "%.3g", r);
+    s.push_back({b, r, [r](EstimateOptions& o) { o.solver.r_N_per_m = r; }});
+  }
+  mark_default(s, [](const EstimateOptions& o) { return o.solver.r_N_per_m; });
+  return s;
+}
+
+std::vector<Setting> cutoff_settings() {
+  auto s = value_settings({4.0, 6.0, 8.0, 10.0, 12.0, 15.0, 20.0}, "%.0f Hz", 1.0, nullptr,
+                          [](EstimateOptions& o, double f) { o.post_cutoff_cycles = 0, o.post_cutoff_hz = f; });
+  mark_default(s, post_filter_setting);
+  return s;
+}
+
+/// The post-filter per stance (EstimateOptions::post_cutoff_cycles) against the paper's fixed 12 Hz.
+std::vector<Setting> post_cutoff_cycles_settings() {
+  std::vector<Setting> s{{"fixed 12 Hz", 0, [](EstimateOptions& o) { o.post_cutoff_cycles = 0, o.post_cutoff_hz = 12; }}};
+  for (Setting& c : value_settings({3.0, 3.5, 4.0, 5.0, 6.0, 8.0}, "%.1f cycles", 1.0, nullptr,
+                                   [](EstimateOptions& o, double v) { o.post_cutoff_cycles = v; }))
+    s.push_back(std::move(c));
+  mark_default(s, post_filter_setting);
+  return s;
+}
+
+std::vector<Setting> kinematic_cutoff_settings() {
+  auto s = value_settings({4.0, 5.0, 6.0, 8.0, 10.0, 12.0}, "%.0f Hz", 1.0, nullptr,
+                          [](EstimateOptions& o, double f) { o.kinematic_cutoff_hz = f; });
+  mark_default(s, [](const EstimateOptions& o) { return o.kinematic_cutoff_hz; });
+  return s;
+}
+
+std::vector<Setting> speed_gate_settings() {
+  auto s = value_settings({0.0, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0}, "%.2f m/s", 1.0, "off", [](EstimateOptions& o, double v) {
+    o.contact.speed_gate.ratio = 0, o.contact.speed_gate.fixed_mps = v;
+  });
+  mark_default(s, [](const EstimateOptions& o) { return std::tuple(o.contact.speed_gate.ratio, o.contact.speed_gate.fixed_mps); });
+  return s;
+}
+
+/// The gate relative to the progression speed, crossed with its floor, against the fixed 1.5 m/s.
+std::vector<Setting> speed_gate_ratio_settings() {
+  std::vector<Setting> s;
+  char b[48];
+  s.push_back({"fixed 1.50 m/s", 0, [](EstimateOptions& o) { o.contact.speed_gate.ratio = 0, o.contact.speed_gate.fixed_mps = 1.5; }});
+  for (double floor : {0.5, 0.75})
+    for (double k : {0.5, 0.7, 1.0, 1.5, 2.0, 3.0}) {
+      std::snprintf(b, sizeof b, "%.1f x speed, >= %.2f", k, floor);
+      s.push_back({b, k, [k, floor](EstimateOptions& o) { o.contact.speed_gate.ratio = k, o.contact.speed_gate.floor_mps = floor; }});
+    }
+  mark_default(s, [](const EstimateOptions& o) {
+    return std::tuple(o.contact.speed_gate.ratio, o.contact.speed_gate.fixed_mps, o.contact.speed_gate.floor_mps);
+  });
+  return s;
+}
+
+/// What the estimate owes to the trunk and arm markers: every trial as recorded, and with the
+/// model torso above the pelvis instead (without_trunk_markers); `mediolateral`: with the
+/// mediolateral force, the trunk being most of the mass whose lateral acceleration it is.
+std::vector<Setting> trunk_ablation_settings(bool mediolateral) {
+  auto apply = [mediolateral](EstimateOptions& o) { o.mediolateral = mediolateral || o.mediolateral; };
+  return {{"intact", 0, apply, 0.0, true}, {"trunk markers removed", 1, apply, 0.0, false, true}};
+}
+
+/// Robustness to what real capture does: 0, 1, 2, 3 mm of Gaussian noise on every marker
+/// coordinate, kNoiseRealizations seeded draws per level (the same draws for every run), their
+/// stances pooled; the estimate otherwise unchanged.
+std::vector<Setting> noise_settings() {
+  std::vector<Setting> s;
+  char b[32];
+  for (double mm : {0.0, 1.0, 2.0, 3.0}) {
+    std::snprintf(b, sizeof b, "%.0f mm noise", mm);
+    s.push_back({b, mm, [](EstimateOptions&) {}, mm / 1000.0});
+  }
+  return s;
+}
+
+std::vector<Setting> torso_length_settings() {
+  std::vector<Setting> s{{"fixed (the paper)", 0, [](EstimateOptions& o) { o.torso_length = TorsoLength::Fixed; }},
+                         {"measured", 1, [](EstimateOptions& o) { o.torso_length = TorsoLength::Measured; }}};
+  mark_default(s, [](const EstimateOptions& o) { return o.torso_length; });
+  return s;
+}
+
+std::vector<Setting> foot_model_settings() {
+  std::vector<Setting> s{{"three-point (model 1)", 1, [](EstimateOptions& o) { o.contact.foot_model = FootModel::ThreePoint; }},
+                         {"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }}};
+  mark_default(s, [](const EstimateOptions& o) { return o.contact.foot_model; });
+  return s;
+}
+
+/// The studies that are not one numeric setting's grid, in the command line's order; the
+/// numeric settings' own studies (numeric_options() rows with a grid) are listed by study_kinds().
+struct StudyKind {
+  const char* name;
+  std::vector<Setting> (*settings)();
+};
+const std::vector<StudyKind>& special_studies() {
+  static const std::vector<StudyKind> kinds{
+      {"r", r_settings},
+      {"cutoff", cutoff_settings},
+      {"post-cutoff-cycles", post_cutoff_cycles_settings},
+      {"kinematic-cutoff", kinematic_cutoff_settings},
+      {"speed-gate", speed_gate_settings},
+      {"speed-gate-ratio", speed_gate_ratio_settings},
+      {"trunk-ablation", [] { return trunk_ablation_settings(false); }},
+      {"mediolateral-ablation", [] { return trunk_ablation_settings(true); }},
+      {"noise", noise_settings},
+      {"torso-length", torso_length_settings},
+      {"foot-model", foot_model_settings},
+  };
+  return kinds;
+}
+
+std::vector<Setting> settings_for(const std::string& kind) {
+  for (const StudyKind& k : special_studies())
+    if (kind == k.name) return k.settings();
+  if (const NumericOption* row = find_numeric_option(kind.c_str()); row && !row->grid.empty()) return grid_settings(*row);
+  std::string kinds;
+  for (const auto& k : study_kinds()) kinds += (kinds.empty() ? "" : ", ") + k;
+  throw InputError("unknown study '" + kind + "' (" + kinds + ")");
 }
 
 /// Pool the stances of one activity ("all": every trial) over the trials that ran.
@@ -195,9 +225,13 @@ StudyCell pool(const std::vector<StudyTrialResult>& trials, const std::string& a
 }  // namespace
 
 const std::vector<std::string>& study_kinds() {
-  static const std::vector<std::string> kinds{"r",     "ground-shift",         "cutoff",         "post-cutoff-cycles", "kinematic-cutoff",
-                                              "speed-gate", "speed-gate-ratio", "touchdown-fraction", "post-cutoff-floor", "trunk-ablation", "mediolateral-ablation", "noise",     "min-kinematic-cycles", "split-distance",
-                                              "torso-length", "torso-lag",      "double-support-sta", "foot-model"};
+  static const std::vector<std::string> kinds = [] {
+    std::vector<std::string> k;
+    for (const StudyKind& s : special_studies()) k.emplace_back(s.name);
+    for (const NumericOption& row : numeric_options())
+      if (!row.grid.empty()) k.emplace_back(row.flag);
+    return k;
+  }();
   return kinds;
 }
 

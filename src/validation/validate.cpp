@@ -157,13 +157,52 @@ struct Candidate {
 /// How far x lies outside the span between a and b (0 inside): a COP beyond a foot's heel-toe span.
 double beyond_span(double x, double a, double b) { return std::max({0.0, std::min(a, b) - x, x - std::max(a, b)}); }
 
+/// The median horizontal distance (m) over a plate stance from the plate's COP to foot f's
+/// heel-hallux segment (lateral place from the landmarks); infinity without a loaded COP.
+double cop_to_foot_m(const EstimateResult& e, const MeasuredPlate& mp, const IndexRun& run, int f) {
+  std::vector<double> d;
+  const int heel = f ? kHeelL : kHeelR, hal = f ? kHalluxL : kHalluxR;
+  for (Eigen::Index i = run.first; i <= run.last; ++i) {
+    if (!std::isfinite(mp.cop_x_m[i])) continue;
+    const double xa = e.landmarks.p[heel](i, 0), xb = e.landmarks.p[hal](i, 0);
+    const double dx = beyond_span(mp.cop_x_m[i], xa, xb);
+    const double dl = std::isfinite(mp.cop_lateral_m[i]) ? mp.cop_lateral_m[i] - e.foot_lateral_m[f][i] : 0.0;
+    d.push_back(std::hypot(dx, dl));
+  }
+  return d.empty() ? std::numeric_limits<double>::infinity() : median(d);
+}
+
+/// The frames of a plate stance in which foot f has a sole point at ground level over the plate
+/// (`outside` false: the other foot, counted only when still, since a swinging foot's toes skim
+/// the plate) or outside its edges by more than the margin (`outside` true: this foot).
+int sole_frames(const EstimateResult& e, const MeasuredPlate& mp, const IndexRun& run, int f, bool outside,
+                const ValidationOptions& o) {
+  const double ground = e.ground_level_m();
+  int k = 0;
+  for (Eigen::Index i = run.first; i <= run.last; ++i) {
+    const double lat = e.foot_lateral_m[f][i];
+    const bool lat_in = lat >= mp.lateral_min && lat <= mp.lateral_max;
+    bool hit = false;
+    for (int s = 0; s < 3; ++s) {
+      const double x = e.feet[static_cast<std::size_t>(f)].sole_m(i, 2 * s);
+      const double y = e.feet[static_cast<std::size_t>(f)].sole_m(i, 2 * s + 1);
+      if (y - ground > o.ground_contact_height_m) continue;
+      const double margin = outside ? o.edge_margin_m : 0.0;
+      const bool x_in = x >= mp.x_min - margin && x <= mp.x_max + margin;
+      if (!outside && !sole_point_planted(e, f, s, i, o)) continue;
+      hit = hit || (outside ? !(x_in && lat_in) : (x_in && lat_in));
+    }
+    k += hit;
+  }
+  return k;
+}
+
 /// Plate stances -> candidates: runs above the threshold, cut ones and blips out, each assigned
 /// to the foot its COP lies under, and set aside (kept = false, with the reason in v.excluded)
 /// when the other foot also stands on the plate, the foot is partly off it, or a foot stands on
 /// two plates at once.
 std::vector<Candidate> assign_stances(const EstimateResult& e, ValidationResult& v, const ValidationOptions& o) {
   const Eigen::Index n = e.time_s.size();
-  const double ground = e.ground_level_m();
   bool noted_geometry = false;
   std::vector<Candidate> cands;
   for (int pi = 0; pi < static_cast<int>(v.plates.size()); ++pi) {
@@ -176,19 +215,7 @@ std::vector<Candidate> assign_stances(const EstimateResult& e, ValidationResult&
         v.excluded.push_back(where + ": stance cut by the processed window's ends or the plate recording's");
         continue;
       }
-      std::array<double, 2> dist{};
-      for (int f = 0; f < 2; ++f) {
-        std::vector<double> d;
-        const int heel = f ? kHeelL : kHeelR, hal = f ? kHalluxL : kHalluxR;
-        for (Eigen::Index i = run.first; i <= run.last; ++i) {
-          if (!std::isfinite(mp.cop_x_m[i])) continue;
-          const double xa = e.landmarks.p[heel](i, 0), xb = e.landmarks.p[hal](i, 0);
-          const double dx = beyond_span(mp.cop_x_m[i], xa, xb);
-          const double dl = std::isfinite(mp.cop_lateral_m[i]) ? mp.cop_lateral_m[i] - e.foot_lateral_m[f][i] : 0.0;
-          d.push_back(std::hypot(dx, dl));
-        }
-        dist[static_cast<std::size_t>(f)] = d.empty() ? std::numeric_limits<double>::infinity() : median(d);
-      }
+      const std::array<double, 2> dist{cop_to_foot_m(e, mp, run, 0), cop_to_foot_m(e, mp, run, 1)};
       const int foot = dist[1] < dist[0] ? 1 : 0;
       char buf[160];
       if (!(dist[static_cast<std::size_t>(foot)] <= o.max_assign_distance_m)) {
@@ -202,29 +229,7 @@ std::vector<Candidate> assign_stances(const EstimateResult& e, ValidationResult&
                           to_string(mp.side_hint));
       bool kept = true;
       if (mp.has_geometry) {
-        // Sole points at ground level over (other foot) or outside (this foot) the plate.
-        auto count = [&](int f, bool outside) {
-          int k = 0;
-          for (Eigen::Index i = run.first; i <= run.last; ++i) {
-            const double lat = e.foot_lateral_m[f][i];
-            const bool lat_in = lat >= mp.lateral_min && lat <= mp.lateral_max;
-            bool hit = false;
-            for (int s = 0; s < 3; ++s) {
-              const double x = e.feet[static_cast<std::size_t>(f)].sole_m(i, 2 * s);
-              const double y = e.feet[static_cast<std::size_t>(f)].sole_m(i, 2 * s + 1);
-              if (y - ground > o.ground_contact_height_m) continue;
-              const double margin = outside ? o.edge_margin_m : 0.0;
-              const bool x_in = x >= mp.x_min - margin && x <= mp.x_max + margin;
-              // The other foot counts only when standing still: a swinging foot's toes skim the plate.
-              if (!outside && !sole_point_planted(e, f, s, i, o)) continue;
-              const bool h = outside ? !(x_in && lat_in) : (x_in && lat_in);
-              hit = hit || h;
-            }
-            k += hit;
-          }
-          return k;
-        };
-        const int other = count(1 - foot, false), off = count(foot, true);
+        const int other = sole_frames(e, mp, run, 1 - foot, false, o), off = sole_frames(e, mp, run, foot, true, o);
         if (other >= 3) {
           v.excluded.push_back(where + ": the " + side_name(1 - foot) + " foot also stands on this plate (" +
                                std::to_string(other) + " frames)");
@@ -786,46 +791,65 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
   return j;
 }
 
+namespace {
+// The plain-text table's columns: a 30-character label, then 12-character cells (a value, or mean (SD)).
+std::string table_text(const std::string& t) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%12s", t.c_str());
+  return std::string(b);
+}
+/// An rRMSE cell; `bracketed`: a stance whose plate fails the registration check (not scored).
+std::string table_cell(const std::optional<SeriesMetrics>& m, bool bracketed = false) {
+  char b[40];
+  if (!(m && std::isfinite(m->rrmse_percent))) return table_text("-");
+  std::snprintf(b, sizeof b, bracketed ? "[%.1f]" : "%.1f", m->rrmse_percent);
+  return table_text(b);
+}
+std::string table_msd(double mean, double sd) {
+  char b[40];
+  if (!std::isfinite(mean)) return table_text("-");
+  std::snprintf(b, sizeof b, "%.1f (%.1f)", mean, sd);
+  return table_text(b);
+}
+std::string table_label(const std::string& l) {
+  char b[64];
+  std::snprintf(b, sizeof b, "  %-28s", l.c_str());
+  return std::string(b);
+}
+
+/// The mediolateral rows (--mediolateral): per stance rRMSE, RMSE in % body weight, r and the
+/// lateral COP's RMSE, then their means.
+void format_lateral_rows(std::ostream& os, const ValidationResult& v, const MeanMetrics& m) {
+  char buf[64];
+  os << table_label("mediolateral force") << table_text("rRMSE %") << table_text("RMSE %BW") << table_text("r") << table_text("COP mm")
+     << "\n";
+  for (const auto& s : v.stances) {
+    if (!s.metrics.lateral) continue;
+    char pct[40], r[40];
+    std::snprintf(pct, sizeof pct, "%.1f", 100 * s.metrics.lateral->rmse / s.body_weight_N);
+    std::snprintf(r, sizeof r, "%.2f", s.metrics.lateral->pearson_r);
+    char cop[40] = "-";
+    if (s.metrics.cop_lateral) std::snprintf(cop, sizeof cop, "%.0f", 1000 * s.metrics.cop_lateral->rmse);
+    os << table_label(std::string(side_name(s.foot)) + " foot on " + s.plate) << table_cell(s.metrics.lateral) << table_text(pct)
+       << table_text(r) << table_text(cop) << "\n";
+  }
+  std::snprintf(buf, sizeof buf, "%.1f", m.lateral_rmse_percent_bw);
+  os << table_label("per foot, mean (SD)") << table_msd(m.lateral, m.lateral_sd) << table_text(buf) << table_text("-");
+  std::snprintf(buf, sizeof buf, "%.0f", m.cop_lateral_rmse_mm);
+  os << table_text(buf) << "\n";
+}
+}  // namespace
+
 std::string format_validation_table(const std::string& trial, const ValidationResult& v) {
-  // Columns: a 30-character label, then four 12-character cells (value, or mean (SD)).
   std::ostringstream os;
   char buf[256];
-  auto text = [](const std::string& t) {
-    char b[40];
-    std::snprintf(b, sizeof b, "%12s", t.c_str());
-    return std::string(b);
-  };
-  auto cell = [&](const std::optional<SeriesMetrics>& m) {
-    char b[40];
-    if (!(m && std::isfinite(m->rrmse_percent))) return text("-");
-    std::snprintf(b, sizeof b, "%.1f", m->rrmse_percent);
-    return text(b);
-  };
-  // A stance whose plate fails the registration check: its COP and moment in brackets (not scored).
-  auto bracketed = [&](const std::optional<SeriesMetrics>& m) {
-    char b[40];
-    if (!(m && std::isfinite(m->rrmse_percent))) return text("-");
-    std::snprintf(b, sizeof b, "[%.1f]", m->rrmse_percent);
-    return text(b);
-  };
-  auto msd = [&](double mean, double sd) {
-    char b[40];
-    if (!std::isfinite(mean)) return text("-");
-    std::snprintf(b, sizeof b, "%.1f (%.1f)", mean, sd);
-    return text(b);
-  };
-  auto label = [](const std::string& l) {
-    char b[64];
-    std::snprintf(b, sizeof b, "  %-28s", l.c_str());
-    return std::string(b);
-  };
   os << "kin2grf validate: " << trial << " (body mass " << v.mass_kg << " kg)\n";
-  os << label("rRMSE % (paper's Eq. 12)") << text("vertical") << text("anterior") << text("COP") << text("moment")
+  os << table_label("rRMSE % (paper's Eq. 12)") << table_text("vertical") << table_text("anterior") << table_text("COP") << table_text("moment")
      << "   frames\n";
   for (const auto& s : v.stances) {
-    os << label(std::string(side_name(s.foot)) + " foot on " + s.plate) << cell(s.metrics.vertical) << cell(s.metrics.anterior)
-       << (s.cop_reference_suspect ? bracketed(s.metrics.cop) : cell(s.metrics.cop))
-       << (s.cop_reference_suspect ? bracketed(s.metrics.moment) : cell(s.metrics.moment));
+    os << table_label(std::string(side_name(s.foot)) + " foot on " + s.plate) << table_cell(s.metrics.vertical)
+       << table_cell(s.metrics.anterior) << table_cell(s.metrics.cop, s.cop_reference_suspect)
+       << table_cell(s.metrics.moment, s.cop_reference_suspect);
     std::snprintf(buf, sizeof buf, "   %ld-%ld\n", static_cast<long>(v.first_frame_number + s.first),
                   static_cast<long>(v.first_frame_number + s.last));
     os << buf;
@@ -833,29 +857,14 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
   if (v.stances.empty()) os << "  (no stance on a plate could be compared)\n";
   const MeanMetrics m = mean_rrmse(v.stances);
   if (m.n > 0)
-    os << label("per foot, mean (SD), n = " + std::to_string(m.n)) << msd(m.vertical, m.vertical_sd)
-       << msd(m.anterior, m.anterior_sd) << msd(m.cop, m.cop_sd) << msd(m.moment, m.moment_sd) << "\n";
-  if (std::isfinite(m.lateral_rmse_percent_bw)) {
-    os << label("mediolateral force") << text("rRMSE %") << text("RMSE %BW") << text("r") << text("COP mm") << "\n";
-    for (const auto& s : v.stances) {
-      if (!s.metrics.lateral) continue;
-      char pct[40], r[40];
-      std::snprintf(pct, sizeof pct, "%.1f", 100 * s.metrics.lateral->rmse / s.body_weight_N);
-      std::snprintf(r, sizeof r, "%.2f", s.metrics.lateral->pearson_r);
-      char cop[40] = "-";
-      if (s.metrics.cop_lateral) std::snprintf(cop, sizeof cop, "%.0f", 1000 * s.metrics.cop_lateral->rmse);
-      os << label(std::string(side_name(s.foot)) + " foot on " + s.plate) << cell(s.metrics.lateral) << text(pct) << text(r) << text(cop) << "\n";
-    }
-    std::snprintf(buf, sizeof buf, "%.1f", m.lateral_rmse_percent_bw);
-    os << label("per foot, mean (SD)") << msd(m.lateral, m.lateral_sd) << text(buf) << text("-");
-    std::snprintf(buf, sizeof buf, "%.0f", m.cop_lateral_rmse_mm);
-    os << text(buf) << "\n";
-  }
+    os << table_label("per foot, mean (SD), n = " + std::to_string(m.n)) << table_msd(m.vertical, m.vertical_sd)
+       << table_msd(m.anterior, m.anterior_sd) << table_msd(m.cop, m.cop_sd) << table_msd(m.moment, m.moment_sd) << "\n";
+  if (std::isfinite(m.lateral_rmse_percent_bw)) format_lateral_rows(os, v, m);
   if (v.total)
-    os << label("total, GRM (" + std::to_string(v.total->frames.size()) + " frames)") << cell(v.total->metrics.vertical)
-       << cell(v.total->metrics.anterior) << text("-") << cell(v.total->metrics.moment) << "\n";
-  os << label("paper, Table 1 (24 gait)") << text("4.1 (1.1)") << text("11.2 (1.7)") << text("-") << text("5.3 (1.1)") << "\n";
-  os << label("Fluit et al. (paper's Tab. 1)") << text("2.7") << text("9.3") << text("-") << text("7.4") << "\n";
+    os << table_label("total, GRM (" + std::to_string(v.total->frames.size()) + " frames)") << table_cell(v.total->metrics.vertical)
+       << table_cell(v.total->metrics.anterior) << table_text("-") << table_cell(v.total->metrics.moment) << "\n";
+  os << table_label("paper, Table 1 (24 gait)") << table_text("4.1 (1.1)") << table_text("11.2 (1.7)") << table_text("-") << table_text("5.3 (1.1)") << "\n";
+  os << table_label("Fluit et al. (paper's Tab. 1)") << table_text("2.7") << table_text("9.3") << table_text("-") << table_text("7.4") << "\n";
   if (v.sync) {
     std::snprintf(buf, sizeof buf, "marker-plate offset: %+.0f ms (+-%.1f; + = the plates lead; median |plates - kinematics| of the total vertical force "
                                    "%.0f N as recorded, %.0f N at the offset); applied: %+.0f ms\n",

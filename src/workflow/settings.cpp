@@ -11,6 +11,7 @@
 #include "kin2grf/trial.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/io/marker_presets.hpp"
+#include "kin2grf/option_table.hpp"
 #include "kin2grf/parallel.hpp"
 
 namespace kin2grf {
@@ -18,47 +19,6 @@ namespace kin2grf {
 namespace {
 const char* torso_length_name(TorsoLength t) { return t == TorsoLength::Fixed ? "fixed" : "measured"; }
 
-/// A numeric setting that is one EstimateOptions field, declared once: its flag (range, default:
-/// the field's, help), its value under --paper (none: the user's) and its key in the settings
-/// JSON all come from its row. Adding one: a row here and the field with its use.
-struct NumericSetting {
-  const char* flag;  ///< without the dashes
-  const char* json_key;
-  double& (*field)(EstimateOptions&);
-  double lo, hi;  ///< the command line's range; lo > hi: none there (the library's check_options)
-  std::optional<double> paper;
-  const char* help;
-};
-const std::vector<NumericSetting>& numeric_settings() {
-  using O = EstimateOptions;
-  static const std::vector<NumericSetting> table = {
-      {"min-kinematic-cycles", "min_kinematic_cycles", [](O& o) -> double& { return o.min_kinematic_cycles; }, 0.0, 20.0, std::nullopt,
-       "Where the noise rule lowers the kinematic cut-off, the dynamics' cut-off stays at least this many cycles over the median "
-       "stance (the COP function's foot angle keeps the lowered one); 0 = no floor"},
-      {"post-cutoff-floor", "post_cutoff_floor_ratio", [](O& o) -> double& { return o.post_cutoff_floor_ratio; }, 0.0, 10.0, std::nullopt,
-       "The per-stance post-filter cut-off is not taken below this multiple of the dynamics' kinematic cut-off (0 = no floor, the "
-       "default)"},
-      {"ground-shift", "ground_shift_m", [](O& o) -> double& { return o.contact.ground_shift_m; }, 1.0, -1.0, std::nullopt,
-       "Shift the ground by this much, m (robustness study)"},
-      {"speed-gate-ratio", "speed_gate_ratio", [](O& o) -> double& { return o.contact.speed_gate.ratio; }, 0.0, 20.0, 0.0,
-       "The speed gate as this multiple of the progression speed (hip or belt), at least --speed-gate-floor; 0 = the fixed "
-       "--speed-gate"},
-      {"speed-gate-floor", "speed_gate_floor_mps", [](O& o) -> double& { return o.contact.speed_gate.floor_mps; }, 0.0, 20.0, std::nullopt,
-       "Lowest speed gate with --speed-gate-ratio, m/s"},
-      {"touchdown-fraction", "touchdown_fraction", [](O& o) -> double& { return o.contact.touchdown_fraction; }, 0.0, 1.0, 0.0,
-       "A landing foot takes no load before its descent speed, past the final approach's peak, has fallen to this fraction of the "
-       "peak (1: from the peak on; 0 = off, the default and the paper)"},
-      {"split-distance", "min_split_distance_m", [](O& o) -> double& { return o.solver.min_split_distance_m; }, 0.0, 1.0, 0.0,
-       "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)"},
-      {"torso-lag", "torso_lag_s", [](O& o) -> double& { return o.torso_lag_s; }, 0.0, 0.2, 0.0,
-       "The upper body's fore-aft lag behind the pelvis, s: the HAT's fore-aft inertial force is delayed by this time, less what "
-       "the trunk markers already lag the hip by (0 = none, the paper)"},
-      {"double-support-sta", "double_support_sta_weight", [](O& o) -> double& { return o.double_support_sta_weight; }, 0.0, 1.0, 0.0,
-       "Weight (0-1) of the smooth transition towards which each walking double support's split between the feet is blended "
-       "(0 = none, the paper)"},
-  };
-  return table;
-}
 }  // namespace
 
 void add_settings_options(CLI::App* c, Settings& a) {
@@ -110,7 +70,7 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
   c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length, no torso lag");
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
-  for (const NumericSetting& s : numeric_settings()) {
+  for (const NumericOption& s : numeric_options()) {
     CLI::Option* opt = c->add_option(std::string("--") + s.flag, s.field(a.numeric), s.help)->capture_default_str();
     if (s.lo <= s.hi) opt->check(CLI::Range(s.lo, s.hi));
   }
@@ -171,7 +131,7 @@ EstimateOptions to_options(const Settings& a) {
   o.landmarks.max_gap_frames = a.max_gap;
   o.landmarks.up_axis = parse_axis(a.up_axis);
   EstimateOptions given = a.numeric;
-  for (const NumericSetting& s : numeric_settings()) s.field(o) = (a.paper && s.paper) ? *s.paper : s.field(given);
+  for (const NumericOption& s : numeric_options()) s.field(o) = (a.paper && s.paper) ? *s.paper : s.field(given);
   return o;
 }
 
@@ -205,7 +165,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"grm_reference_m", {o.grm_reference_m.x(), o.grm_reference_m.y()}},
           {"max_gap_frames", o.landmarks.max_gap_frames}};
   EstimateOptions used = o;
-  for (const NumericSetting& s : numeric_settings()) j[s.json_key] = s.field(used);
+  for (const NumericOption& s : numeric_options()) j[s.json_key] = s.field(used);
   return j;
 }
 

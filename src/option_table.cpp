@@ -1,0 +1,55 @@
+#include "kin2grf/option_table.hpp"
+
+#include <cstring>
+
+namespace kin2grf {
+
+const std::vector<NumericOption>& numeric_options() {
+  using O = EstimateOptions;
+  static const std::vector<NumericOption> table = {
+      {"min-kinematic-cycles", "min_kinematic_cycles", [](O& o) -> double& { return o.min_kinematic_cycles; }, 0.0, 20.0, std::nullopt,
+       "Where the noise rule lowers the kinematic cut-off, the dynamics' cut-off stays at least this many cycles over the median "
+       "stance (the COP function's foot angle keeps the lowered one); 0 = no floor",
+       // measured where it acts: as recorded no development trial's cut-off is lowered
+       {0.0, 2.5, 3.0, 3.5, 4.0, 5.0}, "%.1f cycles, 2 mm", 1.0, "off, 2 mm", 0.002},
+      {"post-cutoff-floor", "post_cutoff_floor_ratio", [](O& o) -> double& { return o.post_cutoff_floor_ratio; }, 0.0, 10.0, std::nullopt,
+       "The per-stance post-filter cut-off is not taken below this multiple of the dynamics' kinematic cut-off (0 = no floor, the "
+       "default)",
+       {0.0, 0.5, 0.75, 1.0, 1.5, 2.0}, "%.2f x kinematic", 1.0, "none"},
+      {"ground-shift", "ground_shift_m", [](O& o) -> double& { return o.contact.ground_shift_m; }, 1.0, -1.0, std::nullopt,
+       "Shift the ground by this much, m (robustness study)",
+       {-0.01, 0.0, 0.01}, "%+.0f mm", 1000.0},
+      {"speed-gate-ratio", "speed_gate_ratio", [](O& o) -> double& { return o.contact.speed_gate.ratio; }, 0.0, 20.0, 0.0,
+       "The speed gate as this multiple of the progression speed (hip or belt), at least --speed-gate-floor; 0 = the fixed "
+       "--speed-gate"},  // its study crosses it with the floor (validation/study)
+      {"speed-gate-floor", "speed_gate_floor_mps", [](O& o) -> double& { return o.contact.speed_gate.floor_mps; }, 0.0, 20.0, std::nullopt,
+       "Lowest speed gate with --speed-gate-ratio, m/s"},
+      {"touchdown-fraction", "touchdown_fraction", [](O& o) -> double& { return o.contact.touchdown_fraction; }, 0.0, 1.0, 0.0,
+       "A landing foot takes no load before its descent speed, past the final approach's peak, has fallen to this fraction of the "
+       "peak (1: from the peak on; 0 = off, the default and the paper)",
+       {0.0, 0.5, 0.7, 0.8, 0.9, 1.0}, "%.1f of the peak", 1.0, "off"},
+      {"split-distance", "min_split_distance_m", [](O& o) -> double& { return o.solver.min_split_distance_m; }, 0.0, 1.0, 0.0,
+       "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)",
+       {0.0, 0.05, 0.1, 0.15, 0.2}, "%.2f m", 1.0, "off"},
+      {"torso-lag", "torso_lag_s", [](O& o) -> double& { return o.torso_lag_s; }, 0.0, 0.2, 0.0,
+       "The upper body's fore-aft lag behind the pelvis, s: the HAT's fore-aft inertial force is delayed by this time, less what "
+       "the trunk markers already lag the hip by (0 = none, the paper)",
+       {0.0, 0.01, 0.02, 0.025, 0.03, 0.035, 0.04, 0.05}, "%.0f ms", 1000.0, "off"},
+      // Up to 0.2: above it a 1 cm error of the ground level moves a walk by 0.3-0.4 points of
+      // vertical (the robustness limit, docs/ROBUSTNESS.md): the double supports' ends move with
+      // the ground, and the prior's timing with them.
+      {"double-support-sta", "double_support_sta_weight", [](O& o) -> double& { return o.double_support_sta_weight; }, 0.0, 1.0, 0.0,
+       "Weight (0-1) of the smooth transition towards which each walking double support's split between the feet is blended "
+       "(0 = none, the paper)",
+       {0.0, 0.1, 0.2}, "%.1f", 1.0, "off"},
+  };
+  return table;
+}
+
+const NumericOption* find_numeric_option(const char* flag) {
+  for (const NumericOption& s : numeric_options())
+    if (std::strcmp(s.flag, flag) == 0) return &s;
+  return nullptr;
+}
+
+}  // namespace kin2grf
