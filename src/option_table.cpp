@@ -23,7 +23,8 @@ const std::vector<NumericOption>& numeric_options() {
        "The speed gate as this multiple of the progression speed (hip or belt), at least --speed-gate-floor; 0 = the fixed "
        "--speed-gate"},  // its study crosses it with the floor (validation/study)
       {"speed-gate-floor", "speed_gate_floor_mps", [](O& o) -> double& { return o.contact.speed_gate.floor_mps; }, 0.0, 20.0, std::nullopt,
-       "Lowest speed gate with --speed-gate-ratio, m/s"},
+       "Lowest speed gate with --speed-gate-ratio, m/s",
+       {0.2, 0.3, 0.5, 0.75, 1.0}, "%.2f m/s"},
       {"touchdown-fraction", "touchdown_fraction", [](O& o) -> double& { return o.contact.touchdown_fraction; }, 0.0, 1.0, 0.0,
        "A landing foot takes no load before its descent speed, past the final approach's peak, has fallen to this fraction of the "
        "peak (1: from the peak on; 0 = off, the default and the paper)",
