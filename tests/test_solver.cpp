@@ -92,9 +92,10 @@ TEST(Solver, SpeedGateScalesWithTheProgressionSpeed) {
   SpeedGateRule o;  // defaults
   EXPECT_NEAR(speed_gate_for(o, 0.0), 0.75, 1e-12);   // standing, squatting: the floor
   EXPECT_NEAR(speed_gate_for(o, 0.4), 0.75, 1e-12);   // a slow walk: the floor
-  EXPECT_NEAR(speed_gate_for(o, 1.3), 1.3, 1e-12);    // walking
-  EXPECT_NEAR(speed_gate_for(o, 9.0), 9.0, 1e-12);    // sprinting: the landing foot is not cut
-  EXPECT_NEAR(speed_gate_for(o, -3.5), 3.5, 1e-12);   // a treadmill belt's sign does not matter
+  EXPECT_NEAR(speed_gate_for(o, 1.0), 0.75, 1e-12);   // 0.7 x 1.0 is under the floor
+  EXPECT_NEAR(speed_gate_for(o, 1.3), 0.91, 1e-12);   // walking: 0.7 x v
+  EXPECT_NEAR(speed_gate_for(o, 9.0), 6.3, 1e-12);    // sprinting: the landing foot is not cut
+  EXPECT_NEAR(speed_gate_for(o, -3.5), 2.45, 1e-12);  // a treadmill belt's sign does not matter
   o.ratio = 0;
   o.fixed_mps = 1.5;
   EXPECT_NEAR(speed_gate_for(o, 9.0), 1.5, 1e-12);    // a fixed gate stays fixed
