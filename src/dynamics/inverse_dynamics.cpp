@@ -22,6 +22,75 @@ constexpr int xy_coordinate(int k) {
                                                : coord::dstar_x(k - coord::kComs / 2 - kSegmentCount);
 }
 
+// The per-frame solve's fixed capacities: at most 6 contact points (12 multipliers).
+constexpr int kMaxK = 2 * kMaxContactPoints;
+using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxK, kMaxK>;
+using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxK, 1>;
+using Tall = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxK + kBilateralCount, kMaxK>;
+using TallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxK + kBilateralCount, 1>;
+// 3 equations, or more in the dense fallback of a degenerate frame (63 - rank of B).
+using Fit = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, coord::kCount, kMaxK>;
+
+/// The frame's candidate points (bit j: point j): the speed gate removes a point sliding faster
+/// than it along the ground (or belt) before the iterations, and a foot still landing
+/// (landing_frames) takes no load yet.
+unsigned candidate_points(const FrameContacts& fc, double speed_gate_mps, double belt_velocity_mps) {
+  const int np = static_cast<int>(fc.points.size());
+  unsigned allowed = (1U << np) - 1U;
+  for (int j = 0; j < np; ++j) {
+    const ContactPoint& p = fc.points[static_cast<std::size_t>(j)];
+    if (speed_gate_mps > 0 && std::abs(p.velocity.x() - belt_velocity_mps) > speed_gate_mps) allowed &= ~(1U << j);
+    if (fc.landing[static_cast<std::size_t>(p.side)]) allowed &= ~(1U << j);
+  }
+  return allowed;
+}
+
+/// The Alart-Curnier classification (Eqs. 8-9): a candidate point is active when
+/// lambda_n - r g_n > 0.
+unsigned activation(const SmallVector& lamC, const FrameContacts& fc, unsigned allowed, double r_N_per_m) {
+  unsigned next = 0;
+  const int np = static_cast<int>(fc.points.size());
+  for (int j = 0; j < np; ++j) {
+    const double crit = lamC[2 * j] - r_N_per_m * fc.points[static_cast<std::size_t>(j)].gap_m;
+    if ((allowed >> j & 1U) && crit > 0) next |= 1U << j;
+  }
+  return next;
+}
+
+/// The bilateral multipliers lambda_B = B^+ (b - C lambda_C), whose rheonomic ones are the joint
+/// torques, and the torques per unit normal multiplier of each point (the double-support
+/// transition moves the torques with the normal multipliers through them).
+void bilateral_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& BpX, const SmallVector& lamC, int np, FrameSolution& sol) {
+  Eigen::Matrix<double, kBilateralCount, 1> lamB = BpX.col(0);
+  for (int c = 0; c < 2 * np; ++c)
+    if (lamC[c] != 0.0) lamB -= BpX.col(1 + c) * lamC[c];
+  sol.joint_torque_Nm = lamB.segment<kJointCount>(row::kDriving);
+  sol.torque_per_normal.resize(kJointCount, np);
+  for (int j = 0; j < np; ++j) sol.torque_per_normal.col(j) = -BpX.block<kJointCount, 1>(row::kDriving, 1 + 2 * j);
+}
+
+/// The structure of N = Phi Phi^T's factor: an AMD order of N's pattern (`order`: constraint
+/// row -> its place in the factor) and the fill of its elimination in that order.
+using FillPattern = Eigen::Matrix<bool, kBilateralCount, kBilateralCount>;
+FillPattern symbolic_factor(const Eigen::MatrixXd& Phi, std::array<int, kBilateralCount>& order) {
+  const Eigen::MatrixXd Npattern = (Phi.cwiseAbs() * Phi.cwiseAbs().transpose()).unaryExpr([](double v) { return v != 0.0 ? 1.0 : 0.0; });
+  Eigen::SparseMatrix<double> Nsparse = Npattern.sparseView();
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
+  Eigen::AMDOrdering<int>()(Nsparse, perm);  // perm: new place -> old row (Eigen's P^-1)
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse = perm.inverse();
+  for (int r = 0; r < kBilateralCount; ++r) order[static_cast<std::size_t>(r)] = inverse.indices()[r];
+  FillPattern fill;
+  fill.setConstant(false);
+  for (int a = 0; a < kBilateralCount; ++a)
+    for (int b = 0; b < kBilateralCount; ++b)
+      if (Npattern(a, b) != 0.0) fill(order[static_cast<std::size_t>(a)], order[static_cast<std::size_t>(b)]) = true;
+  for (int k = 0; k < kBilateralCount; ++k)
+    for (int i = k + 1; i < kBilateralCount; ++i)
+      if (fill(i, k))
+        for (int j = k + 1; j <= i; ++j)
+          if (fill(j, k)) fill(i, j) = fill(j, i) = true;
+  return fill;
+}
 }  // namespace
 
 ContactSolver::ContactSolver(const Model& model, const TrialCalibration& calibration, const SolverOptions& options)
@@ -48,22 +117,7 @@ ContactSolver::ContactSolver(const Model& model, const TrialCalibration& calibra
   }
   phi_column_start[coord::kCount] = static_cast<int>(phi_entries_.size());
   // N's pattern, an AMD order of it, and the factor's fill (symbolic elimination).
-  const Eigen::MatrixXd Npattern = (Phi.cwiseAbs() * Phi.cwiseAbs().transpose()).unaryExpr([](double v) { return v != 0.0 ? 1.0 : 0.0; });
-  Eigen::SparseMatrix<double> Nsparse = Npattern.sparseView();
-  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
-  Eigen::AMDOrdering<int>()(Nsparse, perm);  // perm: new place -> old row (Eigen's P^-1)
-  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse = perm.inverse();
-  for (int r = 0; r < kBilateralCount; ++r) order_[static_cast<std::size_t>(r)] = inverse.indices()[r];
-  Eigen::Matrix<bool, kBilateralCount, kBilateralCount> fill;
-  fill.setConstant(false);
-  for (int a = 0; a < kBilateralCount; ++a)
-    for (int b = 0; b < kBilateralCount; ++b)
-      if (Npattern(a, b) != 0.0) fill(order_[static_cast<std::size_t>(a)], order_[static_cast<std::size_t>(b)]) = true;
-  for (int k = 0; k < kBilateralCount; ++k)
-    for (int i = k + 1; i < kBilateralCount; ++i)
-      if (fill(i, k))
-        for (int j = k + 1; j <= i; ++j)
-          if (fill(j, k)) fill(i, j) = fill(j, i) = true;
+  const FillPattern fill = symbolic_factor(Phi, order_);
   // The factor's entries, row by row (k ascending): entry e of row i is L(i, factor_k_[e]).
   std::array<std::array<int, kBilateralCount>, kBilateralCount> entry{};
   for (auto& row : entry) row.fill(-1);
@@ -269,15 +323,8 @@ double ContactSolver::moment_direction_weight(const FrameContacts& fc, unsigned 
 
 FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixXd>& BpX, const Eigen::Ref<const Eigen::MatrixXd>& UtX,
                                            const FrameContacts& fc) {
-  // Fixed capacities: at most 6 contact points (12 multipliers), so nothing here touches the
-  // heap. Active sets are bit masks (a point j is bit j).
-  constexpr int kMaxK = 2 * kMaxContactPoints;
-  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxK, kMaxK>;
-  using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxK, 1>;
-  using Tall = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxK + kBilateralCount, kMaxK>;
-  using TallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxK + kBilateralCount, 1>;
-  // 3 equations, or more in the dense fallback of a degenerate frame (63 - rank of B).
-  using Fit = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, coord::kCount, kMaxK>;
+  // Fixed capacities (SmallVector etc., above): nothing here touches the heap. Active sets are
+  // bit masks (a point j is bit j).
   const int np = static_cast<int>(fc.points.size());
   const int k = 2 * np;
   const Eigen::VectorXd& wB = weight_bilateral_;
@@ -285,15 +332,7 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
 
   FrameSolution sol;
   sol.contact_lambda = SmallVector::Zero(k);
-  // The speed gate removes a contact from the candidates before the iterations.
-  unsigned allowed = (1U << np) - 1U;
-  if (speed_gate_mps_ > 0)
-    for (int j = 0; j < np; ++j)
-      if (std::abs(fc.points[static_cast<std::size_t>(j)].velocity.x() - belt_velocity_mps_) > speed_gate_mps_)
-        allowed &= ~(1U << j);
-  // A foot still landing (landing_frames) takes no load yet.
-  for (int j = 0; j < np; ++j)
-    if (fc.landing[static_cast<std::size_t>(fc.points[static_cast<std::size_t>(j)].side)]) allowed &= ~(1U << j);
+  const unsigned allowed = candidate_points(fc, speed_gate_mps_, belt_velocity_mps_);
   unsigned active = allowed;
   std::uint64_t seen = 0;  // the active sets tried (2^6 of them at most)
   SmallVector lamC = SmallVector::Zero(k);
@@ -343,12 +382,7 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
       if (keep < 1.0) lam = keep * lam + (1.0 - keep) * fit(rank - 1);
       for (int c = 0; c < ka; ++c) lamC[cols[static_cast<std::size_t>(c)]] = lam[c];
     }
-    // Re-classify (Eqs. 8-9).
-    unsigned next = 0;
-    for (int j = 0; j < np; ++j) {
-      const double crit = lamC[2 * j] - options_.r_N_per_m * fc.points[static_cast<std::size_t>(j)].gap_m;
-      if ((allowed >> j & 1U) && crit > 0) next |= 1U << j;
-    }
+    const unsigned next = activation(lamC, fc, allowed, options_.r_N_per_m);  // Eqs. 8-9
     if (next == active) break;
     if (seen >> next & 1U) {
       sol.cycled = true;
@@ -359,13 +393,7 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
   }
   sol.contact_lambda = lamC;
   for (int j = 0; j < np; ++j) sol.contact_active[static_cast<std::size_t>(j)] = (active >> j & 1U) != 0;
-  // Bilateral multipliers: lambda_B = B^+ (b - C lambda_C); the rheonomic ones are the torques.
-  Eigen::Matrix<double, kBilateralCount, 1> lamB = BpX.col(0);
-  for (int c = 0; c < k; ++c)
-    if (lamC[c] != 0.0) lamB -= BpX.col(1 + c) * lamC[c];
-  sol.joint_torque_Nm = lamB.segment<kJointCount>(row::kDriving);
-  sol.torque_per_normal.resize(kJointCount, np);
-  for (int j = 0; j < np; ++j) sol.torque_per_normal.col(j) = -BpX.block<kJointCount, 1>(row::kDriving, 1 + 2 * j);
+  bilateral_multipliers(BpX, lamC, np, sol);
   return sol;
 }
 

@@ -561,6 +561,67 @@ AnalogData read_c3d_analog(const C3dFile& f, const Bytes& b, const C3dLayout& l,
 
 /// The force plates of FORCE_PLATFORM (types 1-4) from the analog data; none, with a note, when
 /// the file describes plates but holds no analog data.
+/// Plate p's description (FORCE_PLATFORM: TYPE, CORNERS and ORIGIN in m, CHANNEL, and for a
+/// type-4 plate CAL_MATRIX), every entry checked; the caller has checked that TYPE, CORNERS,
+/// ORIGIN and CHANNEL exist.
+PlateDescription plate_description(const C3dFile& f, int p, int nchannels, double to_m, const C3dReadOptions& options,
+                                   const std::string& path) {
+  const auto* types = f.find("FORCE_PLATFORM:TYPE");
+  const auto* corners = f.find("FORCE_PLATFORM:CORNERS");
+  const auto* origin = f.find("FORCE_PLATFORM:ORIGIN");
+  const auto* channel = f.find("FORCE_PLATFORM:CHANNEL");
+  const auto* cal = f.find("FORCE_PLATFORM:CAL_MATRIX");
+  const int chan_rows = channel->dims.empty() ? 0 : channel->dims[0];
+  PlateDescription d;
+  d.name = "FP" + std::to_string(p + 1);
+  if (static_cast<int>(types->numbers.size()) <= p)
+    throw InputError(path + ": FORCE_PLATFORM:TYPE has no entry for plate " + std::to_string(p + 1));
+  d.type = count_value(types->numbers[p]);
+  if (d.type < 1 || d.type > 4) {
+    throw InputError(path + ": FORCE_PLATFORM:TYPE[" + std::to_string(p + 1) + "] = " +
+                     std::to_string(d.type) + " is not supported (types 1-4 are)");
+  }
+  if (corners->numbers.size() < static_cast<std::size_t>(12 * (p + 1)))
+    throw InputError(path + ": FORCE_PLATFORM:CORNERS has no entry for plate " + std::to_string(p + 1));
+  for (int c = 0; c < 4; ++c)
+    for (int a = 0; a < 3; ++a) d.corners(a, c) = corners->numbers[12 * p + 3 * c + a] * to_m;
+  if (origin->numbers.size() < static_cast<std::size_t>(3 * (p + 1)))
+    throw InputError(path + ": FORCE_PLATFORM:ORIGIN has no entry for plate " + std::to_string(p + 1));
+  for (int a = 0; a < 3; ++a) d.origin(a) = origin->numbers[3 * p + a] * to_m;
+  const int nch = d.type == 3 ? 8 : 6;
+  if (chan_rows < nch || channel->numbers.size() < static_cast<std::size_t>(chan_rows * (p + 1))) {
+    throw InputError(path + ": FORCE_PLATFORM:CHANNEL has fewer than " + std::to_string(nch) +
+                     " channels for plate " + std::to_string(p + 1) + " (type " +
+                     std::to_string(d.type) + ")");
+  }
+  for (int c = 0; c < nch; ++c) {
+    const int ch = count_value(channel->numbers[static_cast<std::size_t>(chan_rows * p + c)]);
+    if (ch < 1 || ch > nchannels) {
+      throw InputError(path + ": FORCE_PLATFORM:CHANNEL[" + std::to_string(c + 1) + "," +
+                       std::to_string(p + 1) + "] = " + std::to_string(ch) +
+                       " is not an analog channel (1.." + std::to_string(nchannels) + ")");
+    }
+    d.channels.push_back(ch - 1);
+  }
+  if (d.type == 4) {
+    if (!cal || cal->numbers.size() < static_cast<std::size_t>(36 * (p + 1))) {
+      throw InputError(path + ": plate " + std::to_string(p + 1) +
+                       " is TYPE 4 but FORCE_PLATFORM:CAL_MATRIX has no 6x6 entry for it");
+    }
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 6; ++j) {
+        const std::size_t k = options.cal_matrix_first_index_fastest
+                                  ? static_cast<std::size_t>(36 * p + i + 6 * j)
+                                  : static_cast<std::size_t>(36 * p + 6 * i + j);
+        d.cal_matrix(i, j) = cal->numbers[k];
+      }
+  }
+  if (!d.corners.allFinite() || !d.origin.allFinite())
+    throw InputError(path + ": FORCE_PLATFORM CORNERS/ORIGIN of plate " + std::to_string(p + 1) +
+                     " contain NaN or infinity");
+  return d;
+}
+
 void read_c3d_plates(const C3dFile& f, const C3dLayout& l, const AnalogData& analog, double to_m, const C3dReadOptions& options,
                      const std::string& path, Trial& t) {
   const int nchannels = l.nchannels, spf = l.spf;
@@ -581,62 +642,11 @@ void read_c3d_plates(const C3dFile& f, const C3dLayout& l, const AnalogData& ana
     const auto* corners = f.find("FORCE_PLATFORM:CORNERS");
     const auto* origin = f.find("FORCE_PLATFORM:ORIGIN");
     const auto* channel = f.find("FORCE_PLATFORM:CHANNEL");
-    const auto* cal = f.find("FORCE_PLATFORM:CAL_MATRIX");
     if (!types || !corners || !origin || !channel) {
       throw InputError(path + ": FORCE_PLATFORM:USED = " + std::to_string(nplates) +
                        " but TYPE, CORNERS, ORIGIN or CHANNEL is missing");
     }
-    const int chan_rows = channel->dims.empty() ? 0 : channel->dims[0];
-    for (int p = 0; p < nplates; ++p) {
-      PlateDescription d;
-      d.name = "FP" + std::to_string(p + 1);
-      if (static_cast<int>(types->numbers.size()) <= p)
-        throw InputError(path + ": FORCE_PLATFORM:TYPE has no entry for plate " + std::to_string(p + 1));
-      d.type = count_value(types->numbers[p]);
-      if (d.type < 1 || d.type > 4) {
-        throw InputError(path + ": FORCE_PLATFORM:TYPE[" + std::to_string(p + 1) + "] = " +
-                         std::to_string(d.type) + " is not supported (types 1-4 are)");
-      }
-      if (corners->numbers.size() < static_cast<std::size_t>(12 * (p + 1)))
-        throw InputError(path + ": FORCE_PLATFORM:CORNERS has no entry for plate " + std::to_string(p + 1));
-      for (int c = 0; c < 4; ++c)
-        for (int a = 0; a < 3; ++a) d.corners(a, c) = corners->numbers[12 * p + 3 * c + a] * to_m;
-      if (origin->numbers.size() < static_cast<std::size_t>(3 * (p + 1)))
-        throw InputError(path + ": FORCE_PLATFORM:ORIGIN has no entry for plate " + std::to_string(p + 1));
-      for (int a = 0; a < 3; ++a) d.origin(a) = origin->numbers[3 * p + a] * to_m;
-      const int nch = d.type == 3 ? 8 : 6;
-      if (chan_rows < nch || channel->numbers.size() < static_cast<std::size_t>(chan_rows * (p + 1))) {
-        throw InputError(path + ": FORCE_PLATFORM:CHANNEL has fewer than " + std::to_string(nch) +
-                         " channels for plate " + std::to_string(p + 1) + " (type " +
-                         std::to_string(d.type) + ")");
-      }
-      for (int c = 0; c < nch; ++c) {
-        const int ch = count_value(channel->numbers[static_cast<std::size_t>(chan_rows * p + c)]);
-        if (ch < 1 || ch > nchannels) {
-          throw InputError(path + ": FORCE_PLATFORM:CHANNEL[" + std::to_string(c + 1) + "," +
-                           std::to_string(p + 1) + "] = " + std::to_string(ch) +
-                           " is not an analog channel (1.." + std::to_string(nchannels) + ")");
-        }
-        d.channels.push_back(ch - 1);
-      }
-      if (d.type == 4) {
-        if (!cal || cal->numbers.size() < static_cast<std::size_t>(36 * (p + 1))) {
-          throw InputError(path + ": plate " + std::to_string(p + 1) +
-                           " is TYPE 4 but FORCE_PLATFORM:CAL_MATRIX has no 6x6 entry for it");
-        }
-        for (int i = 0; i < 6; ++i)
-          for (int j = 0; j < 6; ++j) {
-            const std::size_t k = options.cal_matrix_first_index_fastest
-                                      ? static_cast<std::size_t>(36 * p + i + 6 * j)
-                                      : static_cast<std::size_t>(36 * p + 6 * i + j);
-            d.cal_matrix(i, j) = cal->numbers[k];
-          }
-      }
-      if (!d.corners.allFinite() || !d.origin.allFinite())
-        throw InputError(path + ": FORCE_PLATFORM CORNERS/ORIGIN of plate " + std::to_string(p + 1) +
-                         " contain NaN or infinity");
-      descs_fp.push_back(std::move(d));
-    }
+    for (int p = 0; p < nplates; ++p) descs_fp.push_back(plate_description(f, p, nchannels, to_m, options, path));
     PlateProcessing proc;
     proc.cop_threshold_N = options.cop_threshold_N;
     proc.zero_offset = options.zero_offset;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/numeric.hpp"
@@ -147,6 +148,83 @@ Eigen::Matrix3d plate_axes(const Eigen::Matrix<double, 3, 4>& c) {
   return R;
 }
 
+namespace {
+/// The plate's channels' scales to N and N m (and m for a type-1 plate's COP channels), from
+/// their units.
+std::vector<double> channel_scales(const AnalogData& analog, const PlateDescription& d, std::vector<std::string>& warnings) {
+  std::vector<double> scale(d.channels.size(), 1.0);
+  for (std::size_t c = 0; c < d.channels.size(); ++c) {
+    const auto ch = static_cast<std::size_t>(d.channels[c]);
+    const std::string unit = ch < analog.units.size() ? analog.units[ch] : "";
+    const std::string label = ch < analog.labels.size() ? analog.labels[ch] : "";
+    if (d.type == 2 || d.type == 4) {
+      if (c >= 3) scale[c] = moment_unit_scale(unit, warnings, d.name, label);
+    } else if (d.type == 1) {
+      if (c == 3 || c == 4) scale[c] = length_unit_scale_channel(unit, warnings, d.name, label);
+      if (c == 5) scale[c] = moment_unit_scale(unit, warnings, d.name, label);
+    }
+  }
+  return scale;
+}
+
+/// The channels' zero offsets (PlateProcessing::zero_offset): the mean over FORCE_PLATFORM:ZERO's
+/// samples, or the median over the unloaded samples; none (with a warning) when neither exists.
+/// `L`: the loads before the offsets are removed.
+std::optional<Eigen::RowVectorXd> channel_offsets(const Eigen::MatrixXd& ch, const PlateLoads& L, const PlateDescription& d,
+                                                  const PlateProcessing& proc, std::vector<std::string>& warnings) {
+  const Eigen::Index n = ch.rows();
+  if (proc.zero_offset == ZeroOffset::ZeroParameter) {
+    if (proc.zero_first_sample >= 0 && proc.zero_last_sample >= proc.zero_first_sample && proc.zero_last_sample < n &&
+        proc.zero_last_sample > 0)
+      return Eigen::RowVectorXd(ch.middleRows(proc.zero_first_sample, proc.zero_last_sample - proc.zero_first_sample + 1).colwise().mean());
+    warnings.push_back(d.name + ": FORCE_PLATFORM:ZERO gives no valid frame range; offsets not removed");
+    return std::nullopt;
+  }
+  // Unloaded: the force normal to the plate (its own z axis) is small. The plate's axis, not the
+  // lab's up axis: a Y-up lab (RBDS001runT35.c3d) would otherwise take the lateral force for the
+  // load and subtract half the body weight as an "offset".
+  std::vector<Eigen::Index> idx;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (std::abs(L.F(i, 2)) < proc.unloaded_threshold_N) idx.push_back(i);
+  if (idx.size() < 10) {
+    warnings.push_back(d.name + ": never unloaded (|F| < " + std::to_string(proc.unloaded_threshold_N) + " N); offsets not removed");
+    return std::nullopt;
+  }
+  Eigen::RowVectorXd offset = Eigen::RowVectorXd::Zero(ch.cols());
+  for (Eigen::Index c = 0; c < ch.cols(); ++c) {
+    std::vector<double> v;
+    v.reserve(idx.size());
+    for (auto i : idx) v.push_back(ch(i, c));
+    offset(c) = median(std::move(v));
+  }
+  return offset;
+}
+
+/// The plate's lab-frame force, moment about its centre, COP and free moment from its loads in
+/// its own frame (COP and free moment NaN below the COP threshold).
+void plate_lab_series(const PlateLoads& L, double cop_threshold_N, ForcePlate& fp) {
+  const Eigen::Index n = L.F.rows();
+  const Eigen::Matrix3d& R = fp.lab_R_plate;
+  fp.force_N = L.F * R.transpose();
+  fp.moment_centre_Nm = L.Mc * R.transpose();
+  fp.cop_m.resize(n, 3);
+  fp.free_moment_Nm.resize(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Vector3d F = L.F.row(i).transpose();
+    const Eigen::Vector3d Mc = L.Mc.row(i).transpose();
+    if (!(std::abs(F.z()) >= cop_threshold_N)) {
+      fp.cop_m.row(i).setConstant(kNaN);
+      fp.free_moment_Nm.row(i).setConstant(kNaN);
+      continue;
+    }
+    const Eigen::Vector3d p(-Mc.y() / F.z(), Mc.x() / F.z(), 0.0);
+    const double Tz = Mc.z() - (p.x() * F.y() - p.y() * F.x());
+    fp.cop_m.row(i) = (fp.centre_m + R * p).transpose();
+    fp.free_moment_Nm.row(i) = (R * Eigen::Vector3d(0, 0, Tz)).transpose();
+  }
+}
+}  // namespace
+
 ForcePlateRecording compute_plates(const AnalogData& analog,
                                    const std::vector<PlateDescription>& plates,
                                    const PlateProcessing& proc, const std::string& path,
@@ -181,80 +259,18 @@ ForcePlateRecording compute_plates(const AnalogData& analog,
       throw InputError(path + ": FORCE_PLATFORM:CORNERS of " + d.name +
                        " are degenerate (coincident corners)");
     }
-    // Channel scales to N and N m (and m for type-1 COP channels).
-    std::vector<double> scale(d.channels.size(), 1.0);
-    for (std::size_t c = 0; c < d.channels.size(); ++c) {
-      const auto ch = static_cast<std::size_t>(d.channels[c]);
-      const std::string unit = ch < analog.units.size() ? analog.units[ch] : "";
-      const std::string label = ch < analog.labels.size() ? analog.labels[ch] : "";
-      if (d.type == 2 || d.type == 4) {
-        if (c >= 3) scale[c] = moment_unit_scale(unit, warnings, d.name, label);
-      } else if (d.type == 1) {
-        if (c == 3 || c == 4) scale[c] = length_unit_scale_channel(unit, warnings, d.name, label);
-        if (c == 5) scale[c] = moment_unit_scale(unit, warnings, d.name, label);
-      }
-    }
+    const std::vector<double> scale = channel_scales(analog, d, warnings);
     Eigen::MatrixXd ch(n, static_cast<Eigen::Index>(d.channels.size()));
     for (std::size_t c = 0; c < d.channels.size(); ++c) ch.col(static_cast<Eigen::Index>(c)) = analog.values.col(d.channels[c]);
-
-    auto loads = [&](const Eigen::MatrixXd& channels) { return plate_loads(channels, d, scale); };
-    PlateLoads L = loads(ch);
+    PlateLoads L = plate_loads(ch, d, scale);
     if (proc.zero_offset != ZeroOffset::None) {
-      Eigen::RowVectorXd offset = Eigen::RowVectorXd::Zero(ch.cols());
-      bool ok = false;
-      if (proc.zero_offset == ZeroOffset::ZeroParameter) {
-        if (proc.zero_first_sample >= 0 && proc.zero_last_sample >= proc.zero_first_sample &&
-            proc.zero_last_sample < n && proc.zero_last_sample > 0) {
-          offset = ch.middleRows(proc.zero_first_sample, proc.zero_last_sample - proc.zero_first_sample + 1)
-                       .colwise().mean();
-          ok = true;
-        } else {
-          warnings.push_back(d.name + ": FORCE_PLATFORM:ZERO gives no valid frame range; offsets not removed");
-        }
-      } else {
-        // Unloaded: the force normal to the plate (its own z axis) is small. The plate's axis,
-        // not the lab's up axis: a Y-up lab (RBDS001runT35.c3d) would otherwise take the lateral
-        // force for the load and subtract half the body weight as an "offset".
-        std::vector<Eigen::Index> idx;
-        for (Eigen::Index i = 0; i < n; ++i)
-          if (std::abs(L.F(i, 2)) < proc.unloaded_threshold_N) idx.push_back(i);
-        if (idx.size() >= 10) {
-          for (Eigen::Index c = 0; c < ch.cols(); ++c) {
-            std::vector<double> v;
-            v.reserve(idx.size());
-            for (auto i : idx) v.push_back(ch(i, c));
-            offset(c) = median(std::move(v));
-          }
-          ok = true;
-        } else {
-          warnings.push_back(d.name + ": never unloaded (|F| < " +
-                             std::to_string(proc.unloaded_threshold_N) + " N); offsets not removed");
-        }
-      }
-      if (ok) {
-        ch.rowwise() -= offset;
-        L = loads(ch);
+      if (const auto offset = channel_offsets(ch, L, d, proc, warnings)) {
+        ch.rowwise() -= *offset;
+        L = plate_loads(ch, d, scale);
       }
     }
     if (!plate_samples_plausible(ch, L, d.name, analog, path, warnings)) continue;
-    const Eigen::Matrix3d& R = fp.lab_R_plate;
-    fp.force_N = L.F * R.transpose();
-    fp.moment_centre_Nm = L.Mc * R.transpose();
-    fp.cop_m.resize(n, 3);
-    fp.free_moment_Nm.resize(n, 3);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const Eigen::Vector3d F = L.F.row(i).transpose();
-      const Eigen::Vector3d Mc = L.Mc.row(i).transpose();
-      if (!(std::abs(F.z()) >= proc.cop_threshold_N)) {
-        fp.cop_m.row(i).setConstant(kNaN);
-        fp.free_moment_Nm.row(i).setConstant(kNaN);
-        continue;
-      }
-      const Eigen::Vector3d p(-Mc.y() / F.z(), Mc.x() / F.z(), 0.0);
-      const double Tz = Mc.z() - (p.x() * F.y() - p.y() * F.x());
-      fp.cop_m.row(i) = (fp.centre_m + R * p).transpose();
-      fp.free_moment_Nm.row(i) = (R * Eigen::Vector3d(0, 0, Tz)).transpose();
-    }
+    plate_lab_series(L, proc.cop_threshold_N, fp);
     rec.plates.push_back(std::move(fp));
   }
   return rec;

@@ -443,25 +443,15 @@ std::string format_sto(const Table& t) {
 
 void write_sto(const std::string& path, const Table& t) { write_file_text(path, format_sto(t)); }
 
-std::optional<ForcePlateRecording> grf_from_table(const Table& t, const std::string& path,
-                                                  double cop_threshold_N,
-                                                  std::vector<std::string>& warnings) {
-  // Labels PREFIXground_force_SIDEvx (OpenSim's convention, e.g. "ground_force_vx",
-  // "1_ground_force_vx", "ground_force_1_vx"). Parsed by hand: a regex match recurses per
-  // character and overflowed the stack on a 30 KB label.
-  struct Set { std::string prefix, side; };
-  std::vector<Set> sets;
-  static const std::string key = "ground_force_";
-  for (const auto& l : t.labels) {
-    const std::size_t pos = l.rfind(key);
-    if (pos == std::string::npos || l.size() < pos + key.size() + 2 || l.compare(l.size() - 2, 2, "vx") != 0) continue;
-    sets.push_back({l.substr(0, pos), l.substr(pos + key.size(), l.size() - 2 - pos - key.size())});
-  }
-  if (sets.empty()) return std::nullopt;
-  if (t.data.rows() < 2) throw InputError(path + ": a GRF table needs at least 2 rows");
-  ForcePlateRecording rec;
-  rec.cop_threshold_N = cop_threshold_N;
-  rec.up_axis = Axis::Y;
+namespace {
+/// One GRF column set: PREFIXground_force_SIDEv*, p*, and ground_torque_SIDE* when present.
+struct GrfSet {
+  std::string prefix, side;
+};
+
+/// The table's time column as a uniform grid (its rate and times into rec); refused when it does
+/// not increase or strays by half a sample, noted when it deviates by rounding.
+void grf_time_grid(const Table& t, const std::string& path, std::vector<std::string>& warnings, ForcePlateRecording& rec) {
   const Eigen::Index n = t.data.rows();
   const Eigen::VectorXd time = t.data.col(0);
   const double t0 = time[0];
@@ -480,40 +470,46 @@ std::optional<ForcePlateRecording> grf_from_table(const Table& t, const std::str
   rec.rate_hz = 1.0 / dt;
   rec.time_s.resize(n);
   for (Eigen::Index i = 0; i < n; ++i) rec.time_s[i] = t0 + static_cast<double>(i) * dt;
-  for (const auto& s : sets) {
-    ForcePlate fp;
-    fp.name = s.prefix + "ground_force" + (s.side.empty() ? "" : "_" + s.side.substr(0, s.side.size() - 1));
-    const std::string tag = to_lower(s.prefix + s.side);
-    if (tag == "r_" || tag.rfind("r_", 0) == 0 || s.side == "r_") fp.side_hint = Side::Right;
-    if (tag == "l_" || tag.rfind("l_", 0) == 0 || s.side == "l_") fp.side_hint = Side::Left;
-    fp.force_N.resize(n, 3);
-    fp.cop_m.resize(n, 3);
-    fp.free_moment_Nm.resize(n, 3);
-    fp.moment_centre_Nm = Eigen::MatrixX3d::Constant(n, 3, kNaN);
-    bool has_torque = true;
-    for (int a = 0; a < 3; ++a) {
-      const std::string ax(1, "xyz"[a]);
-      const int cv = t.column(s.prefix + "ground_force_" + s.side + "v" + ax);
-      const int cp = t.column(s.prefix + "ground_force_" + s.side + "p" + ax);
-      const int ct = t.column(s.prefix + "ground_torque_" + s.side + ax);
-      if (cv < 0 || cp < 0)
-        throw InputError(path + ": GRF column set '" + fp.name + "' lacks " + (cv < 0 ? "v" : "p") + ax);
-      fp.force_N.col(a) = t.data.col(cv);
-      fp.cop_m.col(a) = t.data.col(cp);
-      if (ct < 0) has_torque = false;
-      else fp.free_moment_Nm.col(a) = t.data.col(ct);
-    }
-    if (!has_torque) {
-      fp.free_moment_Nm.setZero();
-      warnings.push_back(fp.name + ": no ground_torque columns; free moment taken as zero");
-    }
-    if (!fp.force_N.allFinite()) throw InputError(path + ": GRF column set '" + fp.name + "' has NaN forces");
-    rec.plates.push_back(std::move(fp));
+}
+
+/// One column set as a plate without geometry (force, COP, free moment; a zero free moment, with
+/// a warning, when the torque columns are absent).
+ForcePlate grf_plate(const Table& t, const GrfSet& s, const std::string& path, std::vector<std::string>& warnings) {
+  const Eigen::Index n = t.data.rows();
+  ForcePlate fp;
+  fp.name = s.prefix + "ground_force" + (s.side.empty() ? "" : "_" + s.side.substr(0, s.side.size() - 1));
+  const std::string tag = to_lower(s.prefix + s.side);
+  if (tag == "r_" || tag.rfind("r_", 0) == 0 || s.side == "r_") fp.side_hint = Side::Right;
+  if (tag == "l_" || tag.rfind("l_", 0) == 0 || s.side == "l_") fp.side_hint = Side::Left;
+  fp.force_N.resize(n, 3);
+  fp.cop_m.resize(n, 3);
+  fp.free_moment_Nm.resize(n, 3);
+  fp.moment_centre_Nm = Eigen::MatrixX3d::Constant(n, 3, kNaN);
+  bool has_torque = true;
+  for (int a = 0; a < 3; ++a) {
+    const std::string ax(1, "xyz"[a]);
+    const int cv = t.column(s.prefix + "ground_force_" + s.side + "v" + ax);
+    const int cp = t.column(s.prefix + "ground_force_" + s.side + "p" + ax);
+    const int ct = t.column(s.prefix + "ground_torque_" + s.side + ax);
+    if (cv < 0 || cp < 0) throw InputError(path + ": GRF column set '" + fp.name + "' lacks " + (cv < 0 ? "v" : "p") + ax);
+    fp.force_N.col(a) = t.data.col(cv);
+    fp.cop_m.col(a) = t.data.col(cp);
+    if (ct < 0) has_torque = false;
+    else fp.free_moment_Nm.col(a) = t.data.col(ct);
   }
-  // The vertical is OpenSim's Y, unless the forces say otherwise: a ground reaction is mostly
-  // vertical (the body's weight against at most a third of it fore-aft), so the axis that carries
-  // the most force, twice the next, is up (a .mot written in a Z-up lab's frame, e.g. kin2grf's
-  // own -o from a C3D, had its COPs dropped as unloaded and its plates read sideways).
+  if (!has_torque) {
+    fp.free_moment_Nm.setZero();
+    warnings.push_back(fp.name + ": no ground_torque columns; free moment taken as zero");
+  }
+  if (!fp.force_N.allFinite()) throw InputError(path + ": GRF column set '" + fp.name + "' has NaN forces");
+  return fp;
+}
+
+/// The vertical is OpenSim's Y, unless the forces say otherwise: a ground reaction is mostly
+/// vertical (the body's weight against at most a third of it fore-aft), so the axis that carries
+/// the most force, twice the next, is up (a .mot written in a Z-up lab's frame, e.g. kin2grf's
+/// own -o from a C3D, had its COPs dropped as unloaded and its plates read sideways).
+Eigen::Index grf_up_axis(const ForcePlateRecording& rec, Eigen::Index n, std::vector<std::string>& warnings) {
   Eigen::Vector3d load = Eigen::Vector3d::Zero();
   for (const auto& fp : rec.plates) load += fp.force_N.cwiseAbs().colwise().sum().transpose();
   Eigen::Index up = 1;
@@ -526,33 +522,62 @@ std::optional<ForcePlateRecording> grf_from_table(const Table& t, const std::str
     warnings.push_back(std::string("up axis: the forces are largest along ") + "XYZ"[up] + " (" + fmt(most / static_cast<double>(n)) +
                        " N a sample against at most " + fmt(next / static_cast<double>(n)) + "), not OpenSim's Y: " + "XYZ"[up] +
                        " is taken as up");
-  rec.up_axis = static_cast<Axis>(up);
-  for (auto& fp : rec.plates) {
-    // OpenSim's GRF is the force on the body: its vertical points up while a foot stands. A
-    // column set whose load points down holds the force on the plate (another tool's
-    // convention); read as it is, every stance was "never loaded".
-    double down = 0, upward = 0;
-    Eigen::Index first = -1, last = -1;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double v = fp.force_N(i, up);
-      if (std::abs(v) < cop_threshold_N) continue;
-      (v < 0 ? down : upward) += std::abs(v);
-      if (v < 0) last = i, first = first < 0 ? i : first;
-    }
-    if (down > 2 * upward && first >= 0) {
-      fp.force_N = -fp.force_N;
-      fp.free_moment_Nm = -fp.free_moment_Nm;
-      warnings.push_back(path + ": " + fp.name + ": its vertical force points down (loaded from " + fmt(rec.time_s[first]) + " to " +
-                         fmt(rec.time_s[last]) + " s): it is the force on the plate, not on the body as OpenSim's GRF files hold; " +
-                         "read negated");
-    }
-    for (Eigen::Index i = 0; i < n; ++i) {
-      if (std::abs(fp.force_N(i, up)) < cop_threshold_N) {
-        fp.cop_m.row(i).setConstant(kNaN);  // stale or undefined COP of an unloaded plate
-        fp.free_moment_Nm.row(i).setConstant(kNaN);
-      }
+  return up;
+}
+
+/// OpenSim's GRF is the force on the body: its vertical points up while a foot stands. A column
+/// set whose load points down holds the force on the plate (another tool's convention); read as
+/// it is, every stance was "never loaded": it is negated, with a warning. Then the COP and free
+/// moment of unloaded samples become NaN.
+void grf_orient_and_mask(ForcePlate& fp, const ForcePlateRecording& rec, Eigen::Index up, double cop_threshold_N,
+                         const std::string& path, std::vector<std::string>& warnings) {
+  const Eigen::Index n = fp.force_N.rows();
+  double down = 0, upward = 0;
+  Eigen::Index first = -1, last = -1;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double v = fp.force_N(i, up);
+    if (std::abs(v) < cop_threshold_N) continue;
+    (v < 0 ? down : upward) += std::abs(v);
+    if (v < 0) last = i, first = first < 0 ? i : first;
+  }
+  if (down > 2 * upward && first >= 0) {
+    fp.force_N = -fp.force_N;
+    fp.free_moment_Nm = -fp.free_moment_Nm;
+    warnings.push_back(path + ": " + fp.name + ": its vertical force points down (loaded from " + fmt(rec.time_s[first]) + " to " +
+                       fmt(rec.time_s[last]) + " s): it is the force on the plate, not on the body as OpenSim's GRF files hold; " +
+                       "read negated");
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (std::abs(fp.force_N(i, up)) < cop_threshold_N) {
+      fp.cop_m.row(i).setConstant(kNaN);  // stale or undefined COP of an unloaded plate
+      fp.free_moment_Nm.row(i).setConstant(kNaN);
     }
   }
+}
+}  // namespace
+
+std::optional<ForcePlateRecording> grf_from_table(const Table& t, const std::string& path,
+                                                  double cop_threshold_N,
+                                                  std::vector<std::string>& warnings) {
+  // Labels PREFIXground_force_SIDEvx (OpenSim's convention, e.g. "ground_force_vx",
+  // "1_ground_force_vx", "ground_force_1_vx"). Parsed by hand: a regex match recurses per
+  // character and overflowed the stack on a 30 KB label.
+  std::vector<GrfSet> sets;
+  static const std::string key = "ground_force_";
+  for (const auto& l : t.labels) {
+    const std::size_t pos = l.rfind(key);
+    if (pos == std::string::npos || l.size() < pos + key.size() + 2 || l.compare(l.size() - 2, 2, "vx") != 0) continue;
+    sets.push_back({l.substr(0, pos), l.substr(pos + key.size(), l.size() - 2 - pos - key.size())});
+  }
+  if (sets.empty()) return std::nullopt;
+  if (t.data.rows() < 2) throw InputError(path + ": a GRF table needs at least 2 rows");
+  ForcePlateRecording rec;
+  rec.cop_threshold_N = cop_threshold_N;
+  grf_time_grid(t, path, warnings, rec);
+  for (const auto& s : sets) rec.plates.push_back(grf_plate(t, s, path, warnings));
+  const Eigen::Index up = grf_up_axis(rec, t.data.rows(), warnings);
+  rec.up_axis = static_cast<Axis>(up);
+  for (auto& fp : rec.plates) grf_orient_and_mask(fp, rec, up, cop_threshold_N, path, warnings);
   return rec;
 }
 

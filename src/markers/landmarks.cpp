@@ -406,11 +406,10 @@ std::size_t remove_marker_outliers(MarkerTrajectories& m, const std::vector<std:
   return removed;
 }
 
-Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m, const MarkerTrajectories* st,
-                              const LandmarkOptions& options, const std::string& path, MarkerTrajectories* release) {
-  Landmarks3D out;
-  const Eigen::Index n = m.frames();
-  // The last landmark that reads each marker of the trial (-1: none).
+namespace {
+/// Per marker of the trial, the last landmark whose rule reads it (-1: none): after it, the
+/// marker's samples can be let go.
+std::vector<int> last_landmark_use(const MarkerSet& set, const MarkerTrajectories& m) {
   std::vector<int> last_use(m.names.size(), -1);
   for (int id = 0; id < kLandmarkCount; ++id) {
     const LandmarkRule& r = set.rules[static_cast<std::size_t>(id)];
@@ -421,6 +420,50 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
     for (const auto& name : r.cluster) use(name);
     for (const auto& [key, name] : r.pelvis) use(name);
   }
+  return last_use;
+}
+
+/// A virtual point calibrated on the static trial (RuleKind::Static): its place in the cluster's
+/// frame, the median over the static frames, then carried by the cluster through the trial.
+Eigen::MatrixX3d static_landmark(const MarkerSet& set, const LandmarkRule& r, int id, const MarkerTrajectories& m,
+                                 const MarkerTrajectories* st, const std::string& path) {
+  const std::string what = std::string("landmark ") + kNames[id];
+  if (!st) {
+    throw InputError(path + ": landmark " + kNames[id] + " of marker set '" + set.name +
+                     "' is a virtual point calibrated on a static trial: give --static STATIC (it needs markers " +
+                     r.markers[0] + (r.markers.size() > 1 ? ", " + r.markers[1] : "") + ")");
+  }
+  std::vector<Eigen::MatrixX3d> cs, cm;
+  for (const auto& c : r.cluster) {
+    cs.push_back(marker(*st, c, path + " (static)", what));
+    cm.push_back(marker(m, c, path, what));
+  }
+  const Eigen::MatrixX3d sp = mean_of(*st, r.markers, path + " (static)", what);
+  std::vector<double> lx, ly, lz;
+  for (Eigen::Index i = 0; i < st->frames(); ++i) {
+    Eigen::Matrix3d R;
+    Eigen::Vector3d o;
+    if (!sp.row(i).allFinite() || !cluster_frame(cs, i, R, o)) continue;
+    const Eigen::Vector3d l = R.transpose() * (sp.row(i).transpose() - o);
+    lx.push_back(l.x()); ly.push_back(l.y()); lz.push_back(l.z());
+  }
+  if (lx.empty()) throw InputError(path + ": the static trial never shows landmark " + kNames[id] + "'s markers and cluster together");
+  const Eigen::Vector3d local(median(lx), median(ly), median(lz));
+  Eigen::MatrixX3d P = Eigen::MatrixX3d::Constant(m.frames(), 3, kNaN);
+  for (Eigen::Index i = 0; i < m.frames(); ++i) {
+    Eigen::Matrix3d R;
+    Eigen::Vector3d o;
+    if (cluster_frame(cm, i, R, o)) P.row(i) = (o + R * local).transpose();
+  }
+  return P;
+}
+}  // namespace
+
+Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m, const MarkerTrajectories* st,
+                              const LandmarkOptions& options, const std::string& path, MarkerTrajectories* release) {
+  Landmarks3D out;
+  const Eigen::Index n = m.frames();
+  const std::vector<int> last_use = last_landmark_use(set, m);
   auto release_after = [&](int id) {
     if (!release) return;
     for (std::size_t k = 0; k < last_use.size(); ++k)
@@ -475,33 +518,7 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
       if (P.rows() == 0) throw InputError(path + ": landmark " + kNames[id] + ": " + msg);
       out.messages.push_back(std::string(kNames[id]) + ": " + msg);
     } else if (r.kind == RuleKind::Static) {
-      if (!st) {
-        throw InputError(path + ": landmark " + kNames[id] + " of marker set '" + set.name +
-                         "' is a virtual point calibrated on a static trial: give --static STATIC (it needs markers " +
-                         r.markers[0] + (r.markers.size() > 1 ? ", " + r.markers[1] : "") + ")");
-      }
-      // Calibrate: the static point in the cluster frame, median over the static frames.
-      std::vector<Eigen::MatrixX3d> cs, cm;
-      for (const auto& c : r.cluster) {
-        cs.push_back(marker(*st, c, path + " (static)", what));
-        cm.push_back(marker(m, c, path, what));
-      }
-      const Eigen::MatrixX3d sp = mean_of(*st, r.markers, path + " (static)", what);
-      std::vector<double> lx, ly, lz;
-      for (Eigen::Index i = 0; i < st->frames(); ++i) {
-        Eigen::Matrix3d R;
-        Eigen::Vector3d o;
-        if (!sp.row(i).allFinite() || !cluster_frame(cs, i, R, o)) continue;
-        const Eigen::Vector3d l = R.transpose() * (sp.row(i).transpose() - o);
-        lx.push_back(l.x()); ly.push_back(l.y()); lz.push_back(l.z());
-      }
-      if (lx.empty()) throw InputError(path + ": the static trial never shows landmark " + kNames[id] + "'s markers and cluster together");
-      const Eigen::Vector3d local(median(lx), median(ly), median(lz));
-      for (Eigen::Index i = 0; i < n; ++i) {
-        Eigen::Matrix3d R;
-        Eigen::Vector3d o;
-        if (cluster_frame(cm, i, R, o)) P.row(i) = (o + R * local).transpose();
-      }
+      P = static_landmark(set, r, id, m, st, path);
     }
     out.p[static_cast<std::size_t>(id)] = std::move(P);  // virtual_hallux stays NaN: built in the sagittal step
     release_after(id);

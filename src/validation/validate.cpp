@@ -44,6 +44,62 @@ bool sole_point_planted(const EstimateResult& e, int f, int s, Eigen::Index i, c
 
 }  // namespace
 
+namespace {
+/// A plate's surface height, and with geometry its centre and extent, in the sagittal frame
+/// (with turns, the frame of the middle of its loaded samples; without geometry, the median
+/// height of its loaded COPs).
+void plate_place(const ForcePlate& p, const ForcePlateRecording& rec, const SagittalFrame& fr, const Eigen::VectorXd& t,
+                 double cop_threshold_N, Eigen::Index first_index, MeasuredPlate& m) {
+  const Eigen::Index n = t.size();
+  const double dt = n > 1 ? (t[n - 1] - t[0]) / static_cast<double>(n - 1) : 1.0;
+  const Eigen::Index ns = rec.samples();
+  if (p.has_geometry) {
+    // The plate's geometry in the frame of the middle of its loaded samples (turning walks).
+    Eigen::Index g = first_index + n / 2;
+    if (fr.turning()) {
+      std::vector<double> loaded;
+      for (Eigen::Index k = 0; k < ns; ++k)
+        if (p.force_N.row(k).dot(fr.up.transpose()) > cop_threshold_N) loaded.push_back(rec.time_s[k]);
+      if (!loaded.empty() && n > 1) {
+        const double tm = loaded[loaded.size() / 2];
+        g = first_index + std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::lround((tm - t[0]) / dt)), 0, n - 1);
+      }
+    }
+    const Eigen::Vector3d fw = fr.forward_at(g), lt = fr.lateral_at(g);
+    const double off = fr.x_offset_at(g);
+    m.surface_y_m = p.centre_m.dot(fr.up);
+    m.centre_m = {p.centre_m.dot(fw) + off, p.centre_m.dot(lt)};
+    m.x_min = m.lateral_min = std::numeric_limits<double>::infinity();
+    m.x_max = m.lateral_max = -m.x_min;
+    for (const auto& c : p.corners_m) {
+      m.x_min = std::min(m.x_min, c.dot(fw) + off), m.x_max = std::max(m.x_max, c.dot(fw) + off);
+      m.lateral_min = std::min(m.lateral_min, c.dot(lt)), m.lateral_max = std::max(m.lateral_max, c.dot(lt));
+    }
+  } else {
+    std::vector<double> h;
+    for (Eigen::Index k = 0; k < ns; ++k)
+      if (p.cop_m.row(k).allFinite() && std::abs(p.force_N.row(k).dot(fr.up.transpose())) > cop_threshold_N)
+        h.push_back(p.cop_m.row(k).dot(fr.up.transpose()));
+    m.surface_y_m = h.empty() ? 0.0 : median(h);
+  }
+}
+
+/// One plate sample: its force and 3D moment about the lab origin, both in the lab frame.
+void plate_sample(const ForcePlate& p, Eigen::Index k, Eigen::Vector3d& F, Eigen::Vector3d& M, bool& has_cop) {
+  F = p.force_N.row(k).transpose();
+  has_cop = p.cop_m.row(k).allFinite();
+  if (p.has_geometry && p.moment_centre_Nm.row(k).allFinite()) {
+    M = p.moment_centre_Nm.row(k).transpose() + p.centre_m.cross(F);
+  } else if (has_cop) {
+    Eigen::Vector3d T = p.free_moment_Nm.row(k).transpose();
+    if (!T.allFinite()) T.setZero();
+    M = Eigen::Vector3d(p.cop_m.row(k).transpose()).cross(F) + T;
+  } else {
+    M.setZero();  // below the COP threshold: a few newtons at most
+  }
+}
+}  // namespace
+
 std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const SagittalFrame& fr,
                                            const Eigen::VectorXd& t, double cop_threshold_N, Eigen::Index first_index) {
   std::vector<MeasuredPlate> out;
@@ -60,49 +116,7 @@ std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const
     m.moment_origin_Nm = Eigen::VectorXd::Constant(n, kNaN);
     m.cop_x_m = Eigen::VectorXd::Constant(n, kNaN);
     m.cop_lateral_m = Eigen::VectorXd::Constant(n, kNaN);
-    if (p.has_geometry) {
-      // The plate's geometry in the frame of the middle of its loaded samples (turning walks).
-      Eigen::Index g = first_index + n / 2;
-      if (fr.turning()) {
-        std::vector<double> loaded;
-        for (Eigen::Index k = 0; k < ns; ++k)
-          if (p.force_N.row(k).dot(fr.up.transpose()) > cop_threshold_N) loaded.push_back(rec.time_s[k]);
-        if (!loaded.empty() && n > 1) {
-          const double tm = loaded[loaded.size() / 2];
-          g = first_index + std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::lround((tm - t[0]) / dt)), 0, n - 1);
-        }
-      }
-      const Eigen::Vector3d fw = fr.forward_at(g), lt = fr.lateral_at(g);
-      const double off = fr.x_offset_at(g);
-      m.surface_y_m = p.centre_m.dot(fr.up);
-      m.centre_m = {p.centre_m.dot(fw) + off, p.centre_m.dot(lt)};
-      m.x_min = m.lateral_min = std::numeric_limits<double>::infinity();
-      m.x_max = m.lateral_max = -m.x_min;
-      for (const auto& c : p.corners_m) {
-        m.x_min = std::min(m.x_min, c.dot(fw) + off), m.x_max = std::max(m.x_max, c.dot(fw) + off);
-        m.lateral_min = std::min(m.lateral_min, c.dot(lt)), m.lateral_max = std::max(m.lateral_max, c.dot(lt));
-      }
-    } else {
-      std::vector<double> h;
-      for (Eigen::Index k = 0; k < ns; ++k)
-        if (p.cop_m.row(k).allFinite() && std::abs(p.force_N.row(k).dot(fr.up.transpose())) > cop_threshold_N)
-          h.push_back(p.cop_m.row(k).dot(fr.up.transpose()));
-      m.surface_y_m = h.empty() ? 0.0 : median(h);
-    }
-    // Per sample: force and the 3D moment about the lab origin, both in the lab frame.
-    auto sample = [&](Eigen::Index k, Eigen::Vector3d& F, Eigen::Vector3d& M, bool& has_cop) {
-      F = p.force_N.row(k).transpose();
-      has_cop = p.cop_m.row(k).allFinite();
-      if (p.has_geometry && p.moment_centre_Nm.row(k).allFinite()) {
-        M = p.moment_centre_Nm.row(k).transpose() + p.centre_m.cross(F);
-      } else if (has_cop) {
-        Eigen::Vector3d T = p.free_moment_Nm.row(k).transpose();
-        if (!T.allFinite()) T.setZero();
-        M = Eigen::Vector3d(p.cop_m.row(k).transpose()).cross(F) + T;
-      } else {
-        M.setZero();  // below the COP threshold: a few newtons at most
-      }
-    };
+    plate_place(p, rec, fr, t, cop_threshold_N, first_index, m);
     for (Eigen::Index i = 0; i < n && ns > 0; ++i) {
       const double lo = (t[i] - 0.5 * dt - rec.time_s[0]) * rec.rate_hz;
       const double hi = (t[i] + 0.5 * dt - rec.time_s[0]) * rec.rate_hz;
@@ -117,7 +131,7 @@ std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const
       for (Eigen::Index k = k0; k <= k1; ++k) {
         Eigen::Vector3d F, M;
         bool has_cop = false;
-        sample(k, F, M, has_cop);
+        plate_sample(p, k, F, M, has_cop);
         if (!F.allFinite() || !M.allFinite()) continue;
         Fs += F, Ms += M, ++cnt;
         if (has_cop) {
