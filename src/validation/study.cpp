@@ -45,28 +45,10 @@ std::tuple<double, double> post_filter_setting(const EstimateOptions& o) { retur
 /// single draw measures the seed as much as the method.
 constexpr int kNoiseRealizations = 8;
 
-/// A study from its setting's row (option_table.hpp): the row's grid, labels and condition.
-std::vector<Setting> grid_settings(const NumericOption& row) {
-  std::vector<Setting> s;
-  char b[48];
-  for (double v : row.grid) {
-    if (v == 0 && row.zero_label) std::snprintf(b, sizeof b, "%s", row.zero_label);
-    else std::snprintf(b, sizeof b, row.label_format, row.label_scale * v);
-    auto* field = row.field;
-    s.push_back({b, v, [field, v](EstimateOptions& o) { field(o) = v; }, row.study_marker_noise_m});
-  }
-  EstimateOptions defaults;
-  for (Setting& c : s) {
-    EstimateOptions o;
-    c.apply(o);
-    c.is_default = row.field(o) == row.field(defaults);
-  }
-  return s;
-}
-
-/// Settings over a list of values, labelled by `format` (`zero`: the label of 0 when given).
+/// Settings over a list of values, labelled by `format` applied to scale x the value (`zero`: the
+/// label of 0 when given).
 template <class Apply>
-std::vector<Setting> value_settings(std::initializer_list<double> values, const char* format, double scale, const char* zero,
+std::vector<Setting> value_settings(const std::vector<double>& values, const char* format, double scale, const char* zero,
                                     Apply apply) {
   std::vector<Setting> s;
   char b[48];
@@ -75,6 +57,16 @@ std::vector<Setting> value_settings(std::initializer_list<double> values, const 
     else std::snprintf(b, sizeof b, format, scale * v);
     s.push_back({b, v, [apply, v](EstimateOptions& o) { apply(o, v); }});
   }
+  return s;
+}
+
+/// A study from its setting's row (option_table.hpp): the row's grid, labels and condition.
+std::vector<Setting> grid_settings(const NumericOption& row) {
+  auto* field = row.field;
+  auto s = value_settings(row.grid, row.label_format, row.label_scale, row.zero_label,
+                          [field](EstimateOptions& o, double v) { field(o) = v; });
+  for (Setting& c : s) c.marker_noise_m = row.study_marker_noise_m;
+  mark_default(s, [field](EstimateOptions o) { return field(o); });
   return s;
 }
 

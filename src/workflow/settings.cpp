@@ -18,7 +18,6 @@ namespace kin2grf {
 
 namespace {
 const char* torso_length_name(TorsoLength t) { return t == TorsoLength::Fixed ? "fixed" : "measured"; }
-
 }  // namespace
 
 void add_settings_options(CLI::App* c, Settings& a) {

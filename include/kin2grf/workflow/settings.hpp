@@ -30,7 +30,7 @@ struct Settings {
               kinematic_cutoff_rule = "noise";
   double r = SolverOptions{}.r_N_per_m, kinematic_cutoff = EstimateOptions{}.kinematic_cutoff_hz,
          post_cutoff_cycles = EstimateOptions{}.post_cutoff_cycles, speed_gate = SpeedGateRule{}.fixed_mps;
-  /// The numeric settings that are one option field each (settings.cpp's table: flag, range,
+  /// The numeric settings that are one option field each (option_table.hpp's rows: flag, range,
   /// --paper value, JSON key), held in their own fields with the library's defaults.
   EstimateOptions numeric;
   bool paper = false, r_given = false, anthropometry_given = false;
