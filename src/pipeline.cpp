@@ -208,7 +208,7 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   append(msg, std::move(cleaning));
   append(msg, std::move(lm3.messages));
   out.frame = detect_sagittal_frame(lm3, markers, o.landmarks);
-  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, out.frame, markers, o.landmarks, trial.path, o.mediolateral);
+  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, out.frame, markers, o.landmarks, trial.path, o.lateral_force());
   out.landmark_lab_m = std::move(win.lab_m);
   out.lateral_axis = std::move(win.lateral_axis);
   append(msg, std::move(win.messages));
@@ -911,12 +911,19 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   const int cycled_frames = dyn.raw.cycled_frames, capped_frames = dyn.raw.capped_frames;
   const double ground_level_m = dyn.plan.calibration.contact.ground_level_m;
   FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m);
-  if (o.mediolateral) mediolateral_stage(kin.motion, sag, kin.kinematic_cutoff_hz, feet.feet);
+  if (o.lateral_force()) mediolateral_stage(kin.motion, sag, kin.kinematic_cutoff_hz, feet.feet);
+  std::optional<LegMotion3D> legs;
+  if (o.model == ModelKind::ThreeD)
+    legs = leg_motion_3d(*mod.model, sag.landmark_lab_m, sag.lateral_axis, sag.frame.up, kin.motion.rate_hz, kin.kinematic_cutoff_hz);
   sag.landmark_lab_m = {};
   sag.lateral_axis = Eigen::MatrixX3d();
   TotalsStage totals = totals_stage(o, kin.motion, feet.feet, ground_level_m);
 
   EstimateResult r = assemble_result(set.name, mass_kg, sag, mod, kin, dyn, feet, totals, iterations, o);
+  if (legs) {
+    JointMoments3D moments = joint_moments_3d(*legs, estimated_wrenches(r));
+    r.legs_3d = Legs3D{std::move(*legs), std::move(moments)};
+  }
   r.cycled_frames = cycled_frames;
   r.capped_frames = capped_frames;
   r.seconds_kinematics = seconds_kinematics;
@@ -948,6 +955,29 @@ EstimateResult estimate(const Trial& trial, const Trial* static_trial, const Mar
 EstimateResult estimate(Trial&& trial, const Trial* static_trial, const MarkerSet& set, const EstimateOptions& o) {
   const std::string path = trial.path;
   return naming_the_trial(path, [&] { return estimate_impl(trial, &trial, static_trial, set, o); });
+}
+
+const char* model_kind_name(ModelKind kind) { return kind == ModelKind::ThreeD ? "3d" : "sagittal"; }
+
+ModelKind model_kind(const std::string& name) {
+  if (name == "sagittal") return ModelKind::Sagittal;
+  if (name == "3d") return ModelKind::ThreeD;
+  throw InputError("model '" + name + "' is not known: sagittal or 3d");
+}
+
+std::array<FootWrench3D, 2> estimated_wrenches(const EstimateResult& r) {
+  std::array<FootWrench3D, 2> out;
+  const Eigen::Index n = r.time_s.size();
+  for (int side = 0; side < 2; ++side) {
+    Eigen::MatrixX3d force(n, 3), cop(n, 3);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const LabFootFrame f = lab_foot_frame(r, side, i);
+      force.row(i) = f.force_N.transpose();
+      cop.row(i) = f.cop_m.transpose();
+    }
+    out[static_cast<std::size_t>(side)] = foot_wrench(force, cop, Eigen::VectorXd::Zero(n), r.frame.up);
+  }
+  return out;
 }
 
 LabFootFrame lab_foot_frame(const EstimateResult& r, int side, Eigen::Index i) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "kin2grf/dynamics/contact.hpp"
+#include "kin2grf/dynamics/joint_moments_3d.hpp"
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
 #include "kin2grf/trial.hpp"
 #include "kin2grf/kinematics/motion.hpp"
@@ -17,6 +18,15 @@
 #include "kin2grf/model/model.hpp"
 
 namespace kin2grf {
+
+/// The estimate's model (issue 28): the paper's sagittal model, or the 3D one, which adds to it
+/// each foot's mediolateral force (dynamics/mediolateral.hpp) and the ankles' and knees' 3D
+/// moments by bottom-up inverse dynamics (dynamics/joint_moments_3d.hpp). The sagittal results
+/// (forces, COP along progression, GRM, the 2D joint torques) are the same in both.
+enum class ModelKind { Sagittal, ThreeD };
+/// "sagittal" or "3d"; model_kind: InputError otherwise.
+const char* model_kind_name(ModelKind kind);
+ModelKind model_kind(const std::string& name);
 
 struct EstimateOptions {
   std::optional<double> mass_kg;           ///< else the file's (C3D PROCESSING/SUBJECT(S)); none -> error
@@ -91,9 +101,12 @@ struct EstimateOptions {
   /// GRM reference point in the sagittal frame (x along progression, y up), m.
   Eigen::Vector2d grm_reference_m = Eigen::Vector2d::Zero();
   /// The mediolateral force (kin2grf; dynamics/mediolateral.hpp): each foot's force along the
-  /// sagittal frame's lateral axis, from the whole body's lateral acceleration split by the
-  /// inverted-pendulum rule. Off: the sagittal model's outputs, with a zero lateral force.
+  /// sagittal frame's lateral axis, from the whole body's lateral acceleration shared between the
+  /// feet by their vertical loads. Off: the sagittal model's outputs, with a zero lateral force.
+  /// ModelKind::ThreeD includes it.
   bool mediolateral = false;
+  ModelKind model = ModelKind::Sagittal;
+  [[nodiscard]] bool lateral_force() const { return mediolateral || model == ModelKind::ThreeD; }
   /// Called with (frames solved, frames in all) every 1 % of the contact solve; empty: none.
   /// The core prints nothing itself: the front end decides what to show.
   std::function<void(long, long)> progress;
@@ -110,6 +123,15 @@ struct FootResult {
   /// Along the sagittal frame's lateral axis (forward x up), N; zero when inactive; empty unless
   /// EstimateOptions::mediolateral.
   Eigen::VectorXd force_lateral_N;
+};
+
+/// The 3D model's legs (ModelKind::ThreeD): their kinematics, made once, and the ankles' and
+/// knees' moments with the estimated ground reactions (validate runs the same kinematics with the
+/// plates'). The ground reaction: each foot's force (anterior, vertical, mediolateral) at its COP
+/// (lab_foot_frame), no free moment.
+struct Legs3D {
+  LegMotion3D motion;
+  JointMoments3D moments;
 };
 
 struct EstimateResult {
@@ -139,6 +161,7 @@ struct EstimateResult {
   std::vector<int> iterations;
   int cycled_frames = 0, capped_frames = 0;
   std::array<Eigen::VectorXd, 2> foot_lateral_m;
+  std::optional<Legs3D> legs_3d;   ///< ModelKind::ThreeD only
   /// The motion the contact forces were solved with (independent coordinates, about 100 bytes a
   /// frame) and the GRM's reference point: what frame_totals() remakes a frame's totals from.
   ModelMotion motion;
@@ -228,6 +251,9 @@ struct LabFootFrame {
   Eigen::Vector3d force_N, cop_m;
 };
 LabFootFrame lab_foot_frame(const EstimateResult& r, int side, Eigen::Index i);
+/// Each foot's estimated ground reaction (lab_foot_frame, no free moment) as the wrench the 3D
+/// joint moments take.
+std::array<FootWrench3D, 2> estimated_wrenches(const EstimateResult& r);
 /// The per-foot results as lab-frame force plates (force, COP, free moment), lab_foot_frame for
 /// every frame.
 std::array<ForcePlate, 2> as_lab_plates(const EstimateResult& r);

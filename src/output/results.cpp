@@ -56,7 +56,7 @@ void write_grf_mot(const std::string& path, const EstimateResult& r, const std::
   file.commit();
 }
 
-std::vector<std::string> results_columns(bool mediolateral) {
+std::vector<std::string> results_columns(bool mediolateral, bool moments_3d) {
   std::vector<std::string> c = {"frame", "time_s"};
   for (const char* s : {"r", "l"})
     for (const char* name : {"grf_anterior_%s_N", "grf_vertical_%s_N", "cop_x_%s_m", "contact_%s", "gap_%s_m",
@@ -74,6 +74,12 @@ std::vector<std::string> results_columns(bool mediolateral) {
   for (const char* name : {"residual_x_N", "residual_y_N", "residual_moment_Nm", "iterations"}) c.emplace_back(name);
   if (mediolateral)
     for (const char* name : {"grf_lateral_r_N", "grf_lateral_l_N"}) c.emplace_back(name);
+  if (moments_3d)
+    for (const char* s : {"r", "l"}) {
+      for (const char* joint : {"ankle", "knee"})
+        for (const char* plane : {"sagittal", "frontal", "transverse"}) c.push_back(std::string(joint) + "_" + plane + "_" + s + "_Nm");
+      c.push_back(std::string("knee_adduction_moment_") + s + "_Nm");
+    }
   return c;
 }
 
@@ -95,13 +101,20 @@ void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> v) {
   for (int j = 0; j < 2 * kJointCount; ++j) v[k++] = held ? r.joint_force_N(i, j) : t.joint_force_N[static_cast<std::size_t>(j)];
   for (int j = 0; j < 3; ++j) v[k++] = held ? r.residual(i, j) : t.residual[j];
   v[k++] = r.iterations[static_cast<std::size_t>(i)];
-  if (v.size() > k)
+  if (r.feet[0].force_lateral_N.size() > 0)
     for (const auto& f : r.feet) v[k++] = f.force_lateral_N[i];
+  if (r.legs_3d)
+    for (std::size_t s = 0; s < 2; ++s) {
+      const JointMoments3D& m = r.legs_3d->moments;
+      for (const Eigen::MatrixX3d* joint : {&m.ankle_Nm[s], &m.knee_Nm[s]})
+        for (int a = 0; a < 3; ++a) v[k++] = (*joint)(i, a);
+      v[k++] = -m.knee_Nm[s](i, 1);  // the external knee adduction moment (knee_adduction_moment)
+    }
 }
 
 ResultsTable results_table(const EstimateResult& r) {
   ResultsTable t;
-  t.columns = results_columns(r.feet[0].force_lateral_N.size() > 0);
+  t.columns = results_columns(r.feet[0].force_lateral_N.size() > 0, r.legs_3d.has_value());
   const Eigen::Index n = r.time_s.size();
   const auto nc = static_cast<Eigen::Index>(t.columns.size());
   t.values.resize(n, nc);
@@ -114,7 +127,7 @@ ResultsTable results_table(const EstimateResult& r) {
 }
 
 void write_results_csv(std::ostream& os, const EstimateResult& r) {
-  const std::vector<std::string> columns = results_columns(r.feet[0].force_lateral_N.size() > 0);
+  const std::vector<std::string> columns = results_columns(r.feet[0].force_lateral_N.size() > 0, r.legs_3d.has_value());
   std::string buf;
   for (std::size_t k = 0; k < columns.size(); ++k) (buf += k ? "," : "") += columns[k];
   buf += '\n';

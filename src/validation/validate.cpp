@@ -116,6 +116,8 @@ std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const
     m.moment_origin_Nm = Eigen::VectorXd::Constant(n, kNaN);
     m.cop_x_m = Eigen::VectorXd::Constant(n, kNaN);
     m.cop_lateral_m = Eigen::VectorXd::Constant(n, kNaN);
+    m.force_lab_N = Eigen::MatrixX3d::Constant(n, 3, kNaN);
+    m.moment_origin_lab_Nm = Eigen::MatrixX3d::Constant(n, 3, kNaN);
     plate_place(p, rec, fr, t, cop_threshold_N, first_index, m);
     for (Eigen::Index i = 0; i < n && ns > 0; ++i) {
       const double lo = (t[i] - 0.5 * dt - rec.time_s[0]) * rec.rate_hz;
@@ -141,6 +143,8 @@ std::vector<MeasuredPlate> resample_plates(const ForcePlateRecording& rec, const
       }
       if (cnt == 0) continue;  // no valid sample in this frame: stays NaN
       Fs /= cnt, Ms /= cnt;
+      m.force_lab_N.row(i) = Fs.transpose();
+      m.moment_origin_lab_Nm.row(i) = Ms.transpose();
       const double fx = Fs.dot(fr.forward_at(first_index + i)), fy = Fs.dot(fr.up);
       m.force_N(i, 0) = fx;
       m.force_N(i, 1) = fy;
@@ -362,6 +366,7 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
   StanceValidation s;
   s.foot = c.foot;
   s.plate = mp.name;
+  s.plate_index = c.plate;
   s.first = c.run.first;
   s.last = c.run.last;
   s.assign_distance_m = c.distance;
@@ -634,6 +639,7 @@ ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateR
     if (c.kept) v.stances.push_back(compare_stance(e, v, c, o));
   std::sort(v.stances.begin(), v.stances.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   compare_totals(e, v, cands, o);
+  if (e.legs_3d) validate_joint_moments_3d(e, v);
   return v;
 }
 
@@ -671,6 +677,30 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
   return v;
 }
 
+namespace {
+/// The 3D joint moments' means (MeanMetrics::knee_sagittal, knee_adduction, kam_peak_error_percent).
+void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, MeanMetrics& mm) {
+  std::array<std::vector<double>, 4> x;  // knee sagittal rRMSE, KAM rRMSE, |peak error| % (first, second)
+  for (const auto& s : stances) {
+    if ((foot >= 0 && s.foot != foot) || !s.moments_3d) continue;
+    const JointMomentValidation& j = *s.moments_3d;
+    if (j.knee[0] && std::isfinite(j.knee[0]->rrmse_percent)) x[0].push_back(j.knee[0]->rrmse_percent);
+    if (j.knee_adduction && std::isfinite(j.knee_adduction->rrmse_percent)) x[1].push_back(j.knee_adduction->rrmse_percent);
+    for (std::size_t p = 0; p < 2; ++p) {
+      const double m = j.kam_peak_measured_Nm[p];
+      if (std::isfinite(m) && m > 0 && std::isfinite(j.kam_peak_estimated_Nm[p]))
+        x[2 + p].push_back(100 * std::abs(j.kam_peak_estimated_Nm[p] - m) / m);
+    }
+  }
+  std::array<double*, 4> out{&mm.knee_sagittal, &mm.knee_adduction, &mm.kam_peak_error_percent[0], &mm.kam_peak_error_percent[1]};
+  for (std::size_t k = 0; k < 4; ++k) {
+    double sum = 0;
+    for (double a : x[k]) sum += a;
+    *out[k] = x[k].empty() ? kNaN : sum / static_cast<double>(x[k].size());
+  }
+}
+}  // namespace
+
 MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   MeanMetrics mm;
   std::array<std::vector<double>, 5> vals;
@@ -688,6 +718,7 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
       lateral_rmse.push_back(100 * s.metrics.lateral->rmse / s.body_weight_N);
     ++mm.n;
   }
+  mean_joint_moments(stances, foot, mm);
   double cop_lateral_sum = 0;
   for (double x : cop_lateral_rmse) cop_lateral_sum += x;
   mm.cop_lateral_rmse_mm = cop_lateral_rmse.empty() ? kNaN : cop_lateral_sum / static_cast<double>(cop_lateral_rmse.size());
@@ -745,6 +776,25 @@ nlohmann::json component_json(const ComponentMetrics& c, double bw) {
   return j;
 }
 
+/// A stance's 3D joint moments (ModelKind::ThreeD): per joint and plane the rRMSE, RMSE (N m) and
+/// r, estimate-driven against plate-driven; the KAM's and its peaks.
+nlohmann::json joint_moments_json(const JointMomentValidation& jm) {
+  nlohmann::json j;
+  const char* planes[] = {"sagittal", "frontal", "transverse"};
+  auto metrics = [](const std::optional<SeriesMetrics>& m) {
+    return m ? nlohmann::json{{"rrmse_percent", num(m->rrmse_percent)}, {"rmse_Nm", num(m->rmse)}, {"r", num(m->pearson_r)}}
+             : nlohmann::json(nullptr);
+  };
+  for (std::size_t c = 0; c < 3; ++c) {
+    j["ankle"][planes[c]] = metrics(jm.ankle[c]);
+    j["knee"][planes[c]] = metrics(jm.knee[c]);
+  }
+  j["knee_adduction_moment"] = metrics(jm.knee_adduction);
+  j["knee_adduction_moment"]["peaks_estimated_Nm"] = {num(jm.kam_peak_estimated_Nm[0]), num(jm.kam_peak_estimated_Nm[1])};
+  j["knee_adduction_moment"]["peaks_measured_Nm"] = {num(jm.kam_peak_measured_Nm[0]), num(jm.kam_peak_measured_Nm[1])};
+  return j;
+}
+
 }  // namespace
 
 nlohmann::json validation_json(const std::string& trial, const EstimateResult& e, const ValidationResult& v,
@@ -768,6 +818,7 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     x["cop_rmse_percent_foot"] = s.metrics.cop ? num(100 * s.metrics.cop->rmse / s.foot_length_m) : nlohmann::json(nullptr);
     x["cop_reference_suspect"] = s.cop_reference_suspect;
     x["timing_ms"] = {{"onset", opt(s.onset_error_ms)}, {"offset", opt(s.offset_error_ms)}, {"vertical_lag", opt(s.vertical_lag_ms)}};
+    if (s.moments_3d) x["joint_moments_3d"] = joint_moments_json(*s.moments_3d);
     j["per_foot"].push_back(x);
   }
   if (v.total) {
@@ -784,6 +835,12 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     const MeanMetrics m = mean_rrmse(v.stances, f);
     means[f < 0 ? "all" : side_name(f)] = {{"stances", m.n},         {"vertical", num(m.vertical)}, {"anterior", num(m.anterior)},
                                             {"cop", num(m.cop)},      {"moment", num(m.moment)}};
+    if (std::isfinite(m.knee_adduction)) {
+      auto& x = means[f < 0 ? "all" : side_name(f)];
+      x["knee_sagittal_moment"] = num(m.knee_sagittal);
+      x["knee_adduction_moment"] = num(m.knee_adduction);
+      x["knee_adduction_moment_peak_error_percent"] = {num(m.kam_peak_error_percent[0]), num(m.kam_peak_error_percent[1])};
+    }
     if (std::isfinite(m.lateral_rmse_percent_bw)) {
       means[f < 0 ? "all" : side_name(f)]["lateral"] = num(m.lateral);
       means[f < 0 ? "all" : side_name(f)]["lateral_rmse_percent_bw"] = num(m.lateral_rmse_percent_bw);
@@ -852,6 +909,28 @@ void format_lateral_rows(std::ostream& os, const ValidationResult& v, const Mean
   std::snprintf(buf, sizeof buf, "%.0f", m.cop_lateral_rmse_mm);
   os << table_text(buf) << "\n";
 }
+/// The 3D joint moments' rows (--model 3d): per stance the knee's sagittal and adduction moments'
+/// rRMSE and the KAM's two peaks, estimate-driven / plate-driven, then the means.
+void format_joint_moment_rows(std::ostream& os, const ValidationResult& v, const MeanMetrics& m, double mass_kg) {
+  char a[40], b[40];
+  os << table_label("3D knee moments") << table_text("sagittal %") << table_text("KAM %") << table_text("KAM peak 1") << table_text("KAM peak 2")
+     << "   N m/kg, estimate / plates\n";
+  for (const auto& s : v.stances) {
+    if (!s.moments_3d) continue;
+    const JointMomentValidation& j = *s.moments_3d;
+    std::snprintf(a, sizeof a, "%.2f/%.2f", j.kam_peak_estimated_Nm[0] / mass_kg, j.kam_peak_measured_Nm[0] / mass_kg);
+    std::snprintf(b, sizeof b, "%.2f/%.2f", j.kam_peak_estimated_Nm[1] / mass_kg, j.kam_peak_measured_Nm[1] / mass_kg);
+    os << table_label(std::string(side_name(s.foot)) + " foot on " + s.plate) << table_cell(j.knee[0]) << table_cell(j.knee_adduction)
+       << table_text(a) << table_text(b) << "\n";
+  }
+  const auto cell = [](double x, const char* unit) {
+    char c[40];
+    std::snprintf(c, sizeof c, "%.1f%s", x, unit);
+    return table_text(std::isfinite(x) ? c : "-");
+  };
+  os << table_label("per foot, mean; peaks |error|") << cell(m.knee_sagittal, "") << cell(m.knee_adduction, "")
+     << cell(m.kam_peak_error_percent[0], " %") << cell(m.kam_peak_error_percent[1], " %") << "\n";
+}
 }  // namespace
 
 std::string format_validation_table(const std::string& trial, const ValidationResult& v) {
@@ -874,6 +953,7 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
     os << table_label("per foot, mean (SD), n = " + std::to_string(m.n)) << table_msd(m.vertical, m.vertical_sd)
        << table_msd(m.anterior, m.anterior_sd) << table_msd(m.cop, m.cop_sd) << table_msd(m.moment, m.moment_sd) << "\n";
   if (std::isfinite(m.lateral_rmse_percent_bw)) format_lateral_rows(os, v, m);
+  if (std::isfinite(m.knee_adduction)) format_joint_moment_rows(os, v, m, v.mass_kg);
   if (v.total)
     os << table_label("total, GRM (" + std::to_string(v.total->frames.size()) + " frames)") << table_cell(v.total->metrics.vertical)
        << table_cell(v.total->metrics.anterior) << table_text("-") << table_cell(v.total->metrics.moment) << "\n";

@@ -29,6 +29,10 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_flag("--mediolateral", a.mediolateral,
               "Estimate each foot's mediolateral force too (the whole body's lateral acceleration, shared between the feet by "
               "vertical load; docs/METHOD-NOTES.md); off: the sagittal model's zero lateral force");
+  c->add_option("--model", a.model,
+                "sagittal (the paper's model) or 3d: the sagittal results plus each foot's mediolateral force (as "
+                "--mediolateral) and the ankles' and knees' 3D moments, the knee adduction moment among them")
+      ->check(CLI::IsMember({"sagittal", "3d"}))->capture_default_str();
   c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
       ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
   c->add_option_function<double>(
@@ -106,6 +110,7 @@ EstimateOptions to_options(const Settings& a) {
   o.mass_kg = a.mass;  // any given value, checked by the library (a negative one is refused, not ignored)
   o.allow_unusual_mass = a.force_mass;
   o.mediolateral = a.mediolateral;
+  o.model = model_kind(a.model);
   o.anthropometry = (a.paper && !a.anthropometry_given) ? "winter" : a.anthropometry;
   o.kinematic_cutoff_hz = a.kinematic_cutoff;
   if (a.post_cutoff && a.post_cutoff_cycles_given)
@@ -152,8 +157,8 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"r_N_per_m", o.solver.r_N_per_m},
           {"norm", o.solver.norm == MultiplierNorm::Paper ? "paper" : "torque-scaled"},
           {"speed_gate_mps", o.contact.speed_gate.fixed_mps},
-
-          {"mediolateral", o.mediolateral},
+          {"model", model_kind_name(o.model)},
+          {"mediolateral", o.lateral_force()},
           {"torso_length", torso_length_name(o.torso_length)},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"kinematic_cutoff_rule", o.cutoff_from_noise ? "noise" : "fixed"},

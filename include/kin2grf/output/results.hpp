@@ -28,9 +28,12 @@ struct ResultsTable {
 };
 ResultsTable results_table(const EstimateResult& r);
 /// results_table's columns, and its row `i` into `out` (out.size() == the columns' count).
-/// The per-frame table's columns; `mediolateral` (EstimateOptions::mediolateral): and each foot's
-/// lateral force last, grf_lateral_r_N and grf_lateral_l_N.
-std::vector<std::string> results_columns(bool mediolateral = false);
+/// The per-frame table's columns; `mediolateral` (EstimateOptions::lateral_force): and each
+/// foot's lateral force, grf_lateral_r_N and grf_lateral_l_N; `moments_3d` (ModelKind::ThreeD):
+/// and per side (r, l) the ankle's and the knee's internal 3D moments, ankle_sagittal_r_Nm,
+/// ankle_frontal_r_Nm, ankle_transverse_r_Nm, knee_..., then knee_adduction_moment_r_Nm, the
+/// external knee adduction moment (dynamics/joint_moments_3d.hpp's signs), last.
+std::vector<std::string> results_columns(bool mediolateral = false, bool moments_3d = false);
 void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> out);
 /// results_table as CSV: counts (frame, contact, iterations) as integers, the rest to 6
 /// significant digits, NaN as an empty cell. Written row by row as made, never held whole; the

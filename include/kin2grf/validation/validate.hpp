@@ -42,6 +42,7 @@
 
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
+#include <array>
 #include <limits>
 #include <optional>
 #include <string>
@@ -66,6 +67,9 @@ struct MeasuredPlate {
   double surface_y_m = 0.0;        ///< plate surface height in the sagittal frame
   Eigen::Vector2d centre_m = Eigen::Vector2d::Zero();  ///< (x, lateral) of the surface centre
   double x_min = 0, x_max = 0, lateral_min = 0, lateral_max = 0;  ///< extent (with geometry)
+  /// The lab-frame force (N) and its moment about the lab origin (N m), free moment included: the
+  /// wrench the plate-driven 3D joint moments take (validate_joint_moments_3d); NaN outside.
+  Eigen::MatrixX3d force_lab_N, moment_origin_lab_Nm;
 };
 
 /// `first_index`: the trial frame of frame_time_s[0] (a turning frame's heading is per trial
@@ -120,9 +124,23 @@ struct ComponentMetrics {
   std::optional<SeriesMetrics> lateral, cop_lateral;
 };
 
+/// One stance's 3D joint moments (ModelKind::ThreeD): driven by the estimate's ground reaction
+/// against driven by the plate's, on the same leg kinematics (EstimateResult::legs_3d), so that
+/// the difference is the estimate's alone. Components as JointMoments3D's (sagittal, frontal,
+/// transverse, internal moments on the distal segment).
+struct JointMomentValidation {
+  std::array<std::optional<SeriesMetrics>, 3> ankle, knee;
+  std::optional<SeriesMetrics> knee_adduction;  ///< the external knee adduction moment (KAM)
+  /// The KAM's first and second peaks (N m): its largest value in the first and in the second
+  /// half of the stance, estimate-driven and plate-driven.
+  std::array<double, 2> kam_peak_estimated_Nm{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+  std::array<double, 2> kam_peak_measured_Nm{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+};
+
 struct StanceValidation {
   int foot = 0;                 ///< 0 right, 1 left
   std::string plate;
+  int plate_index = -1;         ///< in ValidationResult::plates
   Eigen::Index first = 0, last = 0;  ///< frames in the estimate's window (inclusive)
   double assign_distance_m = 0.0;
   double body_weight_N = 0.0;  ///< the estimate's (for errors in % body weight)
@@ -142,6 +160,7 @@ struct StanceValidation {
   /// estimate lags, - = it leads.
   std::optional<double> vertical_lag_ms;
   Eigen::Vector2d moment_reference_m = Eigen::Vector2d::Zero();
+  std::optional<JointMomentValidation> moments_3d;  ///< ModelKind::ThreeD
 };
 
 struct TotalValidation {
@@ -170,10 +189,19 @@ struct ValidationResult {
   /// recording's ends by the search's reach, or when the best shift lies at the search's limit).
   std::optional<SyncEstimate> sync;
   double plate_shift_s = 0.0;  ///< the shift the comparison above was made with (0 unless Sync::Auto or Fixed)
+  /// ModelKind::ThreeD: the 3D joint moments driven by each foot's kept stances' plates (zero
+  /// ground reaction elsewhere, so only the kept stances' frames are meaningful).
+  std::optional<JointMoments3D> measured_moments_3d;
 };
 
 ValidationResult validate(const EstimateResult& estimate, const ForcePlateRecording& plates,
                           const ValidationOptions& options = {});
+
+/// The 3D joint moments' comparison (validate calls it when the estimate has EstimateResult::
+/// legs_3d): each foot's kept stances' plate wrenches (force and moment about the lab origin,
+/// free moment included) drive joint_moments_3d on the estimate's leg kinematics, into
+/// v.measured_moments_3d, and each stance gets its JointMomentValidation.
+void validate_joint_moments_3d(const EstimateResult& estimate, ValidationResult& v);
 
 /// Mean (and SD) over the stances of each component's rRMSE, per foot or all.
 struct MeanMetrics {
@@ -184,6 +212,11 @@ struct MeanMetrics {
   /// by a range of 10-15 % body weight, so a few newtons read large.
   double lateral_rmse_percent_bw = 0;
   double cop_lateral_rmse_mm = 0;  ///< mean over the stances (NaN without --mediolateral)
+  /// ModelKind::ThreeD (NaN otherwise): mean rRMSE of the knee's sagittal moment and of the
+  /// external knee adduction moment, and the KAM's first and second peaks' mean |estimate -
+  /// plates| in % of the plate-driven peak.
+  double knee_sagittal = 0, knee_adduction = 0;
+  std::array<double, 2> kam_peak_error_percent{0, 0};
 };
 MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot = -1);
 

@@ -1,0 +1,101 @@
+// kin2grf dynamics: 3D ankle and knee moments by bottom-up Newton-Euler inverse dynamics
+// (kin2grf, not the paper: issue 28's third step, the knee adduction moment clinicians read).
+//
+// Run on the same leg kinematics (LegMotion3D, made once) with any ground reaction: the estimate's
+// and, in `validate`, the plates', so that the difference between the two is the estimate's alone.
+//
+// Segments, per side, from the model's landmarks in the lab (markers/landmarks.hpp):
+//   shank: knee -> ankle. Frame: e_y = (knee - ankle) / |.| (up the segment), e_z = the sagittal
+//     frame's lateral axis (to the walker's right) made orthogonal to e_y, e_x = e_y x e_z
+//     (anterior). The landmarks give no axial rotation of the shank, so its frame takes the
+//     walker's heading (a documented fallback; its long-axis inertia is a tenth of the others').
+//   foot: ankle, heel, MT head, with the toes lumped in (foot + toes mass, mass-weighted COM).
+//     Frame: e_x = (MT - heel) / |.|, e_z = e_x x (ankle - heel) / |.| (to the right), e_y =
+//     e_z x e_x. Three landmarks: a full 3D frame.
+// Landmarks are filtered at the dynamics' kinematic cut-off (zero-lag Butterworth), COMs on the
+// proximal-distal line at the model's fraction, accelerations by second differences; angular
+// velocity omega = vee(dR/dt R^T), angular acceleration its central difference (lab frame).
+// Inertia: principal, about the COM in the segment frame: the model's sagittal inertia about the
+// two transverse axes and (rho_long / rho_sag)^2 of it about the long axis, de Leva 1996 (male,
+// Table 4): shank 0.103 / 0.255, foot 0.124 / 0.257 (Winter's table gives no longitudinal radius).
+//
+// Newton-Euler, lab frame, g = -gravity up; F, M_O: the foot's ground force (N) and its moment
+// about the lab origin (N m; c x F + T up for a COP c and a free moment T about up);
+// H = R I R^T alpha + omega x (R I R^T omega):
+//   foot:  F_a = m_f (a_f - g) - F
+//          M_a = H_f - (M_O - G_f x F) - (A - G_f) x F_a
+//   shank: F_k = m_s (a_s - g) + F_a
+//          M_k = H_s + (A - G_s) x F_a + M_a - (K - G_s) x F_k
+// F_a, M_a: the force and moment the shank exerts on the foot at the ankle A (internal, on the
+// distal segment); F_k, M_k the thigh's on the shank at the knee K.
+//
+// Components, in the distal segment's frame (the ankle's in the foot's, the knee's in the shank's),
+// anatomical so that both sides read alike:
+//   sagittal   M . e_z, counter-clockwise + in the sagittal frame (the 2D joint torques' sign);
+//   frontal    + adducts the distal segment (right M . e_x, left -M . e_x): at the knee, an
+//              internal adductor moment; the external knee adduction moment (KAM) is its negative;
+//   transverse + rotates the distal segment internally (right M . e_y, left -M . e_y).
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+
+#include "kin2grf/model/model.hpp"
+
+namespace kin2grf {
+
+/// De Leva's (1996) longitudinal over sagittal radius of gyration (see above).
+inline constexpr double kShankLongitudinalGyrationRatio = 0.103 / 0.255, kFootLongitudinalGyrationRatio = 0.124 / 0.257;
+
+/// One segment's motion in the lab, per frame.
+struct SegmentMotion3D {
+  double mass_kg = 0.0;
+  Eigen::Vector3d inertia_kgm2 = Eigen::Vector3d::Zero();  ///< principal, about the COM, segment frame (x, y, z)
+  Eigen::MatrixX3d com_m, com_acc_mps2;  ///< N x 3
+  Eigen::MatrixXd rotation;              ///< N x 9: the frame's axes e_x, e_y, e_z (lab), three columns each
+  Eigen::MatrixX3d omega_rps, alpha_rps2;
+  [[nodiscard]] Eigen::Matrix3d R(Eigen::Index i) const {
+    Eigen::Matrix3d r;
+    for (int a = 0; a < 3; ++a) r.col(a) = rotation.block<1, 3>(i, 3 * a).transpose();
+    return r;
+  }
+};
+
+/// The legs' kinematics for the 3D joint moments (made once per trial).
+struct LegMotion3D {
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  double gravity_mps2 = 9.81;
+  std::array<SegmentMotion3D, 2> shank, foot;  ///< per side (right, left)
+  std::array<Eigen::MatrixX3d, 2> knee_m, ankle_m;  ///< the joint centres, filtered
+  [[nodiscard]] Eigen::Index frames() const { return knee_m[0].rows(); }
+};
+
+/// `landmark_lab_m`: each landmark's lab position, N x 3 (finite); `lateral_axis`: each frame's
+/// lateral axis (N x 3); `cutoff_hz` <= 0: unfiltered.
+LegMotion3D leg_motion_3d(const Model& model, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
+                          const Eigen::MatrixX3d& lateral_axis, const Eigen::Vector3d& up, double rate_hz, double cutoff_hz);
+
+/// One foot's ground reaction in the lab, per frame, as a wrench at the lab origin: the force on
+/// the body (N) and its moment about the origin (N m), zero without contact. A COP c and a free
+/// moment T about up give M_O = c x F + T up (foot_wrench); a plate's measured force and moment
+/// are one already, and a foot's stances on several plates add.
+struct FootWrench3D {
+  Eigen::MatrixX3d force_N, moment_origin_Nm;
+};
+/// The wrench of forces at COPs (NaN COP: no contact, a zero wrench) with free moments about `up`.
+FootWrench3D foot_wrench(const Eigen::MatrixX3d& force_N, const Eigen::MatrixX3d& cop_m, const Eigen::VectorXd& free_moment_Nm,
+                         const Eigen::Vector3d& up);
+
+/// Per side: the ankle's and the knee's internal moment on the distal segment, N x 3 (sagittal,
+/// frontal, transverse; the header's signs), and the lab-frame vectors they come from.
+struct JointMoments3D {
+  std::array<Eigen::MatrixX3d, 2> ankle_Nm, knee_Nm;
+  std::array<Eigen::MatrixX3d, 2> ankle_lab_Nm, knee_lab_Nm;
+};
+
+JointMoments3D joint_moments_3d(const LegMotion3D& legs, const std::array<FootWrench3D, 2>& feet);
+
+/// The external knee adduction moment (N m) from joint_moments_3d's knee: -frontal.
+inline Eigen::VectorXd knee_adduction_moment(const JointMoments3D& m, int side) { return -m.knee_Nm[static_cast<std::size_t>(side)].col(1); }
+
+}  // namespace kin2grf

@@ -1,0 +1,184 @@
+#include "kin2grf/dynamics/joint_moments_3d.hpp"
+
+#include <cmath>
+
+#include "kin2grf/error.hpp"
+#include "kin2grf/kinematics/filter.hpp"
+
+namespace kin2grf {
+
+namespace {
+
+/// The COM on a body's proximal-distal line at the model's fraction, N x 3.
+Eigen::MatrixX3d body_com(const Body& b, const std::array<Eigen::MatrixX3d, kLandmarkCount>& p) {
+  const double f = b.length_m > 0 ? b.com_local.x() / b.length_m : 0.0;
+  return (1 - f) * p[static_cast<std::size_t>(b.proximal)] + f * p[static_cast<std::size_t>(b.points[0])];
+}
+
+/// omega = vee(dR/dt R^T) by central differences of the frames' axes, and its derivative.
+void angular_motion(SegmentMotion3D& s, double dt) {
+  const Eigen::MatrixXd Rd = central_difference(s.rotation, dt);
+  const Eigen::Index n = s.rotation.rows();
+  s.omega_rps.resize(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Eigen::Matrix3d dR;
+    for (int a = 0; a < 3; ++a) dR.col(a) = Rd.block<1, 3>(i, 3 * a).transpose();
+    const Eigen::Matrix3d W = dR * s.R(i).transpose();
+    s.omega_rps.row(i) = 0.5 * Eigen::RowVector3d(W(2, 1) - W(1, 2), W(0, 2) - W(2, 0), W(1, 0) - W(0, 1));
+  }
+  s.alpha_rps2 = central_difference(s.omega_rps, dt);
+}
+
+void set_axes(SegmentMotion3D& s, Eigen::Index i, const Eigen::Vector3d& ex, const Eigen::Vector3d& ey, const Eigen::Vector3d& ez) {
+  s.rotation.block<1, 3>(i, 0) = ex.transpose();
+  s.rotation.block<1, 3>(i, 3) = ey.transpose();
+  s.rotation.block<1, 3>(i, 6) = ez.transpose();
+}
+
+/// A unit vector, or InputError naming what degenerated (two landmarks at one place).
+Eigen::Vector3d unit(const Eigen::Vector3d& v, const char* what, Eigen::Index i) {
+  const double norm = v.norm();
+  if (!(norm > 1e-9)) throw InputError(std::string("3D joint moments: the ") + what + " is undefined at frame " + std::to_string(i));
+  return v / norm;
+}
+
+SegmentMotion3D shank_motion(const Model& model, int side, const std::array<Eigen::MatrixX3d, kLandmarkCount>& p,
+                             const Eigen::MatrixX3d& lateral_axis, double dt) {
+  const Body& b = model.bodies[static_cast<std::size_t>(segment(side, kShank))];
+  const Eigen::MatrixX3d& knee = p[static_cast<std::size_t>(landmark(side, kKnee))];
+  const Eigen::MatrixX3d& ankle = p[static_cast<std::size_t>(landmark(side, kAnkle))];
+  SegmentMotion3D s;
+  s.mass_kg = b.mass_kg;
+  s.inertia_kgm2 = {b.inertia_kgm2, b.inertia_kgm2 * kShankLongitudinalGyrationRatio * kShankLongitudinalGyrationRatio, b.inertia_kgm2};
+  s.com_m = body_com(b, p);
+  s.com_acc_mps2 = second_difference(s.com_m, dt);
+  const Eigen::Index n = knee.rows();
+  s.rotation.resize(n, 9);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Vector3d ey = unit((knee.row(i) - ankle.row(i)).transpose(), "shank's long axis (knee and ankle at one place)", i);
+    const Eigen::Vector3d lat = lateral_axis.row(i).transpose();
+    const Eigen::Vector3d ez = unit(lat - lat.dot(ey) * ey, "shank's lateral axis (the shank lies along the lateral axis)", i);
+    set_axes(s, i, ey.cross(ez), ey, ez);
+  }
+  angular_motion(s, dt);
+  return s;
+}
+
+SegmentMotion3D foot_motion(const Model& model, int side, const std::array<Eigen::MatrixX3d, kLandmarkCount>& p, double dt) {
+  const Body& f = model.bodies[static_cast<std::size_t>(segment(side, kFoot))];
+  const Body& t = model.bodies[static_cast<std::size_t>(segment(side, kToes))];
+  const Eigen::MatrixX3d& ankle = p[static_cast<std::size_t>(landmark(side, kAnkle))];
+  const Eigen::MatrixX3d& heel = p[static_cast<std::size_t>(landmark(side, kHeel))];
+  const Eigen::MatrixX3d& mt = p[static_cast<std::size_t>(landmark(side, kMt))];
+  SegmentMotion3D s;
+  s.mass_kg = f.mass_kg + t.mass_kg;
+  const Eigen::MatrixX3d cf = body_com(f, p), ct = body_com(t, p);
+  s.com_m = (f.mass_kg * cf + t.mass_kg * ct) / s.mass_kg;
+  s.com_acc_mps2 = second_difference(s.com_m, dt);
+  // Transverse inertia of the two about their common COM (parallel axes, at the first frame's
+  // distances: the toes bend little against the foot's size), the long axis's by de Leva's ratio.
+  const double d = (cf.row(0) - ct.row(0)).norm();
+  const double transverse = f.inertia_kgm2 + t.inertia_kgm2 + f.mass_kg * t.mass_kg / s.mass_kg * d * d;
+  s.inertia_kgm2 = {transverse * kFootLongitudinalGyrationRatio * kFootLongitudinalGyrationRatio, transverse, transverse};
+  const Eigen::Index n = ankle.rows();
+  s.rotation.resize(n, 9);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Vector3d ex = unit((mt.row(i) - heel.row(i)).transpose(), "foot's long axis (heel and MT head at one place)", i);
+    const Eigen::Vector3d ez = unit(ex.cross((ankle.row(i) - heel.row(i)).transpose()), "foot's plane (ankle, heel and MT head in a line)", i);
+    set_axes(s, i, ex, ez.cross(ex), ez);
+  }
+  angular_motion(s, dt);
+  return s;
+}
+
+/// I alpha + omega x I omega about the COM, lab frame.
+Eigen::Vector3d angular_momentum_rate(const SegmentMotion3D& s, Eigen::Index i) {
+  const Eigen::Matrix3d R = s.R(i);
+  const Eigen::Matrix3d I = R * s.inertia_kgm2.asDiagonal() * R.transpose();
+  const Eigen::Vector3d w = s.omega_rps.row(i).transpose();
+  return I * s.alpha_rps2.row(i).transpose() + w.cross(I * w);
+}
+
+/// (sagittal, frontal, transverse) of a lab moment in a segment's frame (the header's signs).
+Eigen::RowVector3d anatomical(const Eigen::Vector3d& M, const Eigen::Matrix3d& R, int side) {
+  const Eigen::Vector3d c = R.transpose() * M;
+  const double mirror = side == kLeft ? -1.0 : 1.0;
+  return {c.z(), mirror * c.x(), mirror * c.y()};
+}
+
+}  // namespace
+
+LegMotion3D leg_motion_3d(const Model& model, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
+                          const Eigen::MatrixX3d& lateral_axis, const Eigen::Vector3d& up, double rate_hz, double cutoff_hz) {
+  const Eigen::Index n = lateral_axis.rows();
+  for (const auto& p : landmark_lab_m)
+    if (p.rows() != n) throw InputError("3D joint moments: the landmarks' lab positions do not match the lateral axes' frames");
+  if (!(rate_hz > 0)) throw InputError("3D joint moments: the rate must be positive");
+  std::array<Eigen::MatrixX3d, kLandmarkCount> p;
+  for (int k = 0; k < kLandmarkCount; ++k) {
+    const auto& q = landmark_lab_m[static_cast<std::size_t>(k)];
+    if (!q.allFinite()) throw InputError(std::string("3D joint moments: landmark ") + std::to_string(k) + " has undefined samples");
+    p[static_cast<std::size_t>(k)] = cutoff_hz > 0 && n > 3 ? Eigen::MatrixX3d(butterworth_filtfilt(Eigen::MatrixXd(q), rate_hz, cutoff_hz)) : q;
+  }
+  LegMotion3D out;
+  out.up = up.normalized();
+  out.gravity_mps2 = model.gravity_mps2;
+  const double dt = 1.0 / rate_hz;
+  for (int side = 0; side < 2; ++side) {
+    const auto k = static_cast<std::size_t>(side);
+    out.shank[k] = shank_motion(model, side, p, lateral_axis, dt);
+    out.foot[k] = foot_motion(model, side, p, dt);
+    out.knee_m[k] = p[static_cast<std::size_t>(landmark(side, kKnee))];
+    out.ankle_m[k] = p[static_cast<std::size_t>(landmark(side, kAnkle))];
+  }
+  return out;
+}
+
+FootWrench3D foot_wrench(const Eigen::MatrixX3d& force_N, const Eigen::MatrixX3d& cop_m, const Eigen::VectorXd& free_moment_Nm,
+                         const Eigen::Vector3d& up) {
+  const Eigen::Index n = force_N.rows();
+  if (cop_m.rows() != n || free_moment_Nm.size() != n) throw InputError("3D joint moments: force, COP and free moment differ in frames");
+  FootWrench3D w;
+  w.force_N = Eigen::MatrixX3d::Zero(n, 3);
+  w.moment_origin_Nm = Eigen::MatrixX3d::Zero(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Vector3d F = force_N.row(i).transpose(), c = cop_m.row(i).transpose();
+    if (!F.allFinite() || !c.allFinite()) continue;
+    const double T = std::isfinite(free_moment_Nm[i]) ? free_moment_Nm[i] : 0.0;
+    w.force_N.row(i) = F.transpose();
+    w.moment_origin_Nm.row(i) = (c.cross(F) + T * up).transpose();
+  }
+  return w;
+}
+
+JointMoments3D joint_moments_3d(const LegMotion3D& legs, const std::array<FootWrench3D, 2>& feet) {
+  const Eigen::Index n = legs.frames();
+  const Eigen::Vector3d g = -legs.gravity_mps2 * legs.up;
+  JointMoments3D out;
+  for (int side = 0; side < 2; ++side) {
+    const auto k = static_cast<std::size_t>(side);
+    const FootWrench3D& w = feet[k];
+    if (w.force_N.rows() != n || w.moment_origin_Nm.rows() != n)
+      throw InputError(std::string("3D joint moments: the ") + side_name(side) + " foot's ground reaction does not match the frames");
+    const SegmentMotion3D &foot = legs.foot[k], &shank = legs.shank[k];
+    for (auto* m : {&out.ankle_Nm[k], &out.knee_Nm[k], &out.ankle_lab_Nm[k], &out.knee_lab_Nm[k]}) m->resize(n, 3);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Vector3d A = legs.ankle_m[k].row(i).transpose(), K = legs.knee_m[k].row(i).transpose();
+      const Eigen::Vector3d Gf = foot.com_m.row(i).transpose(), Gs = shank.com_m.row(i).transpose();
+      Eigen::Vector3d F = w.force_N.row(i).transpose(), MO = w.moment_origin_Nm.row(i).transpose();
+      if (!F.allFinite() || !MO.allFinite()) F.setZero(), MO.setZero();  // no reaction measured: none
+      // The foot (the header's equations), then the shank above it.
+      const Eigen::Vector3d Fa = foot.mass_kg * (foot.com_acc_mps2.row(i).transpose() - g) - F;
+      const Eigen::Vector3d Ma = angular_momentum_rate(foot, i) - (MO - Gf.cross(F)) - (A - Gf).cross(Fa);
+      const Eigen::Vector3d Fk = shank.mass_kg * (shank.com_acc_mps2.row(i).transpose() - g) + Fa;
+      const Eigen::Vector3d Mk = angular_momentum_rate(shank, i) + (A - Gs).cross(Fa) + Ma - (K - Gs).cross(Fk);
+      out.ankle_lab_Nm[k].row(i) = Ma.transpose();
+      out.knee_lab_Nm[k].row(i) = Mk.transpose();
+      out.ankle_Nm[k].row(i) = anatomical(Ma, foot.R(i), side);
+      out.knee_Nm[k].row(i) = anatomical(Mk, shank.R(i), side);
+    }
+  }
+  return out;
+}
+
+}  // namespace kin2grf

@@ -1,0 +1,64 @@
+// kin2grf validation: the 3D joint moments driven by the estimate against driven by the plates,
+// on the same leg kinematics (validate.hpp, validate_joint_moments_3d).
+#include <cmath>
+#include <limits>
+
+#include "kin2grf/validation/validate.hpp"
+
+namespace kin2grf {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// The largest value of v over [from, to] (NaN when none is finite).
+double peak(const Eigen::VectorXd& v, Eigen::Index from, Eigen::Index to) {
+  double best = kNaN;
+  for (Eigen::Index i = from; i <= to; ++i)
+    if (std::isfinite(v[i]) && !(v[i] <= best)) best = v[i];
+  return best;
+}
+
+/// Each foot's kept stances' plate wrenches (lab), zero elsewhere.
+std::array<FootWrench3D, 2> plate_wrenches(const ValidationResult& v, Eigen::Index n) {
+  std::array<FootWrench3D, 2> out;
+  for (auto& w : out) w = {Eigen::MatrixX3d::Zero(n, 3), Eigen::MatrixX3d::Zero(n, 3)};
+  for (const StanceValidation& s : v.stances) {
+    if (s.plate_index < 0) continue;
+    const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(s.plate_index)];
+    FootWrench3D& w = out[static_cast<std::size_t>(s.foot)];
+    for (Eigen::Index i = s.first; i <= s.last; ++i)
+      if (mp.force_lab_N.row(i).allFinite() && mp.moment_origin_lab_Nm.row(i).allFinite()) {
+        w.force_N.row(i) += mp.force_lab_N.row(i);
+        w.moment_origin_Nm.row(i) += mp.moment_origin_lab_Nm.row(i);
+      }
+  }
+  return out;
+}
+
+}  // namespace
+
+void validate_joint_moments_3d(const EstimateResult& e, ValidationResult& v) {
+  if (!e.legs_3d) return;
+  const Eigen::Index n = e.time_s.size();
+  const JointMoments3D measured = joint_moments_3d(e.legs_3d->motion, plate_wrenches(v, n));
+  const JointMoments3D& estimated = e.legs_3d->moments;
+  for (StanceValidation& s : v.stances) {
+    const auto k = static_cast<std::size_t>(s.foot);
+    const Eigen::Index a = s.first, len = s.last - s.first + 1;
+    JointMomentValidation j;
+    for (int c = 0; c < 3; ++c) {
+      j.ankle[static_cast<std::size_t>(c)] = compare_series(estimated.ankle_Nm[k].col(c).segment(a, len), measured.ankle_Nm[k].col(c).segment(a, len));
+      j.knee[static_cast<std::size_t>(c)] = compare_series(estimated.knee_Nm[k].col(c).segment(a, len), measured.knee_Nm[k].col(c).segment(a, len));
+    }
+    const Eigen::VectorXd kam_e = knee_adduction_moment(estimated, s.foot), kam_m = knee_adduction_moment(measured, s.foot);
+    j.knee_adduction = compare_series(kam_e.segment(a, len), kam_m.segment(a, len));
+    const Eigen::Index mid = a + len / 2;
+    j.kam_peak_estimated_Nm = {peak(kam_e, a, mid - 1), peak(kam_e, mid, s.last)};
+    j.kam_peak_measured_Nm = {peak(kam_m, a, mid - 1), peak(kam_m, mid, s.last)};
+    s.moments_3d = j;
+  }
+  v.measured_moments_3d = measured;
+}
+
+}  // namespace kin2grf

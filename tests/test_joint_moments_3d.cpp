@@ -1,0 +1,171 @@
+// 3D ankle and knee moments (dynamics/joint_moments_3d.hpp): bottom-up Newton-Euler on the legs'
+// landmarks, guarded by cases whose answer is known without the code.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "kin2grf/dynamics/joint_moments_3d.hpp"
+#include "kin2grf/error.hpp"
+
+using namespace kin2grf;
+
+namespace {
+
+Model test_model() {
+  BodyGeometry g;
+  g.torso = 0.5;
+  g.thigh = {0.42, 0.42};
+  g.shank = {0.42, 0.42};
+  g.foot = {0.15, 0.15};
+  g.toes = {0.05, 0.05};
+  return build_model(g, 70.0, de_leva_table());
+}
+
+/// A standing pose (lab: z up, x forward, the walker's right -y), `n` frames alike. Each leg
+/// upright in the plane y = -+0.1, knee 0.5 m up.
+std::array<Eigen::MatrixX3d, kLandmarkCount> standing(Eigen::Index n) {
+  std::array<Eigen::MatrixX3d, kLandmarkCount> p;
+  auto put = [&](int id, double x, double y, double z) { p[static_cast<std::size_t>(id)] = Eigen::RowVector3d(x, y, z).replicate(n, 1); };
+  put(kShoulder, 0.0, 0.0, 1.4);
+  put(kHip, 0.0, 0.0, 0.92);
+  for (int side = 0; side < 2; ++side) {
+    const double y = side == kRight ? -0.1 : 0.1;
+    put(landmark(side, kKnee), 0.0, y, 0.5);
+    put(landmark(side, kAnkle), 0.0, y, 0.08);
+    put(landmark(side, kHeel), -0.05, y, 0.02);
+    put(landmark(side, kMt), 0.12, y, 0.02);
+    put(landmark(side, kHallux), 0.17, y, 0.02);
+  }
+  return p;
+}
+
+Eigen::MatrixX3d constant_rows(Eigen::Index n, const Eigen::Vector3d& v) { return v.transpose().replicate(n, 1); }
+
+}  // namespace
+
+// A still leg standing on a vertical force whose COP lies d medial of the knee: the external
+// knee adduction moment is d F on either side (the segments' weights lie in the leg's plane
+// and add nothing to it), the internal one its negative; the ankle's frontal moment likewise.
+TEST(JointMoments3D, AStillLegsKneeAdductionMomentIsTheForceTimesItsMedialLever) {
+  const Eigen::Index n = 20;
+  const auto p = standing(n);
+  const Model model = test_model();
+  const LegMotion3D legs = leg_motion_3d(model, p, constant_rows(n, {0, -1, 0}), Eigen::Vector3d::UnitZ(), 100.0, 6.0);
+  const double F = 700.0, d = 0.03;
+  std::array<FootWrench3D, 2> feet;
+  for (int side = 0; side < 2; ++side) {
+    const double medial = side == kRight ? +1.0 : -1.0;  // right: +y is medial
+    const Eigen::Vector3d cop(0.05, p[landmark(side, kKnee)](0, 1) + medial * d, 0.0);
+    feet[static_cast<std::size_t>(side)] =
+        foot_wrench(constant_rows(n, {0, 0, F}), constant_rows(n, cop), Eigen::VectorXd::Zero(n), Eigen::Vector3d::UnitZ());
+  }
+  const JointMoments3D m = joint_moments_3d(legs, feet);
+  for (int side = 0; side < 2; ++side) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      EXPECT_NEAR(knee_adduction_moment(m, side)[i], d * F, 1e-9) << side_name(side) << " frame " << i;
+      EXPECT_NEAR(m.knee_Nm[static_cast<std::size_t>(side)](i, 1), -d * F, 1e-9);
+      EXPECT_NEAR(m.ankle_Nm[static_cast<std::size_t>(side)](i, 1), -d * F, 1e-9);  // the foot's frame is level here
+      EXPECT_NEAR(m.knee_Nm[static_cast<std::size_t>(side)](i, 2), 0.0, 1e-9);        // no horizontal force: no axial moment
+    }
+  }
+  // Sagittal: the COP 5 cm ahead of the knee's vertical; the weights of shank and foot (on the
+  // leg's line and ahead of it) counted from the model's masses: the internal moment balances
+  // all of it, counter-clockwise + about the walker's right.
+  const Body& shank = model.bodies[segment(kRight, kShank)];
+  const Body& foot = model.bodies[segment(kRight, kFoot)];
+  const Body& toes = model.bodies[segment(kRight, kToes)];
+  const double g = model.gravity_mps2;
+  const double foot_com_x = 0.12 * foot.com_local.x() / foot.length_m;
+  const double toes_com_x = 0.12 + 0.05 * toes.com_local.x() / toes.length_m;
+  // External moment about the knee, about the right axis (-y): for a force along z at x ahead,
+  // r x F . (-y) = x F_z; gravity pulls down (F_z = -m g).
+  const double external = 0.05 * F - foot.mass_kg * g * foot_com_x - toes.mass_kg * g * toes_com_x - shank.mass_kg * g * 0.0;
+  EXPECT_NEAR(m.knee_Nm[0](n / 2, 0), -external, 1e-6);
+}
+
+// A leg falling freely (every landmark accelerating at g, no ground reaction) needs no joint
+// force or moment.
+TEST(JointMoments3D, AFreelyFallingLegNeedsNoMoment) {
+  const Eigen::Index n = 60;
+  auto p = standing(n);
+  const double rate = 100.0, g = 9.81;
+  for (auto& q : p)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double t = static_cast<double>(i) / rate;
+      q.row(i) += Eigen::RowVector3d(1.3 * t, 0.2 * t, 0.5 * t - 0.5 * g * t * t);
+    }
+  const Model model = test_model();
+  const LegMotion3D legs = leg_motion_3d(model, p, constant_rows(n, {0, -1, 0}), Eigen::Vector3d::UnitZ(), rate, 0.0);
+  std::array<FootWrench3D, 2> none;
+  for (auto& w : none) w = {Eigen::MatrixX3d::Zero(n, 3), Eigen::MatrixX3d::Zero(n, 3)};
+  const JointMoments3D m = joint_moments_3d(legs, none);
+  for (int side = 0; side < 2; ++side) {
+    EXPECT_LT(m.knee_Nm[static_cast<std::size_t>(side)].cwiseAbs().maxCoeff(), 1e-9);
+    EXPECT_LT(m.ankle_Nm[static_cast<std::size_t>(side)].cwiseAbs().maxCoeff(), 1e-9);
+  }
+}
+
+// The same moving, loaded legs turned about the vertical by 30 and by 180 degrees give the same
+// anatomical moments: they live in the segments' frames, not the lab's.
+TEST(JointMoments3D, TurningTheLabAboutTheVerticalChangesNoMoment) {
+  const Eigen::Index n = 120;
+  const double rate = 100.0;
+  auto p = standing(n);
+  // A swinging, swaying, toed-out leg: each landmark moves differently.
+  for (int k = 0; k < kLandmarkCount; ++k)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double t = static_cast<double>(i) / rate, s = 0.1 * k;
+      p[static_cast<std::size_t>(k)].row(i) +=
+          Eigen::RowVector3d(1.2 * t + 0.05 * std::sin(6 * t + s), 0.02 * std::sin(3 * t + s), 0.01 * std::cos(5 * t + s));
+    }
+  Eigen::MatrixX3d force(n, 3), cop(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / rate;
+    force.row(i) << 80 * std::sin(4 * t), 30 * std::cos(2 * t), 650 + 100 * std::sin(7 * t);
+    cop.row(i) << 1.2 * t + 0.03, -0.08, 0.0;
+  }
+  const Eigen::VectorXd free = 3 * Eigen::VectorXd::Ones(n);
+  const Model model = test_model();
+  auto moments = [&](double angle) {
+    const Eigen::Matrix3d Rz = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    auto turn = [&](const Eigen::MatrixX3d& m) { return Eigen::MatrixX3d(m * Rz.transpose()); };
+    std::array<Eigen::MatrixX3d, kLandmarkCount> q;
+    for (int k = 0; k < kLandmarkCount; ++k) q[static_cast<std::size_t>(k)] = turn(p[static_cast<std::size_t>(k)]);
+    const LegMotion3D legs = leg_motion_3d(model, q, turn(constant_rows(n, {0, -1, 0})), Eigen::Vector3d::UnitZ(), rate, 8.0);
+    const FootWrench3D w = foot_wrench(turn(force), turn(cop), free, Eigen::Vector3d::UnitZ());
+    return joint_moments_3d(legs, {w, w});
+  };
+  const JointMoments3D m0 = moments(0.0), m30 = moments(M_PI / 6), m180 = moments(M_PI);
+  for (int side = 0; side < 2; ++side) {
+    const auto k = static_cast<std::size_t>(side);
+    EXPECT_GT(m0.knee_Nm[k].cwiseAbs().maxCoeff(), 10.0);  // something to compare
+    for (const JointMoments3D* m : {&m30, &m180}) {
+      EXPECT_LT((m->knee_Nm[k] - m0.knee_Nm[k]).cwiseAbs().maxCoeff(), 1e-6);
+      EXPECT_LT((m->ankle_Nm[k] - m0.ankle_Nm[k]).cwiseAbs().maxCoeff(), 1e-6);
+    }
+  }
+}
+
+// A landmark with undefined samples, two landmarks at one place or a ground reaction of the wrong
+// length: an error naming what, never NaN moments.
+TEST(JointMoments3D, DegenerateInputIsAnErrorNotNaN) {
+  const Eigen::Index n = 10;
+  const Model model = test_model();
+  const Eigen::MatrixX3d lateral = constant_rows(n, {0, -1, 0});
+  auto p = standing(n);
+  p[kKneeR](3, 2) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(leg_motion_3d(model, p, lateral, Eigen::Vector3d::UnitZ(), 100.0, 0.0), InputError);
+  p = standing(n);
+  p[kAnkleR] = p[kKneeR];
+  try {
+    leg_motion_3d(model, p, lateral, Eigen::Vector3d::UnitZ(), 100.0, 0.0);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("knee and ankle at one place"), std::string::npos) << e.what();
+  }
+  const LegMotion3D legs = leg_motion_3d(model, standing(n), lateral, Eigen::Vector3d::UnitZ(), 100.0, 0.0);
+  std::array<FootWrench3D, 2> short_one;
+  for (auto& w : short_one) w = {Eigen::MatrixX3d::Zero(n - 1, 3), Eigen::MatrixX3d::Zero(n - 1, 3)};
+  EXPECT_THROW(joint_moments_3d(legs, short_one), InputError);
+}
