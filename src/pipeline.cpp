@@ -168,6 +168,7 @@ struct SagittalStage {
   Eigen::Index first_index = 0;
   int first_frame_number = 1;
   std::array<Eigen::VectorXd, 2> foot_lateral_m;
+  std::array<Eigen::MatrixX4d, 2> foot_line;                    ///< with EstimateOptions::lateral_force()
   std::array<Eigen::MatrixX3d, kLandmarkCount> landmark_lab_m;  ///< with EstimateOptions::mediolateral
   Eigen::MatrixX3d lateral_axis;                                ///< likewise, per frame
   Messages messages;
@@ -215,6 +216,7 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   out.first_index = win.first;
   out.first_frame_number = trial.markers.first_frame + static_cast<int>(win.first);
   out.foot_lateral_m = std::move(win.foot_lateral_m);
+  out.foot_line = std::move(win.foot_line);
   out.landmarks = std::move(win.landmarks);
   const SagittalLandmarks& lm = out.landmarks;
   // The zero-lag filter's single pass runs at cut-off / 0.802 (Winter's correction), which must
@@ -231,6 +233,32 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
 
 /// The model (fixed segment lengths, the medians over the window, and anthropometry) and the
 /// trial's floor and soles (ground level, contact calibration).
+/// The 3D knee and ankle centres' medial offsets (dynamics/joint_moments_3d.hpp) for the set's
+/// lateral markers: half the joint's width (the trial's measured width, else kKneeWidthPerShank
+/// or kAnkleWidthPerShank of the model's shank) plus the marker's radius. A message says, per
+/// side, what was used; a joint marked as its centre moves nothing.
+JointCentreOffsets joint_centre_offsets(const MarkerSet& set, const Trial& trial, const Model& model, Messages& messages) {
+  JointCentreOffsets out;
+  const double diameter = trial.marker_diameter_m.value_or(kDefaultMarkerDiameterM);
+  for (int side = 0; side < 2; ++side) {
+    const auto k = static_cast<std::size_t>(side);
+    const double shank = model.bodies[static_cast<std::size_t>(segment(side, kShank))].length_m;
+    struct Joint { int landmark; const std::optional<double>& measured; double per_shank; double& offset; const char* name; };
+    for (const Joint& j : {Joint{landmark(side, kKnee), trial.knee_width_m[k], kKneeWidthPerShank, out.knee_m[k], "knee"},
+                           Joint{landmark(side, kAnkle), trial.ankle_width_m[k], kAnkleWidthPerShank, out.ankle_m[k], "ankle"}}) {
+      if (!set.rules[static_cast<std::size_t>(j.landmark)].lateral_surface) continue;
+      const double width = j.measured.value_or(j.per_shank * shank);
+      j.offset = 0.5 * width + 0.5 * diameter;
+      char text[320];
+      std::snprintf(text, sizeof text, "%s: a lateral marker; the 3D %s centre is %.0f mm medial of it (half the %s width %.0f mm, %s, "
+                    "plus the marker radius %.1f mm%s)", landmark_name(j.landmark), j.name, 1000 * j.offset, j.name, 1000 * width,
+                    j.measured ? "the file's" : "from the shank's length", 500 * diameter, trial.marker_diameter_m ? ", the file's" : "");
+      messages.emplace_back(text);
+    }
+  }
+  return out;
+}
+
 struct ModelStage {
   std::shared_ptr<const Model> model;
   /// The floor the contacts and the results take: the measured (or given) ground plus
@@ -737,6 +765,14 @@ void mediolateral_stage(const ModelMotion& motion, const SagittalStage& sag, dou
   for (int k = 0; k < 2; ++k) feet[k].force_lateral_N = std::move(ml.foot_N[k]);
 }
 
+/// Each foot's COP's lateral coordinate on its lateral line (FootResult::cop_lateral_m).
+void lateral_cop_stage(const std::array<Eigen::MatrixX4d, 2>& foot_line, std::array<FootResult, 2>& feet) {
+  for (int k = 0; k < 2; ++k) {
+    FootResult& f = feet[static_cast<std::size_t>(k)];
+    f.cop_lateral_m = cop_lateral_on_foot_line(foot_line[static_cast<std::size_t>(k)], f.cop_x_m);
+  }
+}
+
 /// Every frame's totals (frame_totals), unless the result is not to hold them (keep_all_series).
 struct TotalsStage {
   Eigen::VectorXd grm_Nm;
@@ -911,10 +947,15 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   const int cycled_frames = dyn.raw.cycled_frames, capped_frames = dyn.raw.capped_frames;
   const double ground_level_m = dyn.plan.calibration.contact.ground_level_m;
   FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m);
-  if (o.lateral_force()) mediolateral_stage(kin.motion, sag, kin.kinematic_cutoff_hz, feet.feet);
+  if (o.lateral_force()) {
+    const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kin.kinematic_cutoff_hz) : kin.kinematic_cutoff_hz;
+    mediolateral_stage(kin.motion, sag, cutoff, feet.feet);
+    lateral_cop_stage(sag.foot_line, feet.feet);
+  }
   std::optional<LegMotion3D> legs;
   if (o.model == ModelKind::ThreeD)
-    legs = leg_motion_3d(*mod.model, sag.landmark_lab_m, sag.lateral_axis, sag.frame.up, kin.motion.rate_hz, kin.kinematic_cutoff_hz);
+    legs = leg_motion_3d(*mod.model, sag.landmark_lab_m, sag.lateral_axis, sag.frame.up, kin.motion.rate_hz, kin.kinematic_cutoff_hz,
+                         joint_centre_offsets(set, trial, *mod.model, kin.messages));
   sag.landmark_lab_m = {};
   sag.lateral_axis = Eigen::MatrixX3d();
   TotalsStage totals = totals_stage(o, kin.motion, feet.feet, ground_level_m);
@@ -957,6 +998,19 @@ EstimateResult estimate(Trial&& trial, const Trial* static_trial, const MarkerSe
   return naming_the_trial(path, [&] { return estimate_impl(trial, &trial, static_trial, set, o); });
 }
 
+Eigen::VectorXd cop_lateral_on_foot_line(const Eigen::MatrixX4d& line, const Eigen::VectorXd& cop_x_m) {
+  const Eigen::Index n = cop_x_m.size();
+  if (line.rows() != n) throw InputError("the COP's lateral line and the COP differ in frames");
+  Eigen::VectorXd out = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!std::isfinite(cop_x_m[i])) continue;
+    const double span = line(i, 2) - line(i, 0);
+    const double t = std::abs(span) > 1e-6 ? std::clamp((cop_x_m[i] - line(i, 0)) / span, 0.0, 1.0) : 0.5;
+    out[i] = line(i, 1) + t * (line(i, 3) - line(i, 1));
+  }
+  return out;
+}
+
 const char* model_kind_name(ModelKind kind) { return kind == ModelKind::ThreeD ? "3d" : "sagittal"; }
 
 ModelKind model_kind(const std::string& name) {
@@ -987,7 +1041,8 @@ LabFootFrame lab_foot_frame(const EstimateResult& r, int side, Eigen::Index i) {
   out.force_N = f.force_N(i, 0) * r.frame.forward_at(k) + f.force_N(i, 1) * r.frame.up;
   if (f.force_lateral_N.size() > i) out.force_N += f.force_lateral_N[i] * r.frame.lateral_at(k);
   if (std::isfinite(f.cop_x_m[i]))
-    out.cop_m = r.frame.to_lab(f.cop_x_m[i], r.ground_level_m(), r.foot_lateral_m[static_cast<std::size_t>(side)][i], k);
+    out.cop_m = r.frame.to_lab(f.cop_x_m[i], r.ground_level_m(),
+                               f.cop_lateral_m.size() > i ? f.cop_lateral_m[i] : r.foot_lateral_m[static_cast<std::size_t>(side)][i], k);
   else
     out.cop_m.setConstant(std::numeric_limits<double>::quiet_NaN());
   return out;

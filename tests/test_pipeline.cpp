@@ -8,6 +8,7 @@
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
 #include "kin2grf/dynamics/mediolateral.hpp"
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/json.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
@@ -737,4 +738,68 @@ TEST(Mediolateral, AWalkTurnedAboutTheVerticalGivesTheSameForces) {
   EXPECT_LT(difference(r30, r210), 1e-3 * bw);
   EXPECT_LT(difference(r0, r30), 0.01 * bw);
   EXPECT_GT(r0.feet[0].force_lateral_N.cwiseAbs().maxCoeff(), 10.0);  // the force compared is there
+}
+
+// The 3D COP's lateral place (FootResult::cop_lateral_m) follows the foot's line from the heel to
+// the forefoot's midline at the COP's place along it: a COP at the heel takes the heel's lateral
+// coordinate, one at the MT head the forefoot's, past either end it stays there.
+TEST(LateralCop, TheCopsLateralPlaceFollowsTheFootsLineAtItsPlaceAlongIt) {
+  Eigen::MatrixX4d line(5, 4);
+  line.rowwise() = Eigen::RowVector4d(0.0, 0.10, 0.20, 0.14);  // heel x, heel lat, forefoot x, forefoot lat
+  Eigen::VectorXd cop(5);
+  cop << 0.0, 0.10, 0.20, -0.05, std::numeric_limits<double>::quiet_NaN();
+  const Eigen::VectorXd lat = cop_lateral_on_foot_line(line, cop);
+  EXPECT_NEAR(lat[0], 0.10, 1e-12);
+  EXPECT_NEAR(lat[1], 0.12, 1e-12);
+  EXPECT_NEAR(lat[2], 0.14, 1e-12);
+  EXPECT_NEAR(lat[3], 0.10, 1e-12);  // behind the heel: the heel's
+  EXPECT_TRUE(std::isnan(lat[4]));   // no contact
+  EXPECT_THROW((void)cop_lateral_on_foot_line(line.topRows(3), cop), InputError);
+}
+
+// A marker set's "surface": "lateral" (issue 28's landmarks): a 5th-metatarsal marker moves the
+// COP's lateral line's forefoot end medially by kLateralMtToMidline of the heel-MT length, and
+// lateral knee and ankle markers move the 3D joint centres medially by half the joint's width
+// plus the marker's radius; the sagittal results do not change.
+TEST(LateralCop, LateralMarkersMoveTheCopLineAndTheJointCentresMediallyOnly) {
+  const Trial t = make_synthetic_trial({});
+  nlohmann::json j = read_json_file(std::string(KIN2GRF_SOURCE_DIR) + "/data/presets/kin2grf-example.json");
+  EstimateOptions o;
+  o.model = ModelKind::ThreeD;
+  const EstimateResult centre = estimate(t, nullptr, parse_marker_set(j, "centre"), o);
+  for (const char* id : {"mt_r", "mt_l", "knee_r", "knee_l", "ankle_r", "ankle_l"}) j["landmarks"][id]["surface"] = "lateral";
+  const EstimateResult lateral = estimate(t, nullptr, parse_marker_set(j, "lateral"), o);
+  ASSERT_TRUE(centre.legs_3d && lateral.legs_3d);
+  const Eigen::Index n = centre.time_s.size();
+  int compared = 0;
+  for (int side = 0; side < 2; ++side) {
+    const auto k = static_cast<std::size_t>(side);
+    EXPECT_EQ(centre.feet[k].force_N, lateral.feet[k].force_N);
+    const double to_medial = side == kRight ? -1.0 : 1.0;  // along the lateral axis (the walker's right)
+    double largest = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double d = lateral.feet[k].cop_lateral_m[i] - centre.feet[k].cop_lateral_m[i];
+      if (!std::isfinite(d)) continue;
+      ++compared;
+      EXPECT_GE(d * to_medial, -1e-12) << side_name(side) << " frame " << i;  // never laterally
+      largest = std::max(largest, std::abs(d));
+    }
+    // At most the forefoot end's whole move, kLateralMtToMidline of a heel-MT length under 0.3 m.
+    EXPECT_GT(largest, 0.01) << side_name(side);
+    EXPECT_LT(largest, kLateralMtToMidline * 0.30) << side_name(side);
+    // The joint centres: medially, by the same offset at every frame.
+    const Eigen::Vector3d dk = (lateral.legs_3d->motion.knee_m[k] - centre.legs_3d->motion.knee_m[k]).row(n / 2).transpose();
+    const Eigen::Vector3d lat_axis = centre.frame.lateral_at(centre.first_index + n / 2);
+    const double shank = centre.motion.model->bodies[static_cast<std::size_t>(segment(side, kShank))].length_m;
+    EXPECT_NEAR(dk.dot(lat_axis) * to_medial, 0.5 * kKneeWidthPerShank * shank + 0.5 * kDefaultMarkerDiameterM, 0.005) << side_name(side);
+  }
+  EXPECT_GT(compared, n / 2);
+  // A "surface" on a landmark that has no lateral side is refused, naming it.
+  j["landmarks"]["hip"]["surface"] = "lateral";
+  try {
+    (void)parse_marker_set(j, "bad.json");
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'hip'"), std::string::npos) << e.what();
+  }
 }

@@ -105,6 +105,12 @@ struct EstimateOptions {
   /// feet by their vertical loads. Off: the sagittal model's outputs, with a zero lateral force.
   /// ModelKind::ThreeD includes it.
   bool mediolateral = false;
+  /// The whole body's lateral acceleration's low-pass cut-off, Hz (0: the dynamics' kinematic
+  /// cut-off); never above that cut-off. The body's lateral sway is slow (it swings once a stride,
+  /// about 1 Hz walking): above about 3 Hz the lateral COM acceleration from skin markers is
+  /// mostly their noise and soft tissue. 3 Hz was chosen leave-one-lab-out among 2-5 Hz and the
+  /// kinematic cut-off (docs/METHOD-NOTES.md): walking per-foot rRMSE 23.4 -> 18.0 % held out.
+  double lateral_cutoff_hz = 3.0;
   ModelKind model = ModelKind::Sagittal;
   [[nodiscard]] bool lateral_force() const { return mediolateral || model == ModelKind::ThreeD; }
   /// Called with (frames solved, frames in all) every 1 % of the contact solve; empty: none.
@@ -123,6 +129,12 @@ struct FootResult {
   /// Along the sagittal frame's lateral axis (forward x up), N; zero when inactive; empty unless
   /// EstimateOptions::mediolateral.
   Eigen::VectorXd force_lateral_N;
+  /// The COP's lateral coordinate (along the sagittal frame's lateral axis), m: on the line from
+  /// the heel to the forefoot's midline (SagittalWindow::foot_line) at the COP's place along it,
+  /// the heel's behind the heel, the forefoot's ahead of it; NaN when inactive; empty unless
+  /// EstimateOptions::lateral_force(). Without it the lab COP takes the heel-MT midpoint
+  /// (EstimateResult::foot_lateral_m).
+  Eigen::VectorXd cop_lateral_m;
 };
 
 /// The 3D model's legs (ModelKind::ThreeD): their kinematics, made once, and the ankles' and
@@ -251,6 +263,10 @@ struct LabFootFrame {
   Eigen::Vector3d force_N, cop_m;
 };
 LabFootFrame lab_foot_frame(const EstimateResult& r, int side, Eigen::Index i);
+/// FootResult::cop_lateral_m's rule: per frame, on the line (heel x, heel lateral, forefoot x,
+/// forefoot lateral) at the COP's fraction of the way from heel to forefoot, clamped to the line's
+/// ends; NaN where the COP is (no contact). A line of no length: its midpoint.
+Eigen::VectorXd cop_lateral_on_foot_line(const Eigen::MatrixX4d& line, const Eigen::VectorXd& cop_x_m);
 /// Each foot's estimated ground reaction (lab_foot_frame, no free moment) as the wrench the 3D
 /// joint moments take.
 std::array<FootWrench3D, 2> estimated_wrenches(const EstimateResult& r);

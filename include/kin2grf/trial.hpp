@@ -120,6 +120,11 @@ struct Trial {
   std::vector<Event> events;
   std::optional<double> body_mass_kg;
   std::optional<double> height_m;
+  /// The subject's knee and ankle widths (m; right, left) and the markers' diameter (m) where the
+  /// file holds them (Vicon Plug-in Gait's PROCESSING:RKneeWidth, LAnkleWidth, MarkerDiameter, in
+  /// mm): what moves a lateral knee or ankle marker to the joint centre (joint_centre_offsets).
+  std::array<std::optional<double>, 2> knee_width_m, ankle_width_m;
+  std::optional<double> marker_diameter_m;
   std::vector<std::string> model_outputs;  ///< C3D points that are model outputs, not markers
   std::vector<std::string> warnings;
 };

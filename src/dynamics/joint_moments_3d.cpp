@@ -106,10 +106,30 @@ Eigen::RowVector3d anatomical(const Eigen::Vector3d& M, const Eigen::Matrix3d& R
   return {c.z(), mirror * c.x(), mirror * c.y()};
 }
 
+/// The knee and ankle moved medially by their offsets, along the lateral axis made orthogonal to
+/// the shank (knee - ankle as marked): the lateral axis points to the walker's right, so medial is
+/// its opposite on the right leg and itself on the left.
+void move_to_joint_centres(std::array<Eigen::MatrixX3d, kLandmarkCount>& p, const Eigen::MatrixX3d& lateral_axis, int side,
+                           const JointCentreOffsets& o) {
+  const auto k = static_cast<std::size_t>(side);
+  if (o.knee_m[k] == 0 && o.ankle_m[k] == 0) return;
+  Eigen::MatrixX3d& knee = p[static_cast<std::size_t>(landmark(side, kKnee))];
+  Eigen::MatrixX3d& ankle = p[static_cast<std::size_t>(landmark(side, kAnkle))];
+  const double to_medial = side == kRight ? -1.0 : 1.0;
+  for (Eigen::Index i = 0; i < knee.rows(); ++i) {
+    const Eigen::Vector3d ey = unit((knee.row(i) - ankle.row(i)).transpose(), "shank's long axis (knee and ankle at one place)", i);
+    const Eigen::Vector3d lat = lateral_axis.row(i).transpose();
+    const Eigen::Vector3d medial = to_medial * unit(lat - lat.dot(ey) * ey, "shank's lateral axis (the shank lies along the lateral axis)", i);
+    knee.row(i) += o.knee_m[k] * medial.transpose();
+    ankle.row(i) += o.ankle_m[k] * medial.transpose();
+  }
+}
+
 }  // namespace
 
 LegMotion3D leg_motion_3d(const Model& model, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
-                          const Eigen::MatrixX3d& lateral_axis, const Eigen::Vector3d& up, double rate_hz, double cutoff_hz) {
+                          const Eigen::MatrixX3d& lateral_axis, const Eigen::Vector3d& up, double rate_hz, double cutoff_hz,
+                          const JointCentreOffsets& offsets) {
   const Eigen::Index n = lateral_axis.rows();
   for (const auto& p : landmark_lab_m)
     if (p.rows() != n) throw InputError("3D joint moments: the landmarks' lab positions do not match the lateral axes' frames");
@@ -120,6 +140,7 @@ LegMotion3D leg_motion_3d(const Model& model, const std::array<Eigen::MatrixX3d,
     if (!q.allFinite()) throw InputError(std::string("3D joint moments: landmark ") + std::to_string(k) + " has undefined samples");
     p[static_cast<std::size_t>(k)] = cutoff_hz > 0 && n > 3 ? Eigen::MatrixX3d(butterworth_filtfilt(Eigen::MatrixXd(q), rate_hz, cutoff_hz)) : q;
   }
+  for (int side = 0; side < 2; ++side) move_to_joint_centres(p, lateral_axis, side, offsets);
   LegMotion3D out;
   out.up = up.normalized();
   out.gravity_mps2 = model.gravity_mps2;

@@ -694,6 +694,16 @@ void read_c3d_events_and_subject(const C3dFile& f, Trial& t) {
                                                      std::isfinite(h->numbers[0]) && h->numbers[0] > 0) {
     t.height_m = h->numbers[0] > 10 ? h->numbers[0] / 1000.0 : h->numbers[0];  // stored in mm
   }
+  // Plug-in Gait's subject measurements (mm). A value outside a human joint's width (a 0 left
+  // unmeasured, a value in metres) is not taken: the anthropometric fallback is used instead.
+  const auto width_mm = [&](const char* key, double lo, double hi) -> std::optional<double> {
+    const auto* p = f.find(key);
+    if (p && !p->numbers.empty() && p->numbers[0] >= lo && p->numbers[0] <= hi) return p->numbers[0] / 1000.0;
+    return std::nullopt;
+  };
+  t.knee_width_m = {width_mm("PROCESSING:RKNEEWIDTH", 50, 200), width_mm("PROCESSING:LKNEEWIDTH", 50, 200)};
+  t.ankle_width_m = {width_mm("PROCESSING:RANKLEWIDTH", 30, 150), width_mm("PROCESSING:LANKLEWIDTH", 30, 150)};
+  t.marker_diameter_m = width_mm("PROCESSING:MARKERDIAMETER", 3, 40);
 }
 
 }  // namespace

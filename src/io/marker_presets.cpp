@@ -98,6 +98,15 @@ MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
         throw InputError(source + ": landmark '" + landmark_name(id) + "': unknown rule " + json_excerpt(r) +
                          " (a rule is one of: marker, mean, harrington, static, functional, pelvis_up, virtual_hallux)");
       }
+      if (r.contains("surface")) {
+        const std::string surface = r["surface"].get<std::string>();
+        const std::string name = landmark_name(id);
+        if (surface != "lateral")
+          throw InputError(source + ": landmark '" + name + "': surface '" + surface + "' is not known (\"lateral\": a marker on the joint's lateral skin)");
+        if (name.rfind("knee_", 0) != 0 && name.rfind("ankle_", 0) != 0 && name.rfind("mt_", 0) != 0)
+          throw InputError(source + ": landmark '" + name + "': \"surface\" applies to knee, ankle and MT landmarks only");
+        rule.lateral_surface = true;
+      }
       check_distinct_pelvis_markers(rule.pelvis, source + ": landmark '" + landmark_name(id) + "'");
       if ((rule.kind == RuleKind::Marker || rule.kind == RuleKind::Mean || rule.kind == RuleKind::Static) && rule.markers.empty())
         throw InputError(source + ": landmark '" + landmark_name(id) + "' names no marker");

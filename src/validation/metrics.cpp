@@ -36,6 +36,7 @@ std::optional<SeriesMetrics> compare_series(const Eigen::VectorXd& est, const Ei
   m.pearson_r = (saa > 0 && sbb > 0) ? sab / std::sqrt(saa * sbb) : nan;
   m.max_abs_error = maxe;
   m.peak_difference = amax - bmax;
+  m.mean_error = ma - mb;
   return m;
 }
 

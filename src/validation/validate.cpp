@@ -381,12 +381,12 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
   s.metrics.cop = compare_series(fe.cop_x_m.segment(a, len), mc);
   s.cop_beyond_foot_m = cop_beyond_foot_m(e, c, mv, mc, a);
   if (fe.force_lateral_N.size() == n) {
-    // The COP's lateral place (the heel-MT markers' midpoint, EstimateResult::foot_lateral_m),
-    // scored with the mediolateral force, the first pieces of the 3D model.
+    // The COP's lateral place (FootResult::cop_lateral_m), scored with the mediolateral force.
     Eigen::VectorXd ml = mp.cop_lateral_m.segment(a, len);
     for (Eigen::Index i = 0; i < len; ++i)
       if (!(mv[i] > o.cop_min_force_fraction * bw)) ml[i] = kNaN;
-    s.metrics.cop_lateral = compare_series(e.foot_lateral_m[static_cast<std::size_t>(c.foot)].segment(a, len), ml);
+    const Eigen::VectorXd& el = fe.cop_lateral_m.size() == n ? fe.cop_lateral_m : e.foot_lateral_m[static_cast<std::size_t>(c.foot)];
+    s.metrics.cop_lateral = compare_series(el.segment(a, len), ml);
   }
   s.foot_length_m = stance_foot_length_m(e, c);
   if (s.cop_beyond_foot_m > o.max_cop_beyond_foot_m) {
@@ -772,7 +772,10 @@ nlohmann::json component_json(const ComponentMetrics& c, double bw) {
     j["r"]["lateral"] = num(c.lateral->pearson_r);
     j["peak_difference"]["lateral_N"] = num(c.lateral->peak_difference);
   }
-  if (c.cop_lateral) j["rmse"]["cop_lateral_mm"] = num(1000 * c.cop_lateral->rmse);
+  if (c.cop_lateral) {
+    j["rmse"]["cop_lateral_mm"] = num(1000 * c.cop_lateral->rmse);
+    j["mean_error"] = {{"cop_lateral_mm", num(1000 * c.cop_lateral->mean_error)}};  // + = lateral of the plate's (right foot)
+  }
   return j;
 }
 

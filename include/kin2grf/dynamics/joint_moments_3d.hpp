@@ -4,7 +4,11 @@
 // Run on the same leg kinematics (LegMotion3D, made once) with any ground reaction: the estimate's
 // and, in `validate`, the plates', so that the difference between the two is the estimate's alone.
 //
-// Segments, per side, from the model's landmarks in the lab (markers/landmarks.hpp):
+// Segments, per side, from the model's landmarks in the lab (markers/landmarks.hpp), the knee and
+// the ankle moved to the joint centres first where their markers are on the lateral skin
+// (JointCentreOffsets: medially along the lateral axis made orthogonal to the shank; the sagittal
+// model needs no such move, the 3D frontal moments do: 5 cm of knee lever at 700 N is 35 N m of
+// knee adduction moment):
 //   shank: knee -> ankle. Frame: e_y = (knee - ankle) / |.| (up the segment), e_z = the sagittal
 //     frame's lateral axis (to the walker's right) made orthogonal to e_y, e_x = e_y x e_z
 //     (anterior). The landmarks give no axial rotation of the shank, so its frame takes the
@@ -61,6 +65,22 @@ struct SegmentMotion3D {
   }
 };
 
+/// Per side (right, left), how far medially of its landmark a joint's centre lies, m (0: the
+/// landmark is the centre): half the joint's width plus the marker's radius for a marker on the
+/// joint's lateral skin (markers/landmarks.hpp, "surface": "lateral").
+struct JointCentreOffsets {
+  std::array<double, 2> knee_m{0.0, 0.0}, ankle_m{0.0, 0.0};
+};
+
+/// Without the subject's measured widths: the knee's (femoral bicondylar) and the ankle's
+/// (bimalleolar) width as fractions of the knee-ankle length. Adults' knees are about 95-105 mm
+/// wide and their ankles 65-75 mm for a knee-ankle length of about 0.43 m (de Leva 1996's male
+/// shank, 0.434 m), hence 0.23 and 0.165; scaled by the subject's own shank, a child's or a tall
+/// runner's joint keeps its proportion. Plug-in Gait files carry the measured widths (Trial).
+inline constexpr double kKneeWidthPerShank = 0.23, kAnkleWidthPerShank = 0.165;
+/// The markers' diameter when the file does not give it (m): the 14 mm markers of most gait labs.
+inline constexpr double kDefaultMarkerDiameterM = 0.014;
+
 /// The legs' kinematics for the 3D joint moments (made once per trial).
 struct LegMotion3D {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
@@ -73,7 +93,8 @@ struct LegMotion3D {
 /// `landmark_lab_m`: each landmark's lab position, N x 3 (finite); `lateral_axis`: each frame's
 /// lateral axis (N x 3); `cutoff_hz` <= 0: unfiltered.
 LegMotion3D leg_motion_3d(const Model& model, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
-                          const Eigen::MatrixX3d& lateral_axis, const Eigen::Vector3d& up, double rate_hz, double cutoff_hz);
+                          const Eigen::MatrixX3d& lateral_axis, const Eigen::Vector3d& up, double rate_hz, double cutoff_hz,
+                          const JointCentreOffsets& offsets = {});
 
 /// One foot's ground reaction in the lab, per frame, as a wrench at the lab origin: the force on
 /// the body (N) and its moment about the origin (N m), zero without contact. A COP c and a free

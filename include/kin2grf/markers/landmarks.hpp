@@ -20,6 +20,12 @@
 //   {"pelvis_up": 0.50}                       shoulder fallback when a set has no upper-body
 //       markers: the given length straight up (lab vertical) from the hip centre: a rigid
 //       upright torso (an approximation; the pelvis's tilt and oscillations are not the trunk's).
+//   any of the above with "surface": "lateral" (knee, ankle and MT landmarks): the marker is on the
+//       skin over the joint's lateral side (Plug-in Gait's KNE, ANK), not the joint centre, or on
+//       the 5th metatarsal head, not the foot's midline. The sagittal model takes it as it is (its
+//       projection is the same); the 3D joint moments move a knee or ankle medially by half the
+//       joint's width plus the marker's radius (dynamics/joint_moments_3d.hpp), the COP's lateral
+//       line moves its forefoot end medially by kLateralMtToMidline of the heel-MT length.
 //   {"virtual_hallux": 0.30}                  hallux fallback: a toes segment of that fraction of
 //       the ankle-MT length, straight along the foot in swing, held at the MT head's foot-flat
 //       height while the heel rises (the toes stay on the ground at push-off).
@@ -57,6 +63,8 @@ struct LandmarkRule {
   /// pelvis_up: the shoulder point's horizontal sway as a fraction of the hip centre's (see
   /// kTrunkSwayGain); 1 keeps the torso rigidly upright.
   double sway_gain = 0.0;
+  /// "surface": "lateral": a knee or ankle marker on the joint's lateral skin (see above).
+  bool lateral_surface = false;
 };
 
 /// The horizontal acceleration of the shoulder point (acromia) as a fraction of the hip
@@ -69,6 +77,11 @@ inline constexpr double kTrunkSwayGain = 0.5;
 /// tip about a third of that ahead of the MT head); a toe marker nearer the MT head than half
 /// of it is not on the toe and is replaced by them, with a message.
 inline constexpr double kVirtualToeShare = 0.3, kMinToeShare = 0.15;
+/// A 5th-metatarsal head marker's distance (lateral skin, marker centre) to the foot's midline
+/// (the 2nd metatarsal head) as a fraction of the heel-MT5 length: about 45 mm on an adult's
+/// 180 mm (the MT1-MT5 heads' breadth is about 0.4 of the foot's length, the 2nd head a quarter
+/// of it from the 1st, plus the soft tissue and the marker's radius). Anatomy, not fitted.
+inline constexpr double kLateralMtToMidline = 0.25;
 
 struct MarkerSet {
   std::string name;
@@ -180,7 +193,11 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
 struct SagittalWindow {
   SagittalLandmarks landmarks;  ///< only the processed window
   Eigen::Index first = 0;       ///< index of its first frame in the trial
-  std::array<Eigen::VectorXd, 2> foot_lateral_m;  ///< per side: lateral coordinate of the foot
+  std::array<Eigen::VectorXd, 2> foot_lateral_m;  ///< per side: lateral coordinate of the foot (heel-MT midpoint)
+  /// When asked (keep_lateral), per side, N x 4: the line the COP's lateral place follows along
+  /// the foot, (heel x, heel lateral, forefoot x, forefoot lateral) in the sagittal frame, m; the
+  /// forefoot end on the foot's midline (a 5th-metatarsal marker moved by kLateralMtToMidline).
+  std::array<Eigen::MatrixX4d, 2> foot_line;
   /// When asked (the mediolateral force): every landmark's lab position (m), N x 3 each, with the
   /// virtual hallux at the MT head, and each frame's lateral axis (SagittalFrame::lateral_at),
   /// N x 3. Empty otherwise.

@@ -20,6 +20,7 @@ struct SeriesMetrics {
   double pearson_r = 0.0;        ///< NaN when either series is constant
   double max_abs_error = 0.0;    ///< max_i |u_num,i - u_exp,i|
   double peak_difference = 0.0;  ///< max(u_num) - max(u_exp): the error on the peak value
+  double mean_error = 0.0;       ///< mean(u_num - u_exp): the bias
 };
 
 /// Compare an estimated series with a measured one of the same length. Returns nullopt when
