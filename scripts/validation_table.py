@@ -160,43 +160,134 @@ for a, name, _ in rows:
         print(f"| {a} | {name} | total | GRM | {t['frames_compared']} frames | {f1(t['rrmse_percent']['vertical'])} | "
               f"{f1(t['rrmse_percent']['anterior'])} | | {f1(t['rrmse_percent']['moment'])} | | | | | {paper} |")
 
-print("\n## Mediolateral force (`--mediolateral`)\n")
-print("Each foot's force along the sagittal frame's lateral axis: the whole body's lateral acceleration from the "
-      "landmarks (dynamics/mediolateral.hpp), shared between the feet by vertical load; the sagittal figures above "
-      "are unchanged by it. Per stance: rRMSE %, RMSE in % body weight, Pearson r against the plate's lateral force; "
-      "and the COP's lateral place (the heel and MT markers' midpoint) against the plate's, RMSE in mm, over the "
-      "frames above 5 % body weight. "
-      "The split was chosen among three (vertical share, inverted pendulum, pendulum corrected to the total): the "
-      "vertical share has the lowest walking rRMSE on every lab, so each lab held out chooses it too and in-sample "
-      "equals held-out (docs/METHOD-NOTES.md).\n")
-print("| activity | trial | lab | stances | rRMSE % mean (SD) | RMSE %BW mean | r mean | lateral COP RMSE mm |")
-print("|---|---|---|---|---|---|---|---|")
+LATERAL_CUTOFFS = {"kinematic": "3d-lc0", "2 Hz": "3d-lc2", "2.5 Hz": "3d-lc2.5", "3 Hz": "3d", "3.5 Hz": "3d-lc3.5",
+                   "4 Hz": "3d-lc4", "5 Hz": "3d-lc5"}
+
+
+def load_or_none(name, config):
+    try:
+        return load(name, config)
+    except FileNotFoundError:
+        return None
+
+
+def stances_3d(j):
+    return [s for s in j["per_foot"] if s["rrmse_percent"].get("lateral") is not None]
+
+
+def trial_3d(j, mass):
+    """One trial's 3D figures: means over its plate stances (None where it has none)."""
+    st = stances_3d(j)
+    if not st:
+        return None
+    m = lambda xs: statistics.mean(xs) if xs else None
+    jm = [s["joint_moments_3d"] for s in st if s.get("joint_moments_3d")]
+    kam = [x["knee_adduction_moment"] for x in jm if x.get("knee_adduction_moment")]
+    first = [(k["peaks_estimated_Nm"][0], k["peaks_measured_Nm"][0]) for k in kam
+             if k["peaks_estimated_Nm"][0] is not None and k["peaks_measured_Nm"][0] is not None]
+    return {
+        "stances": len(st),
+        "lateral": m([s["rrmse_percent"]["lateral"] for s in st]),
+        "lateral_bw": m([s["rmse_percent_bw"]["lateral"] for s in st]),
+        "r": m([s["r"]["lateral"] for s in st if s["r"]["lateral"] is not None]),
+        "cop_mm": m([s["rmse"]["cop_lateral_mm"] for s in st if s["rmse"].get("cop_lateral_mm") is not None]),
+        "kam": m([k["rrmse_percent"] for k in kam if k.get("rrmse_percent") is not None]),
+        "knee_sagittal": m([x["knee"]["sagittal"]["rrmse_percent"] for x in jm if x["knee"]["sagittal"].get("rrmse_percent") is not None]),
+        "kam1_est": m([e / mass for e, _ in first]),
+        "kam1_plates": m([p / mass for _, p in first]),
+        "kam1_error": m([abs(e - p) / mass for e, p in first]),
+    }
+
+
+def lateral_criterion(config, held_lab):
+    """Mean over the labs (each weighing the same) of their trials' mean per-foot lateral rRMSE."""
+    per_lab = {}
+    for a, name, args in rows:
+        if lab_of[name] == held_lab:
+            continue
+        j = load_or_none(name, config)
+        t = j and trial_3d(j, j["mass_kg"])
+        if t:
+            per_lab.setdefault(lab_of[name], []).append(t["lateral"])
+    return statistics.mean(statistics.mean(v) for v in per_lab.values())
+
+
+print("\n## The 3D model (`--model 3d`)\n")
+print("The sagittal figures above are the 3D model's too: it adds to them, per foot, the mediolateral force and the "
+      "COP's lateral place, and per leg the ankle's and the knee's 3D moments by bottom-up inverse dynamics "
+      "(dynamics/joint_moments_3d.hpp), run once with the estimate's ground reaction and once with the plates' on "
+      "the same kinematics. The mediolateral force: the whole body's lateral acceleration (filtered at 3 Hz) shared "
+      "between the feet by vertical load. The COP's lateral place: on the line from the heel to the forefoot's "
+      "midline at the COP's place along the foot. Lateral knee, ankle and 5th-metatarsal markers are moved to the "
+      "joint centres and the foot's midline (docs/MARKERSETS.md, \"surface\"). Per stance: the lateral force's "
+      "rRMSE %, RMSE in % body weight, r; the lateral COP's RMSE in mm (frames above 5 % body weight); the external "
+      "knee adduction moment (KAM), estimate-driven against plate-driven: rRMSE %, and its first peak (the largest "
+      "value in the stance's first half) in N m/kg; the knee's sagittal moment's rRMSE %. No value of the 3D model "
+      "was fitted except the lateral cut-off (below); the joint and foot geometry are anatomical ratios.\n")
+print("| activity | trial | lab | stances | lateral force rRMSE % | RMSE %BW | r | lateral COP RMSE mm | "
+      "KAM rRMSE % | KAM 1st peak est / plates N m/kg | knee sagittal rRMSE % |")
+print("|---|---|---|---|---|---|---|---|---|---|---|")
 by_activity = {}
 for a, name, args in rows:
-    try:
-        j = load(name, "mediolateral")
-    except FileNotFoundError:
+    j = load_or_none(name, "3d")
+    if j is None:
         continue
-    st = [s for s in j["per_foot"] if s["rrmse_percent"].get("lateral") is not None]
-    if not st:
-        print(f"| {a} | {name} | {lab_of[name]} | 0 | - | - | - | - |")
+    t = trial_3d(j, j["mass_kg"])
+    if t is None:
+        print(f"| {a} | {name} | {lab_of[name]} | 0 | - | - | - | - | - | - | - |")
         continue
-    rr = [s["rrmse_percent"]["lateral"] for s in st]
-    bw = [s["rmse_percent_bw"]["lateral"] for s in st]
-    rs = [s["r"]["lateral"] for s in st if s["r"]["lateral"] is not None]
-    cop = j["mean_rrmse_percent"]["all"].get("cop_lateral_rmse_mm")
-    print(f"| {a} | {name} | {lab_of[name]} | {len(st)} | {mean_sd(rr)} | {statistics.mean(bw):.1f} | "
-          f"{(statistics.mean(rs) if rs else float('nan')):.2f} | {'-' if cop is None else f'{cop:.0f}'} |")
-    by_activity.setdefault(a, []).append((name, statistics.mean(rr), statistics.mean(bw), cop))
-print("\n| activity | trials | rRMSE % (mean of trials) | RMSE %BW | worst trial | lateral COP RMSE mm (worst) |")
-print("|---|---|---|---|---|---|")
+    g = lambda k, fmt="{:.1f}": "-" if t[k] is None else fmt.format(t[k])
+    print(f"| {a} | {name} | {lab_of[name]} | {t['stances']} | {g('lateral')} | {g('lateral_bw')} | {g('r', '{:.2f}')} | "
+          f"{g('cop_mm', '{:.0f}')} | {g('kam')} | {g('kam1_est', '{:.2f}')} / {g('kam1_plates', '{:.2f}')} | {g('knee_sagittal')} |")
+    by_activity.setdefault(a, []).append((name, t))
+print("\n| activity | trials | lateral force rRMSE % (worst trial) | lateral COP RMSE mm (worst) | KAM rRMSE % (worst) | "
+      "KAM 1st peak mean abs error N m/kg, % of the plates' mean | knee sagittal rRMSE % |")
+print("|---|---|---|---|---|---|---|")
 for a, xs in by_activity.items():
-    worst = max(xs, key=lambda x: x[1])
-    cops = [x for x in xs if x[3] is not None]
-    cop_text = "-" if not cops else (f"{statistics.mean(x[3] for x in cops):.0f} "
-                                     f"({max(cops, key=lambda x: x[3])[0]} {max(x[3] for x in cops):.0f})")
-    print(f"| {a} | {len(xs)} | {statistics.mean(x[1] for x in xs):.1f} | {statistics.mean(x[2] for x in xs):.1f} | "
-          f"{worst[0]} {worst[1]:.1f} | {cop_text} |")
+    def summary(key, fmt):
+        have = [(n, t[key]) for n, t in xs if t[key] is not None]
+        if not have:
+            return "-"
+        worst = max(have, key=lambda x: x[1])
+        return f"{fmt.format(statistics.mean(v for _, v in have))} ({worst[0]} {fmt.format(worst[1])})"
+    peaks = [t for _, t in xs if t["kam1_error"] is not None]
+    peak_text = "-" if not peaks else (f"{statistics.mean(t['kam1_error'] for t in peaks):.2f}, "
+                                       f"{100 * statistics.mean(t['kam1_error'] for t in peaks) / statistics.mean(t['kam1_plates'] for t in peaks):.0f} %")
+    ks = [t["knee_sagittal"] for _, t in xs if t["knee_sagittal"] is not None]
+    print(f"| {a} | {len(xs)} | {summary('lateral', '{:.1f}')} | {summary('cop_mm', '{:.0f}')} | {summary('kam', '{:.1f}')} | "
+          f"{peak_text} | {'-' if not ks else f'{statistics.mean(ks):.1f}'} |")
+
+labs = sorted({lab_of[name] for _, name, _ in rows})
+have_grid = all(load_or_none(rows[0][1], c) is not None for c in LATERAL_CUTOFFS.values())
+if have_grid:
+    print("\n### The lateral force's cut-off, leave-one-lab-out\n")
+    print("Chosen by the per-foot lateral force's rRMSE (per lab, the mean over its trials; then the mean over the labs, "
+          "all activities pooled). In-sample: every trial at the choice made on every lab; held-out: each lab's trials "
+          "at the choice made without it.\n")
+    crit = {k: lateral_criterion(c, None) for k, c in LATERAL_CUTOFFS.items()}
+    print("| cut-off | " + " | ".join(crit) + " |")
+    print("|---|" + "---|" * len(crit))
+    print("| criterion % | " + " | ".join(f"{v:.2f}" for v in crit.values()) + " |")
+    in_sample = min(crit, key=crit.get)
+    choice = {lab: min(LATERAL_CUTOFFS, key=lambda k: lateral_criterion(LATERAL_CUTOFFS[k], lab)) for lab in labs}
+    print("\nIn-sample choice: " + in_sample + "; held out: " + ", ".join(f"{lab} {c}" for lab, c in choice.items()) + ".\n")
+    print("| activity | kinematic cut-off | in-sample | held-out | worst trial held-out |")
+    print("|---|---|---|---|---|")
+    for a in dict.fromkeys(a for a, _, _ in rows):
+        base, ins, held = [], [], []
+        for b, name, _ in rows:
+            if b != a:
+                continue
+            ts = {k: load_or_none(name, c) for k, c in LATERAL_CUTOFFS.items()}
+            if ts["kinematic"] is None or trial_3d(ts["kinematic"], 1) is None:
+                continue
+            base.append(trial_3d(ts["kinematic"], 1)["lateral"])
+            ins.append(trial_3d(ts[in_sample], 1)["lateral"])
+            held.append((trial_3d(ts[choice[lab_of[name]]], 1)["lateral"], name))
+        if held:
+            worst = max(held)
+            print(f"| {a} | {statistics.mean(base):.1f} | {statistics.mean(ins):.1f} | "
+                  f"{statistics.mean(h for h, _ in held):.1f} | {worst[1]} {worst[0]:.1f} |")
 
 print("\n## Excluded stances and notes (defaults)\n")
 for a, name, args in rows:

@@ -702,6 +702,18 @@ TEST(Mediolateral, TheOptionChangesNoSagittalResult) {
   EXPECT_EQ(t1.columns.back(), "grf_lateral_l_N");
   EXPECT_EQ(t1.values(i, t1.values.cols() - 2), r1.feet[0].force_lateral_N[i]);
   EXPECT_EQ(t1.values.leftCols(t0.values.cols()).row(i), t0.values.row(i));
+  // The 3D model likewise: the sagittal results and the 2D joint torques unchanged, the lateral
+  // force and the joint moments added.
+  EstimateOptions three_d;
+  three_d.model = ModelKind::ThreeD;
+  const auto r3 = run({}, three_d);
+  ASSERT_TRUE(r3.legs_3d.has_value());
+  EXPECT_EQ(r3.joint_torque_Nm, r0.joint_torque_Nm);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(r3.feet[k].force_N, r0.feet[k].force_N);
+    EXPECT_EQ(r3.feet[k].force_lateral_N.size(), n);
+  }
+  EXPECT_EQ(results_table(r3).columns.back(), "knee_adduction_moment_l_Nm");
 }
 
 // The same recorded walk turned about the vertical (the lab's axes no longer along the walkway, or

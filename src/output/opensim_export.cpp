@@ -25,8 +25,10 @@ Eigen::Matrix3d lab_to_opensim(const EstimateResult& r) {
 std::string external_loads_xml(const std::string& mot, const OpenSimExportOptions& o) {
   std::ostringstream os;
   os << "<?xml version=\"1.0\" encoding=\"UTF-8\" ?>\n"
-     << "<!-- Written by kin2grf " << KIN2GRF_VERSION << ": estimated ground reactions (sagittal model: the mediolateral\n"
-     << "     force and the free moment are zero; frontal- and transverse-plane joint moments are not valid). -->\n"
+     << "<!-- Written by kin2grf " << KIN2GRF_VERSION << ": estimated ground reactions. The free moment is zero (not\n"
+     << "     estimated); the mediolateral force and the COP's lateral place are estimated by the 3D model or\n"
+     << "     the mediolateral option, else zero and the foot's midpoint: frontal- and transverse-plane joint moments are\n"
+     << "     then not valid. -->\n"
      << "<OpenSimDocument Version=\"40000\">\n"
      << "  <ExternalLoads name=\"kin2grf_external_loads\">\n"
      << "    <objects>\n";
