@@ -154,12 +154,15 @@ BENCHMARK(BM_ContactSolvePerFrame)->Arg(0)->Arg(1)->ArgNames({"real"})->Unit(ben
 
 /// The whole method on a loaded trial: landmarks, sagittal frame, model, kinematics, contact
 /// solve, post-filter, outputs in memory (file reading excluded; see BM_ReadC3dWalking2).
+/// `3d`: the 3D model (--model 3d: the mediolateral force, the COP's lateral place and the 3D
+/// ankle and knee moments on top).
 void BM_EstimatePipeline(benchmark::State& state) {
-  const Workload w = workload(state.range(0) == 1);
+  Workload w = workload(state.range(0) == 1);
   if (!w.ok) {
     state.SkipWithError("shared data not found");
     return;
   }
+  if (state.range(1) == 1) w.options.model = kin2grf::ModelKind::ThreeD;
   long frames = 0;
   for (auto _ : state) {
     const auto r = kin2grf::estimate(w.trial, nullptr, *w.set, w.options);
@@ -168,7 +171,7 @@ void BM_EstimatePipeline(benchmark::State& state) {
   }
   state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_EstimatePipeline)->Arg(0)->Arg(1)->ArgNames({"real"})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EstimatePipeline)->Args({0, 0})->Args({1, 0})->Args({1, 1})->ArgNames({"real", "3d"})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
