@@ -89,3 +89,35 @@ TEST(Report, AnEstimateReportWithoutPlatesRendersWithItsGaitEvents) {
   // 4 figures per foot (vertical, anterior, COP, joint torques) and the GRM.
   EXPECT_NE(dom.find("data-charts-rendered=\"9\""), std::string::npos) << dom.substr(0, 400);
 }
+
+// The 3D model's validation report (issue 28: "the HTML report plots them"): per foot the
+// mediolateral force, the COP's lateral place and the knee adduction moment, estimate-driven
+// against plate-driven, and a table of the 3D figures.
+TEST(Report, TheThreeDReportPlotsTheLateralForceAndTheKneeAdductionMoment) {
+  const Trial walk = load_trial(std::string(KIN2GRF_SOURCE_DIR) + "/data/example/walking2.c3d");
+  ASSERT_TRUE(walk.plates.has_value());
+  EstimateOptions o;
+  o.mass_kg = 64.9;
+  o.model = ModelKind::ThreeD;
+  const EstimateResult e = estimate(walk, nullptr, *recognise_marker_set(walk.markers), o);
+  const ValidationResult v = validate(e, *walk.plates);
+  ASSERT_FALSE(v.stances.empty());
+  const std::string html = validation_report_html("walking2", e, v, validation_json("walking2", e, v, nlohmann::json::object()));
+  const auto count = [&](const std::string& what) {
+    int k = 0;
+    for (auto p = html.find(what); p != std::string::npos; p = html.find(what, p + 1)) ++k;
+    return k;
+  };
+  EXPECT_EQ(count("foot: mediolateral GRF"), 2);
+  EXPECT_EQ(count("foot: COP's lateral place"), 2);
+  EXPECT_EQ(count("knee: external knee adduction moment"), 2);
+  EXPECT_EQ(count("<h3>3D model</h3>"), 1);
+  // The sagittal model's report has none of it.
+  EstimateOptions sagittal;
+  sagittal.mass_kg = 64.9;
+  const EstimateResult e2 = estimate(walk, nullptr, *recognise_marker_set(walk.markers), sagittal);
+  const ValidationResult v2 = validate(e2, *walk.plates);
+  const std::string html2 = validation_report_html("walking2", e2, v2, validation_json("walking2", e2, v2, nlohmann::json::object()));
+  EXPECT_EQ(html2.find("mediolateral GRF"), std::string::npos);
+  EXPECT_EQ(html2.find("<h3>3D model</h3>"), std::string::npos);
+}

@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "kin2grf/numeric.hpp"
@@ -150,6 +151,28 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
     for (const auto& x : v.notes) t << "<li>note: " << html_escape(x) << "</li>\n";
     t << "</ul>\n";
   }
+  if (e.legs_3d) {
+    t << "<h3>3D model</h3>\n<p>Mediolateral force and the COP's lateral place against the plates; the external knee "
+         "adduction moment (KAM) by inverse dynamics with kin2grf's GRF against with the plates' GRF, on the same "
+         "kinematics: rRMSE, and its first and second peaks (largest value in each half of the stance).</p>\n"
+         "<table><tr><th class=l>foot</th><th class=l>plate</th><th>lateral rRMSE %</th><th>lateral RMSE N</th>"
+         "<th>lateral COP RMSE mm</th><th>KAM rRMSE %</th><th>KAM peaks, kin2grf N m</th><th>KAM peaks, plates N m</th>"
+         "<th>knee sagittal rRMSE %</th></tr>\n";
+    for (const auto& s : j["per_foot"]) {
+      const nlohmann::json none;
+      const auto& jm = s.contains("joint_moments_3d") ? s["joint_moments_3d"] : none;
+      const auto& kam = jm.is_null() ? none : jm["knee_adduction_moment"];
+      const auto peaks = [&](const char* key) {
+        return kam.is_null() ? std::string("-") : fmt(kam[key][0], "%.0f") + " / " + fmt(kam[key][1], "%.0f");
+      };
+      t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>())
+        << "</td><td>" << fmt(s["rrmse_percent"].value("lateral", nlohmann::json())) << "</td><td>"
+        << fmt(s["rmse"].value("lateral_N", nlohmann::json())) << "</td><td>" << fmt(s["rmse"].value("cop_lateral_mm", nlohmann::json()), "%.0f")
+        << "</td><td>" << fmt(kam.is_null() ? none : kam["rrmse_percent"]) << "</td><td>" << peaks("peaks_estimated_Nm") << "</td><td>"
+        << peaks("peaks_measured_Nm") << "</td><td>" << fmt(jm.is_null() ? none : jm["knee"]["sagittal"]["rrmse_percent"]) << "</td></tr>\n";
+    }
+    t << "</table>\n";
+  }
   rep.sections_html.push_back(t.str());
 
   const std::vector<double> time = to_vec(e.time_s);
@@ -173,6 +196,27 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
     fig("vertical GRF", "N", fe.force_N.col(1), mf.col(1));
     fig("anterior GRF", "N", fe.force_N.col(0), mf.col(0));
     fig("COP along progression", "m", fe.cop_x_m, v.measured_cop_x_m[static_cast<std::size_t>(f)]);
+    const auto k = static_cast<std::size_t>(f);
+    if (fe.force_lateral_N.size() == e.time_s.size() && v.measured_lateral_N[k].size() == e.time_s.size()) {
+      fig("mediolateral GRF (+ towards the walker's right)", "N", fe.force_lateral_N, v.measured_lateral_N[k]);
+      fig("COP's lateral place (+ towards the walker's right)", "m",
+          fe.cop_lateral_m.size() == e.time_s.size() ? fe.cop_lateral_m : e.foot_lateral_m[k], v.measured_cop_lateral_m[k]);
+    }
+    if (e.legs_3d && v.measured_moments_3d) {
+      // Plate-driven only where a plate stance is compared (zero ground reaction elsewhere).
+      Eigen::VectorXd plate = Eigen::VectorXd::Constant(e.time_s.size(), std::numeric_limits<double>::quiet_NaN());
+      const Eigen::VectorXd kam = knee_adduction_moment(*v.measured_moments_3d, f);
+      for (const auto& s : v.stances)
+        if (s.foot == f) plate.segment(s.first, s.last - s.first + 1) = kam.segment(s.first, s.last - s.first + 1);
+      ReportFigure g;
+      g.title = foot + " knee: external knee adduction moment, estimate-driven and plate-driven inverse dynamics";
+      g.x_label = "time (s)";
+      g.y_label = "N m";
+      g.shaded = shaded;
+      g.series.push_back({"with the plates' GRF", time, to_vec(plate), true});
+      g.series.push_back({"with kin2grf's GRF", time, to_vec(knee_adduction_moment(e.legs_3d->moments, f)), false});
+      rep.figures.push_back(g);
+    }
   }
   if (v.total) {
     ReportFigure g;

@@ -416,6 +416,14 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
     mf.row(a + i) += mp.force_N.row(a + i);
     v.measured_cop_x_m[static_cast<std::size_t>(c.foot)][a + i] = mc[i];
   }
+  if (fe.force_lateral_N.size() == n) {
+    auto& ml = v.measured_lateral_N[static_cast<std::size_t>(c.foot)];
+    auto& cl = v.measured_cop_lateral_m[static_cast<std::size_t>(c.foot)];
+    for (Eigen::Index i = 0; i < len; ++i) {
+      ml[a + i] = (std::isfinite(ml[a + i]) ? ml[a + i] : 0.0) + mp.force_lateral_N[a + i];
+      if (std::isfinite(mc[i])) cl[a + i] = mp.cop_lateral_m[a + i];
+    }
+  }
   return s;
 }
 
@@ -628,6 +636,10 @@ ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateR
   for (int f = 0; f < 2; ++f) {
     v.measured_force_N[static_cast<std::size_t>(f)] = Eigen::MatrixX2d::Constant(n, 2, kNaN);
     v.measured_cop_x_m[static_cast<std::size_t>(f)] = Eigen::VectorXd::Constant(n, kNaN);
+    if (e.feet[static_cast<std::size_t>(f)].force_lateral_N.size() == n) {
+      v.measured_lateral_N[static_cast<std::size_t>(f)] = Eigen::VectorXd::Constant(n, kNaN);
+      v.measured_cop_lateral_m[static_cast<std::size_t>(f)] = Eigen::VectorXd::Constant(n, kNaN);
+    }
   }
   bool any_plate_data = false;
   for (const auto& mp : v.plates) any_plate_data = any_plate_data || mp.force_N.col(1).array().isFinite().any();
@@ -680,7 +692,10 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
 namespace {
 /// The 3D joint moments' means (MeanMetrics::knee_sagittal, knee_adduction, kam_peak_error_percent).
 void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, MeanMetrics& mm) {
-  std::array<std::vector<double>, 4> x;  // knee sagittal rRMSE, KAM rRMSE, |peak error| % (first, second)
+  // Knee sagittal rRMSE, KAM rRMSE; per peak (first, second) the |error| and the plates' |peak|:
+  // a ratio of means, since a stance whose plate-driven peak is near 0 N m would make a per-stance
+  // percentage meaningless.
+  std::array<std::vector<double>, 6> x;
   for (const auto& s : stances) {
     if ((foot >= 0 && s.foot != foot) || !s.moments_3d) continue;
     const JointMomentValidation& j = *s.moments_3d;
@@ -688,15 +703,22 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
     if (j.knee_adduction && std::isfinite(j.knee_adduction->rrmse_percent)) x[1].push_back(j.knee_adduction->rrmse_percent);
     for (std::size_t p = 0; p < 2; ++p) {
       const double m = j.kam_peak_measured_Nm[p];
-      if (std::isfinite(m) && m > 0 && std::isfinite(j.kam_peak_estimated_Nm[p]))
-        x[2 + p].push_back(100 * std::abs(j.kam_peak_estimated_Nm[p] - m) / m);
+      if (std::isfinite(m) && std::isfinite(j.kam_peak_estimated_Nm[p])) {
+        x[2 + 2 * p].push_back(std::abs(j.kam_peak_estimated_Nm[p] - m));
+        x[3 + 2 * p].push_back(std::abs(m));
+      }
     }
   }
-  std::array<double*, 4> out{&mm.knee_sagittal, &mm.knee_adduction, &mm.kam_peak_error_percent[0], &mm.kam_peak_error_percent[1]};
-  for (std::size_t k = 0; k < 4; ++k) {
+  const auto mean = [](const std::vector<double>& v) {
     double sum = 0;
-    for (double a : x[k]) sum += a;
-    *out[k] = x[k].empty() ? kNaN : sum / static_cast<double>(x[k].size());
+    for (double a : v) sum += a;
+    return v.empty() ? kNaN : sum / static_cast<double>(v.size());
+  };
+  mm.knee_sagittal = mean(x[0]);
+  mm.knee_adduction = mean(x[1]);
+  for (std::size_t p = 0; p < 2; ++p) {
+    const double plates = mean(x[3 + 2 * p]);
+    mm.kam_peak_error_percent[p] = plates > 0 ? 100 * mean(x[2 + 2 * p]) / plates : kNaN;
   }
 }
 }  // namespace

@@ -185,6 +185,9 @@ struct ValidationResult {
   /// Per-frame measured per-foot series (sum of the foot's kept stances; NaN elsewhere).
   std::array<Eigen::MatrixX2d, 2> measured_force_N;
   std::array<Eigen::VectorXd, 2> measured_cop_x_m;
+  /// Likewise the lateral force (N) and the COP's lateral place (m, where the COP is compared),
+  /// with the estimate's lateral force (--mediolateral, --model 3d) only; empty otherwise.
+  std::array<Eigen::VectorXd, 2> measured_lateral_N, measured_cop_lateral_m;
   /// Step 6, from the plates as recorded (none with fewer than 10 loaded frames clear of the
   /// recording's ends by the search's reach, or when the best shift lies at the search's limit).
   std::optional<SyncEstimate> sync;
@@ -214,7 +217,8 @@ struct MeanMetrics {
   double cop_lateral_rmse_mm = 0;  ///< mean over the stances (NaN without --mediolateral)
   /// ModelKind::ThreeD (NaN otherwise): mean rRMSE of the knee's sagittal moment and of the
   /// external knee adduction moment, and the KAM's first and second peaks' mean |estimate -
-  /// plates| in % of the plate-driven peak.
+  /// plates| in % of the plate-driven peaks' mean |value| (a ratio of means: one stance's
+  /// plate-driven peak near 0 N m would make its own percentage meaningless).
   double knee_sagittal = 0, knee_adduction = 0;
   std::array<double, 2> kam_peak_error_percent{0, 0};
 };
