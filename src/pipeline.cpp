@@ -231,8 +231,6 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   return out;
 }
 
-/// The model (fixed segment lengths, the medians over the window, and anthropometry) and the
-/// trial's floor and soles (ground level, contact calibration).
 /// The 3D knee and ankle centres' medial offsets (dynamics/joint_moments_3d.hpp) for the set's
 /// lateral markers: half the joint's width (the trial's measured width, else kKneeWidthPerShank
 /// or kAnkleWidthPerShank of the model's shank) plus the marker's radius. A message says, per
@@ -259,6 +257,8 @@ JointCentreOffsets joint_centre_offsets(const MarkerSet& set, const Trial& trial
   return out;
 }
 
+/// The model (fixed segment lengths, the medians over the window, and anthropometry) and the
+/// trial's floor and soles (ground level, contact calibration).
 struct ModelStage {
   std::shared_ptr<const Model> model;
   /// The floor the contacts and the results take: the measured (or given) ground plus

@@ -92,7 +92,7 @@ TEST(Report, AnEstimateReportWithoutPlatesRendersWithItsGaitEvents) {
 
 // The 3D model's validation report (issue 28: "the HTML report plots them"): per foot the
 // mediolateral force, the COP's lateral place and the knee adduction moment, estimate-driven
-// against plate-driven, and a table of the 3D figures.
+// against plate-driven, and a table of the 3D figures; and the total's frontal moment.
 TEST(Report, TheThreeDReportPlotsTheLateralForceAndTheKneeAdductionMoment) {
   const Trial walk = load_trial(std::string(KIN2GRF_SOURCE_DIR) + "/data/example/walking2.c3d");
   ASSERT_TRUE(walk.plates.has_value());
@@ -120,4 +120,12 @@ TEST(Report, TheThreeDReportPlotsTheLateralForceAndTheKneeAdductionMoment) {
   const std::string html2 = validation_report_html("walking2", e2, v2, validation_json("walking2", e2, v2, nlohmann::json::object()));
   EXPECT_EQ(html2.find("mediolateral GRF"), std::string::npos);
   EXPECT_EQ(html2.find("<h3>3D model</h3>"), std::string::npos);
+  // The total's frontal and transverse moments (validate_total_3d): with the lateral force only.
+  // The frontal one is mostly each foot's vertical force times its lateral place, which the
+  // estimate has: a sign or frame error would show as a low or negative r.
+  ASSERT_TRUE(v.total && v2.total);
+  ASSERT_TRUE(v.total->frontal_moment && v.total->transverse_moment);
+  EXPECT_GT(v.total->frontal_moment->pearson_r, 0.9);
+  EXPECT_GT(v.total->transverse_moment->pearson_r, 0.5);
+  EXPECT_FALSE(v2.total->frontal_moment.has_value());
 }

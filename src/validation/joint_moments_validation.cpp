@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "kin2grf/pipeline.hpp"
 #include "kin2grf/validation/validate.hpp"
 
 namespace kin2grf {
@@ -59,6 +60,33 @@ void validate_joint_moments_3d(const EstimateResult& e, ValidationResult& v) {
     s.moments_3d = j;
   }
   v.measured_moments_3d = measured;
+}
+
+void validate_total_3d(const EstimateResult& e, ValidationResult& v) {
+  const Eigen::Index n = e.time_s.size();
+  if (!v.total || e.feet[0].force_lateral_N.size() != n) return;
+  TotalValidation& t = *v.total;
+  double lateral = 0;
+  for (Eigen::Index k : t.frames) lateral += 0.5 * (e.foot_lateral_m[0][k] + e.foot_lateral_m[1][k]);
+  t.lateral_reference_m = lateral / static_cast<double>(t.frames.size());
+  const std::array<FootWrench3D, 2> feet = estimated_wrenches(e);
+  const auto m = static_cast<Eigen::Index>(t.frames.size());
+  Eigen::VectorXd ef(m), mf(m), et(m), mt(m);
+  for (Eigen::Index q = 0; q < m; ++q) {
+    const Eigen::Index k = t.frames[static_cast<std::size_t>(q)], trial_k = e.first_index + k;
+    const Eigen::Vector3d P = e.frame.to_lab(t.grm_reference_m.x(), t.grm_reference_m.y(), t.lateral_reference_m, trial_k);
+    Eigen::Vector3d Fe = Eigen::Vector3d::Zero(), Me = Eigen::Vector3d::Zero(), Fm = Eigen::Vector3d::Zero(), Mm = Eigen::Vector3d::Zero();
+    for (const FootWrench3D& w : feet) Fe += w.force_N.row(k).transpose(), Me += w.moment_origin_Nm.row(k).transpose();
+    for (const MeasuredPlate& p : v.plates)
+      if (p.force_lab_N.rows() == n && p.force_lab_N.row(k).allFinite() && p.moment_origin_lab_Nm.row(k).allFinite())
+        Fm += p.force_lab_N.row(k).transpose(), Mm += p.moment_origin_lab_Nm.row(k).transpose();
+    const Eigen::Vector3d MPe = Me - P.cross(Fe), MPm = Mm - P.cross(Fm);
+    const Eigen::Vector3d fw = e.frame.forward_at(trial_k);
+    ef[q] = MPe.dot(fw), mf[q] = MPm.dot(fw);
+    et[q] = MPe.dot(e.frame.up), mt[q] = MPm.dot(e.frame.up);
+  }
+  t.frontal_moment = compare_series(ef, mf);
+  t.transverse_moment = compare_series(et, mt);
 }
 
 }  // namespace kin2grf

@@ -652,6 +652,7 @@ ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateR
   std::sort(v.stances.begin(), v.stances.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   compare_totals(e, v, cands, o);
   if (e.legs_3d) validate_joint_moments_3d(e, v);
+  validate_total_3d(e, v);
   return v;
 }
 
@@ -851,6 +852,15 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     x["frames_compared"] = v.total->frames.size();
     x["grm_reference_m"] = {v.total->grm_reference_m.x(), v.total->grm_reference_m.y()};
     x["implied_mass_kg"] = num(v.total->implied_mass_kg);
+    const auto moment_json = [](const std::optional<SeriesMetrics>& mm) {
+      return mm ? nlohmann::json{{"rrmse_percent", num(mm->rrmse_percent)}, {"rmse_Nm", num(mm->rmse)}, {"r", num(mm->pearson_r)}}
+                : nlohmann::json(nullptr);
+    };
+    if (v.total->frontal_moment || v.total->transverse_moment) {
+      x["frontal_moment"] = moment_json(v.total->frontal_moment);
+      x["transverse_moment"] = moment_json(v.total->transverse_moment);
+      x["lateral_reference_m"] = num(v.total->lateral_reference_m);
+    }
     j["total"] = x;
   } else {
     j["total"] = nullptr;

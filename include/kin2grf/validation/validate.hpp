@@ -172,6 +172,13 @@ struct TotalValidation {
   /// Body mass that makes the kinematic vertical total fit the plates best (least squares over
   /// `frames`; the kinematic total is linear in the mass): a check on the mass given.
   double implied_mass_kg = 0.0;
+  /// With the estimate's lateral force (--mediolateral, --model 3d; validate_total_3d): the total
+  /// ground reaction's frontal moment (M . forward, right-hand rule about the walker's forward
+  /// axis) and transverse moment (M . up, the plates' free moments included), N m,
+  /// about the GRM reference point on the walker's midline (`lateral_reference_m`, the mean of
+  /// the two feet's lateral places over `frames`).
+  std::optional<SeriesMetrics> frontal_moment, transverse_moment;
+  double lateral_reference_m = 0.0;
 };
 
 struct ValidationResult {
@@ -205,6 +212,10 @@ ValidationResult validate(const EstimateResult& estimate, const ForcePlateRecord
 /// free moment included) drive joint_moments_3d on the estimate's leg kinematics, into
 /// v.measured_moments_3d, and each stance gets its JointMomentValidation.
 void validate_joint_moments_3d(const EstimateResult& estimate, ValidationResult& v);
+/// The total's frontal and transverse moments (TotalValidation::frontal_moment), estimate's
+/// (both feet's wrenches, lab_foot_frame) against the plates' (every plate's measured force and
+/// moment) over the total's frames; validate calls it when the estimate has a lateral force.
+void validate_total_3d(const EstimateResult& estimate, ValidationResult& v);
 
 /// Mean (and SD) over the stances of each component's rRMSE, per foot or all.
 struct MeanMetrics {
