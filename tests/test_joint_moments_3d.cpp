@@ -7,6 +7,10 @@
 
 #include "kin2grf/dynamics/joint_moments_3d.hpp"
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/load.hpp"
+#include "kin2grf/io/marker_presets.hpp"
+#include "kin2grf/output/results.hpp"
+#include "kin2grf/pipeline.hpp"
 
 using namespace kin2grf;
 
@@ -207,4 +211,34 @@ TEST(JointMoments3D, LateralMarkersMovedToTheJointCentresGiveTheCentresMoments) 
     EXPECT_NEAR(knee_adduction_moment(as_marked, side)[n / 2] - knee_adduction_moment(truth, side)[n / 2], 0.05 * F, 1.0)
         << side_name(side);
   }
+}
+
+// The estimate's summary (--json) reports each stance's knee adduction moment peaks with --model 3d:
+// the largest value of the KAM column in each half of the stance.
+TEST(JointMoments3D, TheSummaryReportsEachStancesKneeAdductionPeaks) {
+  const Trial walk = load_trial(std::string(KIN2GRF_SOURCE_DIR) + "/data/example/walking2.c3d");
+  EstimateOptions o;
+  o.mass_kg = 64.9;
+  o.model = ModelKind::ThreeD;
+  const EstimateResult r = estimate(walk, nullptr, *recognise_marker_set(walk.markers), o);
+  const nlohmann::json j = results_summary(r, nlohmann::json::object());
+  ASSERT_TRUE(j.contains("knee_adduction_moment"));
+  int complete = 0;
+  for (int side = 0; side < 2; ++side) {
+    const Eigen::VectorXd kam = knee_adduction_moment(r.legs_3d->moments, side);
+    for (const auto& s : j["knee_adduction_moment"][side_name(side)]) {
+      Eigen::Index a = 0, b = 0;
+      while (r.time_s[a] < s["start_s"].get<double>()) ++a;
+      while (r.time_s[b] < s["end_s"].get<double>()) ++b;
+      const Eigen::Index mid = a + (b - a + 1) / 2;
+      EXPECT_DOUBLE_EQ(s["first_peak_Nm"].get<double>(), kam.segment(a, mid - a).maxCoeff());
+      EXPECT_DOUBLE_EQ(s["second_peak_Nm"].get<double>(), kam.segment(mid, b - mid + 1).maxCoeff());
+      EXPECT_DOUBLE_EQ(s["first_peak_Nm_per_kg"].get<double>(), s["first_peak_Nm"].get<double>() / 64.9);
+      complete += s["complete"].get<bool>();
+    }
+  }
+  EXPECT_GE(complete, 1);  // the walk's window holds a whole stance
+  EstimateOptions sagittal;
+  sagittal.mass_kg = 64.9;
+  EXPECT_FALSE(results_summary(estimate(walk, nullptr, *recognise_marker_set(walk.markers), sagittal), {}).contains("knee_adduction_moment"));
 }

@@ -170,6 +170,30 @@ std::vector<IndexRun> contact_runs(const std::vector<bool>& c) {
   return runs_where(static_cast<Eigen::Index>(c.size()), [&](Eigen::Index i) { return c[static_cast<std::size_t>(i)]; });
 }
 
+/// Per side, per stance (a contact run): the external knee adduction moment's first and second
+/// peaks, its largest value in the stance's first and second halves (N m and N m/kg), as validate
+/// takes them; `complete` is false for a stance the processed window cuts (its peaks may lie
+/// outside it).
+nlohmann::json knee_adduction_peaks_json(const EstimateResult& r) {
+  nlohmann::json out = nlohmann::json::object();
+  const auto n = r.time_s.size();
+  for (int s = 0; s < 2; ++s) {
+    const Eigen::VectorXd kam = knee_adduction_moment(r.legs_3d->moments, s);
+    nlohmann::json stances = nlohmann::json::array();
+    for (const auto& run : contact_runs(r.feet[static_cast<std::size_t>(s)].contact)) {
+      const Eigen::Index mid = run.first + (run.last - run.first + 1) / 2;
+      if (mid <= run.first) continue;  // a stance of one frame has no halves
+      const double first = kam.segment(run.first, mid - run.first).maxCoeff(), second = kam.segment(mid, run.last - mid + 1).maxCoeff();
+      stances.push_back({{"start_s", r.time_s[run.first]}, {"end_s", r.time_s[run.last]},
+                         {"complete", run.first > 0 && run.last < n - 1},
+                         {"first_peak_Nm", first}, {"second_peak_Nm", second},
+                         {"first_peak_Nm_per_kg", first / r.mass_kg}, {"second_peak_Nm_per_kg", second / r.mass_kg}});
+    }
+    out[side_name(s)] = stances;
+  }
+  return out;
+}
+
 }  // namespace
 
 nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings) {
@@ -204,6 +228,7 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
   for (const GaitEvent& e : gait_events({r.feet[0].contact, r.feet[1].contact}, r.time_s, r.motion.rate_hz))
     events.push_back({{"event", e.label}, {"side", side_name(e.side)}, {"frame", r.first_frame_number + e.index}, {"time_s", e.time_s}});
   j["gait_events"] = events;
+  if (r.legs_3d) j["knee_adduction_moment"] = knee_adduction_peaks_json(r);
   double mean_it = 0;
   int max_it = 0;
   for (int it : r.iterations) { mean_it += it; max_it = std::max(max_it, it); }
