@@ -514,31 +514,50 @@ TEST(SharedOpenSim, EveryExportsTrcIsReadByOpenSimsRules) {
   EXPECT_GE(trials, 10);
 }
 
-// The mediolateral force reaches OpenSim: the bundled recorded walk's export with --mediolateral
-// carries it in the .mot's Z columns (OpenSim's lateral axis), read by OpenSim's rules; without
-// it they are zero, as the sagittal model's lateral force is.
+// The mediolateral force reaches OpenSim: the bundled recorded walk's export with --model 3d
+// (--mediolateral takes the same path) carries it in the .mot's Z columns (OpenSim's lateral
+// axis) and the COP's lateral place in the point's Z, read by OpenSim's rules; without it the
+// force is zero, as the sagittal model's lateral force is, and the point is the foot's midpoint.
 TEST(OpenSimExport, TheMediolateralForceIsInTheGrfMotsZColumns) {
   KIN2GRF_REQUIRE_CLI();
   const auto dir = test::temp_dir("opensim_ml");
   const std::string walk = std::string(KIN2GRF_SOURCE_DIR) + "/data/example/walking2.c3d";
   double largest[2] = {0, 0};
+  std::vector<double> point_z[2];
   for (int with = 0; with < 2; ++with) {
     const auto out = dir / std::to_string(with);
-    const std::string cmd = std::string(KIN2GRF_CLI) + " estimate " + walk + " --mass 64.9" + (with ? " --mediolateral" : "") +
+    const std::string cmd = std::string(KIN2GRF_CLI) + " estimate " + walk + " --mass 64.9" + (with ? " --model 3d" : "") +
                             " --opensim " + out.string() + " >/dev/null 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
     std::vector<std::string> labels;
     std::vector<std::vector<double>> rows;
     ASSERT_TRUE(opensim_reads_sto(read_file_text((out / "walking2_grf.mot").string()), &labels, &rows));
-    for (const std::string name : {"ground_force_vz", "1_ground_force_vz"}) {
+    const auto column = [&](const std::string& name) {
       const auto col = std::find(labels.begin(), labels.end(), name) - labels.begin() + 1;  // after time
-      ASSERT_LT(static_cast<std::size_t>(col), labels.size() + 1) << name;
-      for (const auto& r : rows) largest[with] = std::max(largest[with], std::abs(r[static_cast<std::size_t>(col)]));
+      EXPECT_LT(static_cast<std::size_t>(col), labels.size() + 1) << name;
+      return static_cast<std::size_t>(col);
+    };
+    for (const std::string name : {"ground_force_vz", "1_ground_force_vz"}) {
+      const auto col = column(name);
+      for (const auto& r : rows) largest[with] = std::max(largest[with], std::abs(r[col]));
     }
+    const auto vy = column("ground_force_vy"), pz = column("ground_force_pz");
+    for (const auto& r : rows)
+      if (r[vy] > 0.5 * 64.9 * 9.81) point_z[with].push_back(r[pz]);  // the right foot under load
+    // The free moment: OpenSim's torque columns are there (zero: not estimated).
+    (void)column("ground_torque_y");
   }
   EXPECT_EQ(largest[0], 0.0);
   EXPECT_GT(largest[1], 10.0);                // N: a walk's lateral force peaks at 5-10 % body weight
   EXPECT_LT(largest[1], 0.3 * 64.9 * 9.81);
+  // The 3D COP moves across the foot as it rolls (the heel-forefoot line); the midpoint does not
+  // move across more than the foot itself does.
+  ASSERT_EQ(point_z[0].size(), point_z[1].size());
+  ASSERT_FALSE(point_z[1].empty());
+  double moved = 0;
+  for (std::size_t i = 0; i < point_z[0].size(); ++i) moved = std::max(moved, std::abs(point_z[1][i] - point_z[0][i]));
+  EXPECT_GT(moved, 0.002);
+  EXPECT_LT(moved, 0.05);
 }
 
 // The -o file and the plates' .mot kin2grf reads are also read by OpenSim's rules.
