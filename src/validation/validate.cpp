@@ -802,15 +802,18 @@ nlohmann::json component_json(const ComponentMetrics& c, double bw) {
   return j;
 }
 
+/// A moment's comparison: rRMSE (%), RMSE (N m), r; null when there is none.
+nlohmann::json moment_metrics_json(const std::optional<SeriesMetrics>& m) {
+  return m ? nlohmann::json{{"rrmse_percent", num(m->rrmse_percent)}, {"rmse_Nm", num(m->rmse)}, {"r", num(m->pearson_r)}}
+           : nlohmann::json(nullptr);
+}
+
 /// A stance's 3D joint moments (ModelKind::ThreeD): per joint and plane the rRMSE, RMSE (N m) and
 /// r, estimate-driven against plate-driven; the KAM's and its peaks.
 nlohmann::json joint_moments_json(const JointMomentValidation& jm) {
   nlohmann::json j;
   const char* planes[] = {"sagittal", "frontal", "transverse"};
-  auto metrics = [](const std::optional<SeriesMetrics>& m) {
-    return m ? nlohmann::json{{"rrmse_percent", num(m->rrmse_percent)}, {"rmse_Nm", num(m->rmse)}, {"r", num(m->pearson_r)}}
-             : nlohmann::json(nullptr);
-  };
+  const auto metrics = moment_metrics_json;
   for (std::size_t c = 0; c < 3; ++c) {
     j["ankle"][planes[c]] = metrics(jm.ankle[c]);
     j["knee"][planes[c]] = metrics(jm.knee[c]);
@@ -852,13 +855,9 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     x["frames_compared"] = v.total->frames.size();
     x["grm_reference_m"] = {v.total->grm_reference_m.x(), v.total->grm_reference_m.y()};
     x["implied_mass_kg"] = num(v.total->implied_mass_kg);
-    const auto moment_json = [](const std::optional<SeriesMetrics>& mm) {
-      return mm ? nlohmann::json{{"rrmse_percent", num(mm->rrmse_percent)}, {"rmse_Nm", num(mm->rmse)}, {"r", num(mm->pearson_r)}}
-                : nlohmann::json(nullptr);
-    };
     if (v.total->frontal_moment || v.total->transverse_moment) {
-      x["frontal_moment"] = moment_json(v.total->frontal_moment);
-      x["transverse_moment"] = moment_json(v.total->transverse_moment);
+      x["frontal_moment"] = moment_metrics_json(v.total->frontal_moment);
+      x["transverse_moment"] = moment_metrics_json(v.total->transverse_moment);
       x["lateral_reference_m"] = num(v.total->lateral_reference_m);
     }
     j["total"] = x;
