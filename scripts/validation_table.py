@@ -193,6 +193,8 @@ def trial_3d(j, mass):
         "cop_mm": m([s["rmse"]["cop_lateral_mm"] for s in st if s["rmse"].get("cop_lateral_mm") is not None]),
         "kam": m([k["rrmse_percent"] for k in kam if k.get("rrmse_percent") is not None]),
         "knee_sagittal": m([x["knee"]["sagittal"]["rrmse_percent"] for x in jm if x["knee"]["sagittal"].get("rrmse_percent") is not None]),
+        "hip_frontal": m([x["hip"]["frontal"]["rrmse_percent"] for x in jm
+                          if x.get("hip") and x["hip"]["frontal"] and x["hip"]["frontal"].get("rrmse_percent") is not None]),
         "kam1_est": m([e / mass for e, _ in first]),
         "kam1_plates": m([p / mass for _, p in first]),
         "kam1_error": m([abs(e - p) / mass for e, p in first]),
@@ -222,7 +224,7 @@ def lateral_criterion(config, held_lab):
 
 print("\n## The 3D model (`--model 3d`)\n")
 print("The sagittal figures above are the 3D model's too: it adds to them, per foot, the mediolateral force and the "
-      "COP's lateral place, and per leg the ankle's and the knee's 3D moments by bottom-up inverse dynamics "
+      "COP's lateral place, and per leg the ankle's, the knee's and the hip's 3D moments by bottom-up inverse dynamics "
       "(dynamics/joint_moments_3d.hpp), run once with the estimate's ground reaction and once with the plates' on "
       "the same kinematics. The mediolateral force: the whole body's lateral acceleration (filtered at 3 Hz) shared "
       "between the feet by vertical load. The COP's lateral place: on the line from the heel to the forefoot's "
@@ -230,13 +232,13 @@ print("The sagittal figures above are the 3D model's too: it adds to them, per f
       "joint centres and the foot's midline (docs/MARKERSETS.md, \"surface\"). Per stance: the lateral force's "
       "rRMSE %, RMSE in % body weight, r; the lateral COP's RMSE in mm (frames above 5 % body weight); the external "
       "knee adduction moment (KAM), estimate-driven against plate-driven: rRMSE %, and its first peak (the largest "
-      "value in the stance's first half) in N m/kg; the knee's sagittal moment's rRMSE %; per trial, the total ground "
+      "value in the stance's first half) in N m/kg; the knee's sagittal moment's and the hip's frontal moment's rRMSE %; per trial, the total ground "
       "reaction's frontal and transverse moments about the GRM reference on the walker's midline, where every loaded "
       "foot is on a plate (the estimate's free moment is zero, the plates' is in theirs). No value of the 3D model "
       "was fitted except the lateral cut-off (below); the joint and foot geometry are anatomical ratios.\n")
 print("| activity | trial | lab | stances | lateral force rRMSE % | RMSE %BW | r | lateral COP RMSE mm | "
-      "KAM rRMSE % | KAM 1st peak est / plates N m/kg | knee sagittal rRMSE % | total frontal / transverse moment rRMSE % |")
-print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+      "KAM rRMSE % | KAM 1st peak est / plates N m/kg | knee sagittal rRMSE % | hip frontal rRMSE % | total frontal / transverse moment rRMSE % |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 by_activity = {}
 for a, name, args in rows:
     j = load_or_none(name, "3d")
@@ -244,16 +246,17 @@ for a, name, args in rows:
         continue
     t = trial_3d(j, j["mass_kg"])
     if t is None:
-        print(f"| {a} | {name} | {lab_of[name]} | 0 | - | - | - | - | - | - | - | - |")
+        print(f"| {a} | {name} | {lab_of[name]} | 0 | - | - | - | - | - | - | - | - | - |")
         continue
     g = lambda k, fmt="{:.1f}": "-" if t[k] is None else fmt.format(t[k])
     print(f"| {a} | {name} | {lab_of[name]} | {t['stances']} | {g('lateral')} | {g('lateral_bw')} | {g('r', '{:.2f}')} | "
           f"{g('cop_mm', '{:.0f}')} | {g('kam')} | {g('kam1_est', '{:.2f}')} / {g('kam1_plates', '{:.2f}')} | {g('knee_sagittal')} | "
-          f"{g('frontal')} / {g('transverse')} |")
+          f"{g('hip_frontal')} | {g('frontal')} / {g('transverse')} |")
     by_activity.setdefault(a, []).append((name, t))
 print("\n| activity | trials | lateral force rRMSE % (worst trial) | lateral COP RMSE mm (worst) | KAM rRMSE % (worst) | "
-      "KAM 1st peak mean abs error N m/kg, % of the plates' mean | knee sagittal rRMSE % | total frontal moment rRMSE % (worst) |")
-print("|---|---|---|---|---|---|---|---|")
+      "KAM 1st peak mean abs error N m/kg, % of the plates' mean | knee sagittal rRMSE % | hip frontal rRMSE % (worst) | "
+      "total frontal moment rRMSE % (worst) |")
+print("|---|---|---|---|---|---|---|---|---|")
 for a, xs in by_activity.items():
     def summary(key, fmt):
         have = [(n, t[key]) for n, t in xs if t[key] is not None]
@@ -266,7 +269,8 @@ for a, xs in by_activity.items():
                                        f"{100 * statistics.mean(t['kam1_error'] for t in peaks) / statistics.mean(t['kam1_plates'] for t in peaks):.0f} %")
     ks = [t["knee_sagittal"] for _, t in xs if t["knee_sagittal"] is not None]
     print(f"| {a} | {len(xs)} | {summary('lateral', '{:.1f}')} | {summary('cop_mm', '{:.0f}')} | {summary('kam', '{:.1f}')} | "
-          f"{peak_text} | {'-' if not ks else f'{statistics.mean(ks):.1f}'} | {summary('frontal', '{:.1f}')} |")
+          f"{peak_text} | {'-' if not ks else f'{statistics.mean(ks):.1f}'} | {summary('hip_frontal', '{:.1f}')} | "
+          f"{summary('frontal', '{:.1f}')} |")
 
 labs = sorted({lab_of[name] for _, name, _ in rows})
 have_grid = all(load_or_none(rows[0][1], c) is not None for c in LATERAL_CUTOFFS.values())

@@ -169,6 +169,7 @@ struct SagittalStage {
   int first_frame_number = 1;
   std::array<Eigen::VectorXd, 2> foot_lateral_m;
   std::array<Eigen::MatrixX4d, 2> foot_line;                    ///< with EstimateOptions::lateral_force()
+  std::optional<double> hip_half_width_m;                       ///< the hip rule's (Landmarks3D)
   std::array<Eigen::MatrixX3d, kLandmarkCount> landmark_lab_m;  ///< with EstimateOptions::mediolateral
   Eigen::MatrixX3d lateral_axis;                                ///< likewise, per frame
   Messages messages;
@@ -217,6 +218,7 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   out.first_frame_number = trial.markers.first_frame + static_cast<int>(win.first);
   out.foot_lateral_m = std::move(win.foot_lateral_m);
   out.foot_line = std::move(win.foot_line);
+  out.hip_half_width_m = win.hip_half_width_m;
   out.landmarks = std::move(win.landmarks);
   const SagittalLandmarks& lm = out.landmarks;
   // The zero-lag filter's single pass runs at cut-off / 0.802 (Winter's correction), which must
@@ -234,9 +236,17 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
 /// The 3D knee and ankle centres' medial offsets (dynamics/joint_moments_3d.hpp) for the set's
 /// lateral markers: half the joint's width (the trial's measured width, else kKneeWidthPerShank
 /// or kAnkleWidthPerShank of the model's shank) plus the marker's radius. A message says, per
-/// side, what was used; a joint marked as its centre moves nothing.
-JointCentreOffsets joint_centre_offsets(const MarkerSet& set, const Trial& trial, const Model& model, Messages& messages) {
+/// side, what was used; a joint marked as its centre moves nothing. The hip centres: half their
+/// distance from the hip rule (`hip_half_width_m`), else kHipHalfWidthPerThigh of the thigh.
+JointCentreOffsets joint_centre_offsets(const MarkerSet& set, const Trial& trial, const Model& model,
+                                        const std::optional<double>& hip_half_width_m, Messages& messages) {
   JointCentreOffsets out;
+  const double thigh = 0.5 * (model.bodies[kThighR].length_m + model.bodies[kThighL].length_m);
+  out.hip_half_width_m = hip_half_width_m.value_or(kHipHalfWidthPerThigh * thigh);
+  char hip[240];
+  std::snprintf(hip, sizeof hip, "hips: the 3D hip centres %.0f mm either side of the hip landmark (%s)", 1000 * out.hip_half_width_m,
+                hip_half_width_m ? "the hip rule's own centres" : "no hip centres of the hip rule's own: from the thigh's length");
+  messages.emplace_back(hip);
   const double diameter = trial.marker_diameter_m.value_or(kDefaultMarkerDiameterM);
   for (int side = 0; side < 2; ++side) {
     const auto k = static_cast<std::size_t>(side);
@@ -955,7 +965,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   std::optional<LegMotion3D> legs;
   if (o.model == ModelKind::ThreeD)
     legs = leg_motion_3d(*mod.model, sag.landmark_lab_m, sag.lateral_axis, sag.frame.up, kin.motion.rate_hz, kin.kinematic_cutoff_hz,
-                         joint_centre_offsets(set, trial, *mod.model, kin.messages));
+                         joint_centre_offsets(set, trial, *mod.model, sag.hip_half_width_m, kin.messages));
   sag.landmark_lab_m = {};
   sag.lateral_axis = Eigen::MatrixX3d();
   TotalsStage totals = totals_stage(o, kin.motion, feet.feet, ground_level_m);

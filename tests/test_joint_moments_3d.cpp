@@ -107,6 +107,7 @@ TEST(JointMoments3D, AFreelyFallingLegNeedsNoMoment) {
   for (int side = 0; side < 2; ++side) {
     EXPECT_LT(m.knee_Nm[static_cast<std::size_t>(side)].cwiseAbs().maxCoeff(), 1e-9);
     EXPECT_LT(m.ankle_Nm[static_cast<std::size_t>(side)].cwiseAbs().maxCoeff(), 1e-9);
+    EXPECT_LT(m.hip_Nm[static_cast<std::size_t>(side)].cwiseAbs().maxCoeff(), 1e-9);
   }
 }
 
@@ -147,6 +148,7 @@ TEST(JointMoments3D, TurningTheLabAboutTheVerticalChangesNoMoment) {
     for (const JointMoments3D* m : {&m30, &m180}) {
       EXPECT_LT((m->knee_Nm[k] - m0.knee_Nm[k]).cwiseAbs().maxCoeff(), 1e-6);
       EXPECT_LT((m->ankle_Nm[k] - m0.ankle_Nm[k]).cwiseAbs().maxCoeff(), 1e-6);
+      EXPECT_LT((m->hip_Nm[k] - m0.hip_Nm[k]).cwiseAbs().maxCoeff(), 1e-6);
     }
   }
 }
@@ -241,4 +243,38 @@ TEST(JointMoments3D, TheSummaryReportsEachStancesKneeAdductionPeaks) {
   EstimateOptions sagittal;
   sagittal.mass_kg = 64.9;
   EXPECT_FALSE(results_summary(estimate(walk, nullptr, *recognise_marker_set(walk.markers), sagittal), {}).contains("knee_adduction_moment"));
+}
+
+// The hip (JointCentreOffsets::hip_half_width_m): the still leg of the first test, each hip centre
+// straight above its knee (0.1 m either side of the hip landmark) and the COP d medial of the
+// leg's line. The segments' weights lie in the leg's plane, so the external hip adduction moment
+// is d F too (internal frontal -d F), and, without the offset, the thigh leans in to the midpoint
+// and the hip's lever changes: the offset is what the hip's frontal moment reads.
+TEST(JointMoments3D, AStillLegsHipAdductionMomentIsTheForceTimesItsMedialLever) {
+  const Eigen::Index n = 20;
+  const auto p = standing(n);
+  const Model model = test_model();
+  const Eigen::MatrixX3d lateral = constant_rows(n, {0, -1, 0});
+  const double F = 700.0, d = 0.03;
+  std::array<FootWrench3D, 2> feet;
+  for (int side = 0; side < 2; ++side) {
+    const double medial = side == kRight ? +1.0 : -1.0;  // right: +y is medial
+    const Eigen::Vector3d cop(0.05, p[landmark(side, kKnee)](0, 1) + medial * d, 0.0);
+    feet[static_cast<std::size_t>(side)] =
+        foot_wrench(constant_rows(n, {0, 0, F}), constant_rows(n, cop), Eigen::VectorXd::Zero(n), Eigen::Vector3d::UnitZ());
+  }
+  JointCentreOffsets offsets;
+  offsets.hip_half_width_m = 0.1;
+  const LegMotion3D legs = leg_motion_3d(model, p, lateral, Eigen::Vector3d::UnitZ(), 100.0, 6.0, offsets);
+  const JointMoments3D m = joint_moments_3d(legs, feet);
+  for (int side = 0; side < 2; ++side) {
+    const auto k = static_cast<std::size_t>(side);
+    EXPECT_NEAR(legs.hip_m[k](0, 1), p[landmark(side, kKnee)](0, 1), 1e-12) << side_name(side);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      EXPECT_NEAR(m.hip_Nm[k](i, 1), -d * F, 1e-9) << side_name(side) << " frame " << i;
+      EXPECT_NEAR(m.hip_Nm[k](i, 2), 0.0, 1e-9);
+    }
+  }
+  const JointMoments3D midpoint = joint_moments_3d(leg_motion_3d(model, p, lateral, Eigen::Vector3d::UnitZ(), 100.0, 6.0), feet);
+  EXPECT_GT(std::abs(midpoint.hip_Nm[0](n / 2, 1) - m.hip_Nm[0](n / 2, 1)), 10.0);
 }

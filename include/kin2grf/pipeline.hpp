@@ -20,7 +20,7 @@
 namespace kin2grf {
 
 /// The estimate's model (issue 28): the paper's sagittal model, or the 3D one, which adds to it
-/// each foot's mediolateral force (dynamics/mediolateral.hpp) and the ankles' and knees' 3D
+/// each foot's mediolateral force (dynamics/mediolateral.hpp) and the ankles', knees' and hips' 3D
 /// moments by bottom-up inverse dynamics (dynamics/joint_moments_3d.hpp). The sagittal results
 /// (forces, COP along progression, GRM, the 2D joint torques) are the same in both.
 enum class ModelKind { Sagittal, ThreeD };
@@ -137,8 +137,8 @@ struct FootResult {
   Eigen::VectorXd cop_lateral_m;
 };
 
-/// The 3D model's legs (ModelKind::ThreeD): their kinematics, made once, and the ankles' and
-/// knees' moments with the estimated ground reactions (validate runs the same kinematics with the
+/// The 3D model's legs (ModelKind::ThreeD): their kinematics, made once, and the ankles', knees'
+/// and hips' moments with the estimated ground reactions (validate runs the same kinematics with the
 /// plates'). The ground reaction: each foot's force (anterior, vertical, mediolateral) at its COP
 /// (lab_foot_frame), no free moment.
 struct Legs3D {

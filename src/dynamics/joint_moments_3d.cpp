@@ -42,22 +42,25 @@ Eigen::Vector3d unit(const Eigen::Vector3d& v, const char* what, Eigen::Index i)
   return v / norm;
 }
 
-SegmentMotion3D shank_motion(const Model& model, int side, const std::array<Eigen::MatrixX3d, kLandmarkCount>& p,
-                             const Eigen::MatrixX3d& lateral_axis, double dt) {
-  const Body& b = model.bodies[static_cast<std::size_t>(segment(side, kShank))];
-  const Eigen::MatrixX3d& knee = p[static_cast<std::size_t>(landmark(side, kKnee))];
-  const Eigen::MatrixX3d& ankle = p[static_cast<std::size_t>(landmark(side, kAnkle))];
+/// A long segment (thigh, shank) from its proximal to its distal joint centre: COM on that line at
+/// the model's fraction, e_y up the segment, e_z the lateral axis made orthogonal to it.
+SegmentMotion3D long_segment_motion(const Body& b, double longitudinal_ratio, const Eigen::MatrixX3d& proximal,
+                                    const Eigen::MatrixX3d& distal, const Eigen::MatrixX3d& lateral_axis, double dt, const char* name,
+                                    const char* joints) {
   SegmentMotion3D s;
   s.mass_kg = b.mass_kg;
-  s.inertia_kgm2 = {b.inertia_kgm2, b.inertia_kgm2 * kShankLongitudinalGyrationRatio * kShankLongitudinalGyrationRatio, b.inertia_kgm2};
-  s.com_m = body_com(b, p);
+  s.inertia_kgm2 = {b.inertia_kgm2, b.inertia_kgm2 * longitudinal_ratio * longitudinal_ratio, b.inertia_kgm2};
+  const double f = b.length_m > 0 ? b.com_local.x() / b.length_m : 0.0;
+  s.com_m = (1 - f) * proximal + f * distal;
   s.com_acc_mps2 = second_difference(s.com_m, dt);
-  const Eigen::Index n = knee.rows();
+  const Eigen::Index n = proximal.rows();
   s.rotation.resize(n, 9);
+  const std::string axis = std::string(name) + "'s long axis (" + joints + " at one place)";
+  const std::string across = std::string(name) + "'s lateral axis (the segment lies along the lateral axis)";
   for (Eigen::Index i = 0; i < n; ++i) {
-    const Eigen::Vector3d ey = unit((knee.row(i) - ankle.row(i)).transpose(), "shank's long axis (knee and ankle at one place)", i);
+    const Eigen::Vector3d ey = unit((proximal.row(i) - distal.row(i)).transpose(), axis.c_str(), i);
     const Eigen::Vector3d lat = lateral_axis.row(i).transpose();
-    const Eigen::Vector3d ez = unit(lat - lat.dot(ey) * ey, "shank's lateral axis (the shank lies along the lateral axis)", i);
+    const Eigen::Vector3d ez = unit(lat - lat.dot(ey) * ey, across.c_str(), i);
     set_axes(s, i, ey.cross(ez), ey, ez);
   }
   angular_motion(s, dt);
@@ -147,10 +150,15 @@ LegMotion3D leg_motion_3d(const Model& model, const std::array<Eigen::MatrixX3d,
   const double dt = 1.0 / rate_hz;
   for (int side = 0; side < 2; ++side) {
     const auto k = static_cast<std::size_t>(side);
-    out.shank[k] = shank_motion(model, side, p, lateral_axis, dt);
-    out.foot[k] = foot_motion(model, side, p, dt);
     out.knee_m[k] = p[static_cast<std::size_t>(landmark(side, kKnee))];
     out.ankle_m[k] = p[static_cast<std::size_t>(landmark(side, kAnkle))];
+    // The hip centre of this side: the lateral axis points to the walker's right.
+    out.hip_m[k] = p[kHip] + (side == kRight ? 1.0 : -1.0) * offsets.hip_half_width_m * lateral_axis;
+    out.thigh[k] = long_segment_motion(model.bodies[static_cast<std::size_t>(segment(side, kThigh))], kThighLongitudinalGyrationRatio,
+                                       out.hip_m[k], out.knee_m[k], lateral_axis, dt, "thigh", "hip and knee");
+    out.shank[k] = long_segment_motion(model.bodies[static_cast<std::size_t>(segment(side, kShank))], kShankLongitudinalGyrationRatio,
+                                       out.knee_m[k], out.ankle_m[k], lateral_axis, dt, "shank", "knee and ankle");
+    out.foot[k] = foot_motion(model, side, p, dt);
   }
   return out;
 }
@@ -181,8 +189,9 @@ JointMoments3D joint_moments_3d(const LegMotion3D& legs, const std::array<FootWr
     const FootWrench3D& w = feet[k];
     if (w.force_N.rows() != n || w.moment_origin_Nm.rows() != n)
       throw InputError(std::string("3D joint moments: the ") + side_name(side) + " foot's ground reaction does not match the frames");
-    const SegmentMotion3D &foot = legs.foot[k], &shank = legs.shank[k];
-    for (auto* m : {&out.ankle_Nm[k], &out.knee_Nm[k], &out.ankle_lab_Nm[k], &out.knee_lab_Nm[k]}) m->resize(n, 3);
+    const SegmentMotion3D &foot = legs.foot[k], &shank = legs.shank[k], &thigh = legs.thigh[k];
+    for (auto* m : {&out.ankle_Nm[k], &out.knee_Nm[k], &out.hip_Nm[k], &out.ankle_lab_Nm[k], &out.knee_lab_Nm[k], &out.hip_lab_Nm[k]})
+      m->resize(n, 3);
     for (Eigen::Index i = 0; i < n; ++i) {
       const Eigen::Vector3d A = legs.ankle_m[k].row(i).transpose(), K = legs.knee_m[k].row(i).transpose();
       const Eigen::Vector3d Gf = foot.com_m.row(i).transpose(), Gs = shank.com_m.row(i).transpose();
@@ -193,10 +202,15 @@ JointMoments3D joint_moments_3d(const LegMotion3D& legs, const std::array<FootWr
       const Eigen::Vector3d Ma = angular_momentum_rate(foot, i) - (MO - Gf.cross(F)) - (A - Gf).cross(Fa);
       const Eigen::Vector3d Fk = shank.mass_kg * (shank.com_acc_mps2.row(i).transpose() - g) + Fa;
       const Eigen::Vector3d Mk = angular_momentum_rate(shank, i) + (A - Gs).cross(Fa) + Ma - (K - Gs).cross(Fk);
+      const Eigen::Vector3d P = legs.hip_m[k].row(i).transpose(), Gt = thigh.com_m.row(i).transpose();
+      const Eigen::Vector3d Fh = thigh.mass_kg * (thigh.com_acc_mps2.row(i).transpose() - g) + Fk;
+      const Eigen::Vector3d Mh = angular_momentum_rate(thigh, i) + (K - Gt).cross(Fk) + Mk - (P - Gt).cross(Fh);
       out.ankle_lab_Nm[k].row(i) = Ma.transpose();
       out.knee_lab_Nm[k].row(i) = Mk.transpose();
+      out.hip_lab_Nm[k].row(i) = Mh.transpose();
       out.ankle_Nm[k].row(i) = anatomical(Ma, foot.R(i), side);
       out.knee_Nm[k].row(i) = anatomical(Mk, shank.R(i), side);
+      out.hip_Nm[k].row(i) = anatomical(Mh, thigh.R(i), side);
     }
   }
   return out;

@@ -476,12 +476,22 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
     Eigen::MatrixX3d P = Eigen::MatrixX3d::Constant(n, 3, kNaN);
     if (r.kind == RuleKind::Marker || r.kind == RuleKind::Mean) {
       P = mean_of(m, r.markers, path, what);
+      if (id == kHip && r.kind == RuleKind::Mean && r.markers.size() == 2) {  // the two hip centres
+        const Eigen::MatrixX3d a = marker(m, r.markers[0], path, what), b = marker(m, r.markers[1], path, what);
+        std::vector<double> half;
+        for (Eigen::Index i = 0; i < n; ++i)
+          if (a.row(i).allFinite() && b.row(i).allFinite()) half.push_back(0.5 * (a.row(i) - b.row(i)).norm());
+        if (!half.empty()) out.hip_half_width_m = median(half);
+      }
     } else if (r.kind == RuleKind::Harrington) {
       const Pelvis pv = pelvis(m, r.pelvis, path);
+      std::vector<double> half;
       for (Eigen::Index i = 0; i < n; ++i) {
         const double ax = -0.24 * pv.depth[i] - 0.0099, ay = -0.30 * pv.width[i] - 0.0109;
         P.row(i) = pv.origin.row(i) + ax * pv.x.row(i) + ay * pv.y.row(i);
+        if (std::isfinite(pv.width[i])) half.push_back(0.33 * pv.width[i] + 0.0073);  // Harrington's lateral term
       }
+      if (id == kHip && !half.empty()) out.hip_half_width_m = median(half);
     } else if (r.kind == RuleKind::PelvisUp && r.pelvis.empty()) {
       // The model torso above a hip centre made of markers (without_trunk_markers on a set whose
       // hip rule is a mean): upright above their mean.
@@ -781,6 +791,7 @@ void check_toes(SagittalLandmarks& s, const MarkerSet& set, int side, std::vecto
 SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const SagittalFrame& fr,
                                   const MarkerTrajectories& m, const LandmarkOptions& o, const std::string& path, bool keep_lateral) {
   SagittalWindow w;
+  w.hip_half_width_m = lm3.hip_half_width_m;
   const Eigen::Index n = m.frames();
   std::array<Eigen::MatrixX3d, kLandmarkCount>& p = lm3.p;
   std::vector<bool> ok(static_cast<std::size_t>(n), true);

@@ -76,7 +76,7 @@ std::vector<std::string> results_columns(bool mediolateral, bool moments_3d) {
     for (const char* name : {"grf_lateral_r_N", "grf_lateral_l_N"}) c.emplace_back(name);
   if (moments_3d)
     for (const char* s : {"r", "l"}) {
-      for (const char* joint : {"ankle", "knee"})
+      for (const char* joint : {"ankle", "knee", "hip"})
         for (const char* plane : {"sagittal", "frontal", "transverse"}) c.push_back(std::string(joint) + "_" + plane + "_" + s + "_Nm");
       c.push_back(std::string("knee_adduction_moment_") + s + "_Nm");
     }
@@ -106,7 +106,7 @@ void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> v) {
   if (r.legs_3d)
     for (std::size_t s = 0; s < 2; ++s) {
       const JointMoments3D& m = r.legs_3d->moments;
-      for (const Eigen::MatrixX3d* joint : {&m.ankle_Nm[s], &m.knee_Nm[s]})
+      for (const Eigen::MatrixX3d* joint : {&m.ankle_Nm[s], &m.knee_Nm[s], &m.hip_Nm[s]})
         for (int a = 0; a < 3; ++a) v[k++] = (*joint)(i, a);
       v[k++] = -m.knee_Nm[s](i, 1);  // the external knee adduction moment (knee_adduction_moment)
     }

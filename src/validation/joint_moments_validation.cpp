@@ -51,6 +51,7 @@ void validate_joint_moments_3d(const EstimateResult& e, ValidationResult& v) {
     for (int c = 0; c < 3; ++c) {
       j.ankle[static_cast<std::size_t>(c)] = compare_series(estimated.ankle_Nm[k].col(c).segment(a, len), measured.ankle_Nm[k].col(c).segment(a, len));
       j.knee[static_cast<std::size_t>(c)] = compare_series(estimated.knee_Nm[k].col(c).segment(a, len), measured.knee_Nm[k].col(c).segment(a, len));
+      j.hip[static_cast<std::size_t>(c)] = compare_series(estimated.hip_Nm[k].col(c).segment(a, len), measured.hip_Nm[k].col(c).segment(a, len));
     }
     const Eigen::VectorXd kam_e = knee_adduction_moment(estimated, s.foot), kam_m = knee_adduction_moment(measured, s.foot);
     j.knee_adduction = compare_series(kam_e.segment(a, len), kam_m.segment(a, len));

@@ -817,6 +817,7 @@ nlohmann::json joint_moments_json(const JointMomentValidation& jm) {
   for (std::size_t c = 0; c < 3; ++c) {
     j["ankle"][planes[c]] = metrics(jm.ankle[c]);
     j["knee"][planes[c]] = metrics(jm.knee[c]);
+    j["hip"][planes[c]] = metrics(jm.hip[c]);
   }
   j["knee_adduction_moment"] = metrics(jm.knee_adduction);
   j["knee_adduction_moment"]["peaks_estimated_Nm"] = {num(jm.kam_peak_estimated_Nm[0]), num(jm.kam_peak_estimated_Nm[1])};

@@ -31,7 +31,7 @@ void add_settings_options(CLI::App* c, Settings& a) {
               "vertical load; docs/METHOD-NOTES.md); off: the sagittal model's zero lateral force");
   c->add_option("--model", a.model,
                 "sagittal (the paper's model) or 3d: the sagittal results plus each foot's mediolateral force (as "
-                "--mediolateral) and the ankles' and knees' 3D moments, the knee adduction moment among them")
+                "--mediolateral) and the ankles', knees' and hips' 3D moments, the knee adduction moment among them")
       ->check(CLI::IsMember({"sagittal", "3d"}))->capture_default_str();
   c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
       ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();

@@ -1,4 +1,4 @@
-// kin2grf dynamics: 3D ankle and knee moments by bottom-up Newton-Euler inverse dynamics
+// kin2grf dynamics: 3D ankle, knee and hip moments by bottom-up Newton-Euler inverse dynamics
 // (kin2grf, not the paper: issue 28's third step, the knee adduction moment clinicians read).
 //
 // Run on the same leg kinematics (LegMotion3D, made once) with any ground reaction: the estimate's
@@ -9,6 +9,10 @@
 // (JointCentreOffsets: medially along the lateral axis made orthogonal to the shank; the sagittal
 // model needs no such move, the 3D frontal moments do: 5 cm of knee lever at 700 N is 35 N m of
 // knee adduction moment):
+//   thigh: hip centre -> knee. The hip centre of each side: the model's hip landmark (the two
+//     centres' midpoint) moved along the lateral axis by half their distance (JointCentreOffsets::
+//     hip_half_width_m: the hip rule's own, else kHipHalfWidthPerThigh of the thigh): the pelvis's
+//     obliquity and rotation (a few degrees) are left out. Frame as the shank's, thigh axis up.
 //   shank: knee -> ankle. Frame: e_y = (knee - ankle) / |.| (up the segment), e_z = the sagittal
 //     frame's lateral axis (to the walker's right) made orthogonal to e_y, e_x = e_y x e_z
 //     (anterior). The landmarks give no axial rotation of the shank, so its frame takes the
@@ -30,11 +34,15 @@
 //          M_a = H_f - (M_O - G_f x F) - (A - G_f) x F_a
 //   shank: F_k = m_s (a_s - g) + F_a
 //          M_k = H_s + (A - G_s) x F_a + M_a - (K - G_s) x F_k
+//   thigh: F_h = m_t (a_t - g) + F_k
+//          M_h = H_t + (K - G_t) x F_k + M_k - (P - G_t) x F_h
 // F_a, M_a: the force and moment the shank exerts on the foot at the ankle A (internal, on the
-// distal segment); F_k, M_k the thigh's on the shank at the knee K.
+// distal segment); F_k, M_k the thigh's on the shank at the knee K; F_h, M_h the pelvis's on the
+// thigh at the hip centre P.
 //
 // Components, in the distal segment's frame (the ankle's in the foot's, the knee's in the shank's),
 // anatomical so that both sides read alike:
+//   (the hip's in the thigh's)
 //   sagittal   M . e_z, counter-clockwise + in the sagittal frame (the 2D joint torques' sign);
 //   frontal    + adducts the distal segment (right M . e_x, left -M . e_x): at the knee, an
 //              internal adductor moment; the external knee adduction moment (KAM) is its negative;
@@ -49,7 +57,12 @@
 namespace kin2grf {
 
 /// De Leva's (1996) longitudinal over sagittal radius of gyration (see above).
-inline constexpr double kShankLongitudinalGyrationRatio = 0.103 / 0.255, kFootLongitudinalGyrationRatio = 0.124 / 0.257;
+inline constexpr double kShankLongitudinalGyrationRatio = 0.103 / 0.255, kFootLongitudinalGyrationRatio = 0.124 / 0.257,
+                        kThighLongitudinalGyrationRatio = 0.149 / 0.329;
+/// Without hip centres of the hip rule's own: half the distance between the hip joint centres as
+/// a fraction of the thigh's length (adults: about 0.085 m for a 0.42 m thigh; the inter-HJC
+/// distance is about 0.17-0.18 m).
+inline constexpr double kHipHalfWidthPerThigh = 0.2;
 
 /// One segment's motion in the lab, per frame.
 struct SegmentMotion3D {
@@ -70,6 +83,9 @@ struct SegmentMotion3D {
 /// joint's lateral skin (markers/landmarks.hpp, "surface": "lateral").
 struct JointCentreOffsets {
   std::array<double, 2> knee_m{0.0, 0.0}, ankle_m{0.0, 0.0};
+  /// Half the distance between the two hip centres, m: each lies this far to its side of the hip
+  /// landmark (their midpoint). 0: the thigh starts at the midpoint (the sagittal model's).
+  double hip_half_width_m = 0.0;
 };
 
 /// Without the subject's measured widths: the knee's (femoral bicondylar) and the ankle's
@@ -85,8 +101,8 @@ inline constexpr double kDefaultMarkerDiameterM = 0.014;
 struct LegMotion3D {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   double gravity_mps2 = 9.81;
-  std::array<SegmentMotion3D, 2> shank, foot;  ///< per side (right, left)
-  std::array<Eigen::MatrixX3d, 2> knee_m, ankle_m;  ///< the joint centres, filtered
+  std::array<SegmentMotion3D, 2> thigh, shank, foot;  ///< per side (right, left)
+  std::array<Eigen::MatrixX3d, 2> hip_m, knee_m, ankle_m;  ///< the joint centres, filtered
   [[nodiscard]] Eigen::Index frames() const { return knee_m[0].rows(); }
 };
 
@@ -107,11 +123,11 @@ struct FootWrench3D {
 FootWrench3D foot_wrench(const Eigen::MatrixX3d& force_N, const Eigen::MatrixX3d& cop_m, const Eigen::VectorXd& free_moment_Nm,
                          const Eigen::Vector3d& up);
 
-/// Per side: the ankle's and the knee's internal moment on the distal segment, N x 3 (sagittal,
-/// frontal, transverse; the header's signs), and the lab-frame vectors they come from.
+/// Per side: the ankle's, the knee's and the hip's internal moment on the distal segment, N x 3
+/// (sagittal, frontal, transverse; the header's signs), and the lab-frame vectors they come from.
 struct JointMoments3D {
-  std::array<Eigen::MatrixX3d, 2> ankle_Nm, knee_Nm;
-  std::array<Eigen::MatrixX3d, 2> ankle_lab_Nm, knee_lab_Nm;
+  std::array<Eigen::MatrixX3d, 2> ankle_Nm, knee_Nm, hip_Nm;
+  std::array<Eigen::MatrixX3d, 2> ankle_lab_Nm, knee_lab_Nm, hip_lab_Nm;
 };
 
 JointMoments3D joint_moments_3d(const LegMotion3D& legs, const std::array<FootWrench3D, 2>& feet);

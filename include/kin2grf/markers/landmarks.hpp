@@ -121,6 +121,10 @@ struct LandmarkOptions {
 struct Landmarks3D {
   std::array<Eigen::MatrixX3d, kLandmarkCount> p;
   std::vector<std::string> messages;
+  /// Half the distance between the two hip joint centres (m), where the hip rule makes them (the
+  /// mean of two hip-centre markers, or Harrington's, whose lateral term is 0.33 PW + 7.3 mm); the
+  /// median over the frames. The 3D model's hips (dynamics/joint_moments_3d.hpp).
+  std::optional<double> hip_half_width_m;
 };
 
 /// The sagittal frame: x along progression, y up, origin the lab origin.
@@ -194,6 +198,7 @@ struct SagittalWindow {
   SagittalLandmarks landmarks;  ///< only the processed window
   Eigen::Index first = 0;       ///< index of its first frame in the trial
   std::array<Eigen::VectorXd, 2> foot_lateral_m;  ///< per side: lateral coordinate of the foot (heel-MT midpoint)
+  std::optional<double> hip_half_width_m;          ///< Landmarks3D's
   /// When asked (keep_lateral), per side, N x 4: the line the COP's lateral place follows along
   /// the foot, (heel x, heel lateral, forefoot x, forefoot lateral) in the sagittal frame, m; the
   /// forefoot end on the foot's midline (a 5th-metatarsal marker moved by kLateralMtToMidline).

@@ -30,8 +30,8 @@ ResultsTable results_table(const EstimateResult& r);
 /// results_table's columns, and its row `i` into `out` (out.size() == the columns' count).
 /// The per-frame table's columns; `mediolateral` (EstimateOptions::lateral_force): and each
 /// foot's lateral force, grf_lateral_r_N and grf_lateral_l_N; `moments_3d` (ModelKind::ThreeD):
-/// and per side (r, l) the ankle's and the knee's internal 3D moments, ankle_sagittal_r_Nm,
-/// ankle_frontal_r_Nm, ankle_transverse_r_Nm, knee_..., then knee_adduction_moment_r_Nm, the
+/// and per side (r, l) the ankle's, the knee's and the hip's internal 3D moments, ankle_sagittal_r_Nm,
+/// ankle_frontal_r_Nm, ankle_transverse_r_Nm, knee_..., hip_..., then knee_adduction_moment_r_Nm, the
 /// external knee adduction moment (dynamics/joint_moments_3d.hpp's signs), last.
 std::vector<std::string> results_columns(bool mediolateral = false, bool moments_3d = false);
 void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> out);

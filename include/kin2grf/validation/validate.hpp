@@ -129,7 +129,7 @@ struct ComponentMetrics {
 /// the difference is the estimate's alone. Components as JointMoments3D's (sagittal, frontal,
 /// transverse, internal moments on the distal segment).
 struct JointMomentValidation {
-  std::array<std::optional<SeriesMetrics>, 3> ankle, knee;
+  std::array<std::optional<SeriesMetrics>, 3> ankle, knee, hip;
   std::optional<SeriesMetrics> knee_adduction;  ///< the external knee adduction moment (KAM)
   /// The KAM's first and second peaks (N m): its largest value in the first and in the second
   /// half of the stance, estimate-driven and plate-driven.
