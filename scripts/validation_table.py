@@ -199,6 +199,7 @@ def trial_3d(j, mass):
         "kam1_plates": m([p / mass for _, p in first]),
         "kam1_error": m([abs(e - p) / mass for e, p in first]),
         "frontal": total_moment(j, "frontal_moment"),
+        "free": m([s["rmse"]["free_moment_Nm"] for s in st if s["rmse"].get("free_moment_Nm") is not None]),
         "transverse": total_moment(j, "transverse_moment"),
     }
 
@@ -234,11 +235,12 @@ print("The sagittal figures above are the 3D model's too: it adds to them, per f
       "knee adduction moment (KAM), estimate-driven against plate-driven: rRMSE %, and its first peak (the largest "
       "value in the stance's first half) in N m/kg; the knee's sagittal moment's and the hip's frontal moment's rRMSE %; per trial, the total ground "
       "reaction's frontal and transverse moments about the GRM reference on the walker's midline, where every loaded "
-      "foot is on a plate (the estimate's free moment is zero, the plates' is in theirs). No value of the 3D model "
+      "foot is on a plate (the estimate's free moment is zero, the plates' is in theirs); per stance, the free moment's RMSE, which with the estimate's zero is the plate's own RMS "
+      "(a .mot without torque columns reads 0). No value of the 3D model "
       "was fitted except the lateral cut-off (below); the joint and foot geometry are anatomical ratios.\n")
 print("| activity | trial | lab | stances | lateral force rRMSE % | RMSE %BW | r | lateral COP RMSE mm | "
-      "KAM rRMSE % | KAM 1st peak est / plates N m/kg | knee sagittal rRMSE % | hip frontal rRMSE % | total frontal / transverse moment rRMSE % |")
-print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+      "KAM rRMSE % | KAM 1st peak est / plates N m/kg | knee sagittal rRMSE % | hip frontal rRMSE % | total frontal / transverse moment rRMSE % | free moment RMSE N m |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 by_activity = {}
 for a, name, args in rows:
     j = load_or_none(name, "3d")
@@ -246,12 +248,12 @@ for a, name, args in rows:
         continue
     t = trial_3d(j, j["mass_kg"])
     if t is None:
-        print(f"| {a} | {name} | {lab_of[name]} | 0 | - | - | - | - | - | - | - | - | - |")
+        print(f"| {a} | {name} | {lab_of[name]} | 0 | - | - | - | - | - | - | - | - | - | - |")
         continue
     g = lambda k, fmt="{:.1f}": "-" if t[k] is None else fmt.format(t[k])
     print(f"| {a} | {name} | {lab_of[name]} | {t['stances']} | {g('lateral')} | {g('lateral_bw')} | {g('r', '{:.2f}')} | "
           f"{g('cop_mm', '{:.0f}')} | {g('kam')} | {g('kam1_est', '{:.2f}')} / {g('kam1_plates', '{:.2f}')} | {g('knee_sagittal')} | "
-          f"{g('hip_frontal')} | {g('frontal')} / {g('transverse')} |")
+          f"{g('hip_frontal')} | {g('frontal')} / {g('transverse')} | {g('free')} |")
     by_activity.setdefault(a, []).append((name, t))
 print("\n| activity | trials | lateral force rRMSE % (worst trial) | lateral COP RMSE mm (worst) | KAM rRMSE % (worst) | "
       "KAM 1st peak mean abs error N m/kg, % of the plates' mean | knee sagittal rRMSE % | hip frontal rRMSE % (worst) | "

@@ -128,4 +128,9 @@ TEST(Report, TheThreeDReportPlotsTheLateralForceAndTheKneeAdductionMoment) {
   EXPECT_GT(v.total->frontal_moment->pearson_r, 0.9);
   EXPECT_GT(v.total->transverse_moment->pearson_r, 0.5);
   EXPECT_FALSE(v2.total->frontal_moment.has_value());
+  // The plate's free moment (the estimate's is zero): a few N m in walking. Leaving out the COP's
+  // c x F would read the plate's whole moment about the origin, hundreds of N m.
+  ASSERT_TRUE(v.stances[0].metrics.free_moment.has_value());
+  EXPECT_GT(v.stances[0].metrics.free_moment->rmse, 0.5);
+  EXPECT_LT(v.stances[0].metrics.free_moment->rmse, 15.0);
 }

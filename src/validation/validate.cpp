@@ -387,6 +387,15 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
       if (!(mv[i] > o.cop_min_force_fraction * bw)) ml[i] = kNaN;
     const Eigen::VectorXd& el = fe.cop_lateral_m.size() == n ? fe.cop_lateral_m : e.foot_lateral_m[static_cast<std::size_t>(c.foot)];
     s.metrics.cop_lateral = compare_series(el.segment(a, len), ml);
+    // The plate's free moment about the vertical at its COP: (M_O - c x F) . up.
+    Eigen::VectorXd tz = Eigen::VectorXd::Constant(len, kNaN);
+    for (Eigen::Index i = 0; i < len; ++i) {
+      const Eigen::Index k = a + i;
+      if (!std::isfinite(ml[i]) || !std::isfinite(mc[i]) || !mp.force_lab_N.row(k).allFinite()) continue;
+      const Eigen::Vector3d c3 = e.frame.to_lab(mc[i], mp.surface_y_m, ml[i], e.first_index + k);
+      tz[i] = (mp.moment_origin_lab_Nm.row(k).transpose() - c3.cross(mp.force_lab_N.row(k).transpose())).dot(e.frame.up);
+    }
+    s.metrics.free_moment = compare_series(Eigen::VectorXd::Zero(len), tz);
   }
   s.foot_length_m = stance_foot_length_m(e, c);
   if (s.cop_beyond_foot_m > o.max_cop_beyond_foot_m) {
@@ -795,6 +804,7 @@ nlohmann::json component_json(const ComponentMetrics& c, double bw) {
     j["r"]["lateral"] = num(c.lateral->pearson_r);
     j["peak_difference"]["lateral_N"] = num(c.lateral->peak_difference);
   }
+  if (c.free_moment) j["rmse"]["free_moment_Nm"] = num(c.free_moment->rmse);  // the plate's RMS: the estimate's is 0
   if (c.cop_lateral) {
     j["rmse"]["cop_lateral_mm"] = num(1000 * c.cop_lateral->rmse);
     j["mean_error"] = {{"cop_lateral_mm", num(1000 * c.cop_lateral->mean_error)}};  // + = lateral of the plate's (right foot)

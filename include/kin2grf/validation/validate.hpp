@@ -122,6 +122,9 @@ struct ComponentMetrics {
   /// The mediolateral force and the COP's lateral place (m), when the estimate has them
   /// (EstimateOptions::mediolateral).
   std::optional<SeriesMetrics> lateral, cop_lateral;
+  /// The free moment about the vertical (N m) where the COP is compared: the estimate's is zero
+  /// (not estimated), so this reports the plate's own, as the error of that zero.
+  std::optional<SeriesMetrics> free_moment;
 };
 
 /// One stance's 3D joint moments (ModelKind::ThreeD): driven by the estimate's ground reaction
