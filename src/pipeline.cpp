@@ -973,6 +973,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   EstimateResult r = assemble_result(set.name, mass_kg, sag, mod, kin, dyn, feet, totals, iterations, o);
   if (legs) {
     JointMoments3D moments = joint_moments_3d(*legs, estimated_wrenches(r));
+    if (!o.keep_all_series) *legs = LegMotion3D();  // only validate drives them again: about 1.2 kB a frame
     r.legs_3d = Legs3D{std::move(*legs), std::move(moments)};
   }
   r.cycled_frames = cycled_frames;

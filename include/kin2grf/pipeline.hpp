@@ -142,7 +142,7 @@ struct FootResult {
 /// plates'). The ground reaction: each foot's force (anterior, vertical, mediolateral) at its COP
 /// (lab_foot_frame), no free moment.
 struct Legs3D {
-  LegMotion3D motion;
+  LegMotion3D motion;  ///< empty unless EstimateOptions::keep_all_series (validate needs it)
   JointMoments3D moments;
 };
 

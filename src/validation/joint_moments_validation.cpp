@@ -2,6 +2,7 @@
 // on the same leg kinematics (validate.hpp, validate_joint_moments_3d).
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/validation/validate.hpp"
@@ -42,6 +43,11 @@ std::array<FootWrench3D, 2> plate_wrenches(const ValidationResult& v, Eigen::Ind
 void validate_joint_moments_3d(const EstimateResult& e, ValidationResult& v) {
   if (!e.legs_3d) return;
   const Eigen::Index n = e.time_s.size();
+  if (e.legs_3d->motion.frames() != n) {
+    static const std::string why = "3D joint moments not compared: the estimate was made without its per-frame series (keep_all_series)";
+    v.notes.push_back(why);
+    return;
+  }
   const JointMoments3D measured = joint_moments_3d(e.legs_3d->motion, plate_wrenches(v, n));
   const JointMoments3D& estimated = e.legs_3d->moments;
   for (StanceValidation& s : v.stances) {
