@@ -46,6 +46,19 @@ std::array<Eigen::MatrixX3d, kLandmarkCount> standing(Eigen::Index n) {
 
 Eigen::MatrixX3d constant_rows(Eigen::Index n, const Eigen::Vector3d& v) { return v.transpose().replicate(n, 1); }
 
+/// Each foot under a vertical force F (N) whose COP lies d (m) medial of its knee, 5 cm ahead.
+std::array<FootWrench3D, 2> vertical_force_medial_of_the_knees(const std::array<Eigen::MatrixX3d, kLandmarkCount>& p, double F, double d) {
+  const Eigen::Index n = p[kKneeR].rows();
+  std::array<FootWrench3D, 2> feet;
+  for (int side = 0; side < 2; ++side) {
+    const double medial = side == kRight ? +1.0 : -1.0;  // right: +y is medial
+    const Eigen::Vector3d cop(0.05, p[static_cast<std::size_t>(landmark(side, kKnee))](0, 1) + medial * d, 0.0);
+    feet[static_cast<std::size_t>(side)] =
+        foot_wrench(constant_rows(n, {0, 0, F}), constant_rows(n, cop), Eigen::VectorXd::Zero(n), Eigen::Vector3d::UnitZ());
+  }
+  return feet;
+}
+
 }  // namespace
 
 // A still leg standing on a vertical force whose COP lies d medial of the knee: the external
@@ -57,13 +70,7 @@ TEST(JointMoments3D, AStillLegsKneeAdductionMomentIsTheForceTimesItsMedialLever)
   const Model model = test_model();
   const LegMotion3D legs = leg_motion_3d(model, p, constant_rows(n, {0, -1, 0}), Eigen::Vector3d::UnitZ(), 100.0, 6.0);
   const double F = 700.0, d = 0.03;
-  std::array<FootWrench3D, 2> feet;
-  for (int side = 0; side < 2; ++side) {
-    const double medial = side == kRight ? +1.0 : -1.0;  // right: +y is medial
-    const Eigen::Vector3d cop(0.05, p[landmark(side, kKnee)](0, 1) + medial * d, 0.0);
-    feet[static_cast<std::size_t>(side)] =
-        foot_wrench(constant_rows(n, {0, 0, F}), constant_rows(n, cop), Eigen::VectorXd::Zero(n), Eigen::Vector3d::UnitZ());
-  }
+  const std::array<FootWrench3D, 2> feet = vertical_force_medial_of_the_knees(p, F, d);
   const JointMoments3D m = joint_moments_3d(legs, feet);
   for (int side = 0; side < 2; ++side) {
     for (Eigen::Index i = 0; i < n; ++i) {
@@ -256,13 +263,7 @@ TEST(JointMoments3D, AStillLegsHipAdductionMomentIsTheForceTimesItsMedialLever) 
   const Model model = test_model();
   const Eigen::MatrixX3d lateral = constant_rows(n, {0, -1, 0});
   const double F = 700.0, d = 0.03;
-  std::array<FootWrench3D, 2> feet;
-  for (int side = 0; side < 2; ++side) {
-    const double medial = side == kRight ? +1.0 : -1.0;  // right: +y is medial
-    const Eigen::Vector3d cop(0.05, p[landmark(side, kKnee)](0, 1) + medial * d, 0.0);
-    feet[static_cast<std::size_t>(side)] =
-        foot_wrench(constant_rows(n, {0, 0, F}), constant_rows(n, cop), Eigen::VectorXd::Zero(n), Eigen::Vector3d::UnitZ());
-  }
+  const std::array<FootWrench3D, 2> feet = vertical_force_medial_of_the_knees(p, F, d);
   JointCentreOffsets offsets;
   offsets.hip_half_width_m = 0.1;
   const LegMotion3D legs = leg_motion_3d(model, p, lateral, Eigen::Vector3d::UnitZ(), 100.0, 6.0, offsets);
