@@ -43,8 +43,8 @@ const std::vector<NumericOption>& numeric_options() {
        "Weight (0-1) of the smooth transition towards which each walking double support's split between the feet is blended "
        "(0 = none, the paper)",
        {0.0, 0.1, 0.2}, "%.1f", 1.0, "off"},
-      // Chosen leave-one-lab-out on the mediolateral force (scripts/study-3d.sh), not by `kin2grf
-      // study`, whose criterion is the sagittal one: no grid here.
+      // Chosen leave-one-lab-out on the mediolateral force (scripts/validate-all.sh's 3d-lc runs,
+      // VALIDATION.md's table), not by `kin2grf study`, whose criterion is the sagittal one: no grid here.
       {"lateral-cutoff", "lateral_cutoff_hz", [](O& o) -> double& { return o.lateral_cutoff_hz; }, 0.0, 100.0, std::nullopt,
        "Low-pass cut-off of the whole body's lateral acceleration (the mediolateral force, --model 3d), Hz; never above the "
        "kinematic cut-off; 0 = the kinematic cut-off"},

@@ -1,6 +1,7 @@
 #include "kin2grf/dynamics/joint_moments_3d.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/kinematics/filter.hpp"
@@ -11,7 +12,7 @@ namespace {
 
 /// The COM on a body's proximal-distal line at the model's fraction, N x 3.
 Eigen::MatrixX3d body_com(const Body& b, const std::array<Eigen::MatrixX3d, kLandmarkCount>& p) {
-  const double f = b.length_m > 0 ? b.com_local.x() / b.length_m : 0.0;
+  const double f = b.com_fraction();
   return (1 - f) * p[static_cast<std::size_t>(b.proximal)] + f * p[static_cast<std::size_t>(b.points[0])];
 }
 
@@ -50,7 +51,7 @@ SegmentMotion3D long_segment_motion(const Body& b, double longitudinal_ratio, co
   SegmentMotion3D s;
   s.mass_kg = b.mass_kg;
   s.inertia_kgm2 = {b.inertia_kgm2, b.inertia_kgm2 * longitudinal_ratio * longitudinal_ratio, b.inertia_kgm2};
-  const double f = b.length_m > 0 ? b.com_local.x() / b.length_m : 0.0;
+  const double f = b.com_fraction();
   s.com_m = (1 - f) * proximal + f * distal;
   s.com_acc_mps2 = second_difference(s.com_m, dt);
   const Eigen::Index n = proximal.rows();
@@ -161,6 +162,17 @@ LegMotion3D leg_motion_3d(const Model& model, const std::array<Eigen::MatrixX3d,
     out.foot[k] = foot_motion(model, side, p, dt);
   }
   return out;
+}
+
+std::array<double, 2> stance_peaks(const Eigen::VectorXd& kam, Eigen::Index first, Eigen::Index last) {
+  const Eigen::Index mid = first + (last - first + 1) / 2;
+  const auto peak = [&](Eigen::Index from, Eigen::Index to) {
+    double best = std::numeric_limits<double>::quiet_NaN();
+    for (Eigen::Index i = from; i <= to; ++i)
+      if (std::isfinite(kam[i]) && !(kam[i] <= best)) best = kam[i];
+    return best;
+  };
+  return {peak(first, mid - 1), peak(mid, last)};
 }
 
 FootWrench3D foot_wrench(const Eigen::MatrixX3d& force_N, const Eigen::MatrixX3d& cop_m, const Eigen::VectorXd& free_moment_Nm,

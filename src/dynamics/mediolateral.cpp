@@ -18,8 +18,7 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
   Eigen::MatrixXd com = Eigen::MatrixXd::Zero(n, 3);
   for (int s = 0; s < kSegmentCount; ++s) {
     const Body& b = model.bodies[s];
-    // The COM's share of the way from the proximal to the distal landmark (body frame x).
-    const double f = b.length_m > 0 ? b.com_local.x() / b.length_m : 0.0;
+    const double f = b.com_fraction();
     com += (b.mass_kg / mass) * ((1 - f) * landmark_lab_m[static_cast<std::size_t>(b.proximal)] +
                                  f * landmark_lab_m[static_cast<std::size_t>(b.points[0])]);
   }

@@ -108,7 +108,7 @@ void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> v) {
       const JointMoments3D& m = r.legs_3d->moments;
       for (const Eigen::MatrixX3d* joint : {&m.ankle_Nm[s], &m.knee_Nm[s], &m.hip_Nm[s]})
         for (int a = 0; a < 3; ++a) v[k++] = (*joint)(i, a);
-      v[k++] = -m.knee_Nm[s](i, 1);  // the external knee adduction moment (knee_adduction_moment)
+      v[k++] = knee_adduction_moment(m, static_cast<int>(s), i);
     }
 }
 
@@ -181,9 +181,8 @@ nlohmann::json knee_adduction_peaks_json(const EstimateResult& r) {
     const Eigen::VectorXd kam = knee_adduction_moment(r.legs_3d->moments, s);
     nlohmann::json stances = nlohmann::json::array();
     for (const auto& run : contact_runs(r.feet[static_cast<std::size_t>(s)].contact)) {
-      const Eigen::Index mid = run.first + (run.last - run.first + 1) / 2;
-      if (mid <= run.first) continue;  // a stance of one frame has no halves
-      const double first = kam.segment(run.first, mid - run.first).maxCoeff(), second = kam.segment(mid, run.last - mid + 1).maxCoeff();
+      if (run.last <= run.first) continue;  // a stance of one frame has no halves
+      const auto [first, second] = stance_peaks(kam, run.first, run.last);
       stances.push_back({{"start_s", r.time_s[run.first]}, {"end_s", r.time_s[run.last]},
                          {"complete", run.first > 0 && run.last < n - 1},
                          {"first_peak_Nm", first}, {"second_peak_Nm", second},

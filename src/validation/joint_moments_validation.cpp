@@ -1,7 +1,6 @@
 // kin2grf validation: the 3D joint moments driven by the estimate against driven by the plates,
 // on the same leg kinematics (validate.hpp, validate_joint_moments_3d).
 #include <cmath>
-#include <limits>
 #include <string>
 
 #include "kin2grf/pipeline.hpp"
@@ -10,16 +9,6 @@
 namespace kin2grf {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-/// The largest value of v over [from, to] (NaN when none is finite).
-double peak(const Eigen::VectorXd& v, Eigen::Index from, Eigen::Index to) {
-  double best = kNaN;
-  for (Eigen::Index i = from; i <= to; ++i)
-    if (std::isfinite(v[i]) && !(v[i] <= best)) best = v[i];
-  return best;
-}
 
 /// Each foot's kept stances' plate wrenches (lab), zero elsewhere.
 std::array<FootWrench3D, 2> plate_wrenches(const ValidationResult& v, Eigen::Index n) {
@@ -61,9 +50,8 @@ void validate_joint_moments_3d(const EstimateResult& e, ValidationResult& v) {
     }
     const Eigen::VectorXd kam_e = knee_adduction_moment(estimated, s.foot), kam_m = knee_adduction_moment(measured, s.foot);
     j.knee_adduction = compare_series(kam_e.segment(a, len), kam_m.segment(a, len));
-    const Eigen::Index mid = a + len / 2;
-    j.kam_peak_estimated_Nm = {peak(kam_e, a, mid - 1), peak(kam_e, mid, s.last)};
-    j.kam_peak_measured_Nm = {peak(kam_m, a, mid - 1), peak(kam_m, mid, s.last)};
+    j.kam_peak_estimated_Nm = stance_peaks(kam_e, a, s.last);
+    j.kam_peak_measured_Nm = stance_peaks(kam_m, a, s.last);
     s.moments_3d = j;
   }
   v.measured_moments_3d = measured;

@@ -132,7 +132,13 @@ struct JointMoments3D {
 
 JointMoments3D joint_moments_3d(const LegMotion3D& legs, const std::array<FootWrench3D, 2>& feet);
 
-/// The external knee adduction moment (N m) from joint_moments_3d's knee: -frontal.
+/// The external knee adduction moment (N m) from joint_moments_3d's knee: -frontal; at frame i.
 inline Eigen::VectorXd knee_adduction_moment(const JointMoments3D& m, int side) { return -m.knee_Nm[static_cast<std::size_t>(side)].col(1); }
+inline double knee_adduction_moment(const JointMoments3D& m, int side, Eigen::Index i) { return -m.knee_Nm[static_cast<std::size_t>(side)](i, 1); }
+
+/// A stance's first and second KAM peaks (N m): the largest finite value of `kam` over the first
+/// and the second half of frames [first, last] (the second half takes the odd frame); NaN where a
+/// half has none (a stance of one frame has no first half).
+std::array<double, 2> stance_peaks(const Eigen::VectorXd& kam, Eigen::Index first, Eigen::Index last);
 
 }  // namespace kin2grf

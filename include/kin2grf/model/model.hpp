@@ -89,6 +89,8 @@ struct Body {
   double mass_kg = 0.0;
   double inertia_kgm2 = 0.0;  ///< about the COM
   double length_m = 0.0;
+  /// The COM's share of the way from the proximal landmark to the first attached one (body x).
+  [[nodiscard]] double com_fraction() const { return length_m > 0 ? com_local.x() / length_m : 0.0; }
 };
 
 /// The 9 bodies: what the dynamics needs of the subject (Model/Data split, as in Pinocchio and
