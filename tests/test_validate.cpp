@@ -267,6 +267,60 @@ TEST(SyntheticWalk, PlatesCarryTheKinematicTotalsOneStanceEach) {
   EXPECT_LT(v.total->metrics.vertical->rrmse_percent, 8.0);
 }
 
+// Issue 28's synthetic 3D walk: the example walk with a narrower step, a 2.5 cm sway toward the
+// stance foot and 7 degrees of toe-out, its plates carrying the 3D model's own total forces (the
+// lateral total shared between the feet by the walk's hand-over rule, not by load; each plate's
+// COP on its foot's long axis). The total lateral force is then exact, and what is tested is the
+// model's split between the feet, the COP's lateral place on a turned-out foot, and what the two
+// make of the knee adduction moment and the total frontal moment. The model has no kinematic
+// frontal-moment total to give the plates, so that total differs by the feet's COPs.
+TEST(SyntheticWalk3D, TheFeetSplitTheModelsOwnLateralTotal) {
+  SyntheticWalkOptions wo;
+  wo.step_width_m = 0.16;
+  wo.lateral_sway_m = 0.025;
+  wo.toe_out_rad = 0.12;
+  const Trial t = make_example_walk(wo);
+  EstimateOptions eo;
+  eo.model = ModelKind::ThreeD;
+  const auto* set = find_marker_set("kin2grf-example");
+  const EstimateResult r = estimate(t, nullptr, *set, eo);
+  const auto v = validate(r, *t.plates);
+  ASSERT_EQ(v.stances.size(), 2u);
+  const double tan_a = std::tan(wo.toe_out_rad);
+  for (const auto& st : v.stances) {
+    const auto f = static_cast<std::size_t>(st.foot);
+    ASSERT_TRUE(st.metrics.lateral && st.metrics.cop_lateral && st.moments_3d && st.moments_3d->knee_adduction);
+    // The sway is there to split: 2.5 cm at 0.9 Hz is about 45 N on 70 kg, pushing the body toward
+    // the other foot (the walker's right is + lateral: the right foot pushes to - and the left to +).
+    double f_peak = 0, est_lat_min = 1e9, est_lat_max = -1e9;
+    for (Eigen::Index k = st.first; k <= st.last; ++k) {
+      const double F = v.measured_lateral_N[f][k];
+      if (std::isfinite(F) && std::abs(F) > std::abs(f_peak)) f_peak = F;
+      const double est = r.feet[f].cop_lateral_m[k], meas = v.measured_cop_lateral_m[f][k];
+      if (!std::isfinite(est) || !std::isfinite(meas)) continue;
+      est_lat_min = std::min(est_lat_min, est), est_lat_max = std::max(est_lat_max, est);
+      // On the foot's long axis, the lateral place differs by tan(toe-out) times the COP's error
+      // along the foot, and by nothing else (give or take 2 mm: past the MT head at toe-off the
+      // rule holds the MT head's lateral place, a few mm of toes short of the axis's end).
+      EXPECT_LE(std::abs(est - meas), tan_a * std::abs(r.feet[f].cop_x_m[k] - v.measured_cop_x_m[f][k]) + 2e-3)
+          << side_name(st.foot) << " frame " << k;
+    }
+    EXPECT_GT(std::abs(f_peak), 30.0) << side_name(st.foot);
+    EXPECT_LT(f_peak * (st.foot == 0 ? 1 : -1), 0.0) << side_name(st.foot) << " pushes the body toward the other foot";
+    EXPECT_LT(st.metrics.lateral->rrmse_percent, 10.0) << side_name(st.foot);
+    // The estimated COP walks across the lab as it walks along the turned-out foot.
+    EXPECT_GT(est_lat_max - est_lat_min, 0.5 * tan_a * 0.24) << side_name(st.foot);
+    // The knee adduction moment, estimate-driven against plate-driven (24 % here: the plates' COP
+    // follows the walk's own rule along the foot, not the COP function).
+    EXPECT_LT(st.moments_3d->knee_adduction->rrmse_percent, 35.0) << side_name(st.foot);
+    const double peak = st.moments_3d->kam_peak_measured_Nm[0];
+    EXPECT_GT(peak, 0.2 * 70) << side_name(st.foot) << ": an external adduction moment (N m)";
+    EXPECT_NEAR(st.moments_3d->kam_peak_estimated_Nm[0], peak, 0.3 * peak) << side_name(st.foot);
+  }
+  ASSERT_TRUE(v.total && v.total->frontal_moment);
+  EXPECT_LT(v.total->frontal_moment->rrmse_percent, 12.0);
+}
+
 // The marker-plate time offset (step 6): plates whose clock runs 30 ms late are found 30 ms
 // behind from the whole body's vertical force, said in a note, and compared after alignment
 // only when asked.

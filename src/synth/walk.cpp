@@ -11,12 +11,19 @@
 //   a quintic term for the initial velocity), with a heel lift of `clearance_m`.
 // - Knees from the two-link inverse kinematics of hip and ankle (knee forward); the torso leans
 //   forward by 0.05 rad over the hips.
+// - In 3D (issue 28): the feet's lines `step_width_m` apart; the hips and shoulders (0.1 m either
+//   side of the midline) sway toward the stance foot, lat(t) = -+A cos(2 pi (t/T - 0.3)),
+//   furthest over each foot at its mid-stance; each foot turned outward by `toe_out_rad` about
+//   the vertical through its stance's heel ground point (in swing the pivot travels with the
+//   heel). The knee solves the sagittal two-link problem; its lateral place is the hip's and the
+//   ankle's blended by the thigh's share of the leg.
 // Ground reactions ("measured"): the model's own totals from these kinematics (sum m (a + g) and
 // the moment, as estimate() computes them) are shared between the feet in contact by a rule
 // that is not the method's: the trailing foot hands its share to the leading one by a cosine over
 // each double support, each foot's COP starts at a nominal point (the heel during the heel
 // rocker, moving to the MT head over the flat foot, the MT head in the forefoot rocker), and one
-// common shift of the COPs makes the moment exact. So the plates agree with the kinematics
+// common shift of the COPs makes the moment exact. In 3D the lateral total is shared by the same
+// rule and each COP lies on its foot's long axis on the floor. So the plates agree with the kinematics
 // exactly, and the method's per-foot split and COP are tested against an independent rule.
 #include <cmath>
 #include <cstdio>
@@ -53,6 +60,7 @@ Eigen::Vector2d rotated(const Eigen::Vector2d& p, double a) {
 /// One foot's pose at phase p of its own cycle (0 = heel strike) of stride k.
 struct FootPose {
   Eigen::Vector2d heel_ground;  ///< the heel's ground point (where the foot's frame is)
+  double pivot_x = 0;           ///< the heel strike's ground point (toe-out turns about it), moving in swing
   double phi = 0;               ///< inclination, + toes up
   bool stance = false;
   double stance_phase = 0;      ///< p / kStanceEnd in stance
@@ -63,6 +71,7 @@ FootPose stance_pose(double heel_x, double p, const SyntheticWalkOptions& o) {
   FootPose f;
   f.stance = true;
   f.stance_phase = p / kStanceEnd;
+  f.pivot_x = heel_x;
   if (p < kHeelRockerEnd) {
     f.phi = o.heel_strike_angle_rad * (1 - smoothstep(p / kHeelRockerEnd));
     f.heel_ground = {heel_x, 0.0};
@@ -98,6 +107,7 @@ FootPose foot_pose(double cycles, double first_heel_x, const SyntheticWalkOption
   f.phi = off.phi + (on.phi - off.phi) * s + (off.phi - before.phi) * carry;
   f.heel_ground = off.heel_ground + (on.heel_ground - off.heel_ground) * s + (off.heel_ground - before.heel_ground) * carry;
   f.heel_ground.y() += o.clearance_m * std::pow(std::sin(M_PI * u), 2);
+  f.pivot_x = heel_x + stride * s;
   return f;
 }
 
@@ -117,6 +127,10 @@ SyntheticWalk make_synthetic_walk(const SyntheticWalkOptions& o) {
   for (auto& c : w.stance) c.assign(static_cast<std::size_t>(n), false);
   for (auto& s : w.stance_phase) s = Eigen::VectorXd::Zero(n);
   for (auto& s : w.sole_x_m) s = Eigen::MatrixX2d::Constant(n, 2, std::nan(""));
+  for (auto& s : w.sole_axis_origin_m) s = Eigen::MatrixX2d::Constant(n, 2, std::nan(""));
+  const bool toe_out = o.toe_out_rad != 0.0;  // without it, x is the foot's own (no round-off)
+  for (int side = 0; side < 2; ++side)
+    w.sole_axis_direction[static_cast<std::size_t>(side)] << std::cos(o.toe_out_rad), (side ? 1 : -1) * std::sin(o.toe_out_rad);
   for (int i = 0; i < n; ++i) {
     const double time = m.time_s[i];
     // Slowest and highest at each mid-stance (t/T = 0.3 and 0.8): braking, then propulsion.
@@ -124,27 +138,41 @@ SyntheticWalk make_synthetic_walk(const SyntheticWalkOptions& o) {
     const Eigen::Vector2d hip(v * time - o.speed_oscillation_mps * T / (4 * M_PI) * std::sin(wave),
                               o.hip_height_m + o.hip_oscillation_m * std::cos(wave));
     const Eigen::Vector2d sho = hip + Lt * Eigen::Vector2d(std::cos(M_PI / 2 - 0.05), std::sin(M_PI / 2 - 0.05));
+    // Over the right foot (-Y) at its mid-stance (t/T = 0.3), over the left half a stride later.
+    const double sway = -o.lateral_sway_m * std::cos(2 * M_PI * (time / T - 0.3));
     for (int side = 0; side < 2; ++side) {
       // The left foot is half a cycle ahead in its cycle: its current stance began half a stride back.
       const double cycles = time / T + (side ? 0.5 : 0.0);
       const FootPose f = foot_pose(cycles, first_heel_x - (side ? 0.5 * v * T : 0.0), o);
-      const Eigen::Vector2d ankle = f.point(kAnkleMarker);
+      const double foot_y = (side == 0 ? -0.5 : 0.5) * o.step_width_m, body_y = (side == 0 ? -0.1 : 0.1) + sway;
+      const Eigen::Vector2d& dir = w.sole_axis_direction[static_cast<std::size_t>(side)];
+      // A foot point's lab (x, y, z): its sagittal (x, z) turned outward about the pivot.
+      const auto foot_lab = [&](const Eigen::Vector2d& local) -> Eigen::Vector3d {
+        const Eigen::Vector2d q = f.point(local);
+        if (!toe_out) return {q.x(), foot_y, q.y()};
+        const double along = q.x() - f.pivot_x;
+        return {f.pivot_x + along * dir.x(), foot_y + along * dir.y(), q.y()};
+      };
+      const Eigen::Vector3d ankle3 = foot_lab(kAnkleMarker);
+      const Eigen::Vector2d ankle(ankle3.x(), ankle3.z());
       const Eigen::Vector2d d = ankle - hip;
       const double dist = d.norm();
       if (dist > Lth + Lsh - 1e-3) throw InputError("synthetic walk: the leg cannot reach the foot (a longer stride than the legs allow)");
       const double alpha = std::acos(std::clamp((Lth * Lth + dist * dist - Lsh * Lsh) / (2 * Lth * dist), -1.0, 1.0));
       const Eigen::Vector2d knee = hip + Lth * rotated(d / dist, alpha);  // knee forward
-      const Eigen::Vector2d pts[] = {sho, hip, knee, ankle, f.point(kHeelMarker), f.point(kMtMarker), f.point(kHalluxMarker)};
-      const double y = side == 0 ? -0.1 : 0.1;  // right foot at -Y (Y points left)
-      for (int k = 0; k < 7; ++k) m.positions_m[static_cast<std::size_t>(7 * side + k)].row(i) << pts[k].x(), y, pts[k].y();
+      const double knee_y = body_y + (ankle3.y() - body_y) * Lth / (Lth + Lsh);
+      const Eigen::Vector3d pts[] = {{sho.x(), body_y, sho.y()},  {hip.x(), body_y, hip.y()}, {knee.x(), knee_y, knee.y()},
+                                     ankle3,  foot_lab(kHeelMarker),  foot_lab(kMtMarker),   foot_lab(kHalluxMarker)};
+      for (int k = 0; k < 7; ++k) m.positions_m[static_cast<std::size_t>(7 * side + k)].row(i) = pts[k].transpose();
       if (f.stance) {
         w.stance[side][static_cast<std::size_t>(i)] = true;
         w.stance_phase[side][i] = f.stance_phase;
-        // Nominal COP: heel, then heel -> MT head over the flat foot, then the MT head.
+        // Nominal COP: heel, then heel -> MT head over the flat foot, then the MT head (lab x).
         const double p = f.stance_phase * kStanceEnd;
-        const double heel = f.point(Eigen::Vector2d::Zero()).x(), mt = f.point(kMtGround).x();
+        const double heel = foot_lab(Eigen::Vector2d::Zero()).x(), mt = foot_lab(kMtGround).x();
         w.sole_x_m[side](i, 0) = heel;
-        w.sole_x_m[side](i, 1) = f.point(kHalluxMarker).x();
+        w.sole_x_m[side](i, 1) = foot_lab(kHalluxMarker).x();
+        w.sole_axis_origin_m[side].row(i) << f.pivot_x, foot_y;
         w.nominal_cop_x_m[side][i] =
             p < kHeelRockerEnd ? heel : p < kFlatEnd ? heel + (mt - heel) * (p - kHeelRockerEnd) / (kFlatEnd - kHeelRockerEnd) : mt;
       }
@@ -182,6 +210,10 @@ std::array<ForcePlate, 2> synthetic_walk_feet(const SyntheticWalk& w, const Esti
     const double sum = share[0] + share[1];
     if (sum <= 0) continue;  // a flight: no synthetic walk has one
     const Eigen::Vector3d total = r.kinematic_total.row(i).transpose();  // (Fx, Fy, M about the origin)
+    // The 3D model's lateral total (along the walker's right), shared like the rest.
+    const Eigen::Vector3d lateral = r.feet[0].force_lateral_N.size() == n
+                                        ? ((r.feet[0].force_lateral_N[i] + r.feet[1].force_lateral_N[i]) * r.frame.lateral_at(k)).eval()
+                                        : Eigen::Vector3d::Zero();
     double moment_nominal = 0;
     for (int side = 0; side < 2; ++side)
       if (share[side] > 0) moment_nominal += w.nominal_cop_x_m[side][k] * total.y() * share[side] / sum;
@@ -193,9 +225,11 @@ std::array<ForcePlate, 2> synthetic_walk_feet(const SyntheticWalk& w, const Esti
       if (share[side] <= 0) continue;
       auto& p = feet[static_cast<std::size_t>(side)];
       const double f = share[side] / sum;
-      p.force_N.row(k) << f * total.x(), 0.0, f * total.y();
+      p.force_N.row(k) << f * total.x(), f * lateral.y(), f * total.y();
       const double x = std::clamp(w.nominal_cop_x_m[side][k] + shift, w.sole_x_m[side](k, 0), w.sole_x_m[side](k, 1));
-      p.cop_m.row(k) << x, side ? 0.1 : -0.1, r.ground_level_m();
+      const Eigen::Vector2d& axis = w.sole_axis_direction[static_cast<std::size_t>(side)];
+      const double y = w.sole_axis_origin_m[side](k, 1) + (x - w.sole_axis_origin_m[side](k, 0)) * axis.y() / axis.x();
+      p.cop_m.row(k) << x, y, r.ground_level_m();
     }
   }
   return feet;
@@ -204,7 +238,11 @@ std::array<ForcePlate, 2> synthetic_walk_feet(const SyntheticWalk& w, const Esti
 Trial make_example_walk(const SyntheticWalkOptions& o) {
   SyntheticWalk w = make_synthetic_walk(o);
   const auto* set = find_marker_set("kin2grf-example");
-  const EstimateResult r = estimate(w.trial, nullptr, *set, EstimateOptions{});
+  EstimateOptions eo;
+  // Its lateral total for the plates where the walk moves sideways (the sagittal results are the
+  // same); a walk in the feet's planes keeps plates with no lateral force (not round-off's).
+  if (o.lateral_sway_m != 0.0 || o.toe_out_rad != 0.0) eo.model = ModelKind::ThreeD;
+  const EstimateResult r = estimate(w.trial, nullptr, *set, eo);
   const auto feet = synthetic_walk_feet(w, r);
   // Two plates in series along the walkway, 0.6 m long and 0.5 m wide, each under one stance of
   // the middle stride: the right foot's on FP1, the left foot's next on FP2.

@@ -53,6 +53,11 @@ struct SyntheticWalkOptions {
   double clearance_m = 0.08;        ///< heel lift at mid-swing
   double heel_strike_angle_rad = 0.25;  ///< foot inclination at heel strike (toes up)
   double toe_off_angle_rad = 0.7;       ///< at toe-off (heel up)
+  /// 3D gait (issue 28's synthetic walk; the defaults keep every marker in its side's vertical
+  /// plane, the walk of the 2D tests):
+  double step_width_m = 0.2;    ///< lateral distance between the feet's lines
+  double lateral_sway_m = 0.0;  ///< amplitude of the hips' and shoulders' sway toward the stance foot
+  double toe_out_rad = 0.0;     ///< each foot's long axis turned outward about the vertical
 };
 
 struct SyntheticWalk {
@@ -62,18 +67,26 @@ struct SyntheticWalk {
   std::array<std::vector<bool>, 2> stance;
   std::array<Eigen::VectorXd, 2> stance_phase, nominal_cop_x_m;
   std::array<Eigen::MatrixX2d, 2> sole_x_m;  ///< x of the heel's ground point and the hallux in stance
+  /// In stance, the foot's long axis on the floor: the point (x, y) it turns about for toe-out
+  /// (the heel's ground point at heel strike) and its direction (cos a, -+sin a) rotated outward
+  /// by SyntheticWalkOptions::toe_out_rad: a COP at lab x lies at y = y0 + (x - x0) tan(+-a).
+  std::array<Eigen::MatrixX2d, 2> sole_axis_origin_m;
+  std::array<Eigen::Vector2d, 2> sole_axis_direction{Eigen::Vector2d::UnitX(), Eigen::Vector2d::UnitX()};
 };
 
 SyntheticWalk make_synthetic_walk(const SyntheticWalkOptions& options);
 
 /// The walk's ground reactions per foot, lab frame, one row per trial frame (zero in swing): the
 /// estimate's kinematic totals shared between the feet by the synthetic rule (walk.cpp), not by
-/// the method. `estimate` is estimate() on `walk.trial`.
+/// the method. `estimate` is estimate() on `walk.trial`; with a lateral force (ModelKind::ThreeD)
+/// its total (the sum of the feet's) is shared by the same rule, and each COP lies on its foot's
+/// long axis (SyntheticWalk::sole_axis_origin_m), so the plates carry the model's own 3D totals.
 std::array<ForcePlate, 2> synthetic_walk_feet(const SyntheticWalk& walk, const EstimateResult& estimate);
 
 /// The bundled example: the walk with two force plates in series along the walkway, the right
 /// foot's middle stance on FP1 and the left foot's next on FP2 (each plate records the foot whose
-/// COP is over it).
+/// COP is over it). With sway or toe-out the plates carry the 3D model's totals
+/// (synthetic_walk_feet), a lateral force included.
 Trial make_example_walk(const SyntheticWalkOptions& options = {});
 
 /// The bundled examples in `dir` (`kin2grf make-example`): example_walk.c3d/.trc/_grf.mot (the
