@@ -227,8 +227,8 @@ print("\n## The 3D model (`--model 3d`)\n")
 print("The sagittal figures above are the 3D model's too: it adds to them, per foot, the mediolateral force and the "
       "COP's lateral place, and per leg the ankle's, the knee's and the hip's 3D moments by bottom-up inverse dynamics "
       "(dynamics/joint_moments_3d.hpp), run once with the estimate's ground reaction and once with the plates' on "
-      "the same kinematics. The mediolateral force: the whole body's lateral acceleration (filtered at 3 Hz) shared "
-      "between the feet by vertical load. The COP's lateral place: on the line from the heel to the forefoot's "
+      "the same kinematics. The mediolateral force: the whole body's lateral acceleration (filtered at 3 Hz), each "
+      "foot in contact carrying its own lower leg's lateral inertia and the rest shared by vertical load. The COP's lateral place: on the line from the heel to the forefoot's "
       "midline at the COP's place along the foot. Lateral knee, ankle and 5th-metatarsal markers are moved to the "
       "joint centres and the foot's midline (docs/MARKERSETS.md, \"surface\"). Per stance: the lateral force's "
       "rRMSE %, RMSE in % body weight, r; the lateral COP's RMSE in mm (frames above 5 % body weight); the external "
@@ -237,7 +237,7 @@ print("The sagittal figures above are the 3D model's too: it adds to them, per f
       "reaction's frontal and transverse moments about the GRM reference on the walker's midline, where every loaded "
       "foot is on a plate (the estimate's free moment is zero, the plates' is in theirs); per stance, the free moment's RMSE, which with the estimate's zero is the plate's own RMS "
       "(a .mot without torque columns reads 0). No value of the 3D model "
-      "was fitted except the lateral cut-off (below); the joint and foot geometry are anatomical ratios.\n")
+      "was fitted except the lateral cut-off and the split's rule, chosen leave-one-lab-out (below); the joint and foot geometry are anatomical ratios.\n")
 print("| activity | trial | lab | stances | lateral force rRMSE % | RMSE %BW | r | lateral COP RMSE mm | "
       "KAM rRMSE % | KAM 1st peak est / plates N m/kg | knee sagittal rRMSE % | hip frontal rRMSE % | total frontal / transverse moment rRMSE % | free moment RMSE N m |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -275,36 +275,50 @@ for a, xs in by_activity.items():
           f"{summary('frontal', '{:.1f}')} |")
 
 labs = sorted({lab_of[name] for _, name, _ in rows})
-have_grid = all(load_or_none(rows[0][1], c) is not None for c in LATERAL_CUTOFFS.values())
-if have_grid:
-    print("\n### The lateral force's cut-off, leave-one-lab-out\n")
-    print("Chosen by the per-foot lateral force's rRMSE (per lab, the mean over its trials; then the mean over the labs, "
-          "all activities pooled). In-sample: every trial at the choice made on every lab; held-out: each lab's trials "
-          "at the choice made without it.\n")
-    crit = {k: lateral_criterion(c, None) for k, c in LATERAL_CUTOFFS.items()}
-    print("| cut-off | " + " | ".join(crit) + " |")
+LATERAL_SPLITS = {"load": "3d-load", "own-leg": "3d"}
+
+
+def lolo_table(title, intro, configs, label):
+    """A setting of the lateral force chosen leave-one-lab-out among `configs` (name -> run): the criterion
+    per candidate, the choices, and per activity the first candidate, in-sample and held-out figures."""
+    if not all(load_or_none(rows[0][1], c) is not None for c in configs.values()):
+        return
+    print(f"\n### {title}, leave-one-lab-out\n")
+    print(intro + " Chosen by the per-foot lateral force's rRMSE (per lab, the mean over its trials; then the mean "
+          "over the labs, all activities pooled). In-sample: every trial at the choice made on every lab; held-out: "
+          "each lab's trials at the choice made without it.\n")
+    crit = {k: lateral_criterion(c, None) for k, c in configs.items()}
+    print(f"| {label} | " + " | ".join(crit) + " |")
     print("|---|" + "---|" * len(crit))
     print("| criterion % | " + " | ".join(f"{v:.2f}" for v in crit.values()) + " |")
     in_sample = min(crit, key=crit.get)
-    choice = {lab: min(LATERAL_CUTOFFS, key=lambda k: lateral_criterion(LATERAL_CUTOFFS[k], lab)) for lab in labs}
+    choice = {lab: min(configs, key=lambda k: lateral_criterion(configs[k], lab)) for lab in labs}
     print("\nIn-sample choice: " + in_sample + "; held out: " + ", ".join(f"{lab} {c}" for lab, c in choice.items()) + ".\n")
-    print("| activity | kinematic cut-off | in-sample | held-out | worst trial held-out |")
+    first = next(iter(configs))
+    print(f"| activity | {first} | in-sample | held-out | worst trial held-out |")
     print("|---|---|---|---|---|")
     for a in dict.fromkeys(a for a, _, _ in rows):
         base, ins, held = [], [], []
         for b, name, _ in rows:
             if b != a:
                 continue
-            ts = {k: load_or_none(name, c) for k, c in LATERAL_CUTOFFS.items()}
-            if ts["kinematic"] is None or trial_3d(ts["kinematic"], 1) is None:
+            ts = {k: load_or_none(name, c) for k, c in configs.items()}
+            if ts[first] is None or trial_3d(ts[first], 1) is None:
                 continue
-            base.append(trial_3d(ts["kinematic"], 1)["lateral"])
+            base.append(trial_3d(ts[first], 1)["lateral"])
             ins.append(trial_3d(ts[in_sample], 1)["lateral"])
             held.append((trial_3d(ts[choice[lab_of[name]]], 1)["lateral"], name))
         if held:
             worst = max(held)
             print(f"| {a} | {statistics.mean(base):.1f} | {statistics.mean(ins):.1f} | "
                   f"{statistics.mean(h for h, _ in held):.1f} | {worst[1]} {worst[0]:.1f} |")
+
+
+lolo_table("The lateral force's cut-off", "The whole body's lateral acceleration's low-pass cut-off (`--lateral-cutoff`), "
+           "with the split's default (own-leg).", LATERAL_CUTOFFS, "cut-off")
+lolo_table("The lateral force's split between the feet", "`--lateral-split`: load (all of the whole body's lateral "
+           "force shared by vertical load) or own-leg (each foot in contact carries its own shank's, foot's and toes' "
+           "lateral inertia, filtered at the kinematic cut-off, the rest shared by load), at 3 Hz.", LATERAL_SPLITS, "split")
 
 print("\n## Excluded stances and notes (defaults)\n")
 for a, name, args in rows:

@@ -767,11 +767,12 @@ FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, dou
 }
 
 /// The mediolateral force (EstimateOptions::mediolateral) into each foot's result.
-void mediolateral_stage(const ModelMotion& motion, const SagittalStage& sag, double cutoff_hz, std::array<FootResult, 2>& feet) {
+void mediolateral_stage(const ModelMotion& motion, const SagittalStage& sag, double cutoff_hz, double leg_cutoff_hz, bool own_leg_inertia,
+                        std::array<FootResult, 2>& feet) {
   std::array<Eigen::VectorXd, 2> vertical{feet[0].force_N.col(1), feet[1].force_N.col(1)};
   std::array<FootLoad, 2> loads;
   for (int k = 0; k < 2; ++k) loads[k] = {&vertical[k], &feet[k].contact};
-  MediolateralForces ml = mediolateral_forces(motion, sag.landmark_lab_m, sag.lateral_axis, cutoff_hz, loads);
+  MediolateralForces ml = mediolateral_forces(motion, sag.landmark_lab_m, sag.lateral_axis, cutoff_hz, loads, leg_cutoff_hz, own_leg_inertia);
   for (int k = 0; k < 2; ++k) feet[k].force_lateral_N = std::move(ml.foot_N[k]);
 }
 
@@ -959,7 +960,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m);
   if (o.lateral_force()) {
     const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kin.kinematic_cutoff_hz) : kin.kinematic_cutoff_hz;
-    mediolateral_stage(kin.motion, sag, cutoff, feet.feet);
+    mediolateral_stage(kin.motion, sag, cutoff, kin.kinematic_cutoff_hz, o.lateral_own_leg_inertia, feet.feet);
     lateral_cop_stage(sag.foot_line, feet.feet);
   }
   std::optional<LegMotion3D> legs;

@@ -646,7 +646,9 @@ TEST(Mediolateral, TheFeetCarryTheBodysLateralAccelerationSharedByLoad) {
   for (Eigen::Index i = n / 4; i < 3 * n / 4; ++i) {
     EXPECT_NEAR(ml.total_N[i], -peak * std::sin(w * r.time_s[i]), 0.01 * peak) << "frame " << i;
     EXPECT_NEAR(ml.foot_N[0][i] + ml.foot_N[1][i], ml.total_N[i], 1e-9 * peak);
-    EXPECT_NEAR(ml.foot_N[0][i], ml.total_N[i] * fy[0][i] / (fy[0][i] + fy[1][i]), 1e-9 * peak);
+    // Each foot its own lower leg's inertia, the rest by load.
+    const double rest = ml.total_N[i] - ml.lower_leg_N[0][i] - ml.lower_leg_N[1][i];
+    EXPECT_NEAR(ml.foot_N[0][i], ml.lower_leg_N[0][i] + rest * fy[0][i] / (fy[0][i] + fy[1][i]), 1e-9 * peak);
   }
   // A foot off the ground carries none of it, the other all.
   std::vector<bool> off(static_cast<std::size_t>(n), false);
@@ -710,6 +712,49 @@ TEST(Mediolateral, ARotatingFrameAddsNoForce) {
   const std::array<FootLoad, 2> loads{FootLoad{&fy[0], &r.feet[0].contact}, FootLoad{&fy[1], &r.feet[1].contact}};
   const MediolateralForces ml = mediolateral_forces(r.motion, lab, lateral, 6.0, loads);
   EXPECT_LT(ml.total_N.segment(n / 4, n / 2).cwiseAbs().maxCoeff(), 0.5);
+}
+
+// The split's own-leg rule (dynamics/mediolateral.hpp): a landing foot brakes its own shank's and
+// foot's sideways swing while it takes little weight. Only the left lower leg (knee, ankle, heel,
+// MT, toes) swings sideways, 2 cm at 2 Hz, with the left foot carrying a tenth of the weight: the
+// left foot carries that leg's inertia m a (shank, foot and toes) and a tenth of the rest (the
+// thigh's share, its distal end moving with the knee); shared by load alone it would carry a
+// tenth of all.
+TEST(Mediolateral, ALandingFootCarriesItsOwnLowerLegsInertia) {
+  const auto r = run({});
+  const Eigen::Index n = r.time_s.size();
+  const double A = 0.02, w = 2 * M_PI * 2.0;
+  std::array<Eigen::MatrixX3d, kLandmarkCount> lab;
+  for (auto& p : lab) p = Eigen::MatrixX3d::Zero(n, 3);
+  for (LegLandmark l : {kKnee, kAnkle, kHeel, kMt, kHallux})
+    for (Eigen::Index i = 0; i < n; ++i) lab[static_cast<std::size_t>(landmark(kLeft, l))](i, 1) = A * std::sin(w * r.time_s[i]);
+  const Eigen::MatrixX3d lateral = Eigen::RowVector3d(0, 1, 0).replicate(n, 1);
+  std::array<Eigen::VectorXd, 2> fy{Eigen::VectorXd::Constant(n, 630.0), Eigen::VectorXd::Constant(n, 70.0)};
+  const std::vector<bool> both(static_cast<std::size_t>(n), true);
+  const std::array<FootLoad, 2> loads{FootLoad{&fy[0], &both}, FootLoad{&fy[1], &both}};
+  const MediolateralForces own = mediolateral_forces(r.motion, lab, lateral, 3.0, loads, 8.0);
+  const MediolateralForces load = mediolateral_forces(r.motion, lab, lateral, 3.0, loads, 8.0, false);
+  double lower_leg_kg = 0;
+  for (LegSegment s : {kShank, kFoot, kToes}) lower_leg_kg += r.model().bodies[static_cast<std::size_t>(segment(kLeft, s))].mass_kg;
+  const double peak = lower_leg_kg * A * w * w;  // about 11 N for 70 kg
+  for (Eigen::Index i = n / 4; i < 3 * n / 4; ++i) {
+    const double ma = -peak * std::sin(w * r.time_s[i]);
+    EXPECT_NEAR(own.lower_leg_N[1][i], ma, 0.03 * peak) << "frame " << i;
+    EXPECT_EQ(own.lower_leg_N[0][i], 0.0);
+    const double rest = own.total_N[i] - own.lower_leg_N[1][i];
+    EXPECT_NEAR(own.foot_N[1][i], own.lower_leg_N[1][i] + 0.1 * rest, 1e-9 * peak);
+    EXPECT_NEAR(own.foot_N[0][i] + own.foot_N[1][i], own.total_N[i], 1e-9 * peak);
+    EXPECT_NEAR(load.foot_N[1][i], 0.1 * load.total_N[i], 1e-9 * peak);
+  }
+  // The left foot's force: near the leg's own inertia, where the load share gives it a tenth.
+  double own_error = 0, load_error = 0;
+  for (Eigen::Index i = n / 4; i < 3 * n / 4; ++i) {
+    const double ma = -peak * std::sin(w * r.time_s[i]);
+    own_error = std::max(own_error, std::abs(own.foot_N[1][i] - ma));
+    load_error = std::max(load_error, std::abs(load.foot_N[1][i] - ma));
+  }
+  EXPECT_LT(own_error, 0.25 * peak);
+  EXPECT_GT(load_error, 0.7 * peak);
 }
 
 // --mediolateral adds the lateral force and changes nothing else; without lateral motion (the

@@ -102,7 +102,7 @@ struct EstimateOptions {
   Eigen::Vector2d grm_reference_m = Eigen::Vector2d::Zero();
   /// The mediolateral force (kin2grf; dynamics/mediolateral.hpp): each foot's force along the
   /// sagittal frame's lateral axis, from the whole body's lateral acceleration shared between the
-  /// feet by their vertical loads. Off: the sagittal model's outputs, with a zero lateral force.
+  /// feet (lateral_own_leg_inertia). Off: the sagittal model's outputs, with a zero lateral force.
   /// ModelKind::ThreeD includes it.
   bool mediolateral = false;
   /// The whole body's lateral acceleration's low-pass cut-off, Hz (0: the dynamics' kinematic
@@ -111,6 +111,9 @@ struct EstimateOptions {
   /// mostly their noise and soft tissue. 3 Hz was chosen leave-one-lab-out among 2-5 Hz and the
   /// kinematic cut-off (docs/METHOD-NOTES.md): walking per-foot rRMSE 23.4 -> 18.0 % held out.
   double lateral_cutoff_hz = 3.0;
+  /// Each foot in contact carries its own lower leg's lateral inertia, the rest shared by load
+  /// (dynamics/mediolateral.hpp); false: the load share alone.
+  bool lateral_own_leg_inertia = true;
   ModelKind model = ModelKind::Sagittal;
   [[nodiscard]] bool lateral_force() const { return mediolateral || model == ModelKind::ThreeD; }
   /// Called with (frames solved, frames in all) every 1 % of the contact solve; empty: none.

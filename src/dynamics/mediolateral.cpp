@@ -6,7 +6,8 @@
 namespace kin2grf {
 
 MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
-                                       const Eigen::MatrixX3d& lateral_axis, double cutoff_hz, const std::array<FootLoad, 2>& feet) {
+                                       const Eigen::MatrixX3d& lateral_axis, double cutoff_hz, const std::array<FootLoad, 2>& feet,
+                                       double leg_cutoff_hz, bool own_leg_inertia) {
   const Model& model = *motion.model;
   const Eigen::Index n = motion.frames();
   bool sizes = lateral_axis.rows() == n;
@@ -14,20 +15,28 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
   if (!sizes) throw InputError("mediolateral force: the landmarks' lab positions do not match the motion's frames");
   double mass = 0;
   for (const Body& b : model.bodies) mass += b.mass_kg;
-  // The whole body's COM in the lab (a linear filter: the same as filtering each landmark).
-  Eigen::MatrixXd com = Eigen::MatrixXd::Zero(n, 3);
-  for (int s = 0; s < kSegmentCount; ++s) {
-    const Body& b = model.bodies[s];
+  // A segment's COM in the lab, times its mass (a linear filter: the same as filtering each landmark).
+  const auto first_moment = [&](int s) -> Eigen::MatrixXd {
+    const Body& b = model.bodies[static_cast<std::size_t>(s)];
     const double f = b.com_fraction();
-    com += (b.mass_kg / mass) * ((1 - f) * landmark_lab_m[static_cast<std::size_t>(b.proximal)] +
-                                 f * landmark_lab_m[static_cast<std::size_t>(b.points[0])]);
-  }
+    return b.mass_kg * ((1 - f) * landmark_lab_m[static_cast<std::size_t>(b.proximal)] + f * landmark_lab_m[static_cast<std::size_t>(b.points[0])]);
+  };
+  const auto lateral_part = [&](const Eigen::MatrixXd& a) -> Eigen::VectorXd { return (a.array() * lateral_axis.array()).rowwise().sum().matrix(); };
+  Eigen::MatrixXd com = Eigen::MatrixXd::Zero(n, 3);
+  for (int s = 0; s < kSegmentCount; ++s) com += first_moment(s) / mass;
   if (cutoff_hz > 0) com = butterworth_filtfilt(std::move(com), motion.rate_hz, cutoff_hz);
-  const Eigen::MatrixXd acc = second_difference(com, 1.0 / motion.rate_hz);
   MediolateralForces out;
-  out.com_lateral_m = (com.array() * lateral_axis.array()).rowwise().sum().matrix();
-  out.total_N = mass * (acc.array() * lateral_axis.array()).rowwise().sum().matrix();
-  for (int k = 0; k < 2; ++k) out.foot_N[static_cast<std::size_t>(k)] = Eigen::VectorXd::Zero(n);
+  out.com_lateral_m = lateral_part(com);
+  out.total_N = mass * lateral_part(second_difference(com, 1.0 / motion.rate_hz));
+  for (int k = 0; k < 2; ++k) {
+    Eigen::MatrixXd leg = Eigen::MatrixXd::Zero(n, 3);
+    if (own_leg_inertia)
+      for (LegSegment s : {kShank, kFoot, kToes}) leg += first_moment(segment(k, s));
+    const double c = leg_cutoff_hz > 0 ? leg_cutoff_hz : cutoff_hz;
+    if (own_leg_inertia && c > 0) leg = butterworth_filtfilt(std::move(leg), motion.rate_hz, c);
+    out.lower_leg_N[static_cast<std::size_t>(k)] = own_leg_inertia ? lateral_part(second_difference(leg, 1.0 / motion.rate_hz)) : Eigen::VectorXd::Zero(n);
+    out.foot_N[static_cast<std::size_t>(k)] = Eigen::VectorXd::Zero(n);
+  }
   for (Eigen::Index i = 0; i < n; ++i) {
     std::array<double, 2> fy{0.0, 0.0};
     for (int k = 0; k < 2; ++k) {
@@ -36,7 +45,12 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
     }
     const double sum_fy = fy[0] + fy[1];
     if (!(sum_fy > 0)) continue;  // flight: no foot to carry it
-    for (int k = 0; k < 2; ++k) out.foot_N[static_cast<std::size_t>(k)][i] = out.total_N[i] * fy[static_cast<std::size_t>(k)] / sum_fy;
+    double rest = out.total_N[i];
+    for (int k = 0; k < 2; ++k)
+      if (fy[static_cast<std::size_t>(k)] > 0) rest -= out.lower_leg_N[static_cast<std::size_t>(k)][i];
+    for (int k = 0; k < 2; ++k)
+      if (fy[static_cast<std::size_t>(k)] > 0)
+        out.foot_N[static_cast<std::size_t>(k)][i] = out.lower_leg_N[static_cast<std::size_t>(k)][i] + rest * fy[static_cast<std::size_t>(k)] / sum_fy;
   }
   return out;
 }

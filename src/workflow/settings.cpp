@@ -27,12 +27,16 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("--mass", a.mass, "Body mass, kg (default: the C3D's PROCESSING:Bodymass or SUBJECT(S):WEIGHT); 20-300");
   c->add_flag("--force-mass", a.force_mass, "Accept a body mass outside 20-300 kg");
   c->add_flag("--mediolateral", a.mediolateral,
-              "Estimate each foot's mediolateral force too (the whole body's lateral acceleration, shared between the feet by "
-              "vertical load; docs/METHOD-NOTES.md); off: the sagittal model's zero lateral force");
+              "Estimate each foot's mediolateral force too (the whole body's lateral acceleration, shared between the feet as "
+              "--lateral-split says; docs/METHOD-NOTES.md); off: the sagittal model's zero lateral force");
   c->add_option("--model", a.model,
                 "sagittal (the paper's model) or 3d: the sagittal results plus each foot's mediolateral force (as "
                 "--mediolateral) and the ankles', knees' and hips' 3D moments, the knee adduction moment among them")
       ->check(CLI::IsMember({"sagittal", "3d"}))->capture_default_str();
+  c->add_option("--lateral-split", a.lateral_split,
+                "How the feet share the whole body's lateral force (--model 3d): own-leg (each foot in contact carries its own "
+                "lower leg's lateral inertia, the rest by vertical load) or load (all by vertical load)")
+      ->check(CLI::IsMember({"own-leg", "load"}))->capture_default_str();
   c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
       ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
   c->add_option_function<double>(
@@ -111,6 +115,7 @@ EstimateOptions to_options(const Settings& a) {
   o.allow_unusual_mass = a.force_mass;
   o.mediolateral = a.mediolateral;
   o.model = model_kind(a.model);
+  o.lateral_own_leg_inertia = a.lateral_split == "own-leg";
   o.anthropometry = (a.paper && !a.anthropometry_given) ? "winter" : a.anthropometry;
   o.kinematic_cutoff_hz = a.kinematic_cutoff;
   if (a.post_cutoff && a.post_cutoff_cycles_given)
@@ -159,6 +164,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"speed_gate_mps", o.contact.speed_gate.fixed_mps},
           {"model", model_kind_name(o.model)},
           {"mediolateral", o.lateral_force()},
+          {"lateral_split", o.lateral_own_leg_inertia ? "own-leg" : "load"},
           {"torso_length", torso_length_name(o.torso_length)},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"kinematic_cutoff_rule", o.cutoff_from_noise ? "noise" : "fixed"},

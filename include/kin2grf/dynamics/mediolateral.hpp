@@ -10,11 +10,17 @@
 // dynamics' kinematic cut-off, differentiated twice (central differences) and projected on each
 // frame's lateral axis.
 //
-// Split between the feet in contact (k = right, left) by their vertical forces F_y,k (the
-// sagittal solve's, post-filtered):
-//   F_z,k = F_z F_y,k / sum_j F_y,j,
-// so that a foot alone carries F_z and a double support shares it as it shares the weight; zero
-// where a foot is not in contact, and in flight. An inverted-pendulum split (each foot's reaction
+// Split between the feet in contact (k = right, left). Each foot in contact carries its own
+// lower leg's lateral inertia (shank, foot and toes: L_k = sum m_s a_s,z over them), the rest
+// shared by the feet's vertical forces F_y,k (the sagittal solve's, post-filtered):
+//   F_z,k = L_k + (F_z - sum_{j in contact} L_j) F_y,k / sum_j F_y,j,
+// so that a foot alone carries F_z and a double support shares the body above the shanks as it
+// shares the weight; zero where a foot is not in contact, and in flight. Why: a landing foot
+// brakes its own shank's and foot's sideways swing (its plate's brief lateral force at heel
+// strike, 10-20 N on the development walks) while it takes almost no weight yet; the load share
+// alone gave that force to the trailing foot. The lower legs' motion is the crisp one (bony
+// landmarks, not the trunk's skin): it is filtered at the dynamics' kinematic cut-off, the whole
+// body's at `cutoff_hz`. The thigh stays in the shared part: its proximal end is the pelvis's. An inverted-pendulum split (each foot's reaction
 // pointing from its COP to the COM, F_y,k (z_G - z_k) / (y_G - y_ground), which gives the feet
 // opposite signs in double support) was measured and lost on every development lab's walks
 // (per-foot rRMSE 24-53 % against 14-33 %; docs/METHOD-NOTES.md).
@@ -37,6 +43,7 @@ struct FootLoad {
 
 struct MediolateralForces {
   Eigen::VectorXd total_N;                  ///< M a_Gz, per frame
+  std::array<Eigen::VectorXd, 2> lower_leg_N;  ///< L_k, each lower leg's lateral inertia (N)
   Eigen::VectorXd com_lateral_m;            ///< z_G, filtered
   std::array<Eigen::VectorXd, 2> foot_N;    ///< per foot (right, left), zero without contact
 };
@@ -44,8 +51,12 @@ struct MediolateralForces {
 /// `landmark_lab_m`: each landmark's lab position (unfiltered), N x 3; `lateral_axis`: each
 /// frame's lateral axis, N x 3 (a turning walk's rotates: the acceleration is taken in the lab and
 /// projected, so the frame's rotation adds nothing); `motion`: the sagittal motion (its model's
-/// masses, its rate and frames); `cutoff_hz`: the dynamics' kinematic cut-off.
+/// masses, its rate and frames); `cutoff_hz`: the whole body's lateral acceleration's cut-off
+/// (EstimateOptions::lateral_cutoff_hz); `leg_cutoff_hz`: the lower legs' (the dynamics'
+/// kinematic cut-off; 0: `cutoff_hz`); `own_leg_inertia` false: the load share alone (the
+/// split before issue 28's third step, for comparison).
 MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
-                                       const Eigen::MatrixX3d& lateral_axis, double cutoff_hz, const std::array<FootLoad, 2>& feet);
+                                       const Eigen::MatrixX3d& lateral_axis, double cutoff_hz, const std::array<FootLoad, 2>& feet,
+                                       double leg_cutoff_hz = 0.0, bool own_leg_inertia = true);
 
 }  // namespace kin2grf
