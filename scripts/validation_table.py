@@ -227,7 +227,8 @@ print("\n## The 3D model (`--model 3d`)\n")
 print("The sagittal figures above are the 3D model's too: it adds to them, per foot, the mediolateral force and the "
       "COP's lateral place, and per leg the ankle's, the knee's and the hip's 3D moments by bottom-up inverse dynamics "
       "(dynamics/joint_moments_3d.hpp), run once with the estimate's ground reaction and once with the plates' on "
-      "the same kinematics. The mediolateral force: the whole body's lateral acceleration (filtered at 3 Hz), each "
+      "the same kinematics. The mediolateral force: the whole body's lateral acceleration (filtered at 3 Hz; the arms and "
+      "the head as segments of their own where their markers hold data), each "
       "foot in contact carrying its own lower leg's lateral inertia and the rest shared by vertical load. The COP's lateral place: on the line from the heel to the forefoot's "
       "midline at the COP's place along the foot. Lateral knee, ankle and 5th-metatarsal markers are moved to the "
       "joint centres and the foot's midline (docs/MARKERSETS.md, \"surface\"). Per stance: the lateral force's "
@@ -237,7 +238,7 @@ print("The sagittal figures above are the 3D model's too: it adds to them, per f
       "reaction's frontal and transverse moments about the GRM reference on the walker's midline, where every loaded "
       "foot is on a plate (the estimate's free moment is zero, the plates' is in theirs); per stance, the free moment's RMSE, which with the estimate's zero is the plate's own RMS "
       "(a .mot without torque columns reads 0). No value of the 3D model "
-      "was fitted except the lateral cut-off and the split's rule, chosen leave-one-lab-out (below); the joint and foot geometry are anatomical ratios.\n")
+      "was fitted except the lateral cut-off, the split's rule and the arms' and head's segments, chosen leave-one-lab-out (below); the joint and foot geometry are anatomical ratios.\n")
 print("| activity | trial | lab | stances | lateral force rRMSE % | RMSE %BW | r | lateral COP RMSE mm | "
       "KAM rRMSE % | KAM 1st peak est / plates N m/kg | knee sagittal rRMSE % | hip frontal rRMSE % | total frontal / transverse moment rRMSE % | free moment RMSE N m |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -276,6 +277,7 @@ for a, xs in by_activity.items():
 
 labs = sorted({lab_of[name] for _, name, _ in rows})
 LATERAL_SPLITS = {"load": "3d-load", "own-leg": "3d"}
+UPPER_BODY = {"lumped": "3d-lumped", "segments": "3d"}
 
 
 def lolo_table(title, intro, configs, label):
@@ -319,6 +321,9 @@ lolo_table("The lateral force's cut-off", "The whole body's lateral acceleration
 lolo_table("The lateral force's split between the feet", "`--lateral-split`: load (all of the whole body's lateral "
            "force shared by vertical load) or own-leg (each foot in contact carries its own shank's, foot's and toes' "
            "lateral inertia, filtered at the kinematic cut-off, the rest shared by load), at 3 Hz.", LATERAL_SPLITS, "split")
+lolo_table("The arms and the head", "`--upper-body`: lumped (into the torso, as the sagittal model has them) or segments "
+           "(the arms and the head of their own in the lateral force, where the marker set names their markers and the "
+           "file holds them: 5 walks, a run and the drop jump).", UPPER_BODY, "upper body")
 
 print("\n## Excluded stances and notes (defaults)\n")
 for a, name, args in rows:

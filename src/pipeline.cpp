@@ -172,6 +172,7 @@ struct SagittalStage {
   std::optional<double> hip_half_width_m;                       ///< the hip rule's (Landmarks3D)
   std::array<Eigen::MatrixX3d, kLandmarkCount> landmark_lab_m;  ///< with EstimateOptions::mediolateral
   Eigen::MatrixX3d lateral_axis;                                ///< likewise, per frame
+  std::array<Eigen::MatrixX3d, kUpperBodyCount> upper_body_lab_m;  ///< likewise (SagittalWindow's)
   Messages messages;
 };
 
@@ -193,8 +194,10 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   // The samples the landmarks are made of are released as they are used (the trial's, when the
   // caller gave it up).
   MarkerTrajectories* releasable = release ? &release->markers : nullptr;
-  Landmarks3D lm3 = compute_landmarks(set, cleaned ? *cleaned : trial.markers, static_trial ? &static_trial->markers : nullptr,
-                                      o.landmarks, trial.path, releasable);
+  LandmarkOptions lo = o.landmarks;
+  lo.upper_body = o.lateral_force() && o.upper_body_segments;
+  Landmarks3D lm3 = compute_landmarks(set, cleaned ? *cleaned : trial.markers, static_trial ? &static_trial->markers : nullptr, lo,
+                                      trial.path, releasable);
   // Every sample is released now (compute_landmarks lets go of unread markers too). From here on,
   // only the markers' frame count, numbers, times, rate and up axis are read (the trial's, which
   // the cleaned copy shares).
@@ -210,8 +213,9 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   append(msg, std::move(cleaning));
   append(msg, std::move(lm3.messages));
   out.frame = detect_sagittal_frame(lm3, markers, o.landmarks);
-  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, out.frame, markers, o.landmarks, trial.path, o.lateral_force());
+  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, out.frame, markers, lo, trial.path, o.lateral_force());
   out.landmark_lab_m = std::move(win.lab_m);
+  out.upper_body_lab_m = std::move(win.upper_body_lab_m);
   out.lateral_axis = std::move(win.lateral_axis);
   append(msg, std::move(win.messages));
   out.first_index = win.first;
@@ -768,11 +772,16 @@ FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, dou
 
 /// The mediolateral force (EstimateOptions::mediolateral) into each foot's result.
 void mediolateral_stage(const ModelMotion& motion, const SagittalStage& sag, double cutoff_hz, double leg_cutoff_hz, bool own_leg_inertia,
-                        std::array<FootResult, 2>& feet) {
+                        const AnthropometricTable& table, std::array<FootResult, 2>& feet, Messages& messages) {
   std::array<Eigen::VectorXd, 2> vertical{feet[0].force_N.col(1), feet[1].force_N.col(1)};
   std::array<FootLoad, 2> loads;
   for (int k = 0; k < 2; ++k) loads[k] = {&vertical[k], &feet[k].contact};
-  MediolateralForces ml = mediolateral_forces(motion, sag.landmark_lab_m, sag.lateral_axis, cutoff_hz, loads, leg_cutoff_hz, own_leg_inertia);
+  const UpperBodySegments upper = upper_body_segments(sag.upper_body_lab_m, table);
+  if (!upper.parts.empty())
+    messages.push_back("upper body: " + upper.description +
+                       (upper.description.find(" and ") != std::string::npos ? " are segments of their own" : " is a segment of its own") +
+                       " in the lateral force");
+  MediolateralForces ml = mediolateral_forces(motion, sag.landmark_lab_m, sag.lateral_axis, cutoff_hz, loads, leg_cutoff_hz, own_leg_inertia, &upper);
   for (int k = 0; k < 2; ++k) feet[k].force_lateral_N = std::move(ml.foot_N[k]);
 }
 
@@ -960,7 +969,8 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m);
   if (o.lateral_force()) {
     const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kin.kinematic_cutoff_hz) : kin.kinematic_cutoff_hz;
-    mediolateral_stage(kin.motion, sag, cutoff, kin.kinematic_cutoff_hz, o.lateral_own_leg_inertia, feet.feet);
+    mediolateral_stage(kin.motion, sag, cutoff, kin.kinematic_cutoff_hz, o.lateral_own_leg_inertia, anthropometric_table(o.anthropometry),
+                       feet.feet, kin.messages);
     lateral_cop_stage(sag.foot_line, feet.feet);
   }
   std::optional<LegMotion3D> legs;

@@ -274,6 +274,9 @@ TEST(MappingFile, MistakesAreRefusedNamingTheLandmark) {
       {"two rules", [&](auto& j) { j["landmarks"]["knee_r"] = {{"marker", "RKJC"}, {"mean", {"RKJC", "LKJC"}}}; }, "two rules"},
       {"unknown landmark", [&](auto& j) { j["landmarks"]["kneee_r"] = {{"marker", "RKJC"}}; }, "unknown landmark 'kneee_r'"},
       {"unknown rule", [&](auto& j) { j["landmarks"]["knee_r"] = {{"markr", "RKJC"}}; }, "unknown rule"},
+      {"unknown upper-body landmark", [&](auto& j) { j["upper_body"] = {{"elbw_r", {"RELB"}}}; }, "unknown upper-body landmark 'elbw_r'"},
+      {"upper-body landmark of no marker", [&](auto& j) { j["upper_body"] = {{"wrist_l", nlohmann::json::array()}}; }, "'wrist_l' names no marker"},
+      {"upper body not an object", [&](auto& j) { j["upper_body"] = {"RELB"}; }, "\"upper_body\" is not an object"},
   };
   EXPECT_NO_THROW((void)parse_marker_set(good, "good.json"));
   for (const auto& c : cases) {

@@ -757,6 +757,63 @@ TEST(Mediolateral, ALandingFootCarriesItsOwnLowerLegsInertia) {
   EXPECT_GT(load_error, 0.7 * peak);
 }
 
+// The arms as segments of their own (--upper-body segments, MarkerSet::upper_body): the squat's
+// body still sideways, its right forearm and hand swinging 10 cm sideways at 1 Hz about the
+// elbow. The lateral force is then that arm's m a (forearm at its COM fraction, hand at the
+// wrist), through the whole chain (the set's markers, the landmarks, the window, the force);
+// lumped into the torso it is nothing. A marker the file lacks lumps its arm, and says so.
+TEST(Mediolateral, AnArmOfItsOwnCarriesItsSidewaysSwing) {
+  Trial t = make_synthetic_trial({});
+  const Eigen::Index n = t.markers.frames();
+  const auto& S = t.markers.positions_m[static_cast<std::size_t>(t.markers.find("RSHO"))];
+  const double A = 0.10, w = 2 * M_PI * 1.0;
+  Eigen::MatrixX3d elbow = S, wrist = S;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    elbow(i, 2) -= 0.30;
+    wrist(i, 2) -= 0.55;
+    wrist(i, 1) += A * std::sin(w * t.markers.time_s[i]);
+  }
+  t.markers.names.insert(t.markers.names.end(), {"RELB", "RWRI"});
+  t.markers.positions_m.push_back(elbow);
+  t.markers.positions_m.push_back(wrist);
+  MarkerSet set = *find_marker_set("kin2grf-example");
+  set.upper_body[kShoulderR] = {"RSHO"};
+  set.upper_body[kElbowR] = {"RELB"};
+  set.upper_body[kWristR] = {"RWRI"};
+  set.upper_body[kShoulderL] = {"LSHO"};
+  set.upper_body[kElbowL] = {"LELB"};  // not in the file
+  set.upper_body[kWristL] = {"LWRI"};
+  EstimateOptions eo;
+  eo.model = ModelKind::ThreeD;
+  const auto r = estimate(t, nullptr, set, eo);
+  eo.upper_body_segments = false;
+  const auto lumped = estimate(t, nullptr, set, eo);
+  const auto& table = anthropometric_table(EstimateOptions{}.anthropometry);
+  double mass = 0;
+  for (const Body& b : r.model().bodies) mass += b.mass_kg;
+  // The forearm's COM moves by its fraction of the wrist's swing, the hand's by all of it.
+  const double swing_kg = mass * (table.forearm.mass_fraction * table.forearm.com_fraction + table.hand.mass_fraction);
+  const double peak = swing_kg * A * w * w;  // about 5 N; Y is the walker's left, the lateral axis its right
+  double worst = 0, lumped_worst = 0;
+  for (Eigen::Index i = n / 4; i < 3 * n / 4; ++i) {
+    const double expected = peak * std::sin(w * r.time_s[i]);  // -(m a) along +Y, with a = -A w^2 sin
+    const double total = r.feet[0].force_lateral_N[i] + r.feet[1].force_lateral_N[i];
+    worst = std::max(worst, std::abs(total - expected));
+    lumped_worst = std::max(lumped_worst, std::abs(lumped.feet[0].force_lateral_N[i] + lumped.feet[1].force_lateral_N[i]));
+  }
+  EXPECT_GT(peak, 3.0);
+  EXPECT_LT(worst, 0.1 * peak);
+  EXPECT_LT(lumped_worst, 0.01 * peak);
+  bool said_arm = false, said_lumped = false;
+  for (const auto& m : r.messages) {
+    said_arm = said_arm || m == "upper body: the right arm is a segment of its own in the lateral force";
+    said_lumped = said_lumped || (m.find("elbow_l: marker LELB") != std::string::npos && m.find("lumped into the torso") != std::string::npos);
+  }
+  EXPECT_TRUE(said_arm);
+  EXPECT_TRUE(said_lumped);
+  EXPECT_EQ(r.feet[0].force_N, lumped.feet[0].force_N);  // the sagittal model keeps its HAT
+}
+
 // --mediolateral adds the lateral force and changes nothing else; without lateral motion (the
 // synthetic squat) it is near zero, and the lab-frame outputs carry it.
 TEST(Mediolateral, TheOptionChangesNoSagittalResult) {

@@ -114,6 +114,10 @@ struct EstimateOptions {
   /// Each foot in contact carries its own lower leg's lateral inertia, the rest shared by load
   /// (dynamics/mediolateral.hpp); false: the load share alone.
   bool lateral_own_leg_inertia = true;
+  /// The arms and the head as segments of their own in the lateral force, where the marker set
+  /// names their markers and the file holds them (MarkerSet::upper_body); false: lumped into the
+  /// HAT, as the sagittal model has them.
+  bool upper_body_segments = true;
   ModelKind model = ModelKind::Sagittal;
   [[nodiscard]] bool lateral_force() const { return mediolateral || model == ModelKind::ThreeD; }
   /// Called with (frames solved, frames in all) every 1 % of the contact solve; empty: none.

@@ -5,9 +5,31 @@
 
 namespace kin2grf {
 
+UpperBodySegments upper_body_segments(const std::array<Eigen::MatrixX3d, kUpperBodyCount>& p, const AnthropometricTable& t) {
+  UpperBodySegments out;
+  std::vector<std::string> names;
+  for (int side = 0; side < 2; ++side) {
+    const auto& S = p[static_cast<std::size_t>(side ? kShoulderL : kShoulderR)];
+    const auto& E = p[static_cast<std::size_t>(side ? kElbowL : kElbowR)];
+    const auto& W = p[static_cast<std::size_t>(side ? kWristL : kWristR)];
+    if (S.rows() == 0 || E.rows() != S.rows() || W.rows() != S.rows()) continue;
+    out.parts.push_back({t.upper_arm.mass_fraction, S + t.upper_arm.com_fraction * (E - S)});
+    out.parts.push_back({t.forearm.mass_fraction, E + t.forearm.com_fraction * (W - E)});
+    out.parts.push_back({t.hand.mass_fraction, W});
+    names.emplace_back(side ? "the left arm" : "the right arm");
+  }
+  if (p[kHead].rows() > 0) {
+    out.parts.push_back({t.head.mass_fraction, p[kHead]});
+    names.emplace_back("the head");
+  }
+  for (std::size_t k = 0; k < names.size(); ++k)
+    out.description += (k == 0 ? "" : k + 1 == names.size() ? " and " : ", ") + names[k];
+  return out;
+}
+
 MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
                                        const Eigen::MatrixX3d& lateral_axis, double cutoff_hz, const std::array<FootLoad, 2>& feet,
-                                       double leg_cutoff_hz, bool own_leg_inertia) {
+                                       double leg_cutoff_hz, bool own_leg_inertia, const UpperBodySegments* upper) {
   const Model& model = *motion.model;
   const Eigen::Index n = motion.frames();
   bool sizes = lateral_axis.rows() == n;
@@ -24,6 +46,12 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
   const auto lateral_part = [&](const Eigen::MatrixXd& a) -> Eigen::VectorXd { return (a.array() * lateral_axis.array()).rowwise().sum().matrix(); };
   Eigen::MatrixXd com = Eigen::MatrixXd::Zero(n, 3);
   for (int s = 0; s < kSegmentCount; ++s) com += first_moment(s) / mass;
+  if (upper)
+    for (const auto& part : upper->parts) {
+      if (part.com_m.rows() != n) throw InputError("mediolateral force: an upper-body segment does not match the motion's frames");
+      // The part's mass moves from the HAT's COM to its own.
+      com += part.mass_fraction * (part.com_m - first_moment(kTorso) / model.bodies[kTorso].mass_kg);
+    }
   if (cutoff_hz > 0) com = butterworth_filtfilt(std::move(com), motion.rate_hz, cutoff_hz);
   MediolateralForces out;
   out.com_lateral_m = lateral_part(com);

@@ -112,6 +112,23 @@ MarkerSet parse_marker_set(const nlohmann::json& j, const std::string& source) {
         throw InputError(source + ": landmark '" + landmark_name(id) + "' names no marker");
       s.rules[static_cast<std::size_t>(id)] = rule;
     }
+    // Optional: the arms' and the head's landmarks, each the mean of the markers named.
+    if (j.contains("upper_body")) {
+      const auto& ub = j["upper_body"];
+      if (!ub.is_object()) throw InputError(source + ": \"upper_body\" is not an object of landmark: [markers]");
+      for (const auto& [key, value] : ub.items()) {
+        int id = -1;
+        std::string names;
+        for (int k = 0; k < kUpperBodyCount; ++k) {
+          if (key == upper_body_name(k)) id = k;
+          names += std::string(k ? ", " : "") + upper_body_name(k);
+        }
+        if (id < 0) throw InputError(source + ": unknown upper-body landmark '" + key + "' (they are: " + names + ")");
+        auto markers = value.get<std::vector<std::string>>();
+        if (markers.empty()) throw InputError(source + ": upper-body landmark '" + key + "' names no marker");
+        s.upper_body[static_cast<std::size_t>(id)] = std::move(markers);
+      }
+    }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(source + ": invalid marker-set file: " + e.what());
   }

@@ -184,6 +184,11 @@ Eigen::MatrixX3d functional_joint_centre(const std::vector<Eigen::MatrixX3d>& pr
 
 const char* landmark_name(int id) { return kNames[id]; }
 
+const char* upper_body_name(int id) {
+  static const char* const names[kUpperBodyCount] = {"shoulder_r", "elbow_r", "wrist_r", "shoulder_l", "elbow_l", "wrist_l", "head"};
+  return names[id];
+}
+
 namespace {
 /// The mean of every marker at frame i, or NaN.
 Eigen::Vector3d marker_centroid(const MarkerTrajectories& m, Eigen::Index i) {
@@ -287,7 +292,11 @@ const char* rule_kind_name(RuleKind kind) {
 
 std::optional<MarkerSet> without_trunk_markers(const MarkerSet& set, std::string& why) {
   const LandmarkRule& shoulder = set.rules[kShoulder];
-  if (shoulder.kind == RuleKind::PelvisUp) return set;
+  if (shoulder.kind == RuleKind::PelvisUp) {
+    MarkerSet out = set;
+    out.upper_body = {};  // no arm or head markers either
+    return out;
+  }
   const LandmarkRule& hip = set.rules[kHip];
   const bool from_pelvis = hip.kind == RuleKind::Harrington && !hip.pelvis.empty();
   const bool from_markers = (hip.kind == RuleKind::Mean || hip.kind == RuleKind::Marker) && !hip.markers.empty();
@@ -304,6 +313,7 @@ std::optional<MarkerSet> without_trunk_markers(const MarkerSet& set, std::string
   r.sway_gain = kTrunkSwayGain;
   if (from_pelvis) r.pelvis = hip.pelvis;
   else r.markers = hip.markers;  // upright above their mean
+  out.upper_body = {};
   return out;
 }
 
@@ -469,6 +479,22 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
     for (std::size_t k = 0; k < last_use.size(); ++k)
       if (last_use[k] == id) release->positions_m[k].resize(0, 3);
   };
+  // The upper body's landmarks first: their markers may be released by the loop below.
+  if (options.upper_body)
+    for (int id = 0; id < kUpperBodyCount; ++id) {
+      const auto& names = set.upper_body[static_cast<std::size_t>(id)];
+      if (names.empty()) continue;
+      // An arm or the head is optional: a marker not in the file (or under a repeated label)
+      // lumps its part into the torso rather than refusing the trial.
+      std::string absent;
+      for (const auto& name : names)
+        if (m.find(name) < 0 || occurrences(m, name) > 1) absent += (absent.empty() ? "" : ", ") + name;
+      if (!absent.empty()) {
+        out.messages.push_back(std::string(upper_body_name(id)) + ": marker " + absent + " not in the file (or repeated): its part is lumped into the torso");
+        continue;
+      }
+      out.upper_body[static_cast<std::size_t>(id)] = mean_of(m, names, path, std::string("landmark ") + upper_body_name(id));
+    }
   release_after(-1);
   for (int id = 0; id < kLandmarkCount; ++id) {
     const LandmarkRule& r = set.rules[static_cast<std::size_t>(id)];
@@ -674,39 +700,79 @@ namespace {
 
 /// Short gaps filled in place (cubic Hermite between the valid neighbours, tangents by central
 /// differences there), each named in `messages`; `ok` false on the frames of the gaps left.
+/// A landmark's gaps of up to `max_gap` frames with defined frames on both sides, filled by a
+/// cubic Hermite curve (end slopes from the neighbours); returns the gaps it filled and, in
+/// `unfilled`, the others, as [first, end) frame ranges.
+using FrameRange = std::pair<Eigen::Index, Eigen::Index>;
+std::vector<FrameRange> fill_gaps(Eigen::MatrixX3d& P, int max_gap, std::vector<FrameRange>& unfilled) {
+  const Eigen::Index n = P.rows();
+  std::vector<FrameRange> filled;
+  Eigen::Index i = 0;
+  while (i < n) {
+    if (P.row(i).allFinite()) { ++i; continue; }
+    Eigen::Index j = i;
+    while (j < n && !P.row(j).allFinite()) ++j;
+    const Eigen::Index len = j - i;
+    if (i > 0 && j < n && len <= max_gap) {
+      const Eigen::Index i0 = i - 1, i1 = j;
+      const double span = static_cast<double>(i1 - i0);
+      const Eigen::RowVector3d p1 = P.row(i0), p2 = P.row(i1);
+      const Eigen::RowVector3d d1 = (i0 > 0 && P.row(i0 - 1).allFinite()) ? Eigen::RowVector3d((p2 - P.row(i0 - 1)) / (span + 1))
+                                                                       : Eigen::RowVector3d((p2 - p1) / span);
+      const Eigen::RowVector3d d2 = (i1 + 1 < n && P.row(i1 + 1).allFinite()) ? Eigen::RowVector3d((P.row(i1 + 1) - p1) / (span + 1))
+                                                                          : Eigen::RowVector3d((p2 - p1) / span);
+      for (Eigen::Index k = i; k < j; ++k) {
+        const double t = static_cast<double>(k - i0) / span, t2 = t * t, t3 = t2 * t;
+        P.row(k) = (2 * t3 - 3 * t2 + 1) * p1 + (t3 - 2 * t2 + t) * span * d1 + (-2 * t3 + 3 * t2) * p2 + (t3 - t2) * span * d2;
+      }
+      filled.emplace_back(i, j);
+    } else {
+      unfilled.emplace_back(i, j);
+    }
+    i = j;
+  }
+  return filled;
+}
+
 void fill_short_gaps(std::array<Eigen::MatrixX3d, kLandmarkCount>& p, const MarkerSet& set, const MarkerTrajectories& m,
                      const LandmarkOptions& o, std::vector<bool>& ok, std::vector<std::string>& messages) {
-  const Eigen::Index n = m.frames();
   for (int id = 0; id < kLandmarkCount; ++id) {
     if (set.rules[static_cast<std::size_t>(id)].kind == RuleKind::VirtualHallux) continue;
-    auto& P = p[static_cast<std::size_t>(id)];
-    Eigen::Index i = 0;
-    while (i < n) {
-      if (P.row(i).allFinite()) { ++i; continue; }
-      Eigen::Index j = i;
-      while (j < n && !P.row(j).allFinite()) ++j;
-      const Eigen::Index len = j - i;
-      if (i > 0 && j < n && len <= o.max_gap_frames) {
-        const Eigen::Index i0 = i - 1, i1 = j;
-        const double span = static_cast<double>(i1 - i0);
-        const Eigen::RowVector3d p1 = P.row(i0), p2 = P.row(i1);
-        const Eigen::RowVector3d d1 = (i0 > 0 && P.row(i0 - 1).allFinite()) ? Eigen::RowVector3d((p2 - P.row(i0 - 1)) / (span + 1))
-                                                                         : Eigen::RowVector3d((p2 - p1) / span);
-        const Eigen::RowVector3d d2 = (i1 + 1 < n && P.row(i1 + 1).allFinite()) ? Eigen::RowVector3d((P.row(i1 + 1) - p1) / (span + 1))
-                                                                            : Eigen::RowVector3d((p2 - p1) / span);
-        for (Eigen::Index k = i; k < j; ++k) {
-          const double t = static_cast<double>(k - i0) / span, t2 = t * t, t3 = t2 * t;
-          P.row(k) = (2 * t3 - 3 * t2 + 1) * p1 + (t3 - 2 * t2 + t) * span * d1 + (-2 * t3 + 3 * t2) * p2 +
-                     (t3 - t2) * span * d2;
-        }
-        messages.push_back(std::string(kNames[id]) + ": filled a gap of " + std::to_string(len) + " frames at frames " +
-                           std::to_string(m.first_frame + i) + "-" + std::to_string(m.first_frame + j - 1));
-      } else {
-        for (Eigen::Index k = i; k < j; ++k) ok[static_cast<std::size_t>(k)] = false;
-      }
-      i = j;
-    }
+    std::vector<FrameRange> unfilled;
+    for (const auto& [i, j] : fill_gaps(p[static_cast<std::size_t>(id)], o.max_gap_frames, unfilled))
+      messages.push_back(std::string(kNames[id]) + ": filled a gap of " + std::to_string(j - i) + " frames at frames " +
+                         std::to_string(m.first_frame + i) + "-" + std::to_string(m.first_frame + j - 1));
+    for (const auto& [i, j] : unfilled)
+      for (Eigen::Index k = i; k < j; ++k) ok[static_cast<std::size_t>(k)] = false;
   }
+}
+
+/// The upper-body landmarks over the window [a, a + len): short gaps filled; one still undefined
+/// somewhere in it is dropped (its part lumped into the HAT), with a message naming the frames.
+std::array<Eigen::MatrixX3d, kUpperBodyCount> upper_body_window(std::array<Eigen::MatrixX3d, kUpperBodyCount>& u, Eigen::Index a,
+                                                                Eigen::Index len, const MarkerTrajectories& m, const LandmarkOptions& o,
+                                                                std::vector<std::string>& messages) {
+  std::array<Eigen::MatrixX3d, kUpperBodyCount> out;
+  for (int id = 0; id < kUpperBodyCount; ++id) {
+    auto& P = u[static_cast<std::size_t>(id)];
+    if (P.rows() < a + len) continue;
+    Eigen::MatrixX3d W = P.middleRows(a, len);
+    P.resize(0, 3);
+    std::vector<FrameRange> unfilled;
+    const auto filled = fill_gaps(W, o.max_gap_frames, unfilled);
+    if (!unfilled.empty()) {
+      Eigen::Index missing = 0;
+      for (const auto& [i, j] : unfilled) missing += j - i;
+      messages.push_back(std::string(upper_body_name(id)) + ": undefined on " + std::to_string(missing) + " frames of the window (from frame " +
+                         std::to_string(m.first_frame + a + unfilled.front().first) + "): its part is lumped into the torso");
+      continue;
+    }
+    for (const auto& [i, j] : filled)
+      messages.push_back(std::string(upper_body_name(id)) + ": filled a gap of " + std::to_string(j - i) + " frames at frames " +
+                         std::to_string(m.first_frame + a + i) + "-" + std::to_string(m.first_frame + a + j - 1));
+    out[static_cast<std::size_t>(id)] = std::move(W);
+  }
+  return out;
 }
 
 /// The longest run of frames where every landmark is defined (`ok`): its first frame and length;
@@ -817,6 +883,7 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
   if (keep_lateral) {
     w.lateral_axis.resize(best_len, 3);
     for (Eigen::Index i = 0; i < best_len; ++i) w.lateral_axis.row(i) = fr.lateral_at(best_a + i).transpose();
+    w.upper_body_lab_m = upper_body_window(lm3.upper_body, best_a, best_len, m, o, w.messages);
   }
   for (int id = 0; id < kLandmarkCount; ++id) {
     s.p[static_cast<std::size_t>(id)].resize(best_len, 2);

@@ -37,6 +37,10 @@ void add_settings_options(CLI::App* c, Settings& a) {
                 "How the feet share the whole body's lateral force (--model 3d): own-leg (each foot in contact carries its own "
                 "lower leg's lateral inertia, the rest by vertical load) or load (all by vertical load)")
       ->check(CLI::IsMember({"own-leg", "load"}))->capture_default_str();
+  c->add_option("--upper-body", a.upper_body,
+                "The arms and the head in the lateral force (--model 3d): segments (their own, where the marker set names their "
+                "markers and the file holds them) or lumped (into the torso, as the sagittal model has them)")
+      ->check(CLI::IsMember({"segments", "lumped"}))->capture_default_str();
   c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
       ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
   c->add_option_function<double>(
@@ -116,6 +120,7 @@ EstimateOptions to_options(const Settings& a) {
   o.mediolateral = a.mediolateral;
   o.model = model_kind(a.model);
   o.lateral_own_leg_inertia = a.lateral_split == "own-leg";
+  o.upper_body_segments = a.upper_body == "segments";
   o.anthropometry = (a.paper && !a.anthropometry_given) ? "winter" : a.anthropometry;
   o.kinematic_cutoff_hz = a.kinematic_cutoff;
   if (a.post_cutoff && a.post_cutoff_cycles_given)
@@ -165,6 +170,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"model", model_kind_name(o.model)},
           {"mediolateral", o.lateral_force()},
           {"lateral_split", o.lateral_own_leg_inertia ? "own-leg" : "load"},
+          {"upper_body", o.upper_body_segments ? "segments" : "lumped"},
           {"torso_length", torso_length_name(o.torso_length)},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"kinematic_cutoff_rule", o.cutoff_from_noise ? "noise" : "fixed"},

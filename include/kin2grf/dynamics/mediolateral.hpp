@@ -6,7 +6,9 @@
 // Total (Newton's second law across the plane; gravity has no lateral part):
 //   F_z(t) = M a_Gz(t),  z_G = sum_s m_s z_s / M,
 // with each segment's COM on the line between its proximal and distal landmarks at its
-// anthropometric fraction (the model's com_local); the COM's lab position is filtered at the
+// anthropometric fraction (the model's com_local), the arms and the head where their markers
+// hold data at their own COMs, their mass taken off the HAT's (UpperBodySegments: an arm swings
+// sideways on its own, 7 N of lateral force on a 70 kg walker at 1 m/s^2); the COM's lab position is filtered at the
 // dynamics' kinematic cut-off, differentiated twice (central differences) and projected on each
 // frame's lateral axis.
 //
@@ -31,9 +33,26 @@
 #include <vector>
 
 #include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/markers/landmarks.hpp"
+#include "kin2grf/model/anthropometry.hpp"
 #include "kin2grf/model/model.hpp"
 
 namespace kin2grf {
+
+/// The arms and the head as segments of their own (kin2grf's 3D model; issue 28): each part's mass
+/// (a fraction of body mass from the anthropometric table) at its own COM's lab position, N x 3,
+/// its mass taken off the HAT's COM. An upper arm's COM lies between shoulder and elbow at its
+/// table fraction, a forearm's between elbow and wrist, the hand's at the wrist, the head's at its
+/// markers' mean. An arm needs its shoulder, elbow and wrist landmarks.
+struct UpperBodySegments {
+  struct Part {
+    double mass_fraction = 0.0;
+    Eigen::MatrixX3d com_m;
+  };
+  std::vector<Part> parts;
+  std::string description;  ///< "the right arm, the left arm and the head"; empty: none
+};
+UpperBodySegments upper_body_segments(const std::array<Eigen::MatrixX3d, kUpperBodyCount>& lab_m, const AnthropometricTable& table);
 
 /// What the split needs of one foot: its vertical force (N) and contact state, per frame.
 struct FootLoad {
@@ -57,6 +76,6 @@ struct MediolateralForces {
 /// split before issue 28's third step, for comparison).
 MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
                                        const Eigen::MatrixX3d& lateral_axis, double cutoff_hz, const std::array<FootLoad, 2>& feet,
-                                       double leg_cutoff_hz = 0.0, bool own_leg_inertia = true);
+                                       double leg_cutoff_hz = 0.0, bool own_leg_inertia = true, const UpperBodySegments* upper = nullptr);
 
 }  // namespace kin2grf

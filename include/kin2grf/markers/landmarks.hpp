@@ -83,11 +83,20 @@ inline constexpr double kVirtualToeShare = 0.3, kMinToeShare = 0.15;
 /// of it from the 1st, plus the soft tissue and the marker's radius). Anatomy, not fitted.
 inline constexpr double kLateralMtToMidline = 0.25;
 
+/// The upper body's landmarks for the arms and the head as segments of their own (the 3D model's
+/// lateral force; the sagittal model keeps them in its HAT): a marker set's optional
+/// "upper_body" object names each one's markers (their mean).
+enum UpperBodyLandmark : int { kShoulderR = 0, kElbowR, kWristR, kShoulderL, kElbowL, kWristL, kHead, kUpperBodyCount };
+/// "shoulder_r", "elbow_r", "wrist_r", "shoulder_l", "elbow_l", "wrist_l", "head".
+const char* upper_body_name(int id);
+
 struct MarkerSet {
   std::string name;
   std::string description;
   std::vector<std::string> signature;  ///< markers whose presence recognises the set
   std::array<LandmarkRule, kLandmarkCount> rules;
+  /// Per UpperBodyLandmark, the markers whose mean it is; empty: none in this set.
+  std::array<std::vector<std::string>, kUpperBodyCount> upper_body;
   bool preset = false;  ///< one of kin2grf's built-in presets (not a user's mapping file)
   /// Every marker a motion trial must have.
   [[nodiscard]] std::vector<std::string> motion_markers() const;
@@ -96,8 +105,9 @@ struct MarkerSet {
 /// The set as if the trial had no trunk or arm markers (an ablation: how much the estimate owes
 /// to them): the shoulder point becomes the model torso above the pelvis (pelvis_up, swaying by
 /// kTrunkSwayGain), above the hip centre of the hip's rule (its pelvis markers, or the mean of
-/// its hip-centre markers). None when the hip centre is made otherwise (`why` says so); a set
-/// without trunk markers already is returned as it is.
+/// its hip-centre markers), and the arms and head are lumped (no upper_body). None when the hip
+/// centre is made otherwise (`why` says so); a set without trunk markers already is returned as it
+/// is, without upper_body.
 std::optional<MarkerSet> without_trunk_markers(const MarkerSet& set, std::string& why);
 
 /// A landmark's name in marker-set files ("shoulder", "hip", "knee_r", ...).
@@ -115,11 +125,16 @@ struct LandmarkOptions {
   std::optional<Axis> up_axis;      ///< default: the file's
   std::optional<int> progression_sign;  ///< +1/-1 along the detected axis; default: detected
   std::optional<Axis> progression_axis;
+  /// Make the upper-body landmarks too (MarkerSet::upper_body): the 3D model's lateral force.
+  bool upper_body = false;
 };
 
 /// 3D landmarks in the lab frame, N x 3 each, NaN where undefined.
 struct Landmarks3D {
   std::array<Eigen::MatrixX3d, kLandmarkCount> p;
+  /// With LandmarkOptions::upper_body, per UpperBodyLandmark whose markers are all in the file;
+  /// empty otherwise.
+  std::array<Eigen::MatrixX3d, kUpperBodyCount> upper_body;
   std::vector<std::string> messages;
   /// Half the distance between the two hip joint centres (m), where the hip rule makes them (the
   /// mean of two hip-centre markers, or Harrington's, whose lateral term is 0.33 PW + 7.3 mm); the
@@ -208,6 +223,9 @@ struct SagittalWindow {
   /// N x 3. Empty otherwise.
   std::array<Eigen::MatrixX3d, kLandmarkCount> lab_m;
   Eigen::MatrixX3d lateral_axis;
+  /// Likewise the upper-body landmarks (lab, m) defined on every frame of the window (short gaps
+  /// filled); empty where not (the part is then lumped into the HAT, and `messages` says so).
+  std::array<Eigen::MatrixX3d, kUpperBodyCount> upper_body_lab_m;
   std::vector<std::string> messages;
 };
 

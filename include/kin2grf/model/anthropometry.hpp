@@ -15,6 +15,12 @@
 // and the foot COM stays at mid ankle-MT (de Leva measures the foot from heel to toe tip).
 // Toes are in neither table: they get 10 % of the foot mass (the foot keeps 90 %), COM at
 // mid MT-hallux, rho 0.29 (a slender rod); documented choices.
+// The upper body's parts (part of the HAT above; the 3D model's lateral force takes the arms and
+// the head as segments of their own where their markers hold data): Winter upper arm 0.028 (COM
+// 0.436 from the shoulder), forearm 0.016 (0.430 from the elbow), hand 0.006, head and neck
+// 0.081; de Leva (male) upper arm 0.0271 (0.5772), forearm 0.0162 (0.4574), hand 0.0061, head
+// 0.0694. The hand's COM is taken at the wrist and the head's at its markers' mean (no hand or
+// skull landmarks), so their COM fractions are not used.
 #pragma once
 
 #include <string>
@@ -30,6 +36,7 @@ struct SegmentInertia {
 struct AnthropometricTable {
   std::string name;
   SegmentInertia hat, thigh, shank, foot, toes;
+  SegmentInertia upper_arm, forearm, hand, head;  ///< parts of the HAT (see above)
 };
 
 const AnthropometricTable& winter_table();
