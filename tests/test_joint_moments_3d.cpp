@@ -279,3 +279,63 @@ TEST(JointMoments3D, AStillLegsHipAdductionMomentIsTheForceTimesItsMedialLever) 
   const JointMoments3D midpoint = joint_moments_3d(leg_motion_3d(model, p, lateral, Eigen::Vector3d::UnitZ(), 100.0, 6.0), feet);
   EXPECT_GT(std::abs(midpoint.hip_Nm[0](n / 2, 1) - m.hip_Nm[0](n / 2, 1)), 10.0);
 }
+
+// Made a block at a time (joint_moments_3d_in_blocks, the estimate's path when nothing keeps the
+// legs' kinematics: a long trial's memory), the moments are those of the whole trial at once,
+// frame for frame, blocks' edges included: the filter runs over the whole trial, and each block
+// carries enough of its neighbours for the differences.
+TEST(JointMoments3D, BlockByBlockGivesTheWholeTrialsMoments) {
+  const Eigen::Index n = 230;
+  const double rate = 100.0;
+  auto p = standing(n);
+  for (int k = 0; k < kLandmarkCount; ++k)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double t = static_cast<double>(i) / rate, s = 0.1 * k;
+      p[static_cast<std::size_t>(k)].row(i) +=
+          Eigen::RowVector3d(1.2 * t + 0.05 * std::sin(6 * t + s), 0.02 * std::sin(3 * t + s), 0.01 * std::cos(5 * t + s));
+    }
+  Eigen::MatrixX3d force(n, 3), cop(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / rate;
+    force.row(i) << 80 * std::sin(4 * t), 30 * std::cos(2 * t), 650 + 100 * std::sin(7 * t);
+    cop.row(i) << 1.2 * t + 0.03, -0.08, 0.0;
+  }
+  const FootWrench3D w = foot_wrench(force, cop, 3 * Eigen::VectorXd::Ones(n), Eigen::Vector3d::UnitZ());
+  const Model model = test_model();
+  const Eigen::MatrixX3d lateral = constant_rows(n, {0, -1, 0});
+  JointCentreOffsets offsets;
+  offsets.hip_half_width_m = 0.08;
+  const JointMoments3D whole =
+      joint_moments_3d(leg_motion_3d(model, p, lateral, Eigen::Vector3d::UnitZ(), rate, 8.0, offsets), {w, w});
+  for (Eigen::Index block : {1, 7, 50, 229, 230, 2000}) {
+    const JointMoments3D blocks = joint_moments_3d_in_blocks(model, p, lateral, Eigen::Vector3d::UnitZ(), rate, 8.0, offsets, {w, w}, block);
+    for (std::size_t k = 0; k < 2; ++k) {
+      ASSERT_EQ(blocks.knee_Nm[k].rows(), n);
+      EXPECT_LT((blocks.knee_Nm[k] - whole.knee_Nm[k]).cwiseAbs().maxCoeff(), 1e-9) << block;
+      EXPECT_LT((blocks.ankle_Nm[k] - whole.ankle_Nm[k]).cwiseAbs().maxCoeff(), 1e-9) << block;
+      EXPECT_LT((blocks.hip_Nm[k] - whole.hip_Nm[k]).cwiseAbs().maxCoeff(), 1e-9) << block;
+      EXPECT_LT((blocks.hip_lab_Nm[k] - whole.hip_lab_Nm[k]).cwiseAbs().maxCoeff(), 1e-9) << block;
+    }
+  }
+  EXPECT_GT(whole.knee_Nm[0].cwiseAbs().maxCoeff(), 10.0);
+}
+
+// The estimate's two paths to the 3D moments, the legs' kinematics kept (validate) or made a block
+// at a time (the command line's estimate), give the same moments on a recorded walk.
+TEST(JointMoments3D, TheEstimateGivesTheSameMomentsWithOrWithoutTheLegsKinematics) {
+  const Trial walk = load_trial(std::string(KIN2GRF_SOURCE_DIR) + "/data/example/walking2.c3d");
+  EstimateOptions eo;
+  eo.mass_kg = 64.9;
+  eo.model = ModelKind::ThreeD;
+  const auto& set = *recognise_marker_set(walk.markers);
+  const EstimateResult kept = estimate(walk, nullptr, set, eo);
+  eo.keep_all_series = false;
+  const EstimateResult blocks = estimate(walk, nullptr, set, eo);
+  ASSERT_TRUE(kept.legs_3d && blocks.legs_3d);
+  EXPECT_GT(kept.legs_3d->motion.frames(), 0);
+  EXPECT_EQ(blocks.legs_3d->motion.frames(), 0);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_LT((kept.legs_3d->moments.knee_Nm[k] - blocks.legs_3d->moments.knee_Nm[k]).cwiseAbs().maxCoeff(), 1e-9);
+    EXPECT_LT((kept.legs_3d->moments.hip_Nm[k] - blocks.legs_3d->moments.hip_Nm[k]).cwiseAbs().maxCoeff(), 1e-9);
+  }
+}

@@ -68,7 +68,15 @@ SegmentMotion3D long_segment_motion(const Body& b, double longitudinal_ratio, co
   return s;
 }
 
-SegmentMotion3D foot_motion(const Model& model, int side, const std::array<Eigen::MatrixX3d, kLandmarkCount>& p, double dt) {
+/// The distance between the foot's and the toes' COMs at frame i (m).
+double foot_toes_com_distance(const Model& model, int side, const std::array<Eigen::MatrixX3d, kLandmarkCount>& p, Eigen::Index i) {
+  const Body& f = model.bodies[static_cast<std::size_t>(segment(side, kFoot))];
+  const Body& t = model.bodies[static_cast<std::size_t>(segment(side, kToes))];
+  return (body_com(f, p).row(i) - body_com(t, p).row(i)).norm();
+}
+
+/// `d`: the foot's and toes' COMs' distance for their common inertia (foot_toes_com_distance).
+SegmentMotion3D foot_motion(const Model& model, int side, const std::array<Eigen::MatrixX3d, kLandmarkCount>& p, double dt, double d) {
   const Body& f = model.bodies[static_cast<std::size_t>(segment(side, kFoot))];
   const Body& t = model.bodies[static_cast<std::size_t>(segment(side, kToes))];
   const Eigen::MatrixX3d& ankle = p[static_cast<std::size_t>(landmark(side, kAnkle))];
@@ -79,9 +87,9 @@ SegmentMotion3D foot_motion(const Model& model, int side, const std::array<Eigen
   const Eigen::MatrixX3d cf = body_com(f, p), ct = body_com(t, p);
   s.com_m = (f.mass_kg * cf + t.mass_kg * ct) / s.mass_kg;
   s.com_acc_mps2 = second_difference(s.com_m, dt);
-  // Transverse inertia of the two about their common COM (parallel axes, at the first frame's
-  // distances: the toes bend little against the foot's size), the long axis's by de Leva's ratio.
-  const double d = (cf.row(0) - ct.row(0)).norm();
+  // Transverse inertia of the two about their common COM (parallel axes, at the trial's first
+  // frame's distance: the toes bend little against the foot's size), the long axis's by de
+  // Leva's ratio.
   const double transverse = f.inertia_kgm2 + t.inertia_kgm2 + f.mass_kg * t.mass_kg / s.mass_kg * d * d;
   s.inertia_kgm2 = {transverse * kFootLongitudinalGyrationRatio * kFootLongitudinalGyrationRatio, transverse, transverse};
   const Eigen::Index n = ankle.rows();
@@ -131,9 +139,13 @@ void move_to_joint_centres(std::array<Eigen::MatrixX3d, kLandmarkCount>& p, cons
 
 }  // namespace
 
-LegMotion3D leg_motion_3d(const Model& model, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
-                          const Eigen::MatrixX3d& lateral_axis, const Eigen::Vector3d& up, double rate_hz, double cutoff_hz,
-                          const JointCentreOffsets& offsets) {
+namespace {
+
+/// leg_motion_3d, with each foot's foot-toes COM distance given (a block of a trial takes the
+/// trial's first frame's) or, when null, taken at the first frame.
+LegMotion3D leg_motion(const Model& model, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
+                       const Eigen::MatrixX3d& lateral_axis, const Eigen::Vector3d& up, double rate_hz, double cutoff_hz,
+                       const JointCentreOffsets& offsets, const std::array<double, 2>* foot_toes_distance) {
   const Eigen::Index n = lateral_axis.rows();
   for (const auto& p : landmark_lab_m)
     if (p.rows() != n) throw InputError("3D joint moments: the landmarks' lab positions do not match the lateral axes' frames");
@@ -159,9 +171,17 @@ LegMotion3D leg_motion_3d(const Model& model, const std::array<Eigen::MatrixX3d,
                                        out.hip_m[k], out.knee_m[k], lateral_axis, dt, "thigh", "hip and knee");
     out.shank[k] = long_segment_motion(model.bodies[static_cast<std::size_t>(segment(side, kShank))], kShankLongitudinalGyrationRatio,
                                        out.knee_m[k], out.ankle_m[k], lateral_axis, dt, "shank", "knee and ankle");
-    out.foot[k] = foot_motion(model, side, p, dt);
+    out.foot[k] = foot_motion(model, side, p, dt, foot_toes_distance ? (*foot_toes_distance)[k] : foot_toes_com_distance(model, side, p, 0));
   }
   return out;
+}
+
+}  // namespace
+
+LegMotion3D leg_motion_3d(const Model& model, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
+                          const Eigen::MatrixX3d& lateral_axis, const Eigen::Vector3d& up, double rate_hz, double cutoff_hz,
+                          const JointCentreOffsets& offsets) {
+  return leg_motion(model, landmark_lab_m, lateral_axis, up, rate_hz, cutoff_hz, offsets, nullptr);
 }
 
 std::array<double, 2> stance_peaks(const Eigen::VectorXd& kam, Eigen::Index first, Eigen::Index last) {
@@ -223,6 +243,54 @@ JointMoments3D joint_moments_3d(const LegMotion3D& legs, const std::array<FootWr
       out.ankle_Nm[k].row(i) = anatomical(Ma, foot.R(i), side);
       out.knee_Nm[k].row(i) = anatomical(Mk, shank.R(i), side);
       out.hip_Nm[k].row(i) = anatomical(Mh, thigh.R(i), side);
+    }
+  }
+  return out;
+}
+
+JointMoments3D joint_moments_3d_in_blocks(const Model& model, std::array<Eigen::MatrixX3d, kLandmarkCount> filtered,
+                                          const Eigen::MatrixX3d& lateral_axis, const Eigen::Vector3d& up, double rate_hz, double cutoff_hz,
+                                          const JointCentreOffsets& offsets, const std::array<FootWrench3D, 2>& feet, Eigen::Index block_frames) {
+  const Eigen::Index n = lateral_axis.rows();
+  if (block_frames < 1) throw InputError("3D joint moments: a block needs at least one frame");
+  // The filter is the one step over the whole trial (zero-lag: every frame sees both ends).
+  for (auto& q : filtered) {
+    if (q.rows() != n) throw InputError("3D joint moments: the landmarks' lab positions do not match the lateral axes' frames");
+    if (cutoff_hz > 0 && n > 3 && q.allFinite()) q = butterworth_filtfilt(Eigen::MatrixXd(std::move(q)), rate_hz, cutoff_hz);
+  }
+  // The trial's first frame's foot-toes distances (as the whole trial's leg_motion_3d takes them).
+  std::array<double, 2> distance{0.0, 0.0};
+  if (n > 0) {
+    std::array<Eigen::MatrixX3d, kLandmarkCount> first;
+    for (int k = 0; k < kLandmarkCount; ++k) first[static_cast<std::size_t>(k)] = filtered[static_cast<std::size_t>(k)].topRows(1);
+    for (int side = 0; side < 2; ++side) move_to_joint_centres(first, lateral_axis.topRows(1), side, offsets);
+    for (int side = 0; side < 2; ++side) distance[static_cast<std::size_t>(side)] = foot_toes_com_distance(model, side, first, 0);
+  }
+  JointMoments3D out;
+  for (int side = 0; side < 2; ++side) {
+    const auto k = static_cast<std::size_t>(side);
+    if (feet[k].force_N.rows() != n || feet[k].moment_origin_Nm.rows() != n)
+      throw InputError(std::string("3D joint moments: the ") + side_name(side) + " foot's ground reaction does not match the frames");
+    for (auto* m : {&out.ankle_Nm[k], &out.knee_Nm[k], &out.hip_Nm[k], &out.ankle_lab_Nm[k], &out.knee_lab_Nm[k], &out.hip_lab_Nm[k]})
+      m->resize(n, 3);
+  }
+  for (Eigen::Index a = 0; a < n; a += block_frames) {
+    const Eigen::Index len = std::min(block_frames, n - a);
+    const Eigen::Index lo = std::max<Eigen::Index>(0, a - kBlockHaloFrames), hi = std::min(n, a + len + kBlockHaloFrames);
+    std::array<Eigen::MatrixX3d, kLandmarkCount> p;
+    for (int k = 0; k < kLandmarkCount; ++k) p[static_cast<std::size_t>(k)] = filtered[static_cast<std::size_t>(k)].middleRows(lo, hi - lo);
+    std::array<FootWrench3D, 2> w;
+    for (std::size_t k = 0; k < 2; ++k)
+      w[k] = {feet[k].force_N.middleRows(lo, hi - lo), feet[k].moment_origin_Nm.middleRows(lo, hi - lo)};
+    const JointMoments3D m =
+        joint_moments_3d(leg_motion(model, p, lateral_axis.middleRows(lo, hi - lo), up, rate_hz, 0.0, offsets, &distance), w);
+    for (std::size_t k = 0; k < 2; ++k) {
+      out.ankle_Nm[k].middleRows(a, len) = m.ankle_Nm[k].middleRows(a - lo, len);
+      out.knee_Nm[k].middleRows(a, len) = m.knee_Nm[k].middleRows(a - lo, len);
+      out.hip_Nm[k].middleRows(a, len) = m.hip_Nm[k].middleRows(a - lo, len);
+      out.ankle_lab_Nm[k].middleRows(a, len) = m.ankle_lab_Nm[k].middleRows(a - lo, len);
+      out.knee_lab_Nm[k].middleRows(a, len) = m.knee_lab_Nm[k].middleRows(a - lo, len);
+      out.hip_lab_Nm[k].middleRows(a, len) = m.hip_lab_Nm[k].middleRows(a - lo, len);
     }
   }
   return out;

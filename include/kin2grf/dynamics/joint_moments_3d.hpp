@@ -132,6 +132,18 @@ struct JointMoments3D {
 
 JointMoments3D joint_moments_3d(const LegMotion3D& legs, const std::array<FootWrench3D, 2>& feet);
 
+/// joint_moments_3d(leg_motion_3d(...), feet) made `block_frames` frames at a time: the landmarks
+/// filtered once over the whole trial, then each block's leg kinematics (with kBlockHaloFrames of
+/// its neighbours on each side, so that its differences are those of the whole) made, used and let
+/// go. The same moments frame for frame, with one block's kinematics (about 1.2 kB a frame) held
+/// instead of the trial's: a long trial's memory when nothing else needs the legs' kinematics.
+inline constexpr Eigen::Index kBlockHaloFrames = 4;
+/// `landmark_lab_m` is taken (filtered in place): moved in, it is not copied.
+JointMoments3D joint_moments_3d_in_blocks(const Model& model, std::array<Eigen::MatrixX3d, kLandmarkCount> landmark_lab_m,
+                                          const Eigen::MatrixX3d& lateral_axis, const Eigen::Vector3d& up, double rate_hz, double cutoff_hz,
+                                          const JointCentreOffsets& offsets, const std::array<FootWrench3D, 2>& feet,
+                                          Eigen::Index block_frames = 2000);
+
 /// The external knee adduction moment (N m) from joint_moments_3d's knee: -frontal; at frame i.
 inline Eigen::VectorXd knee_adduction_moment(const JointMoments3D& m, int side) { return -m.knee_Nm[static_cast<std::size_t>(side)].col(1); }
 inline double knee_adduction_moment(const JointMoments3D& m, int side, Eigen::Index i) { return -m.knee_Nm[static_cast<std::size_t>(side)](i, 1); }
