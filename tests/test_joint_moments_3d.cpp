@@ -46,6 +46,29 @@ std::array<Eigen::MatrixX3d, kLandmarkCount> standing(Eigen::Index n) {
 
 Eigen::MatrixX3d constant_rows(Eigen::Index n, const Eigen::Vector3d& v) { return v.transpose().replicate(n, 1); }
 
+/// Swinging, swaying, toed-out legs walking at 1.2 m/s (each landmark moving differently), and a
+/// ground reaction whose three components and COP vary: the moving, loaded legs of the frame and
+/// block tests.
+struct MovingLegs {
+  std::array<Eigen::MatrixX3d, kLandmarkCount> p;
+  Eigen::MatrixX3d force, cop;
+};
+MovingLegs moving_loaded_legs(Eigen::Index n, double rate) {
+  MovingLegs m{standing(n), Eigen::MatrixX3d(n, 3), Eigen::MatrixX3d(n, 3)};
+  for (int k = 0; k < kLandmarkCount; ++k)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double t = static_cast<double>(i) / rate, s = 0.1 * k;
+      m.p[static_cast<std::size_t>(k)].row(i) +=
+          Eigen::RowVector3d(1.2 * t + 0.05 * std::sin(6 * t + s), 0.02 * std::sin(3 * t + s), 0.01 * std::cos(5 * t + s));
+    }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / rate;
+    m.force.row(i) << 80 * std::sin(4 * t), 30 * std::cos(2 * t), 650 + 100 * std::sin(7 * t);
+    m.cop.row(i) << 1.2 * t + 0.03, -0.08, 0.0;
+  }
+  return m;
+}
+
 /// Each foot under a vertical force F (N) whose COP lies d (m) medial of its knee, 5 cm ahead.
 std::array<FootWrench3D, 2> vertical_force_medial_of_the_knees(const std::array<Eigen::MatrixX3d, kLandmarkCount>& p, double F, double d) {
   const Eigen::Index n = p[kKneeR].rows();
@@ -123,20 +146,7 @@ TEST(JointMoments3D, AFreelyFallingLegNeedsNoMoment) {
 TEST(JointMoments3D, TurningTheLabAboutTheVerticalChangesNoMoment) {
   const Eigen::Index n = 120;
   const double rate = 100.0;
-  auto p = standing(n);
-  // A swinging, swaying, toed-out leg: each landmark moves differently.
-  for (int k = 0; k < kLandmarkCount; ++k)
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double t = static_cast<double>(i) / rate, s = 0.1 * k;
-      p[static_cast<std::size_t>(k)].row(i) +=
-          Eigen::RowVector3d(1.2 * t + 0.05 * std::sin(6 * t + s), 0.02 * std::sin(3 * t + s), 0.01 * std::cos(5 * t + s));
-    }
-  Eigen::MatrixX3d force(n, 3), cop(n, 3);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double t = static_cast<double>(i) / rate;
-    force.row(i) << 80 * std::sin(4 * t), 30 * std::cos(2 * t), 650 + 100 * std::sin(7 * t);
-    cop.row(i) << 1.2 * t + 0.03, -0.08, 0.0;
-  }
+  const auto [p, force, cop] = moving_loaded_legs(n, rate);
   const Eigen::VectorXd free = 3 * Eigen::VectorXd::Ones(n);
   const Model model = test_model();
   auto moments = [&](double angle) {
@@ -287,19 +297,7 @@ TEST(JointMoments3D, AStillLegsHipAdductionMomentIsTheForceTimesItsMedialLever) 
 TEST(JointMoments3D, BlockByBlockGivesTheWholeTrialsMoments) {
   const Eigen::Index n = 230;
   const double rate = 100.0;
-  auto p = standing(n);
-  for (int k = 0; k < kLandmarkCount; ++k)
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double t = static_cast<double>(i) / rate, s = 0.1 * k;
-      p[static_cast<std::size_t>(k)].row(i) +=
-          Eigen::RowVector3d(1.2 * t + 0.05 * std::sin(6 * t + s), 0.02 * std::sin(3 * t + s), 0.01 * std::cos(5 * t + s));
-    }
-  Eigen::MatrixX3d force(n, 3), cop(n, 3);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double t = static_cast<double>(i) / rate;
-    force.row(i) << 80 * std::sin(4 * t), 30 * std::cos(2 * t), 650 + 100 * std::sin(7 * t);
-    cop.row(i) << 1.2 * t + 0.03, -0.08, 0.0;
-  }
+  const auto [p, force, cop] = moving_loaded_legs(n, rate);
   const FootWrench3D w = foot_wrench(force, cop, 3 * Eigen::VectorXd::Ones(n), Eigen::Vector3d::UnitZ());
   const Model model = test_model();
   const Eigen::MatrixX3d lateral = constant_rows(n, {0, -1, 0});
