@@ -8,9 +8,10 @@
 // with each segment's COM on the line between its proximal and distal landmarks at its
 // anthropometric fraction (the model's com_local), the arms and the head where their markers
 // hold data at their own COMs, their mass taken off the HAT's (UpperBodySegments: an arm swings
-// sideways on its own, 7 N of lateral force on a 70 kg walker at 1 m/s^2); the COM's lab position is filtered at the
-// dynamics' kinematic cut-off, differentiated twice (central differences) and projected on each
-// frame's lateral axis.
+// sideways on its own, 7 N of lateral force on a 70 kg walker at 1 m/s^2); the COM's lab
+// position is low-pass filtered (`cutoff_hz`, EstimateOptions::lateral_cutoff_hz: the body's
+// sway is slow, the skin markers' noise is not), differentiated twice (central differences) and
+// projected on each frame's lateral axis.
 //
 // Split between the feet in contact (k = right, left). Each foot in contact carries its own
 // lower leg's lateral inertia (shank, foot and toes: L_k = sum m_s a_s,z over them), the rest
@@ -22,10 +23,12 @@
 // strike, 10-20 N on the development walks) while it takes almost no weight yet; the load share
 // alone gave that force to the trailing foot. The lower legs' motion is the crisp one (bony
 // landmarks, not the trunk's skin): it is filtered at the dynamics' kinematic cut-off, the whole
-// body's at `cutoff_hz`. The thigh stays in the shared part: its proximal end is the pelvis's. An inverted-pendulum split (each foot's reaction
-// pointing from its COP to the COM, F_y,k (z_G - z_k) / (y_G - y_ground), which gives the feet
-// opposite signs in double support) was measured and lost on every development lab's walks
-// (per-foot rRMSE 24-53 % against 14-33 %; docs/METHOD-NOTES.md).
+// body's at `cutoff_hz`. The thigh stays in the shared part: its proximal end is the pelvis's.
+// An inverted-pendulum split (each foot's reaction pointing from its COP to the COM,
+// F_y,k (z_G - z_k) / (y_G - y_ground), which gives the feet opposite signs in double support)
+// was measured and lost on every development lab's walks (per-foot rRMSE 24-53 % against
+// 14-33 %; docs/METHOD-NOTES.md), and so did a share of it added in double support only
+// (session 22: 16.1 -> 16.2-19.2 % walking at weights 0.15-0.5).
 #pragma once
 
 #include <Eigen/Dense>
