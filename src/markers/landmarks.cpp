@@ -698,8 +698,6 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
 
 namespace {
 
-/// Short gaps filled in place (cubic Hermite between the valid neighbours, tangents by central
-/// differences there), each named in `messages`; `ok` false on the frames of the gaps left.
 /// A landmark's gaps of up to `max_gap` frames with defined frames on both sides, filled by a
 /// cubic Hermite curve (end slopes from the neighbours); returns the gaps it filled and, in
 /// `unfilled`, the others, as [first, end) frame ranges.
@@ -734,6 +732,8 @@ std::vector<FrameRange> fill_gaps(Eigen::MatrixX3d& P, int max_gap, std::vector<
   return filled;
 }
 
+/// Short gaps filled in place (fill_gaps), each named in `messages`; `ok` false on the frames of
+/// the gaps left.
 void fill_short_gaps(std::array<Eigen::MatrixX3d, kLandmarkCount>& p, const MarkerSet& set, const MarkerTrajectories& m,
                      const LandmarkOptions& o, std::vector<bool>& ok, std::vector<std::string>& messages) {
   for (int id = 0; id < kLandmarkCount; ++id) {
