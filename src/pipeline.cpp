@@ -976,19 +976,18 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   // The 3D model's legs: validate drives their kinematics again with the plates, so the result
   // keeps them (keep_all_series); otherwise they are made a block at a time (about 1.2 kB a frame
   // held for a block, not for the trial) once the feet's wrenches are known.
+  const auto release_lab = [&sag] {
+    sag.landmark_lab_m = {};
+    sag.lateral_axis = Eigen::MatrixX3d();
+  };
   std::optional<LegMotion3D> legs;
   std::optional<JointCentreOffsets> offsets;
   if (o.model == ModelKind::ThreeD) {
     offsets = joint_centre_offsets(set, trial, *mod.model, sag.hip_half_width_m, kin.messages);
-    if (o.keep_all_series) {
+    if (o.keep_all_series)
       legs = leg_motion_3d(*mod.model, sag.landmark_lab_m, sag.lateral_axis, sag.frame.up, kin.motion.rate_hz, kin.kinematic_cutoff_hz, *offsets);
-      sag.landmark_lab_m = {};
-      sag.lateral_axis = Eigen::MatrixX3d();
-    }
-  } else {
-    sag.landmark_lab_m = {};
-    sag.lateral_axis = Eigen::MatrixX3d();
   }
+  if (!offsets || legs) release_lab();  // the blocks below are the only other reader
   TotalsStage totals = totals_stage(o, kin.motion, feet.feet, ground_level_m);
 
   EstimateResult r = assemble_result(set.name, mass_kg, sag, mod, kin, dyn, feet, totals, iterations, o);
@@ -998,8 +997,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   } else if (offsets) {
     JointMoments3D moments = joint_moments_3d_in_blocks(*mod.model, std::move(sag.landmark_lab_m), sag.lateral_axis, r.frame.up, kin.motion.rate_hz,
                                                         kin.kinematic_cutoff_hz, *offsets, estimated_wrenches(r));
-    sag.landmark_lab_m = {};
-    sag.lateral_axis = Eigen::MatrixX3d();
+    release_lab();
     r.legs_3d = Legs3D{LegMotion3D(), std::move(moments)};
   }
   r.cycled_frames = cycled_frames;

@@ -46,24 +46,30 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
   const auto lateral_part = [&](const Eigen::MatrixXd& a) -> Eigen::VectorXd { return (a.array() * lateral_axis.array()).rowwise().sum().matrix(); };
   Eigen::MatrixXd com = Eigen::MatrixXd::Zero(n, 3);
   for (int s = 0; s < kSegmentCount; ++s) com += first_moment(s) / mass;
-  if (upper)
+  if (upper && !upper->parts.empty()) {
+    const Eigen::MatrixXd hat_com = first_moment(kTorso) / model.bodies[kTorso].mass_kg;
     for (const auto& part : upper->parts) {
       if (part.com_m.rows() != n) throw InputError("mediolateral force: an upper-body segment does not match the motion's frames");
       // The part's mass moves from the HAT's COM to its own.
-      com += part.mass_fraction * (part.com_m - first_moment(kTorso) / model.bodies[kTorso].mass_kg);
+      com += part.mass_fraction * (part.com_m - hat_com);
     }
+  }
   if (cutoff_hz > 0) com = butterworth_filtfilt(std::move(com), motion.rate_hz, cutoff_hz);
   MediolateralForces out;
   out.com_lateral_m = lateral_part(com);
   out.total_N = mass * lateral_part(second_difference(com, 1.0 / motion.rate_hz));
+  const double leg_cutoff = leg_cutoff_hz > 0 ? leg_cutoff_hz : cutoff_hz;
   for (int k = 0; k < 2; ++k) {
-    Eigen::MatrixXd leg = Eigen::MatrixXd::Zero(n, 3);
-    if (own_leg_inertia)
-      for (LegSegment s : {kShank, kFoot, kToes}) leg += first_moment(segment(k, s));
-    const double c = leg_cutoff_hz > 0 ? leg_cutoff_hz : cutoff_hz;
-    if (own_leg_inertia && c > 0) leg = butterworth_filtfilt(std::move(leg), motion.rate_hz, c);
-    out.lower_leg_N[static_cast<std::size_t>(k)] = own_leg_inertia ? lateral_part(second_difference(leg, 1.0 / motion.rate_hz)) : Eigen::VectorXd::Zero(n);
     out.foot_N[static_cast<std::size_t>(k)] = Eigen::VectorXd::Zero(n);
+    auto& lower_leg = out.lower_leg_N[static_cast<std::size_t>(k)];
+    if (!own_leg_inertia) {
+      lower_leg = Eigen::VectorXd::Zero(n);
+      continue;
+    }
+    Eigen::MatrixXd leg = Eigen::MatrixXd::Zero(n, 3);
+    for (LegSegment s : {kShank, kFoot, kToes}) leg += first_moment(segment(k, s));
+    if (leg_cutoff > 0) leg = butterworth_filtfilt(std::move(leg), motion.rate_hz, leg_cutoff);
+    lower_leg = lateral_part(second_difference(leg, 1.0 / motion.rate_hz));
   }
   for (Eigen::Index i = 0; i < n; ++i) {
     std::array<double, 2> fy{0.0, 0.0};
