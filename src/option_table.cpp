@@ -20,11 +20,14 @@ const std::vector<NumericOption>& numeric_options() {
        "Shift the ground by this much, m (robustness study)",
        {-0.01, 0.0, 0.01}, "%+.0f mm", 1000.0},
       {"speed-gate-ratio", "speed_gate_ratio", [](O& o) -> double& { return o.contact.speed_gate.ratio; }, 0.0, 20.0, 0.0,
-       "The speed gate as this multiple of the progression speed (hip or belt), at least --speed-gate-floor; 0 = the fixed "
-       "--speed-gate"},  // its study crosses it with the floor (validation/study)
+       "The speed gate as this multiple of the progression speed (hip or belt), at least --speed-gate-standstill (near a flight "
+       "phase --speed-gate-floor); 0 = the fixed --speed-gate"},  // its study varies the ratio alone (validation/study)
       {"speed-gate-floor", "speed_gate_floor_mps", [](O& o) -> double& { return o.contact.speed_gate.floor_mps; }, 0.0, 20.0, std::nullopt,
-       "Lowest speed gate with --speed-gate-ratio, m/s",
+       "Lowest speed gate with --speed-gate-ratio near a flight phase (a jump's or a run's landing), m/s",
        {0.2, 0.3, 0.5, 0.75, 1.0}, "%.2f m/s"},
+      {"speed-gate-standstill", "speed_gate_standstill_mps", [](O& o) -> double& { return o.contact.speed_gate.standstill_mps; }, 0.0,
+       20.0, std::nullopt, "Lowest speed gate with --speed-gate-ratio away from flight phases (a slow walk, standing), m/s",
+       {0.05, 0.1, 0.2, 0.3, 0.5, 0.75}, "%.2f m/s"},
       {"touchdown-fraction", "touchdown_fraction", [](O& o) -> double& { return o.contact.touchdown_fraction; }, 0.0, 1.0, 0.0,
        "A landing foot takes no load before its descent speed, past the final approach's peak, has fallen to this fraction of the "
        "peak (1: from the peak on; 0 = off, the default and the paper)",

@@ -126,6 +126,9 @@ void check_options(const EstimateOptions& o) {
           "speed gate ratio", o.contact.speed_gate.ratio, "between 0 (a fixed gate) and 20");
   require(finite(o.contact.speed_gate.floor_mps) && o.contact.speed_gate.floor_mps >= 0 && o.contact.speed_gate.floor_mps <= 20,
           "speed gate floor (m/s)", o.contact.speed_gate.floor_mps, "between 0 and 20");
+  require(finite(o.contact.speed_gate.standstill_mps) && o.contact.speed_gate.standstill_mps >= 0 &&
+              o.contact.speed_gate.standstill_mps <= 20,
+          "speed gate at standstill (m/s)", o.contact.speed_gate.standstill_mps, "between 0 and 20");
   require(finite(o.solver.min_split_distance_m) && o.solver.min_split_distance_m >= 0 && o.solver.min_split_distance_m <= 1,
           "split distance (m)", o.solver.min_split_distance_m, "between 0 (none) and 1");
   require(finite(o.torso_lag_s) && o.torso_lag_s >= 0 && o.torso_lag_s <= 0.2, "torso lag (s)", o.torso_lag_s,
@@ -351,6 +354,7 @@ Messages lag_torso_stage(const EstimateOptions& o, ModelMotion& motion) {
 /// velocity, always, on a treadmill, from every frame's contact points; the progression speed and
 /// the speed gate) and, with the touchdown rule, each foot's landing frames (landing_frames).
 struct ContactPlan {
+  std::vector<bool> near_flight;              ///< frames near a flight phase (flight_frames), where it matters
   std::vector<bool> running;                  ///< frames that take the running COP function
   std::array<std::vector<bool>, 2> landing;   ///< per side, frames where the foot is still landing (landing_frames)
   TrialCalibration calibration;
@@ -362,8 +366,13 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
                           const ModelMotion& motion) {
   ContactPlan plan;
   const ContactModelOptions& co = o.contact;
-  if (co.foot_model == FootModel::Cop && co.running_cop) {
-    plan.running = flight_frames(model, motion, soles);
+  const bool running_cop = co.foot_model == FootModel::Cop && co.running_cop;
+  // The flight phases: for the running COP function, and for the speed gate where its floor near
+  // a flight differs from its gate elsewhere (SpeedGateRule::floor_mps).
+  const SpeedGateRule& gate = co.speed_gate;
+  if (running_cop || (gate.ratio > 0 && gate.floor_mps != gate.standstill_mps)) plan.near_flight = flight_frames(model, motion, soles);
+  if (running_cop) {
+    plan.running = plan.near_flight;
     const auto nrun = std::count(plan.running.begin(), plan.running.end(), true);
     if (nrun > 0) {
       char b[160];
@@ -409,12 +418,20 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
     }
   }
   cal.progression_speed_mps = treadmill ? std::abs(cal.belt_velocity_mps) : hip_speed_mps;
-  cal.speed_gate_mps = speed_gate_for(o.contact.speed_gate, cal.progression_speed_mps);
-  if (o.contact.speed_gate.ratio > 0) {
-    char b[160];
+  cal.speed_gate_mps = speed_gate_for(gate, cal.progression_speed_mps);
+  cal.flight_speed_gate_mps = speed_gate_for(gate, cal.progression_speed_mps, true);
+  if (gate.ratio > 0) {
+    char b[240];
     std::snprintf(b, sizeof b, "contact speed gate %.2f m/s (%.2f x the progression speed %.2f m/s, at least %.2f)", cal.speed_gate_mps,
-                  o.contact.speed_gate.ratio, cal.progression_speed_mps, o.contact.speed_gate.floor_mps);
-    plan.messages.push_back(b);
+                  gate.ratio, cal.progression_speed_mps, gate.standstill_mps);
+    std::string said = b;
+    const auto near = std::count(plan.near_flight.begin(), plan.near_flight.end(), true);
+    if (near > 0 && cal.flight_speed_gate_mps != cal.speed_gate_mps) {
+      std::snprintf(b, sizeof b, "; %.2f m/s (at least %.2f) on the %ld frames near a flight phase, where a landing foot still moves in the "
+                    "filtered kinematics", cal.flight_speed_gate_mps, gate.floor_mps, static_cast<long>(near));
+      said += b;
+    }
+    plan.messages.push_back(said);
   }
   if (touchdown) {
     LandingRule rule;
@@ -531,6 +548,7 @@ RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCa
       motion.frame(i, f);
       contact_frame(model, calibration.contact, o.contact, is_running_frame(running, i), f, fc);
       for (int side = 0; side < 2; ++side) fc.landing[side] = flag_at(plan.landing[side], i);
+      fc.near_flight = flag_at(plan.near_flight, i);
       const FrameSolution s = solver.solve(f.q, f.qdd, fc);
       record_frame(raw, i, fc, s, o.keep_all_series);
       if (keep_torque_map) {

@@ -41,6 +41,19 @@ TEST(Contact, FlightFramesAreFoundFromTheKinematicsAlone) {
       EXPECT_FALSE(run[static_cast<std::size_t>(i)]) << time;  // far from it
     }
   }
+  // The speed gate's floor holds near the flight alone (SpeedGateRule::floor_mps), whatever COP
+  // function the frames take: the estimate says on how many frames.
+  for (const bool running_cop : {true, false}) {
+    EstimateOptions o;
+    if (!running_cop) o.contact.running_cop.reset();
+    const auto e = estimate(t, nullptr, *find_marker_set("kin2grf-example"), o);
+    EXPECT_NEAR(e.calibration.flight_speed_gate_mps, 0.75, 1e-12);
+    EXPECT_LT(e.calibration.speed_gate_mps, 0.75);
+    const std::string near = std::to_string(std::count(run.begin(), run.end(), true)) + " frames near a flight phase";
+    bool said = false;
+    for (const auto& m : e.messages) said = said || (m.find("contact speed gate") != std::string::npos && m.find(near) != std::string::npos);
+    EXPECT_TRUE(said) << running_cop;
+  }
   for (const double depth : {0.0, 1.0}) {  // quiet standing and squats: never
     SyntheticOptions sq;
     sq.squat_depth = depth;

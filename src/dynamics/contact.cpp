@@ -9,9 +9,9 @@
 
 namespace kin2grf {
 
-double speed_gate_for(const SpeedGateRule& rule, double v) {
+double speed_gate_for(const SpeedGateRule& rule, double v, bool near_flight) {
   if (rule.ratio <= 0) return std::max(0.0, rule.fixed_mps);
-  return std::max(rule.floor_mps, rule.ratio * std::abs(v));
+  return std::max(near_flight ? rule.floor_mps : rule.standstill_mps, rule.ratio * std::abs(v));
 }
 
 namespace {

@@ -31,10 +31,11 @@ using TallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxK + kBilatera
 // 3 equations, or more in the dense fallback of a degenerate frame (63 - rank of B).
 using Fit = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, coord::kCount, kMaxK>;
 
-/// The frame's candidate points (bit j: point j): the speed gate removes a point sliding faster
-/// than it along the ground (or belt) before the iterations, and a foot still landing
-/// (landing_frames) takes no load yet.
-unsigned candidate_points(const FrameContacts& fc, double speed_gate_mps, double belt_velocity_mps) {
+/// The frame's candidate points (bit j: point j): the speed gate (near a flight phase, the flight
+/// gate) removes a point sliding faster than it along the ground (or belt) before the iterations,
+/// and a foot still landing (landing_frames) takes no load yet.
+unsigned candidate_points(const FrameContacts& fc, double speed_gate_mps, double flight_speed_gate_mps, double belt_velocity_mps) {
+  if (fc.near_flight) speed_gate_mps = flight_speed_gate_mps;
   const int np = static_cast<int>(fc.points.size());
   unsigned allowed = (1U << np) - 1U;
   for (int j = 0; j < np; ++j) {
@@ -95,7 +96,7 @@ FillPattern symbolic_factor(const Eigen::MatrixXd& Phi, std::array<int, kBilater
 
 ContactSolver::ContactSolver(const Model& model, const TrialCalibration& calibration, const SolverOptions& options)
     : model_(model), options_(options), belt_velocity_mps_(calibration.belt_velocity_mps),
-      speed_gate_mps_(calibration.speed_gate_mps), Phi_(Eigen::MatrixXd::Zero(kBilateralCount, coord::kCount)) {
+      speed_gate_mps_(calibration.speed_gate_mps), flight_speed_gate_mps_(calibration.flight_speed_gate_mps), Phi_(Eigen::MatrixXd::Zero(kBilateralCount, coord::kCount)) {
   mass_ = model.mass_diagonal();
   gravity_ = model.gravity_force();
   weight_bilateral_ = Eigen::VectorXd::Ones(kBilateralCount);
@@ -332,7 +333,7 @@ FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixX
 
   FrameSolution sol;
   sol.contact_lambda = SmallVector::Zero(k);
-  const unsigned allowed = candidate_points(fc, speed_gate_mps_, belt_velocity_mps_);
+  const unsigned allowed = candidate_points(fc, speed_gate_mps_, flight_speed_gate_mps_, belt_velocity_mps_);
   unsigned active = allowed;
   std::uint64_t seen = 0;  // the active sets tried (2^6 of them at most)
   SmallVector lamC = SmallVector::Zero(k);

@@ -60,6 +60,9 @@ struct TrialCalibration {
   /// belt's speed.
   double progression_speed_mps = 0.0;
   double speed_gate_mps = 0.0;  ///< the trial's contact speed gate (speed_gate_for); 0: none
+  /// The gate on frames near a flight phase (FrameContacts::near_flight: landings from a jump or
+  /// a run's flight), speed_gate_for(..., true); 0: none.
+  double flight_speed_gate_mps = 0.0;
 };
 
 /// One row of a contact point's Jacobian, d(y)/dq or d(x)/dq (63 wide), by its non-zeros: a
@@ -107,24 +110,29 @@ struct FrameContacts {
   /// Per side, the foot is still landing this frame (landing_frames()): none of its points may be
   /// active. Set by the caller of contact_frame (the pipeline), which knows the whole descent.
   std::array<bool, 2> landing{};
+  /// The frame is within flight_frames()' window of a flight phase: the solver takes
+  /// TrialCalibration::flight_speed_gate_mps. Set by the caller, as `landing` is.
+  bool near_flight = false;
 };
 
 /// The contact speed gate's rule (kin2grf, not the paper). The pipeline resolves it once per
-/// trial (speed_gate_for) into TrialCalibration::speed_gate_mps, the only gate the solver reads.
+/// trial (speed_gate_for) into TrialCalibration::speed_gate_mps and, for the frames near a flight
+/// phase, TrialCalibration::flight_speed_gate_mps: the only gates the solver reads.
 struct SpeedGateRule {
   /// A fixed gate (m/s), used when ratio is 0: a contact point may be active only while its
   /// horizontal speed relative to the ground (or belt) is below it; <= 0 disables the gate (the paper). kin2grf's default: 1.5
   /// (`kin2grf study speed-gate`: walking flat from 0.5 to 3 m/s, running best at 1-1.5 m/s).
   double fixed_mps = 1.5;
   /// The gate relative to the subject's progression speed v (overground: the hip's; treadmill:
-  /// the belt's): when > 0 the trial's gate is max(floor_mps, ratio x v)
-  /// and fixed_mps is not used. Why: a stance contact point stays (nearly) still on the
-  /// ground at any speed, while a swing foot moves at 2-3 v; a fixed 1.5 m/s lets a 0.4 m/s
-  /// walker's swing foot (about 1 m/s, 8-12 mm above the floor) take the load, and cuts a
-  /// sprinter's landing. The floor keeps standing and squatting trials (v ~ 0) gated only
-  /// against feet that really slide. See speed_gate_for() and `kin2grf study speed-gate-ratio`.
-  /// kin2grf's default 0.7 x v, at least 0.75 m/s (the floor: `kin2grf study speed-gate-floor`;
-  /// it acts only where 0.7 v is below it, on these trials the drop jump alone, which needs it).
+  /// the belt's): when > 0 the trial's gate is max(standstill_mps, ratio x v), and near a flight
+  /// phase max(floor_mps, ratio x v); fixed_mps is not used. Why: a stance contact point stays
+  /// (nearly) still on the ground at any speed, while a swing foot moves at 2-3 v; a fixed
+  /// 1.5 m/s lets a 0.4 m/s walker's swing foot (about 1 m/s, 8-12 mm above the floor) take the
+  /// load, and cuts a sprinter's landing. See speed_gate_for() and `kin2grf study speed-gate-ratio`.
+  /// kin2grf's default 0.7 x v; near a flight at least 0.75 m/s (`kin2grf study
+  /// speed-gate-floor`: on these trials it acts on the drop jump alone, which needs it: its
+  /// landing feet still move in the 6 Hz kinematics, which spread the impact's stop over
+  /// +-40 ms), elsewhere at least standstill_mps.
   /// Chosen leave-one-lab-out, `kin2grf study speed-gate-ratio --cross-validate lab` with the
   /// ratio alone at the default floor (14 trials, 8 labs): 6 labs' held-out choice is 0.7, 2 take
   /// 0.5; held out, walking 6.6 / 7.8 / 6.1 % (vertical / anterior / COP), GRM 5.6 %, at 1 x v
@@ -139,12 +147,21 @@ struct SpeedGateRule {
   /// lab whose trials cannot tell the floors apart took the grid's first floor, which cost the
   /// drop jump 1.7 points and hid the gain.
   double ratio = 0.7;
+  /// The lowest gate near a flight phase (m/s): a landing from a jump or a run.
   double floor_mps = 0.75;
+  /// The lowest gate elsewhere (m/s), for a walker however slow and for standing (v ~ 0): a foot
+  /// at rest seen through the markers' noise and the 6 Hz filter moves at about 0.02 m/s (2 mm
+  /// of noise at 60-100 Hz), so 0.1 m/s leaves it 5 x that margin. Until session 23 the floor
+  /// held everywhere: a 0.36 m/s walk was gated at 0.75 m/s, twice its speed, and its swing foot,
+  /// hovering 7-10 mm up and slower than that for 200 ms, took load 180 ms before it landed (issue
+  /// 29). No development walk is slower than 1.07 m/s (0.7 v > 0.75), so on them the two are one.
+  double standstill_mps = 0.1;
 };
 
 /// The trial's speed gate (m/s) for a progression speed v (m/s): rule.fixed_mps, or with a ratio
-/// max(rule.floor_mps, rule.ratio x |v|); 0 = no gate.
-double speed_gate_for(const SpeedGateRule& rule, double progression_speed_mps);
+/// max(rule.standstill_mps, rule.ratio x |v|), near a flight phase max(rule.floor_mps,
+/// rule.ratio x |v|); 0 = no gate.
+double speed_gate_for(const SpeedGateRule& rule, double progression_speed_mps, bool near_flight = false);
 
 struct ContactModelOptions {
   FootModel foot_model = FootModel::Cop;

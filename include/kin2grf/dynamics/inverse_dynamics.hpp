@@ -104,7 +104,7 @@ class ContactSolver {
   FrameSolution solve_dense(const Eigen::MatrixXd& B, const FrameVector& qdd, const FrameContacts& contacts);
   const Model& model_;
   SolverOptions options_;
-  double belt_velocity_mps_ = 0.0, speed_gate_mps_ = 0.0;  ///< the trial's (TrialCalibration)
+  double belt_velocity_mps_ = 0.0, speed_gate_mps_ = 0.0, flight_speed_gate_mps_ = 0.0;  ///< the trial's (TrialCalibration)
   Eigen::VectorXd mass_, gravity_, weight_bilateral_;
   Eigen::MatrixXd Phi_;  ///< the frame's bilateral Jacobian (60 x 63), reused
   // The structure of N = Phi Phi^T and of its factor, found once (constructor).
