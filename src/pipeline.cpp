@@ -335,8 +335,9 @@ KinematicsStage kinematics_stage(const EstimateOptions& o, const std::shared_ptr
 
 /// The upper body's fore-aft lag: what the trunk markers do not already show of it
 /// (lag_torso_fore_aft, measured_torso_lag_s). The motion is changed in place.
-Messages lag_torso_stage(const EstimateOptions& o, ModelMotion& motion) {
+Messages lag_torso_stage(const EstimateOptions& o, ModelMotion& motion, double& added_s) {
   Messages out;
+  added_s = 0.0;
   if (!(o.torso_lag_s > 0)) return out;
   const double measured = measured_torso_lag_s(motion);
   const double added = std::clamp(o.torso_lag_s - measured, 0.0, o.torso_lag_s);
@@ -347,6 +348,7 @@ Messages lag_torso_stage(const EstimateOptions& o, ModelMotion& motion) {
     out.emplace_back(b);
   }
   lag_torso_fore_aft(motion, added);
+  added_s = added;
   return out;
 }
 
@@ -367,10 +369,13 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
   ContactPlan plan;
   const ContactModelOptions& co = o.contact;
   const bool running_cop = co.foot_model == FootModel::Cop && co.running_cop;
-  // The flight phases: for the running COP function, and for the speed gate where its floor near
-  // a flight differs from its gate elsewhere (SpeedGateRule::floor_mps).
+  // The flight phases: for the running COP function, for the speed gate where its floor near a
+  // flight differs from its gate elsewhere (SpeedGateRule::floor_mps), and for the lateral force's
+  // torso lag, which they do not take (EstimateOptions::lateral_torso_lag).
   const SpeedGateRule& gate = co.speed_gate;
-  if (running_cop || (gate.ratio > 0 && gate.floor_mps != gate.standstill_mps)) plan.near_flight = flight_frames(model, motion, soles);
+  const bool lateral_lag = o.lateral_force() && o.lateral_torso_lag && o.torso_lag_s > 0;
+  if (running_cop || lateral_lag || (gate.ratio > 0 && gate.floor_mps != gate.standstill_mps))
+    plan.near_flight = flight_frames(model, motion, soles);
   if (running_cop) {
     plan.running = plan.near_flight;
     const auto nrun = std::count(plan.running.begin(), plan.running.end(), true);
@@ -583,6 +588,7 @@ struct DynamicsPass {
   ContactPlan plan;  ///< its messages: the torso lag's first, then the contact stage's
   RawSolve raw;
   double seconds_kinematics = 0, seconds_dynamics = 0;
+  double torso_lag_added_s = 0;  ///< the upper body's delay lag_torso_stage added (the lateral force takes it too)
 };
 DynamicsPass dynamics_pass(const EstimateOptions& o, const Model& model, const ContactCalibration& soles, bool treadmill,
                            double hip_speed_mps, ModelMotion& motion, const std::function<void(long, long)>& progress,
@@ -590,7 +596,7 @@ DynamicsPass dynamics_pass(const EstimateOptions& o, const Model& model, const C
   using clock = std::chrono::steady_clock;
   const auto ta = clock::now();
   DynamicsPass pass;
-  Messages lag = lag_torso_stage(o, motion);
+  Messages lag = lag_torso_stage(o, motion, pass.torso_lag_added_s);
   pass.plan = contact_stage(o, model, soles, treadmill, hip_speed_mps, motion);
   pass.plan.messages.insert(pass.plan.messages.begin(), std::make_move_iterator(lag.begin()), std::make_move_iterator(lag.end()));
   const auto tb = clock::now();
@@ -790,6 +796,7 @@ FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, dou
 
 /// The mediolateral force (EstimateOptions::mediolateral) into each foot's result.
 void mediolateral_stage(const ModelMotion& motion, const SagittalStage& sag, double cutoff_hz, double leg_cutoff_hz, bool own_leg_inertia,
+                        double upper_body_lag_s, const std::vector<bool>& near_flight,
                         const AnthropometricTable& table, std::array<FootResult, 2>& feet, Messages& messages) {
   std::array<Eigen::VectorXd, 2> vertical{feet[0].force_N.col(1), feet[1].force_N.col(1)};
   std::array<FootLoad, 2> loads;
@@ -799,7 +806,9 @@ void mediolateral_stage(const ModelMotion& motion, const SagittalStage& sag, dou
     messages.push_back("upper body: " + upper.description +
                        (upper.description.find(" and ") != std::string::npos ? " are segments of their own" : " is a segment of its own") +
                        " in the lateral force");
-  MediolateralForces ml = mediolateral_forces(motion, sag.landmark_lab_m, sag.lateral_axis, cutoff_hz, loads, leg_cutoff_hz, own_leg_inertia, &upper);
+  MediolateralForces ml =
+      mediolateral_forces(motion, sag.landmark_lab_m, sag.lateral_axis, cutoff_hz, loads, leg_cutoff_hz, own_leg_inertia, &upper, upper_body_lag_s,
+                          &near_flight);
   for (int k = 0; k < 2; ++k) feet[k].force_lateral_N = std::move(ml.foot_N[k]);
 }
 
@@ -987,7 +996,9 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m);
   if (o.lateral_force()) {
     const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kin.kinematic_cutoff_hz) : kin.kinematic_cutoff_hz;
-    mediolateral_stage(kin.motion, sag, cutoff, kin.kinematic_cutoff_hz, o.lateral_own_leg_inertia, anthropometric_table(o.anthropometry),
+    const double lateral_lag_s = o.lateral_torso_lag ? dyn.torso_lag_added_s : 0.0;
+    mediolateral_stage(kin.motion, sag, cutoff, kin.kinematic_cutoff_hz, o.lateral_own_leg_inertia, lateral_lag_s, dyn.plan.near_flight,
+                       anthropometric_table(o.anthropometry),
                        feet.feet, kin.messages);
     lateral_cop_stage(sag.foot_line, feet.feet);
   }

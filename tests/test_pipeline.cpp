@@ -658,6 +658,43 @@ TEST(Mediolateral, TheFeetCarryTheBodysLateralAccelerationSharedByLoad) {
   EXPECT_LT((single.foot_N[0] - single.total_N).cwiseAbs().maxCoeff(), 1e-9 * peak);
 }
 
+// The torso's lateral lag (EstimateOptions::lateral_torso_lag): the body sways at 1 Hz, every
+// landmark alike; with a delay tau the trunk's share of the mass (the HAT, here with no arm or
+// head of its own) accelerates tau late, the rest on time, so the total is
+// -M_rest A w^2 sin(w t) - M_trunk A w^2 sin(w (t - tau)). Frames near a flight phase take the
+// total as measured.
+TEST(Mediolateral, TheTorsosShareSwaysLateAwayFromFlightPhases) {
+  const auto r = run({});
+  const Eigen::Index n = r.time_s.size();
+  const double A = 0.03, w = 2 * M_PI * 1.0, tau = 0.03;
+  std::array<Eigen::MatrixX3d, kLandmarkCount> lab;
+  for (auto& p : lab) {
+    p = Eigen::MatrixX3d::Zero(n, 3);
+    for (Eigen::Index i = 0; i < n; ++i) p(i, 1) = A * std::sin(w * r.time_s[i]);
+  }
+  const Eigen::MatrixX3d lateral = Eigen::RowVector3d(0, 1, 0).replicate(n, 1);
+  std::array<Eigen::VectorXd, 2> fy{r.feet[0].force_N.col(1), r.feet[1].force_N.col(1)};
+  const std::array<FootLoad, 2> loads{FootLoad{&fy[0], &r.feet[0].contact}, FootLoad{&fy[1], &r.feet[1].contact}};
+  double mass = 0;
+  for (const Body& b : r.model().bodies) mass += b.mass_kg;
+  const double trunk = r.model().bodies[kTorso].mass_kg, peak = mass * A * w * w;
+  std::vector<bool> near(static_cast<std::size_t>(n), false);
+  for (Eigen::Index i = n / 2; i < n; ++i) near[static_cast<std::size_t>(i)] = true;  // a flight in the second half
+  const MediolateralForces lagged = mediolateral_forces(r.motion, lab, lateral, 6.0, loads, 0.0, true, nullptr, tau, &near);
+  const MediolateralForces plain = mediolateral_forces(r.motion, lab, lateral, 6.0, loads);
+  for (Eigen::Index i = n / 8; i < 3 * n / 8; ++i) {
+    const double t = r.time_s[i];
+    const double expected = -(mass - trunk) * A * w * w * std::sin(w * t) - trunk * A * w * w * std::sin(w * (t - tau));
+    EXPECT_NEAR(lagged.total_N[i], expected, 0.01 * peak) << "frame " << i;
+    EXPECT_NEAR(lagged.foot_N[0][i] + lagged.foot_N[1][i], lagged.total_N[i], 1e-9 * peak);
+  }
+  // The delay matters: the trunk is over half the mass, and 30 ms is 11 degrees of a 1 Hz sway.
+  double largest = 0;
+  for (Eigen::Index i = n / 8; i < 3 * n / 8; ++i) largest = std::max(largest, std::abs(lagged.total_N[i] - plain.total_N[i]));
+  EXPECT_GT(largest, 0.05 * peak);
+  for (Eigen::Index i = n / 2; i < n; ++i) EXPECT_EQ(lagged.total_N[i], plain.total_N[i]) << "frame " << i;
+}
+
 // The lateral force's cut-off (EstimateOptions::lateral_cutoff_hz, 3 Hz): the body's sway is slow,
 // the markers' noise is not. A 3 cm sway at 1 Hz seen through 1 mm of noise on every landmark
 // coordinate: at 3 Hz the total follows M a within a few % of its peak, at the 6 Hz kinematic

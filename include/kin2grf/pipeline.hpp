@@ -118,6 +118,10 @@ struct EstimateOptions {
   /// names their markers and the file holds them (MarkerSet::upper_body); false: lumped into the
   /// HAT, as the sagittal model has them.
   bool upper_body_segments = true;
+  /// The torso's share of the whole body's lateral acceleration takes the upper body's lag
+  /// (torso_lag_s, less what the trunk markers already lag the hip by: the fore-aft's own delay),
+  /// away from flight phases; false: none (dynamics/mediolateral.hpp).
+  bool lateral_torso_lag = true;
   ModelKind model = ModelKind::Sagittal;
   [[nodiscard]] bool lateral_force() const { return mediolateral || model == ModelKind::ThreeD; }
   /// Called with (frames solved, frames in all) every 1 % of the contact solve; empty: none.

@@ -1,4 +1,5 @@
 #include "kin2grf/dynamics/mediolateral.hpp"
+#include <algorithm>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/kinematics/filter.hpp"
@@ -27,9 +28,28 @@ UpperBodySegments upper_body_segments(const std::array<Eigen::MatrixX3d, kUpperB
   return out;
 }
 
+namespace {
+
+/// x delayed by d frames (row i takes x at i - d, linearly interpolated; the first row before
+/// the first frame).
+Eigen::MatrixXd delayed(const Eigen::MatrixXd& x, double d) {
+  const Eigen::Index n = x.rows();
+  Eigen::MatrixXd out(n, x.cols());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = std::max(0.0, static_cast<double>(i) - d);
+    const auto a = std::min<Eigen::Index>(static_cast<Eigen::Index>(t), n - 1), b = std::min<Eigen::Index>(a + 1, n - 1);
+    const double w = t - static_cast<double>(a);
+    out.row(i) = (1 - w) * x.row(a) + w * x.row(b);
+  }
+  return out;
+}
+
+}  // namespace
+
 MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
                                        const Eigen::MatrixX3d& lateral_axis, double cutoff_hz, const std::array<FootLoad, 2>& feet,
-                                       double leg_cutoff_hz, bool own_leg_inertia, const UpperBodySegments* upper) {
+                                       double leg_cutoff_hz, bool own_leg_inertia, const UpperBodySegments* upper, double upper_body_lag_s,
+                                       const std::vector<bool>* near_flight) {
   const Model& model = *motion.model;
   const Eigen::Index n = motion.frames();
   bool sizes = lateral_axis.rows() == n;
@@ -45,19 +65,33 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
   };
   const auto lateral_part = [&](const Eigen::MatrixXd& a) -> Eigen::VectorXd { return (a.array() * lateral_axis.array()).rowwise().sum().matrix(); };
   Eigen::MatrixXd com = Eigen::MatrixXd::Zero(n, 3);
-  for (int s = 0; s < kSegmentCount; ++s) com += first_moment(s) / mass;
-  if (upper && !upper->parts.empty()) {
-    const Eigen::MatrixXd hat_com = first_moment(kTorso) / model.bodies[kTorso].mass_kg;
+  for (int s = 0; s < kSegmentCount; ++s)
+    if (s != kTorso) com += first_moment(s) / mass;
+  // The upper body: the HAT's COM with its share of the mass, less the parts of their own (arms,
+  // head), each at its own COM.
+  const Eigen::MatrixXd hat_com = first_moment(kTorso) / model.bodies[kTorso].mass_kg;
+  double trunk_share = model.bodies[kTorso].mass_kg / mass;
+  if (upper)
     for (const auto& part : upper->parts) {
       if (part.com_m.rows() != n) throw InputError("mediolateral force: an upper-body segment does not match the motion's frames");
-      // The part's mass moves from the HAT's COM to its own.
-      com += part.mass_fraction * (part.com_m - hat_com);
+      com += part.mass_fraction * part.com_m;
+      trunk_share -= part.mass_fraction;
     }
-  }
-  if (cutoff_hz > 0) com = butterworth_filtfilt(std::move(com), motion.rate_hz, cutoff_hz);
+  const auto filtered = [&](Eigen::MatrixXd x) { return cutoff_hz > 0 ? butterworth_filtfilt(std::move(x), motion.rate_hz, cutoff_hz) : x; };
   MediolateralForces out;
+  const double dt = 1.0 / motion.rate_hz;
+  if (upper_body_lag_s > 0) {
+    // The trunk's share delayed (its acceleration a(t - tau)); near a flight phase as measured.
+    const Eigen::VectorXd lagged = mass * lateral_part(second_difference(filtered(com + delayed(trunk_share * hat_com, upper_body_lag_s * motion.rate_hz)), dt));
+    com = filtered(com + trunk_share * hat_com);
+    out.total_N = mass * lateral_part(second_difference(com, dt));
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (!(near_flight && i < static_cast<Eigen::Index>(near_flight->size()) && (*near_flight)[static_cast<std::size_t>(i)])) out.total_N[i] = lagged[i];
+  } else {
+    com = filtered(com + trunk_share * hat_com);
+    out.total_N = mass * lateral_part(second_difference(com, dt));
+  }
   out.com_lateral_m = lateral_part(com);
-  out.total_N = mass * lateral_part(second_difference(com, 1.0 / motion.rate_hz));
   const double leg_cutoff = leg_cutoff_hz > 0 ? leg_cutoff_hz : cutoff_hz;
   for (int k = 0; k < 2; ++k) {
     out.foot_N[static_cast<std::size_t>(k)] = Eigen::VectorXd::Zero(n);

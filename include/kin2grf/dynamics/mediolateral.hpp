@@ -76,9 +76,14 @@ struct MediolateralForces {
 /// masses, its rate and frames); `cutoff_hz`: the whole body's lateral acceleration's cut-off
 /// (EstimateOptions::lateral_cutoff_hz); `leg_cutoff_hz`: the lower legs' (the dynamics'
 /// kinematic cut-off; 0: `cutoff_hz`); `own_leg_inertia` false: the load share alone (the
-/// split before issue 28's third step, for comparison).
+/// split before issue 28's third step, for comparison); `upper_body_lag_s`: the torso's share
+/// of the COM (the HAT less the arms and head of their own) enters the total delayed by this
+/// (a(t - tau), as lag_torso_fore_aft delays its fore-aft acceleration: the upper body's mass,
+/// mostly viscera, arms and head on a compliant spine, follows the pelvis late sideways too),
+/// except on the frames `near_flight` flags (flight_frames), which take the total as measured.
 MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::array<Eigen::MatrixX3d, kLandmarkCount>& landmark_lab_m,
                                        const Eigen::MatrixX3d& lateral_axis, double cutoff_hz, const std::array<FootLoad, 2>& feet,
-                                       double leg_cutoff_hz = 0.0, bool own_leg_inertia = true, const UpperBodySegments* upper = nullptr);
+                                       double leg_cutoff_hz = 0.0, bool own_leg_inertia = true, const UpperBodySegments* upper = nullptr,
+                                       double upper_body_lag_s = 0.0, const std::vector<bool>* near_flight = nullptr);
 
 }  // namespace kin2grf
