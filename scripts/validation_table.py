@@ -233,8 +233,8 @@ print("The sagittal figures above are the 3D model's too: it adds to them, per f
       "COP's lateral place, and per leg the ankle's, the knee's and the hip's 3D moments by bottom-up inverse dynamics "
       "(dynamics/joint_moments_3d.hpp), run once with the estimate's ground reaction and once with the plates' on "
       "the same kinematics. The mediolateral force: the whole body's lateral acceleration (filtered at 3 Hz; the arms and "
-      "the head as segments of their own where their markers hold data; the torso's share delayed as its fore-aft one is, away "
-      "from flight phases), each "
+      "the head as segments of their own where their markers hold data; the measured torso's share delayed as its fore-aft "
+      "one is, away from flight phases), each "
       "foot in contact carrying its own lower leg's lateral inertia and the rest shared by vertical load. The COP's lateral place: on the line from the heel to the forefoot's "
       "midline at the COP's place along the foot. Lateral knee, ankle and 5th-metatarsal markers are moved to the "
       "joint centres and the foot's midline (docs/MARKERSETS.md, \"surface\"). Per stance: the lateral force's "
@@ -333,8 +333,9 @@ lolo_table("The arms and the head", "`--upper-body`: lumped (into the torso, as 
            "file holds them: 5 walks, a run and the drop jump).", UPPER_BODY, "upper body")
 lolo_table("The torso's lateral lag", "`--lateral-lag`: none, or torso (the torso's share of the whole body's lateral "
            "acceleration delayed as its fore-aft one is, by `--torso-lag` less what the trunk markers already lag the hip by, "
-           "on the frames away from flight phases; no value of its own is fitted). Everywhere, runs included, it was measured "
-           "worse held out (pooled criterion 22.48 % against 21.96 % without it; docs/METHOD-NOTES.md).", LATERAL_LAG, "lateral lag")
+           "where trunk markers measure the torso and on the frames away from flight phases; no value of its own is fitted). "
+           "On every frame, runs included, it was worse held out (criterion 22.48 % against 21.96 % without it); on the model "
+           "torso too, it cost the trunk-ablated walks 19.1 -> 20.3 % (docs/METHOD-NOTES.md).", LATERAL_LAG, "lateral lag")
 
 print("\n## Excluded stances and notes (defaults)\n")
 for a, name, args in rows:

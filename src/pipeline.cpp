@@ -173,6 +173,7 @@ struct SagittalStage {
   std::array<Eigen::VectorXd, 2> foot_lateral_m;
   std::array<Eigen::MatrixX4d, 2> foot_line;                    ///< with EstimateOptions::lateral_force()
   std::optional<double> hip_half_width_m;                       ///< the hip rule's (Landmarks3D)
+  bool trunk_measured = true;  ///< the shoulder point from upper-body markers, not the model torso (pelvis_up)
   std::array<Eigen::MatrixX3d, kLandmarkCount> landmark_lab_m;  ///< with EstimateOptions::mediolateral
   Eigen::MatrixX3d lateral_axis;                                ///< likewise, per frame
   std::array<Eigen::MatrixX3d, kUpperBodyCount> upper_body_lab_m;  ///< likewise (SagittalWindow's)
@@ -226,6 +227,7 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   out.foot_lateral_m = std::move(win.foot_lateral_m);
   out.foot_line = std::move(win.foot_line);
   out.hip_half_width_m = win.hip_half_width_m;
+  out.trunk_measured = set.rules[kShoulder].kind != RuleKind::PelvisUp;
   out.landmarks = std::move(win.landmarks);
   const SagittalLandmarks& lm = out.landmarks;
   // The zero-lag filter's single pass runs at cut-off / 0.802 (Winter's correction), which must
@@ -996,7 +998,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m);
   if (o.lateral_force()) {
     const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kin.kinematic_cutoff_hz) : kin.kinematic_cutoff_hz;
-    const double lateral_lag_s = o.lateral_torso_lag ? dyn.torso_lag_added_s : 0.0;
+    const double lateral_lag_s = o.lateral_torso_lag && sag.trunk_measured ? dyn.torso_lag_added_s : 0.0;
     mediolateral_stage(kin.motion, sag, cutoff, kin.kinematic_cutoff_hz, o.lateral_own_leg_inertia, lateral_lag_s, dyn.plan.near_flight,
                        anthropometric_table(o.anthropometry),
                        feet.feet, kin.messages);
