@@ -625,23 +625,38 @@ TEST(Pipeline, GaitEventsAreTheStancesEndsInsideTheWindow) {
   EXPECT_DOUBLE_EQ(ev[3].time_s, 1.7);
 }
 
+namespace {
+
+/// Every landmark swaying sideways alike, A sin(w t) along y (the mediolateral tests' body).
+std::array<Eigen::MatrixX3d, kLandmarkCount> swaying_landmarks(const Eigen::VectorXd& time_s, double A, double w) {
+  std::array<Eigen::MatrixX3d, kLandmarkCount> lab;
+  for (auto& p : lab) {
+    p = Eigen::MatrixX3d::Zero(time_s.size(), 3);
+    for (Eigen::Index i = 0; i < time_s.size(); ++i) p(i, 1) = A * std::sin(w * time_s[i]);
+  }
+  return lab;
+}
+
+double total_mass(const Model& model) {
+  double mass = 0;
+  for (const Body& b : model.bodies) mass += b.mass_kg;
+  return mass;
+}
+
+}  // namespace
+
 // The mediolateral force (dynamics/mediolateral.hpp): the whole body's lateral acceleration,
 // carried by the feet in proportion to their vertical loads.
 TEST(Mediolateral, TheFeetCarryTheBodysLateralAccelerationSharedByLoad) {
   const auto r = run({});  // a squat: both feet on the ground throughout
   const Eigen::Index n = r.time_s.size();
   const double A = 0.03, w = 2 * M_PI * 1.0;  // a 3 cm sway at 1 Hz, every landmark alike
-  std::array<Eigen::MatrixX3d, kLandmarkCount> lab;
-  for (auto& p : lab) {
-    p = Eigen::MatrixX3d::Zero(n, 3);
-    for (Eigen::Index i = 0; i < n; ++i) p(i, 1) = A * std::sin(w * r.time_s[i]);
-  }
+  const std::array<Eigen::MatrixX3d, kLandmarkCount> lab = swaying_landmarks(r.time_s, A, w);
   const Eigen::MatrixX3d lateral = Eigen::RowVector3d(0, 1, 0).replicate(n, 1);
   std::array<Eigen::VectorXd, 2> fy{r.feet[0].force_N.col(1), r.feet[1].force_N.col(1)};
   const std::array<FootLoad, 2> loads{FootLoad{&fy[0], &r.feet[0].contact}, FootLoad{&fy[1], &r.feet[1].contact}};
   const MediolateralForces ml = mediolateral_forces(r.motion, lab, lateral, 6.0, loads);
-  double mass = 0;
-  for (const Body& b : r.model().bodies) mass += b.mass_kg;
+  const double mass = total_mass(r.model());
   const double peak = mass * A * w * w;  // 83 N for 70 kg
   for (Eigen::Index i = n / 4; i < 3 * n / 4; ++i) {
     EXPECT_NEAR(ml.total_N[i], -peak * std::sin(w * r.time_s[i]), 0.01 * peak) << "frame " << i;
@@ -667,16 +682,11 @@ TEST(Mediolateral, TheTorsosShareSwaysLateAwayFromFlightPhases) {
   const auto r = run({});
   const Eigen::Index n = r.time_s.size();
   const double A = 0.03, w = 2 * M_PI * 1.0, tau = 0.03;
-  std::array<Eigen::MatrixX3d, kLandmarkCount> lab;
-  for (auto& p : lab) {
-    p = Eigen::MatrixX3d::Zero(n, 3);
-    for (Eigen::Index i = 0; i < n; ++i) p(i, 1) = A * std::sin(w * r.time_s[i]);
-  }
+  const std::array<Eigen::MatrixX3d, kLandmarkCount> lab = swaying_landmarks(r.time_s, A, w);
   const Eigen::MatrixX3d lateral = Eigen::RowVector3d(0, 1, 0).replicate(n, 1);
   std::array<Eigen::VectorXd, 2> fy{r.feet[0].force_N.col(1), r.feet[1].force_N.col(1)};
   const std::array<FootLoad, 2> loads{FootLoad{&fy[0], &r.feet[0].contact}, FootLoad{&fy[1], &r.feet[1].contact}};
-  double mass = 0;
-  for (const Body& b : r.model().bodies) mass += b.mass_kg;
+  const double mass = total_mass(r.model());
   const double trunk = r.model().bodies[kTorso].mass_kg, peak = mass * A * w * w;
   std::vector<bool> near(static_cast<std::size_t>(n), false);
   for (Eigen::Index i = n / 2; i < n; ++i) near[static_cast<std::size_t>(i)] = true;  // a flight in the second half
@@ -713,8 +723,7 @@ TEST(Mediolateral, ALowerCutoffKeepsTheSwayAndDropsTheMarkersNoise) {
   const Eigen::MatrixX3d lateral = Eigen::RowVector3d(0, 1, 0).replicate(n, 1);
   std::array<Eigen::VectorXd, 2> fy{r.feet[0].force_N.col(1), r.feet[1].force_N.col(1)};
   const std::array<FootLoad, 2> loads{FootLoad{&fy[0], &r.feet[0].contact}, FootLoad{&fy[1], &r.feet[1].contact}};
-  double mass = 0;
-  for (const Body& b : r.model().bodies) mass += b.mass_kg;
+  const double mass = total_mass(r.model());
   const double peak = mass * A * w * w;
   const auto rms_error = [&](double cutoff_hz) {
     const MediolateralForces ml = mediolateral_forces(r.motion, lab, lateral, cutoff_hz, loads);
@@ -826,8 +835,7 @@ TEST(Mediolateral, AnArmOfItsOwnCarriesItsSidewaysSwing) {
   eo.upper_body_segments = false;
   const auto lumped = estimate(t, nullptr, set, eo);
   const auto& table = anthropometric_table(EstimateOptions{}.anthropometry);
-  double mass = 0;
-  for (const Body& b : r.model().bodies) mass += b.mass_kg;
+  const double mass = total_mass(r.model());
   // The forearm's COM moves by its fraction of the wrist's swing, the hand's by all of it.
   const double swing_kg = mass * (table.forearm.mass_fraction * table.forearm.com_fraction + table.hand.mass_fraction);
   const double peak = swing_kg * A * w * w;  // about 5 N; Y is the walker's left, the lateral axis its right
