@@ -808,6 +808,12 @@ void mediolateral_stage(const ModelMotion& motion, const SagittalStage& sag, dou
     messages.push_back("upper body: " + upper.description +
                        (upper.description.find(" and ") != std::string::npos ? " are segments of their own" : " is a segment of its own") +
                        " in the lateral force");
+  if (upper_body_lag_s > 0) {
+    char b[160];
+    std::snprintf(b, sizeof b, "lateral force: the torso's share delayed by %.0f ms (as its fore-aft force; not near flight phases)",
+                  1000 * upper_body_lag_s);
+    messages.push_back(b);
+  }
   MediolateralForces ml =
       mediolateral_forces(motion, sag.landmark_lab_m, sag.lateral_axis, cutoff_hz, loads, leg_cutoff_hz, own_leg_inertia, &upper, upper_body_lag_s,
                           &near_flight);

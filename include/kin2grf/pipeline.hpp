@@ -120,7 +120,8 @@ struct EstimateOptions {
   bool upper_body_segments = true;
   /// The torso's share of the whole body's lateral acceleration takes the upper body's lag
   /// (torso_lag_s, less what the trunk markers already lag the hip by: the fore-aft's own delay),
-  /// away from flight phases; false: none (dynamics/mediolateral.hpp).
+  /// where trunk markers measure the torso (not the model torso of a set without them) and away
+  /// from flight phases; false: none (dynamics/mediolateral.hpp, docs/METHOD-NOTES.md).
   bool lateral_torso_lag = true;
   ModelKind model = ModelKind::Sagittal;
   [[nodiscard]] bool lateral_force() const { return mediolateral || model == ModelKind::ThreeD; }

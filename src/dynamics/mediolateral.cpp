@@ -1,4 +1,5 @@
 #include "kin2grf/dynamics/mediolateral.hpp"
+
 #include <algorithm>
 
 #include "kin2grf/error.hpp"
@@ -82,7 +83,8 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
   const double dt = 1.0 / motion.rate_hz;
   if (upper_body_lag_s > 0) {
     // The trunk's share delayed (its acceleration a(t - tau)); near a flight phase as measured.
-    const Eigen::VectorXd lagged = mass * lateral_part(second_difference(filtered(com + delayed(trunk_share * hat_com, upper_body_lag_s * motion.rate_hz)), dt));
+    const Eigen::MatrixXd trunk_late = delayed(trunk_share * hat_com, upper_body_lag_s * motion.rate_hz);
+    const Eigen::VectorXd lagged = mass * lateral_part(second_difference(filtered(com + trunk_late), dt));
     com = filtered(com + trunk_share * hat_com);
     out.total_N = mass * lateral_part(second_difference(com, dt));
     for (Eigen::Index i = 0; i < n; ++i)
