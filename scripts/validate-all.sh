@@ -19,8 +19,9 @@ for row in "${TRIALS[@]}"; do
   IFS='|' read -r activity lab name args <<<"$row"
   # 3d: the 3D model (--model 3d) at its defaults; 3d-lcX: its lateral force's cut-off at X Hz (0:
   # the kinematic cut-off), 3d-load: the split by load alone, 3d-lumped: the arms and head in the
-  # torso, 3d-nolag: the torso's lateral share not delayed, for the leave-one-lab-out choices.
-  for config in defaults paper 3d 3d-lc0 3d-lc2 3d-lc2.5 3d-lc3.5 3d-lc4 3d-lc5 3d-load 3d-lumped 3d-nolag; do
+  # torso, 3d-nolag: the torso's lateral share not delayed, 3d-split: a landing's bilateral stance
+  # split as everywhere else, for the leave-one-lab-out choices.
+  for config in defaults paper 3d 3d-lc0 3d-lc2 3d-lc2.5 3d-lc3.5 3d-lc4 3d-lc5 3d-load 3d-lumped 3d-nolag 3d-split; do
     extra=""
     [ "$config" = paper ] && extra="--paper"
     [ "$config" = 3d ] && extra="--model 3d"
@@ -28,6 +29,7 @@ for row in "${TRIALS[@]}"; do
     [ "$config" = 3d-load ] && extra="--model 3d --lateral-split load"
     [ "$config" = 3d-lumped ] && extra="--model 3d --upper-body lumped"
     [ "$config" = 3d-nolag ] && extra="--model 3d --lateral-lag none"
+    [ "$config" = 3d-split ] && extra="--model 3d --lateral-bilateral split"
     # shellcheck disable=SC2086
     if ! $BIN validate $args $extra --json "$OUT/$name.$config.json" >"$OUT/$name.$config.txt" 2>"$OUT/$name.$config.log"; then
       echo "validate-all: $name ($config) failed:" >&2; cat "$OUT/$name.$config.log" >&2; exit 1

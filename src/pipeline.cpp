@@ -372,11 +372,12 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
   const ContactModelOptions& co = o.contact;
   const bool running_cop = co.foot_model == FootModel::Cop && co.running_cop;
   // The flight phases: for the running COP function, for the speed gate where its floor near a
-  // flight differs from its gate elsewhere (SpeedGateRule::floor_mps), and for the lateral force's
-  // torso lag, which they do not take (EstimateOptions::lateral_torso_lag).
+  // flight differs from its gate elsewhere (SpeedGateRule::floor_mps), and for the lateral force:
+  // its torso lag, which they do not take (EstimateOptions::lateral_torso_lag), and the least
+  // squares of a landing's bilateral stance (EstimateOptions::lateral_least_squares).
   const SpeedGateRule& gate = co.speed_gate;
-  const bool lateral_lag = o.lateral_force() && o.lateral_torso_lag && o.torso_lag_s > 0;
-  if (running_cop || lateral_lag || (gate.ratio > 0 && gate.floor_mps != gate.standstill_mps))
+  const bool lateral = o.lateral_force() && ((o.lateral_torso_lag && o.torso_lag_s > 0) || o.lateral_least_squares);
+  if (running_cop || lateral || (gate.ratio > 0 && gate.floor_mps != gate.standstill_mps))
     plan.near_flight = flight_frames(model, motion, soles);
   if (running_cop) {
     plan.running = plan.near_flight;
@@ -821,6 +822,21 @@ void mediolateral_stage(const ModelMotion& motion, const SagittalStage& sag, dou
   for (int k = 0; k < 2; ++k) feet[k].force_lateral_N = std::move(ml.foot_N[k]);
 }
 
+/// A landing's bilateral stance: frames near a flight phase (`near_flight`, flight_frames) with
+/// both feet in contact outside a walking handover (walking_double_supports, at most half the
+/// median stance).
+std::vector<bool> bilateral_frames(const std::array<FootResult, 2>& feet, double rate_hz, const std::vector<bool>& near_flight) {
+  const std::array<std::vector<bool>, 2> contact{feet[0].contact, feet[1].contact};
+  const auto n = std::min(contact[0].size(), contact[1].size());
+  std::vector<bool> out(n, false);
+  for (std::size_t i = 0; i < n; ++i)
+    out[i] = contact[0][i] && contact[1][i] && i < near_flight.size() && near_flight[i];
+  if (const auto stance = median_stance_s(contact, rate_hz))
+    for (const DoubleSupport& ds : walking_double_supports(contact, static_cast<Eigen::Index>(0.5 * *stance * rate_hz)))
+      for (Eigen::Index i = ds.first; i <= ds.last; ++i) out[static_cast<std::size_t>(i)] = false;
+  return out;
+}
+
 /// Each foot's COP's lateral coordinate on its lateral line (FootResult::cop_lateral_m).
 void lateral_cop_stage(const std::array<Eigen::MatrixX4d, 2>& foot_line, std::array<FootResult, 2>& feet) {
   for (int k = 0; k < 2; ++k) {
@@ -1020,7 +1036,11 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   };
   std::optional<LegMotion3D> legs;
   std::optional<JointCentreOffsets> offsets;
-  if (o.model == ModelKind::ThreeD) {
+  const std::vector<bool> bilateral = o.lateral_force() && o.lateral_least_squares
+                                          ? bilateral_frames(feet.feet, kin.motion.rate_hz, dyn.plan.near_flight)
+                                          : std::vector<bool>();
+  const bool split_by_least_squares = std::find(bilateral.begin(), bilateral.end(), true) != bilateral.end();
+  if (o.model == ModelKind::ThreeD || split_by_least_squares) {
     offsets = joint_centre_offsets(set, trial, *mod.model, sag.hip_half_width_m, kin.messages);
     if (o.keep_all_series)
       legs = leg_motion_3d(*mod.model, sag.landmark_lab_m, sag.lateral_axis, sag.frame.up, kin.motion.rate_hz, kin.kinematic_cutoff_hz, *offsets);
@@ -1029,14 +1049,42 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   TotalsStage totals = totals_stage(o, kin.motion, feet.feet, ground_level_m);
 
   EstimateResult r = assemble_result(set.name, mass_kg, sag, mod, kin, dyn, feet, totals, iterations, o);
-  if (legs) {
-    JointMoments3D moments = joint_moments_3d(*legs, estimated_wrenches(r));
-    r.legs_3d = Legs3D{std::move(*legs), std::move(moments)};
-  } else if (offsets) {
-    JointMoments3D moments = joint_moments_3d_in_blocks(*mod.model, std::move(sag.landmark_lab_m), sag.lateral_axis, r.frame.up, kin.motion.rate_hz,
-                                                        kin.kinematic_cutoff_hz, *offsets, estimated_wrenches(r));
-    release_lab();
-    r.legs_3d = Legs3D{LegMotion3D(), std::move(moments)};
+  if (offsets) {
+    // The legs' 3D moments for the feet's wrenches; with a bilateral stance twice (its frames'
+    // lateral forces zero, then 1 N a foot), the least squares's split and its moments from the
+    // two by linearity (least_squares_lateral_split).
+    const auto moments_for = [&](const std::array<FootWrench3D, 2>& w, bool last) {
+      if (legs) return joint_moments_3d(*legs, w);
+      if (!last)
+        return joint_moments_3d_in_blocks(*mod.model, sag.landmark_lab_m, sag.lateral_axis, r.frame.up, kin.motion.rate_hz,
+                                          kin.kinematic_cutoff_hz, *offsets, w);
+      JointMoments3D m = joint_moments_3d_in_blocks(*mod.model, std::move(sag.landmark_lab_m), sag.lateral_axis, r.frame.up,
+                                                    kin.motion.rate_hz, kin.kinematic_cutoff_hz, *offsets, w);
+      release_lab();
+      return m;
+    };
+    JointMoments3D moments;
+    if (split_by_least_squares) {
+      std::array<Eigen::VectorXd, 2> lateral{r.feet[0].force_lateral_N, r.feet[1].force_lateral_N};
+      const auto with_lateral = [&](double force_N) {
+        for (std::size_t k = 0; k < 2; ++k)
+          for (std::size_t i = 0; i < bilateral.size(); ++i)
+            if (bilateral[i]) r.feet[k].force_lateral_N[static_cast<Eigen::Index>(i)] = force_N;
+        return estimated_wrenches(r);
+      };
+      const JointMoments3D zero = moments_for(with_lateral(0.0), false);
+      const JointMoments3D unit = moments_for(with_lateral(1.0), true);
+      moments = least_squares_lateral_split(zero, unit, bilateral, lateral);
+      for (std::size_t k = 0; k < 2; ++k) r.feet[k].force_lateral_N = std::move(lateral[k]);
+      const auto frames = std::count(bilateral.begin(), bilateral.end(), true);
+      char b[200];
+      std::snprintf(b, sizeof b, "lateral force: %ld frames of a landing's bilateral stance (both feet down, near a flight phase) split "
+                    "by the least squares with the legs' 3D joint moments", static_cast<long>(frames));
+      r.messages.push_back(b);
+    } else {
+      moments = moments_for(estimated_wrenches(r), true);
+    }
+    if (o.model == ModelKind::ThreeD) r.legs_3d = Legs3D{legs ? std::move(*legs) : LegMotion3D(), std::move(moments)};
   }
   r.cycled_frames = cycled_frames;
   r.capped_frames = capped_frames;

@@ -861,6 +861,59 @@ TEST(Mediolateral, AnArmOfItsOwnCarriesItsSidewaysSwing) {
 
 // --mediolateral adds the lateral force and changes nothing else; without lateral motion (the
 // synthetic squat) it is near zero, and the lab-frame outputs carry it.
+// A two-footed landing with the feet wider than the hips (EstimateOptions::lateral_least_squares):
+// the whole body has no sideways acceleration, so the split of one total gives each foot nothing,
+// while the paper's least squares with the legs' 3D joint moments directs each foot's force up its
+// spread leg, toward the midline: the feet push toward each other, as a landing's plates show. The
+// sum stays the whole body's, the moments are those of the new forces (linearity), and quiet
+// standing away from the flight keeps the split.
+TEST(Mediolateral, ALandingsSpreadFeetPushTowardEachOtherByTheLeastSquares) {
+  SyntheticOptions so;
+  so.squat_depth = 0.0;
+  so.flight_height_m = 0.3;  // flight 1.253-1.747 s
+  Trial t = make_synthetic_trial(so);
+  const int up = static_cast<int>(t.markers.up_axis);
+  const int across = up == 2 ? 1 : 2;  // the trial's feet lie apart along this lab axis
+  const double outward = t.markers.positions_m[t.markers.find("RHEE")](0, across) > t.markers.positions_m[t.markers.find("LHEE")](0, across) ? 1 : -1;
+  for (const char* side : {"R", "L"})
+    for (const char* name : {"KJC", "AJC", "HEE", "MT1", "HLX"}) {
+      auto& p = t.markers.positions_m[t.markers.find(std::string(side) + name)];
+      const double knee = std::string(name) == "KJC" ? 0.5 : 1.0;  // the knee half as far: a straight leg
+      p.col(across).array() += (side[0] == 'R' ? 1 : -1) * outward * 0.08 * knee;
+    }
+  EstimateOptions o;
+  o.model = ModelKind::ThreeD;
+  const auto* set = find_marker_set("kin2grf-example");
+  const EstimateResult ls = estimate(t, nullptr, *set, o);
+  o.lateral_least_squares = false;
+  const EstimateResult split = estimate(t, nullptr, *set, o);
+  ASSERT_TRUE(ls.legs_3d.has_value());
+  int landing = 0;
+  for (Eigen::Index i = 0; i < ls.time_s.size(); ++i) {
+    const double time = ls.time_s[i], fz = ls.feet[0].force_N(i, 1);
+    const double sum = ls.feet[0].force_lateral_N[i] + ls.feet[1].force_lateral_N[i];
+    EXPECT_NEAR(sum, split.feet[0].force_lateral_N[i] + split.feet[1].force_lateral_N[i], 1e-9) << time;
+    if (time > 1.75 && time < 2.0 && fz > 400) {  // the landing's loaded frames
+      ++landing;
+      // The right foot's force points to the walker's left (-), the left foot's to the right (+),
+      // by about the legs' spread over their length times the load (8 cm / 0.85 m x 400-600 N).
+      EXPECT_LT(ls.feet[0].force_lateral_N[i], -0.04 * fz) << time;
+      EXPECT_GT(ls.feet[1].force_lateral_N[i], 0.04 * fz) << time;
+      EXPECT_LT(std::abs(split.feet[0].force_lateral_N[i]), 0.02 * fz) << time;
+    }
+    if (time < 0.7) {  // quiet standing
+      EXPECT_EQ(ls.feet[0].force_lateral_N[i], split.feet[0].force_lateral_N[i]) << time;
+    }
+  }
+  EXPECT_GT(landing, 5);
+  // The moments are the new forces' own: a direct run on the same legs gives them.
+  const JointMoments3D direct = joint_moments_3d(ls.legs_3d->motion, estimated_wrenches(ls));
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_LT((direct.knee_Nm[k] - ls.legs_3d->moments.knee_Nm[k]).cwiseAbs().maxCoeff(), 1e-6);
+    EXPECT_LT((direct.hip_lab_Nm[k] - ls.legs_3d->moments.hip_lab_Nm[k]).cwiseAbs().maxCoeff(), 1e-6);
+  }
+}
+
 TEST(Mediolateral, TheOptionChangesNoSagittalResult) {
   EstimateOptions with;
   with.mediolateral = true;

@@ -123,6 +123,11 @@ struct EstimateOptions {
   /// where trunk markers measure the torso (not the model torso of a set without them) and away
   /// from flight phases; false: none (dynamics/mediolateral.hpp, docs/METHOD-NOTES.md).
   bool lateral_torso_lag = true;
+  /// In a landing's bilateral stance (both feet down near a flight phase, outside a walking
+  /// handover) the feet's lateral forces split the whole body's by the paper's least squares
+  /// with the legs' 3D joint moments (least_squares_lateral_split); false: by the split of
+  /// mediolateral_forces, as everywhere else.
+  bool lateral_least_squares = true;
   ModelKind model = ModelKind::Sagittal;
   [[nodiscard]] bool lateral_force() const { return mediolateral || model == ModelKind::ThreeD; }
   /// Called with (frames solved, frames in all) every 1 % of the contact solve; empty: none.

@@ -125,4 +125,31 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
   return out;
 }
 
+JointMoments3D least_squares_lateral_split(const JointMoments3D& zero, const JointMoments3D& unit, const std::vector<bool>& frames,
+                                           std::array<Eigen::VectorXd, 2>& foot_N) {
+  JointMoments3D out = zero;
+  const auto n = static_cast<Eigen::Index>(frames.size());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!frames[static_cast<std::size_t>(i)]) continue;
+    std::array<double, 2> A{0.0, 0.0}, B{0.0, 0.0};
+    for (std::size_t k = 0; k < 2; ++k)
+      for (const auto member : {&JointMoments3D::ankle_lab_Nm, &JointMoments3D::knee_lab_Nm, &JointMoments3D::hip_lab_Nm}) {
+        const Eigen::RowVector3d a = (zero.*member)[k].row(i), h = (unit.*member)[k].row(i) - a;
+        A[k] += h.squaredNorm();
+        B[k] += a.dot(h);
+      }
+    if (!(A[0] + A[1] > 0)) continue;
+    const double T = foot_N[0][i] + foot_N[1][i];
+    const std::array<double, 2> F{(A[1] * T + B[1] - B[0]) / (A[0] + A[1]), 0.0};
+    const std::array<double, 2> split{F[0], T - F[0]};
+    for (std::size_t k = 0; k < 2; ++k) {
+      foot_N[k][i] = split[k];
+      for (const auto member : {&JointMoments3D::ankle_Nm, &JointMoments3D::knee_Nm, &JointMoments3D::hip_Nm, &JointMoments3D::ankle_lab_Nm,
+                                &JointMoments3D::knee_lab_Nm, &JointMoments3D::hip_lab_Nm})
+        (out.*member)[k].row(i) = (zero.*member)[k].row(i) + split[k] * ((unit.*member)[k].row(i) - (zero.*member)[k].row(i));
+    }
+  }
+  return out;
+}
+
 }  // namespace kin2grf

@@ -45,6 +45,10 @@ void add_settings_options(CLI::App* c, Settings& a) {
                 "The torso's share of the lateral force (--model 3d): torso (delayed as its fore-aft force is, by --torso-lag less "
                 "what the trunk markers already lag the hip by, away from flight phases) or none")
       ->check(CLI::IsMember({"torso", "none"}))->capture_default_str();
+  c->add_option("--lateral-bilateral", a.lateral_bilateral,
+                "The lateral force in a landing's bilateral stance (both feet down near a flight phase): least-squares (the paper's "
+                "least squares with the legs' 3D joint moments) or split (as --lateral-split, as everywhere else)")
+      ->check(CLI::IsMember({"least-squares", "split"}))->capture_default_str();
   c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
       ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
   c->add_option_function<double>(
@@ -126,6 +130,7 @@ EstimateOptions to_options(const Settings& a) {
   o.lateral_own_leg_inertia = a.lateral_split == "own-leg";
   o.upper_body_segments = a.upper_body == "segments";
   o.lateral_torso_lag = a.lateral_lag == "torso";
+  o.lateral_least_squares = a.lateral_bilateral == "least-squares";
   o.anthropometry = (a.paper && !a.anthropometry_given) ? "winter" : a.anthropometry;
   o.kinematic_cutoff_hz = a.kinematic_cutoff;
   if (a.post_cutoff && a.post_cutoff_cycles_given)
@@ -177,6 +182,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"lateral_split", o.lateral_own_leg_inertia ? "own-leg" : "load"},
           {"upper_body", o.upper_body_segments ? "segments" : "lumped"},
           {"lateral_lag", o.lateral_torso_lag ? "torso" : "none"},
+          {"lateral_bilateral", o.lateral_least_squares ? "least-squares" : "split"},
           {"torso_length", torso_length_name(o.torso_length)},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"kinematic_cutoff_rule", o.cutoff_from_noise ? "noise" : "fixed"},

@@ -30,6 +30,7 @@
 // 14-33 %; docs/METHOD-NOTES.md), and so did a share of it added in double support only
 // (session 22: 16.1 -> 16.2-19.2 % walking at weights 0.15-0.5).
 #pragma once
+#include "kin2grf/dynamics/joint_moments_3d.hpp"
 
 #include <Eigen/Dense>
 #include <array>
@@ -85,5 +86,22 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
                                        const Eigen::MatrixX3d& lateral_axis, double cutoff_hz, const std::array<FootLoad, 2>& feet,
                                        double leg_cutoff_hz = 0.0, bool own_leg_inertia = true, const UpperBodySegments* upper = nullptr,
                                        double upper_body_lag_s = 0.0, const std::vector<bool>* near_flight = nullptr);
+
+/// The paper's least squares (Eq. 5: the multipliers of least norm, joint torques in it) for the
+/// lateral split of a bilateral stance (the pipeline's: a landing's, both feet on the ground near
+/// a flight phase): at each flagged frame the two feet's lateral forces F_0 + F_1 =
+/// T (the whole body's, as mediolateral_forces gave it) minimise the sum of the squared 3D joint
+/// moments of both legs (ankle, knee, hip; lab-frame vectors), which are linear in them:
+///   M_jk = a_jk + h_jk F_k,   a: the moments with those frames' lateral forces zero (`zero`),
+///   h = `unit` - `zero` (`unit`: with 1 N on each foot; h_jk = (J - c_k) x e, J the joint,
+///   c_k the COP, e the lateral axis), so
+///   F_0 = (A_1 T + B_1 - B_0) / (A_0 + A_1),  A_k = sum_j |h_jk|^2,  B_k = sum_j a_jk . h_jk.
+/// A walking handover keeps the split of mediolateral_forces (measured better there on every
+/// walk), and so does quiet standing (Camargo's gait initiation, slightly); a landing is where
+/// the feet push apart or together, which a share of one total cannot give (the drop jump:
+/// per-foot lateral rRMSE 70 / 62 -> 43 / 41 %; docs/METHOD-NOTES.md). `foot_N` (per foot) is changed at the flagged
+/// frames; the returned moments are `zero`'s, with those frames' made the new forces' (linear).
+JointMoments3D least_squares_lateral_split(const JointMoments3D& zero, const JointMoments3D& unit, const std::vector<bool>& frames,
+                                           std::array<Eigen::VectorXd, 2>& foot_N);
 
 }  // namespace kin2grf

@@ -26,7 +26,7 @@ struct Settings {
   std::optional<double> mass;
   bool force_mass = false, mediolateral = false;
   std::string model = "sagittal";  ///< --model: sagittal or 3d (ModelKind)
-  std::string lateral_split = "own-leg", upper_body = "segments", lateral_lag = "torso";
+  std::string lateral_split = "own-leg", upper_body = "segments", lateral_lag = "torso", lateral_bilateral = "least-squares";
   std::string foot_model = "cop", norm = "torque-scaled", anthropometry = EstimateOptions{}.anthropometry, up_axis,
               cop_function, running_cop = "builtin", torso_length = "measured",
               kinematic_cutoff_rule = "noise";
