@@ -327,7 +327,7 @@ def lolo_table(title, intro, configs, label):
 
 lolo_table("The lateral force's cut-off", "The whole body's lateral acceleration's low-pass cut-off (`--lateral-cutoff`), "
            "with the split's default (own-leg). Since the torso's lateral lag (session 23) 2.5 Hz has the lower criterion "
-           "on all trials, but each lab at the choice made without it gives 21.59 % against 21.55 % at 3 Hz (the held-out "
+           "on all trials, but each lab at the choice made without it gives 20.11 % against 20.08 % at 3 Hz (the held-out "
            "figure decides): 3 Hz stays.", LATERAL_CUTOFFS, "cut-off")
 lolo_table("The lateral force's split between the feet", "`--lateral-split`: load (all of the whole body's lateral "
            "force shared by vertical load) or own-leg (each foot in contact carries its own shank's, foot's and toes' "
