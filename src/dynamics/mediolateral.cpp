@@ -1,6 +1,7 @@
 #include "kin2grf/dynamics/mediolateral.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/kinematics/filter.hpp"
@@ -140,8 +141,9 @@ JointMoments3D least_squares_lateral_split(const JointMoments3D& zero, const Joi
       }
     if (!(A[0] + A[1] > 0)) continue;
     const double T = foot_N[0][i] + foot_N[1][i];
-    const std::array<double, 2> F{(A[1] * T + B[1] - B[0]) / (A[0] + A[1]), 0.0};
-    const std::array<double, 2> split{F[0], T - F[0]};
+    const double F0 = (A[1] * T + B[1] - B[0]) / (A[0] + A[1]);
+    if (!std::isfinite(F0)) continue;  // a moment not finite at this frame: the split stays
+    const std::array<double, 2> split{F0, T - F0};
     for (std::size_t k = 0; k < 2; ++k) {
       foot_N[k][i] = split[k];
       for (const auto member : {&JointMoments3D::ankle_Nm, &JointMoments3D::knee_Nm, &JointMoments3D::hip_Nm, &JointMoments3D::ankle_lab_Nm,
