@@ -809,8 +809,10 @@ void mediolateral_stage(const ModelMotion& motion, const SagittalStage& sag, dou
     messages.push_back("upper body: " + upper.description +
                        (upper.description.find(" and ") != std::string::npos ? " are segments of their own" : " is a segment of its own") +
                        " in the lateral force");
+  // The lag acts only away from flight phases: a run, near them throughout, skips its work.
   const auto away = static_cast<long>(motion.frames()) - std::count(near_flight.begin(), near_flight.end(), true);
-  if (upper_body_lag_s > 0 && away > 0) {
+  if (away == 0) upper_body_lag_s = 0.0;
+  if (upper_body_lag_s > 0) {
     char b[200];
     std::snprintf(b, sizeof b, "lateral force: the torso's share delayed by %.0f ms, as its fore-aft force, on the %ld of %ld frames away "
                   "from flight phases", 1000 * upper_body_lag_s, away, static_cast<long>(motion.frames()));

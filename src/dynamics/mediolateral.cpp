@@ -80,21 +80,20 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
       trunk_share -= part.mass_fraction;
     }
   const auto filtered = [&](Eigen::MatrixXd x) { return cutoff_hz > 0 ? butterworth_filtfilt(std::move(x), motion.rate_hz, cutoff_hz) : x; };
+  const auto total_of = [&](const Eigen::MatrixXd& filtered_com) -> Eigen::VectorXd {
+    return mass * lateral_part(second_difference(filtered_com, 1.0 / motion.rate_hz));
+  };
   MediolateralForces out;
-  const double dt = 1.0 / motion.rate_hz;
+  const Eigen::MatrixXd but_trunk = std::move(com);  // every part of the COM but the trunk's share
+  com = filtered(but_trunk + trunk_share * hat_com);
+  out.total_N = total_of(com);
+  out.com_lateral_m = lateral_part(com);
   if (upper_body_lag_s > 0) {
     // The trunk's share delayed (its acceleration a(t - tau)); near a flight phase as measured.
-    const Eigen::MatrixXd trunk_late = delayed(trunk_share * hat_com, upper_body_lag_s * motion.rate_hz);
-    const Eigen::VectorXd lagged = mass * lateral_part(second_difference(filtered(com + trunk_late), dt));
-    com = filtered(com + trunk_share * hat_com);
-    out.total_N = mass * lateral_part(second_difference(com, dt));
+    const Eigen::VectorXd lagged = total_of(filtered(but_trunk + delayed(trunk_share * hat_com, upper_body_lag_s * motion.rate_hz)));
     for (Eigen::Index i = 0; i < n; ++i)
       if (!(near_flight && i < static_cast<Eigen::Index>(near_flight->size()) && (*near_flight)[static_cast<std::size_t>(i)])) out.total_N[i] = lagged[i];
-  } else {
-    com = filtered(com + trunk_share * hat_com);
-    out.total_N = mass * lateral_part(second_difference(com, dt));
   }
-  out.com_lateral_m = lateral_part(com);
   const double leg_cutoff = leg_cutoff_hz > 0 ? leg_cutoff_hz : cutoff_hz;
   for (int k = 0; k < 2; ++k) {
     out.foot_N[static_cast<std::size_t>(k)] = Eigen::VectorXd::Zero(n);

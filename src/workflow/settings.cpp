@@ -5,6 +5,8 @@
 
 #include <cctype>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/cop_function.hpp"
@@ -18,6 +20,11 @@ namespace kin2grf {
 
 namespace {
 const char* torso_length_name(TorsoLength t) { return t == TorsoLength::Fixed ? "fixed" : "measured"; }
+
+/// A setting that takes one of a few words, its default shown in the help.
+void add_choice(CLI::App* c, const std::string& flag, std::string& value, const std::string& help, const std::vector<std::string>& words) {
+  c->add_option(flag, value, help)->check(CLI::IsMember(words))->capture_default_str();
+}
 }  // namespace
 
 void add_settings_options(CLI::App* c, Settings& a) {
@@ -29,35 +36,35 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_flag("--mediolateral", a.mediolateral,
               "Estimate each foot's mediolateral force too (the whole body's lateral acceleration, shared between the feet as "
               "--lateral-split says; docs/METHOD-NOTES.md); off: the sagittal model's zero lateral force");
-  c->add_option("--model", a.model,
-                "sagittal (the paper's model) or 3d: the sagittal results plus each foot's mediolateral force (as "
-                "--mediolateral) and the ankles', knees' and hips' 3D moments, the knee adduction moment among them")
-      ->check(CLI::IsMember({"sagittal", "3d"}))->capture_default_str();
-  c->add_option("--lateral-split", a.lateral_split,
-                "How the feet share the whole body's lateral force (--model 3d): own-leg (each foot in contact carries its own "
-                "lower leg's lateral inertia, the rest by vertical load) or load (all by vertical load)")
-      ->check(CLI::IsMember({"own-leg", "load"}))->capture_default_str();
-  c->add_option("--upper-body", a.upper_body,
-                "The arms and the head in the lateral force (--model 3d): segments (their own, where the marker set names their "
-                "markers and the file holds them) or lumped (into the torso, as the sagittal model has them)")
-      ->check(CLI::IsMember({"segments", "lumped"}))->capture_default_str();
-  c->add_option("--lateral-lag", a.lateral_lag,
-                "The torso's share of the lateral force (--model 3d): torso (delayed as its fore-aft force is, by --torso-lag less "
-                "what the trunk markers already lag the hip by, away from flight phases) or none")
-      ->check(CLI::IsMember({"torso", "none"}))->capture_default_str();
-  c->add_option("--lateral-bilateral", a.lateral_bilateral,
-                "The lateral force in a landing's bilateral stance (both feet down near a flight phase): least-squares (the paper's "
-                "least squares with the legs' 3D joint moments) or split (as --lateral-split, as everywhere else)")
-      ->check(CLI::IsMember({"least-squares", "split"}))->capture_default_str();
-  c->add_option("--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)")
-      ->check(CLI::IsMember({"cop", "three-point"}))->capture_default_str();
+  add_choice(c, "--model", a.model,
+             "sagittal (the paper's model) or 3d: the sagittal results plus each foot's mediolateral force (as "
+             "--mediolateral) and the ankles', knees' and hips' 3D moments, the knee adduction moment among them",
+             {"sagittal", "3d"});
+  add_choice(c, "--lateral-split", a.lateral_split,
+             "How the feet share the whole body's lateral force (--model 3d): own-leg (each foot in contact carries its own "
+             "lower leg's lateral inertia, the rest by vertical load) or load (all by vertical load)",
+             {"own-leg", "load"});
+  add_choice(c, "--upper-body", a.upper_body,
+             "The arms and the head in the lateral force (--model 3d): segments (their own, where the marker set names their "
+             "markers and the file holds them) or lumped (into the torso, as the sagittal model has them)",
+             {"segments", "lumped"});
+  add_choice(c, "--lateral-lag", a.lateral_lag,
+             "The torso's share of the lateral force (--model 3d): torso (delayed as its fore-aft force is, by --torso-lag less "
+             "what the trunk markers already lag the hip by, where trunk markers measure the torso and away from flight phases) "
+             "or none",
+             {"torso", "none"});
+  add_choice(c, "--lateral-bilateral", a.lateral_bilateral,
+             "The lateral force in a landing's bilateral stance (both feet down near a flight phase): least-squares (the paper's "
+             "least squares with the legs' 3D joint moments) or split (as --lateral-split, as everywhere else)",
+             {"least-squares", "split"});
+  add_choice(c, "--foot-model", a.foot_model, "cop (paper's model 2) or three-point (model 1)", {"cop", "three-point"});
   c->add_option_function<double>(
        "--r", [&a](double v) { a.r = v, a.r_given = true; },
        "Activation parameter r, N/m (Eq. 8); default 1000 (from `kin2grf study r`), 10000 with --paper");
   c->add_option("--kinematic-cutoff", a.kinematic_cutoff, "Kinematics low-pass cut-off, Hz")->capture_default_str();
-  c->add_option("--kinematic-cutoff-rule", a.kinematic_cutoff_rule,
-                "noise: --kinematic-cutoff lowered where the markers' noise needs it (residual analysis); fixed: as given (--paper)")
-      ->check(CLI::IsMember({"noise", "fixed"}))->capture_default_str();
+  add_choice(c, "--kinematic-cutoff-rule", a.kinematic_cutoff_rule,
+             "noise: --kinematic-cutoff lowered where the markers' noise needs it (residual analysis); fixed: as given (--paper)",
+             {"noise", "fixed"});
   c->add_option("--post-cutoff", a.post_cutoff,
                 "Multiplier post-filter at this fixed cut-off, Hz (the paper: 12; 0: none); replaces --post-cutoff-cycles");
   c->add_option_function<double>(
@@ -72,11 +79,10 @@ void add_settings_options(CLI::App* c, Settings& a) {
        "--speed-gate", [&a](double v) { a.speed_gate = v, a.numeric.contact.speed_gate.ratio = 0; },
        "A fixed speed gate: contact allowed only below this sole speed, m/s (0 = off, the paper); replaces --speed-gate-ratio")
       ->check(CLI::Range(0.0, 20.0));
-  c->add_option("--torso-length", a.torso_length,
-                "measured (the hip-shoulder distance of each frame, filtered) or fixed (its median, the paper's rigid HAT)")
-      ->check(CLI::IsMember({"measured", "fixed"}))->capture_default_str();
-  c->add_option("--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled")
-      ->check(CLI::IsMember({"paper", "torque-scaled"}))->capture_default_str();
+  add_choice(c, "--torso-length", a.torso_length,
+             "measured (the hip-shoulder distance of each frame, filtered) or fixed (its median, the paper's rigid HAT)",
+             {"measured", "fixed"});
+  add_choice(c, "--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled", {"paper", "torque-scaled"});
   c->add_option_function<std::string>(
        "--anthropometry", [&a](const std::string& v) { a.anthropometry = v, a.anthropometry_given = true; },
        "winter or de-leva; default de-leva, winter with --paper")
