@@ -1,7 +1,11 @@
 #include "kin2grf/trial.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <random>
+#include <string>
+
+#include "kin2grf/error.hpp"
 
 namespace kin2grf {
 
@@ -69,6 +73,27 @@ void add_marker_noise(MarkerTrajectories& m, double sigma_m, unsigned seed) {
   std::normal_distribution<double> noise(0.0, sigma_m);
   for (auto& P : m.positions_m)
     for (Eigen::Index i = 0; i < P.size(); ++i) P.data()[i] += noise(rng);
+}
+
+MarkerTrajectories decimated(MarkerTrajectories m, int factor) {
+  if (factor < 1) throw InputError("decimation factor " + std::to_string(factor) + ": it must be 1 or more");
+  if (factor == 1) return m;
+  const Eigen::Index n = m.frames(), kept = (n + factor - 1) / factor;
+  Eigen::VectorXd t(kept);
+  for (Eigen::Index i = 0; i < kept; ++i) t[i] = m.time_s[i * factor];
+  for (auto& P : m.positions_m) {
+    Eigen::MatrixX3d Q(kept, 3);
+    for (Eigen::Index i = 0; i < kept; ++i) Q.row(i) = P.row(i * factor);
+    P = std::move(Q);
+  }
+  m.time_s = std::move(t);
+  m.rate_hz /= factor;
+  return m;
+}
+
+int decimation_factor(double rate_hz, double target_hz) {
+  if (!(rate_hz > 0) || !(target_hz > 0)) return 1;
+  return std::max(1, static_cast<int>(std::lround(rate_hz / target_hz)));
 }
 
 double ForcePlate::width_m() const { return (corners_m[0] - corners_m[1]).norm(); }

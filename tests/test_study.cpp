@@ -170,6 +170,44 @@ TEST(Study, NoiseStudyPoolsEightDistinctDraws) {
   EXPECT_NE(noisy[0].metrics.vertical->rrmse_percent, noisy[clean].metrics.vertical->rrmse_percent);
 }
 
+// The marker-rate study decimates the markers (every k-th frame, each at its own time) and keeps
+// the plates: the example walk's 100 Hz row is validate itself, its 50 Hz row holds the same
+// stances, and each stance stays within two points of vertical rRMSE (the pipeline measures time in
+// seconds: a rule counting frames would move the 50 Hz row by far more).
+TEST(Study, MarkerRateStudyDecimatesTheMarkersAndKeepsThePlates) {
+  const Trial walk = make_example_walk();
+  ASSERT_NEAR(walk.markers.rate_hz, 100.0, 1e-9);
+  const MarkerTrajectories half = decimated(walk.markers, 2);
+  EXPECT_EQ(half.frames(), (walk.markers.frames() + 1) / 2);
+  EXPECT_DOUBLE_EQ(half.rate_hz, 50.0);
+  EXPECT_DOUBLE_EQ(half.time_s[3], walk.markers.time_s[6]);
+  EXPECT_TRUE(half.positions_m[0].row(3).isApprox(walk.markers.positions_m[0].row(6)));
+  EXPECT_THROW((void)decimated(walk.markers, 0), InputError);
+  EXPECT_EQ(decimation_factor(250.0, 60.0), 4);
+  EXPECT_EQ(decimation_factor(100.0, 100.0), 1);
+  EXPECT_EQ(decimation_factor(60.0, 100.0), 1) << "never upsampled";
+
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  StudyTrial t;
+  t.name = "walk", t.activity = "walking", t.lab = "lab", t.trial = &walk, t.plates = &*walk.plates, t.marker_set = &set;
+  const StudyResult s = run_study("marker-rate", {t});
+  ASSERT_EQ(s.rows.size(), 4u);  // as recorded, about 100, 60 and 50 Hz
+  ASSERT_TRUE(s.failures.empty());
+  EXPECT_TRUE(s.rows[0].is_default);
+  const auto& recorded = s.per_trial[0][0].stances;
+  const auto& at100 = s.per_trial[1][0].stances;
+  const auto& at50 = s.per_trial[3][0].stances;
+  ASSERT_GT(recorded.size(), 0u);
+  ASSERT_EQ(at100.size(), recorded.size());
+  ASSERT_EQ(at50.size(), recorded.size());
+  for (std::size_t k = 0; k < recorded.size(); ++k) {
+    ASSERT_TRUE(recorded[k].metrics.vertical && at100[k].metrics.vertical && at50[k].metrics.vertical);
+    EXPECT_DOUBLE_EQ(at100[k].metrics.vertical->rrmse_percent, recorded[k].metrics.vertical->rrmse_percent);
+    EXPECT_NE(at50[k].metrics.vertical->rrmse_percent, recorded[k].metrics.vertical->rrmse_percent);
+    EXPECT_NEAR(at50[k].metrics.vertical->rrmse_percent, recorded[k].metrics.vertical->rrmse_percent, 2.0) << "stance " << k;
+  }
+}
+
 // One parser reads a whole list (issue 31: 100,000 lines took 12 s, a line of 200,000 options
 // 20 s to refuse): a line's options never leak into the next, line endings may be LF, CRLF or a
 // lone CR, a byte-order mark is skipped, and an overlong line is refused at once.

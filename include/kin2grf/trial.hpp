@@ -73,6 +73,15 @@ MarkerTrajectories rotated(MarkerTrajectories m, const Eigen::Matrix3d& R, Axis 
 /// study, make-example --marker-noise).
 void add_marker_noise(MarkerTrajectories& m, double sigma_m, unsigned seed);
 
+/// Every `factor`-th frame of the markers (frames 0, factor, 2 factor, ...), at rate_hz / factor,
+/// each kept frame at its own time: what a capture at a lower rate would have sampled of the same
+/// motion (a camera samples positions; it does not low-pass them first). The marker-rate study.
+/// factor 1 returns the markers as they are; factor < 1 is an InputError.
+MarkerTrajectories decimated(MarkerTrajectories m, int factor);
+
+/// The whole factor that brings `rate_hz` nearest to `target_hz` (at least 1: never upsampled).
+int decimation_factor(double rate_hz, double target_hz);
+
 /// One force plate (or one per-foot channel set of a processed GRF file).
 struct ForcePlate {
   std::string name;               ///< e.g. "FP1" or "right" for GRF .mot columns

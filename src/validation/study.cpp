@@ -23,6 +23,7 @@ struct Setting {
   double marker_noise_m = 0.0;  ///< the `noise` study: Gaussian noise added to every marker coordinate
   bool is_default = false;      ///< leaves kin2grf's default options as they are
   bool without_trunk = false;   ///< the `trunk-ablation` study: the trial's trunk and arm markers unused
+  double marker_rate_hz = 0.0;  ///< the `marker-rate` study: markers decimated to about this rate (0: as recorded)
 };
 
 /// Marks the settings that leave the fields `get` reads at kin2grf's defaults (the added marker
@@ -151,6 +152,24 @@ std::vector<Setting> noise_settings() {
   return s;
 }
 
+/// Robustness to the capture rate: every trial's markers as recorded and decimated to about 100,
+/// 60 and 50 Hz (every k-th frame, k the whole factor nearest the rate; a trial already at or
+/// under a rate keeps its frames), the plates as recorded. Clinical systems capture at 50-120 Hz,
+/// the development trials at 60-250 Hz, so a rule that counted frames where it means seconds would
+/// show here. `validate` averages the plates over each marker frame, so at a lower rate the
+/// plates' impact transient is smoothed in the reference too.
+std::vector<Setting> marker_rate_settings() {
+  std::vector<Setting> s{{"as recorded", 0, [](EstimateOptions&) {}, 0.0, true}};
+  for (double hz : {100.0, 60.0, 50.0}) {
+    char b[32];
+    std::snprintf(b, sizeof b, "about %.0f Hz", hz);
+    Setting c{b, hz, [](EstimateOptions&) {}};
+    c.marker_rate_hz = hz;
+    s.push_back(std::move(c));
+  }
+  return s;
+}
+
 std::vector<Setting> torso_length_settings() {
   std::vector<Setting> s{{"fixed (the paper)", 0, [](EstimateOptions& o) { o.torso_length = TorsoLength::Fixed; }},
                          {"measured", 1, [](EstimateOptions& o) { o.torso_length = TorsoLength::Measured; }}};
@@ -182,6 +201,7 @@ const std::vector<StudyKind>& special_studies() {
       {"trunk-ablation", [] { return trunk_ablation_settings(false); }},
       {"mediolateral-ablation", [] { return trunk_ablation_settings(true); }},
       {"noise", noise_settings},
+      {"marker-rate", marker_rate_settings},
       {"torso-length", torso_length_settings},
       {"foot-model", foot_model_settings},
   };
@@ -239,10 +259,14 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
     double grm_sum = 0;
     int grm_n = 0;
     for (int seed = 1; seed <= draws; ++seed) {
-      Trial noisy;
-      if (s.marker_noise_m > 0) {
-        noisy = *d.trial;
-        add_marker_noise(noisy.markers, s.marker_noise_m, static_cast<unsigned>(seed));
+      // The trial as recorded, or a copy with the setting's noise or capture rate.
+      const int factor = s.marker_rate_hz > 0 ? decimation_factor(d.trial->markers.rate_hz, s.marker_rate_hz) : 1;
+      const bool changed = s.marker_noise_m > 0 || factor > 1;
+      Trial working;
+      if (changed) {
+        working = *d.trial;
+        if (factor > 1) working.markers = decimated(std::move(working.markers), factor);
+        if (s.marker_noise_m > 0) add_marker_noise(working.markers, s.marker_noise_m, static_cast<unsigned>(seed));
       }
       std::optional<MarkerSet> ablated;
       if (s.without_trunk) {
@@ -250,7 +274,7 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
         ablated = without_trunk_markers(*d.marker_set, why);
         if (!ablated) throw InputError(why);
       }
-      const EstimateResult e = estimate(s.marker_noise_m > 0 ? noisy : *d.trial, d.static_trial, ablated ? *ablated : *d.marker_set, o);
+      const EstimateResult e = estimate(changed ? working : *d.trial, d.static_trial, ablated ? *ablated : *d.marker_set, o);
       const ValidationResult v = validate(e, *d.plates);
       tr.stances.insert(tr.stances.end(), v.stances.begin(), v.stances.end());
       if (v.total && v.total->metrics.moment) grm_sum += v.total->metrics.moment->rrmse_percent, ++grm_n;
