@@ -15,9 +15,11 @@
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/io/marker_labels.hpp"
 #include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
+#include "kin2grf/workflow/settings.hpp"
 #include "test_support.hpp"
 
 using namespace kin2grf;
@@ -530,4 +532,138 @@ TEST(Landmarks, WithoutTrunkMarkersTheTorsoStandsOnTheHipCentre) {
   functional_hip.rules[kHip].kind = RuleKind::Functional;
   EXPECT_FALSE(without_trunk_markers(functional_hip, why).has_value());
   EXPECT_NE(why.find("'functional'"), std::string::npos);
+}
+
+// A marker set no preset knows is mapped from its labels (io/marker_labels.hpp): each label read
+// as a side and a landmark word, in the spellings of Plug-in Gait, ISB/CAST, OpenSim, OpenCap and
+// Visual3D. A word kin2grf does not know is left out, never guessed.
+TEST(MarkerLabels, ReadsTheSpellingsOfTheFieldsMarkerSets) {
+  const std::vector<std::tuple<std::string, char, std::string>> cases = {
+      {"RKNE", 'r', "knee_lateral"},   {"L_FLE", 'l', "knee_lateral"},  {"R.Knee.Medial", 'r', "knee_medial"},
+      {"r_mknee", 'r', "knee_medial"}, {"RLMAL", 'r', "ankle_lateral"}, {"LMMAL", 'l', "ankle_medial"},
+      {"R_TAM", 'r', "ankle_medial"},  {"RMED", 'r', "ankle_medial"},   {"RFCC", 'r', "heel"},
+      {"L.Heel", 'l', "heel"},         {"Heel", 0, "heel"},             {"R.Toe.Tip", 'r', "hallux"},
+      {"R_Toe_Lat", 'r', "mt5"},       {"r_5meta", 'r', "mt5"},         {"RFM1", 'r', "mt1"},
+      {"RTOE", 'r', "toe"},            {"C7", 0, "c7"},                 {"CLAV", 0, "clav"},
+      {"SACR", 0, "sacrum"},           {"V.Sacral", 0, "sacrum"},       {"ASIS_R", 'r', "asis"},
+      {"LeftASIS", 'l', "asis"},       {"RightKnee", 'r', "knee_lateral"}, {"KneeL", 'l', "knee_lateral"},
+      {"RHJC", 'r', "hjc"},            {"L_KJC", 'l', "kjc"},           {"RSHO", 'r', "shoulder"},
+      {"R.Acromium", 'r', "shoulder"}, {"LFHD", 'l', "head"},           {"RWRA", 'r', "wrist"},
+      {"RTHI", 0, ""},                 {"LTIB", 0, ""},                 {"RTH1", 0, ""},
+      {"*51", 0, ""},                  {"LASI#2", 0, ""},
+  };
+  for (const auto& [label, side, key] : cases) {
+    const MarkerLabel l = read_marker_label(label);
+    EXPECT_EQ(l.landmark, key) << label;
+    EXPECT_EQ(l.side, side) << label;
+  }
+}
+
+namespace {
+
+/// The example walk with its markers renamed as an ISB-minded lab would name them.
+Trial isb_labelled_walk() {
+  Trial t = make_example_walk();
+  const std::map<std::string, std::string> isb = {
+      {"RSHO", "RACR"},      {"LSHO", "L_AC"},    {"RHJC", "R_HJC"},  {"LHJC", "HJC_L"}, {"RKJC", "RightKJC"},
+      {"LKJC", "L.KJC"},     {"RAJC", "R_AJC"},   {"LAJC", "LAJC"},   {"RHEE", "R_FCC"}, {"LHEE", "L.Heel"},
+      {"RMT1", "R_FM1"},     {"LMT1", "LMT1"},    {"RHLX", "R.Toe.Tip"}, {"LHLX", "L_Hallux"}};
+  for (auto& n : t.markers.names) n = isb.at(n);
+  return t;
+}
+
+}  // namespace
+
+// The same walk under other labels: the mapping made from them gives the preset's landmarks, so
+// the estimate is the preset's to the last bit; every rule taken is said.
+TEST(MarkerLabels, AnISBLabelledWalkIsEstimatedAsItsPresetIs) {
+  const Trial walk = make_example_walk();
+  const Trial isb = isb_labelled_walk();
+  EXPECT_EQ(recognise_marker_set(isb.markers), nullptr);
+  Settings s;
+  s.trial = "isb.c3d";
+  MarkerSet custom;
+  std::string why;
+  const MarkerSet& set = resolve_marker_set(s, isb, custom, &why);
+  EXPECT_EQ(set.name, "labels");
+  EXPECT_NE(why.find("no preset recognised"), std::string::npos) << why;
+  EXPECT_NE(why.find("knee_r = RightKJC (joint centre)"), std::string::npos) << why;
+  EXPECT_NE(why.find("mt_r = R_FM1"), std::string::npos) << why;
+  EXPECT_NE(why.find("hallux_l = L_Hallux"), std::string::npos) << why;
+  const EstimateResult a = estimate(walk, nullptr, *recognise_marker_set(walk.markers), EstimateOptions{});
+  const EstimateResult b = estimate(isb, nullptr, set, EstimateOptions{});
+  for (int side = 0; side < 2; ++side) {
+    ASSERT_EQ(a.feet[side].force_N.rows(), b.feet[side].force_N.rows());
+    EXPECT_TRUE(a.feet[side].force_N.isApprox(b.feet[side].force_N, 1e-12)) << "side " << side;
+  }
+  // Asked for by name, the labels' mapping is made even where a preset matches.
+  s.markers = "labels";
+  EXPECT_EQ(resolve_marker_set(s, walk, custom).name, "labels");
+}
+
+// A landmark no label gives is named, with the spellings looked for, and the file; what was found
+// is listed beside it. An empty label (a lower-body capture's trunk) does not count as present.
+TEST(MarkerLabels, AMissingLandmarkIsNamedWithTheFileAndTheSpellingsLookedFor) {
+  Trial isb = isb_labelled_walk();
+  for (auto& n : isb.markers.names)
+    if (n == "RightKJC") n = "R_knee_thing";
+  const std::size_t sho = static_cast<std::size_t>(isb.markers.find("RACR"));
+  isb.markers.positions_m[sho].setConstant(std::nan(""));
+  const LabelMapping lm = map_marker_labels(isb.markers);
+  EXPECT_FALSE(lm.mapping);
+  ASSERT_EQ(lm.missing.size(), 2u);
+  EXPECT_EQ(lm.missing[0].rfind("knee_r: no joint centre (kjc", 0), 0u) << lm.missing[0];
+  EXPECT_EQ(lm.missing[1].rfind("shoulder: no acromion markers", 0), 0u) << lm.missing[1];
+  Settings s;
+  s.trial = "isb.c3d";
+  MarkerSet custom;
+  try {
+    (void)resolve_marker_set(s, isb, custom);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("isb.c3d"), std::string::npos) << what;
+    EXPECT_NE(what.find("knee_r: no joint centre"), std::string::npos) << what;
+    EXPECT_NE(what.find("ankle_r = R_AJC"), std::string::npos) << what;
+  }
+}
+
+// The rules a biomechanist writes by hand: lateral and medial markers averaged, a lateral one
+// alone marked as on the skin, the metatarsal heads averaged, a Plug-in Gait TOE on the 2nd MT
+// head with virtual toes, the pelvis by Harrington from ASIS and sacrum, an upright torso when no
+// trunk marker holds data; two labels for one place: the better-seen one, said.
+TEST(MarkerLabels, MakesTheRulesABiomechanistWouldWrite) {
+  MarkerTrajectories m;
+  const Eigen::Index n = 40;
+  m.time_s = Eigen::VectorXd::LinSpaced(n, 0.0, 0.39);
+  m.rate_hz = 100;
+  const auto add = [&](const std::string& name, long frames) {
+    m.names.push_back(name);
+    m.descriptions.emplace_back();
+    Eigen::MatrixX3d p = Eigen::MatrixX3d::Constant(n, 3, 0.1 * static_cast<double>(m.names.size()));
+    p.bottomRows(n - frames).setConstant(std::nan(""));
+    m.positions_m.push_back(p);
+  };
+  for (const char* x : {"RASI", "LASI", "SACR", "RKNE", "RKNM", "LKNE", "RANK", "LANK", "LMED", "RHEE", "LHEE", "R_MT1", "R_MT5",
+                        "RMT2", "LTOE", "RTOE"})
+    add(x, n);
+  add("R.Heel", 30);  // a second heel label, seen less
+  add("RSHO", 0);     // a lower-body capture's empty trunk labels
+  add("LSHO", 0);
+  const LabelMapping lm = map_marker_labels(m);
+  ASSERT_TRUE(lm.mapping) << (lm.missing.empty() ? "" : lm.missing[0]);
+  const auto& L = (*lm.mapping)["landmarks"];
+  EXPECT_EQ(L["hip"]["harrington"]["sacrum"], "SACR");
+  EXPECT_EQ(L["knee_r"]["mean"], nlohmann::json({"RKNE", "RKNM"}));
+  EXPECT_EQ(L["knee_l"]["surface"], "lateral");
+  EXPECT_EQ(L["ankle_l"]["mean"], nlohmann::json({"LANK", "LMED"}));
+  EXPECT_EQ(L["heel_r"]["marker"], "RHEE");
+  EXPECT_EQ(L["mt_r"]["mean"], nlohmann::json({"R_MT1", "RMT2", "R_MT5"}));
+  EXPECT_EQ(L["hallux_r"]["marker"], "RTOE");  // a toe ahead of MT markers is a toe
+  EXPECT_EQ(L["mt_l"]["marker"], "LTOE");       // a toe with no MT marker is Plug-in Gait's
+  EXPECT_TRUE(L["hallux_l"].contains("virtual_hallux"));
+  EXPECT_EQ(L["shoulder"]["pelvis_up"], 0.5);
+  ASSERT_EQ(lm.notes.size(), 1u);
+  EXPECT_EQ(lm.notes[0], "heel (r): RHEE taken (most frames) over R.Heel");
+  EXPECT_NO_THROW((void)parse_marker_set(*lm.mapping, "labels"));
 }

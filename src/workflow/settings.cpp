@@ -12,6 +12,7 @@
 #include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/trial.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/io/marker_labels.hpp"
 #include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/option_table.hpp"
 #include "kin2grf/parallel.hpp"
@@ -30,7 +31,7 @@ void add_choice(CLI::App* c, const std::string& flag, std::string& value, const 
 void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("TRIAL", a.trial, "Motion trial (C3D or TRC)")->required();
   c->add_option("--static", a.static_trial, "Static calibration trial (for virtual knee/ankle landmarks)");
-  c->add_option("--markers", a.markers, "Marker-set preset name or mapping file (JSON); default: recognised");
+  c->add_option("--markers", a.markers, "Marker-set preset name, mapping file (JSON), or labels (a mapping made from the file's own marker labels); default: the preset recognised, else labels");
   c->add_option("--mass", a.mass, "Body mass, kg (default: the C3D's PROCESSING:Bodymass or SUBJECT(S):WEIGHT); 20-300");
   c->add_flag("--force-mass", a.force_mass, "Accept a body mass outside 20-300 kg");
   c->add_flag("--mediolateral", a.mediolateral,
@@ -206,6 +207,29 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
 const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, MarkerSet& custom, std::string* why) {
   std::vector<std::string> presets;
   for (const auto& s : builtin_marker_sets()) presets.push_back(s.name);
+  // A mapping made from the file's own labels (io/marker_labels.hpp): every rule is said in `why`,
+  // and a landmark no label gives is named in the error.
+  const auto from_labels = [&](const std::string& because) -> const MarkerSet& {
+    const LabelMapping lm = map_marker_labels(trial.markers);
+    if (!lm.mapping) {
+      std::string found, lacking;
+      for (const auto& r : lm.rules) found += "\n  " + r;
+      for (const auto& r : lm.missing) lacking += "\n  " + r;
+      throw InputError(a.trial + ": " + because + "; from the file's labels no mapping could be made. Missing:" + lacking +
+                       (found.empty() ? std::string() : "\nFound:" + found) +
+                       "\nGive a mapping file (--markers FILE.json, docs/MARKERSETS.md) with a rule for each landmark: shoulder, hip, knee_r, "
+                       "ankle_r, heel_r, mt_r, hallux_r and the same _l (a set whose joint markers are on the static trial only, "
+                       "or whose joints are found from clusters, needs its static or functional rules)");
+    }
+    custom = parse_marker_set(*lm.mapping, a.trial + " (its labels)");
+    if (why) {
+      *why = "made from the file's labels (" + because + "): ";
+      for (std::size_t i = 0; i < lm.rules.size(); ++i) *why += (i ? "; " : "") + lm.rules[i];
+      for (const auto& n : lm.notes) *why += "; " + n;
+    }
+    return custom;
+  };
+  if (a.markers == "labels") return from_labels("--markers labels");
   if (!a.markers.empty()) {
     if (const auto* set = find_marker_set(a.markers)) return *set;
     std::error_code ec;
@@ -215,7 +239,7 @@ const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, Marke
       for (const auto& n : presets) list += (list.empty() ? "" : ", ") + n;
       const std::string near = closest_match(a.markers, presets);
       throw InputError("--markers " + a.markers + ": neither a preset nor a file" + (near.empty() ? "" : "; did you mean " + near + "?") +
-                       " (presets: " + list + "; or a mapping file, docs/MARKERSETS.md)");
+                       " (presets: " + list + "; labels, a mapping from the file's own labels; or a mapping file, docs/MARKERSETS.md)");
     }
     custom = load_marker_set(a.markers);
     return custom;
@@ -228,9 +252,7 @@ const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, Marke
   if (!set) {
     std::string names;
     for (const auto& s : builtin_marker_sets()) names += " " + s.name;
-    throw InputError(a.trial + ": marker set not recognised (presets:" + names +
-                     "). Give a mapping file (markers setting) with a rule for each landmark: shoulder, hip, knee_r, "
-                     "ankle_r, heel_r, mt_r, hallux_r and the same _l (see docs/MARKERSETS.md)");
+    return from_labels("no preset recognised: presets" + names);
   }
   if (why) *why = set->name + " (" + reason + ")";
   return *set;
