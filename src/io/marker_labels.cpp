@@ -5,6 +5,7 @@
 #include <array>
 #include <cctype>
 #include <map>
+#include <optional>
 #include <utility>
 
 namespace kin2grf {
@@ -62,11 +63,23 @@ std::string lower_alnum(const std::string& s) {
   return out;
 }
 
+/// `word` is `stem` followed by one or more digits (RTH1's "th1", RTB3's "tb3").
+bool numbered(const std::string& word, const std::string& stem) {
+  return word.size() > stem.size() && word.compare(0, stem.size(), stem) == 0 &&
+         std::all_of(word.begin() + static_cast<std::ptrdiff_t>(stem.size()), word.end(), [](unsigned char c) { return std::isdigit(c); });
+}
+bool starts_with(const std::string& word, const std::string& stem) { return word.size() > stem.size() && word.compare(0, stem.size(), stem) == 0; }
+
 std::string lookup(const std::string& word) {
   if (word.empty()) return {};
   for (const auto& w : vocabulary())
     for (const char* s : w.spellings)
       if (word == s) return w.key;
+  // Technical clusters: numbered (RTH1-3, RTB1-3, RSK1-4) or named by place on the segment
+  // (R.Thigh.Upper, R.Shank.Top.Lateral). A single wand (RTHI, RTIB) is not a cluster.
+  if (numbered(word, "th") || numbered(word, "thi") || numbered(word, "thigh") || starts_with(word, "thigh")) return "thigh_cluster";
+  if (numbered(word, "tb") || numbered(word, "tib") || numbered(word, "sk") || starts_with(word, "shank") || starts_with(word, "shin"))
+    return "shank_cluster";
   return {};
 }
 
@@ -170,8 +183,10 @@ std::string join(const std::vector<std::string>& v) {
 
 }  // namespace
 
-LabelMapping map_marker_labels(const MarkerTrajectories& m) {
-  LabelMapping out;
+namespace {
+
+/// Every label of `m` that reads as a landmark and holds data.
+Found find_labels(const MarkerTrajectories& m) {
   Found f;
   f.frames = m.frames();
   std::vector<long> held(m.names.size(), 0);
@@ -188,6 +203,15 @@ LabelMapping map_marker_labels(const MarkerTrajectories& m) {
     if (held[i] == 0 || 5 * held[i] < most) continue;
     f.by_place[{l.side, l.landmark}].emplace_back(m.names[i], held[i]);
   }
+  return f;
+}
+
+}  // namespace
+
+LabelMapping map_marker_labels(const MarkerTrajectories& m, const MarkerTrajectories* static_markers) {
+  LabelMapping out;
+  const Found f = find_labels(m);
+  const std::optional<Found> fs = static_markers ? std::optional<Found>(find_labels(*static_markers)) : std::nullopt;
   nlohmann::json lm = nlohmann::json::object();
   auto& notes = out.notes;
   const auto rule = [&](const std::string& landmark, nlohmann::json r, const std::string& said) {
@@ -219,23 +243,49 @@ LabelMapping map_marker_labels(const MarkerTrajectories& m) {
   for (const char side : {'r', 'l'}) {
     const std::string s(1, side);
     // Knee and ankle: the joint centre, else the mean of the lateral and medial markers, else the lateral one.
+    // The foot's markers, for a functional ankle (the foot as the distal segment).
+    const std::string heel = f.one(side, "heel", notes), mt1 = f.one(side, "mt1", notes), mt2 = f.one(side, "mt2", notes),
+                      mt5 = f.one(side, "mt5", notes), toe = f.one(side, "toe", notes), hallux = f.one(side, "hallux", notes);
+    std::vector<std::string> foot;
+    for (const auto* x : {&heel, &mt1, &mt2, &mt5, &toe, &hallux})
+      if (!x->empty()) foot.push_back(*x);
     for (const auto& [joint, centre] : std::array<std::pair<const char*, const char*>, 2>{{{"knee", "kjc"}, {"ankle", "ajc"}}}) {
-      const std::string name = std::string(joint) + "_" + s;
-      const std::string jc = f.one(side, centre, notes), lat = f.one(side, std::string(joint) + "_lateral", notes),
-                        med = f.one(side, std::string(joint) + "_medial", notes);
+      const std::string name = std::string(joint) + "_" + s, lateral = std::string(joint) + "_lateral", medial = std::string(joint) + "_medial";
+      const std::string jc = f.one(side, centre, notes), lat = f.one(side, lateral, notes), med = f.one(side, medial, notes);
+      const bool knee = std::string(joint) == "knee";
+      // The segment above the joint carries a static trial's markers (the knee's epicondyles on
+      // the thigh, the malleoli on the shank); for a functional centre, the segment below moves
+      // against it.
+      const std::vector<std::string> carrier = f.all(side, knee ? "thigh_cluster" : "shank_cluster");
+      const std::vector<std::string> below = knee ? f.all(side, "shank_cluster") : foot;
+      std::string slat, smed;
+      bool carried = carrier.size() >= 3 && static_markers;
+      if (carried) {
+        slat = fs->one(side, lateral, notes), smed = fs->one(side, medial, notes);
+        for (const auto& c : carrier) carried = carried && static_markers->find(c) >= 0;
+      }
       if (!jc.empty()) rule(name, {{"marker", jc}}, jc + " (joint centre)");
       else if (!lat.empty() && !med.empty()) rule(name, {{"mean", {lat, med}}}, "mean of " + lat + " and " + med + " (lateral and medial)");
       else if (!lat.empty()) rule(name, {{"marker", lat}, {"surface", "lateral"}}, lat + " (lateral marker; moved to the joint centre in 3D)");
+      else if (carried && !slat.empty() && !smed.empty())
+        rule(name, {{"static", {slat, smed}}, {"cluster", carrier}},
+             "mean of the static trial's " + slat + " and " + smed + ", carried by " + join(carrier));
+      else if (carried && !slat.empty())
+        rule(name, {{"static", {slat}}, {"cluster", carrier}, {"surface", "lateral"}},
+             "the static trial's lateral " + slat + ", carried by " + join(carrier));
+      else if (carrier.size() >= 3 && below.size() >= 3)
+        rule(name, {{"functional", {{"proximal", carrier}, {"distal", below}}}},
+             "functional centre (SCoRE) of " + join(carrier) + " against " + join(below));
       else
-        missing(name, "no joint centre (" + spellings_of(centre) + ") and no lateral marker (" + spellings_of(std::string(joint) + "_lateral") +
-                          ")" + (med.empty() ? "" : "; the medial marker " + med + " alone does not make one"));
+        missing(name, "no joint centre (" + spellings_of(centre) + "), no lateral marker (" + spellings_of(lateral) + ")" +
+                          (med.empty() ? "" : ", the medial marker " + med + " alone does not make one") + ", and no " +
+                          (knee ? "thigh" : "shank") + " cluster of 3 or more markers (RTH1-3, R.Thigh.Upper; RTB1-3, R.Shank.Upper) " +
+                          (static_markers ? "on both trials with the static trial's joint markers or " : "with a static trial (--static) or ") +
+                          "with a cluster below it for a functional centre");
     }
-    const std::string heel = f.one(side, "heel", notes);
     if (!heel.empty()) rule("heel_" + s, {{"marker", heel}}, heel);
     else missing("heel_" + s, "no heel marker (" + spellings_of("heel") + ")");
     // The MT head, along the foot's midline where the labels allow.
-    const std::string mt1 = f.one(side, "mt1", notes), mt2 = f.one(side, "mt2", notes), mt5 = f.one(side, "mt5", notes),
-                      toe = f.one(side, "toe", notes), hallux = f.one(side, "hallux", notes);
     bool toe_is_mt = false;
     std::vector<std::string> heads;
     for (const auto* h : {&mt1, &mt2, &mt5})

@@ -1,6 +1,7 @@
 #include "kin2grf/markers/landmarks.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -110,6 +111,51 @@ bool cluster_frame(const std::vector<Eigen::MatrixX3d>& c, Eigen::Index i, Eigen
   return true;
 }
 
+/// A cluster's reference shape: each marker's place in the cluster's own frame (cluster_frame),
+/// the median over the frames that show the whole cluster; empty when none does.
+std::vector<Eigen::Vector3d> cluster_shape(const std::vector<Eigen::MatrixX3d>& c) {
+  std::vector<std::array<std::vector<double>, 3>> xyz(c.size());
+  for (Eigen::Index i = 0; i < c.front().rows(); ++i) {
+    Eigen::Matrix3d R;
+    Eigen::Vector3d o;
+    if (!cluster_frame(c, i, R, o)) continue;
+    for (std::size_t k = 0; k < c.size(); ++k) {
+      const Eigen::Vector3d l = R.transpose() * (c[k].row(i).transpose() - o);
+      for (int a = 0; a < 3; ++a) xyz[k][static_cast<std::size_t>(a)].push_back(l[a]);
+    }
+  }
+  std::vector<Eigen::Vector3d> shape;
+  if (xyz.front()[0].empty()) return shape;
+  for (auto& v : xyz) shape.emplace_back(median(v[0]), median(v[1]), median(v[2]));
+  return shape;
+}
+
+/// The cluster's pose at frame i: the rigid motion (R, t) that best carries its reference shape
+/// onto the markers, x_k ~ R s_k + t, by least squares (Soderkvist and Wedin 1993, J Biomech
+/// 26:1473; the SVD of the markers' cross-covariance). Why not cluster_frame's axes: those come
+/// from the first two markers alone, so a skin-mounted cluster's deformation moves a virtual point
+/// by whichever markers a mapping lists first (Rajagopal's run: anterior force 9.7 % with RTH1,
+/// RTH2, RTH3 and 15.3 % with RTH2, RTH3, RTH1); the fit weighs every marker alike, in any order.
+bool fit_cluster(const std::vector<Eigen::MatrixX3d>& c, Eigen::Index i, const std::vector<Eigen::Vector3d>& shape, Eigen::Matrix3d& R,
+                 Eigen::Vector3d& t) {
+  if (shape.size() != c.size()) return false;
+  Eigen::Vector3d xbar = Eigen::Vector3d::Zero(), sbar = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    if (!c[k].row(i).allFinite()) return false;
+    xbar += c[k].row(i).transpose(), sbar += shape[k];
+  }
+  xbar /= static_cast<double>(c.size()), sbar /= static_cast<double>(c.size());
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+  for (std::size_t k = 0; k < c.size(); ++k) H += (shape[k] - sbar) * (c[k].row(i).transpose() - xbar).transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  if (svd.singularValues()[1] < 1e-12) return false;  // the markers on one line: no orientation
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  R = svd.matrixV() * D * svd.matrixU().transpose();
+  t = xbar - R * sbar;
+  return true;
+}
+
 /// SCoRE (Ehrig et al. 2006, J Biomech 39:2798): the joint centre is the point fixed in both
 /// segments, c1 in the proximal cluster's frame and c2 in the distal one's, by least squares over
 /// every frame where both clusters are seen: sum_i |R1_i c1 + o1_i - R2_i c2 - o2_i|^2 -> min.
@@ -134,9 +180,10 @@ Eigen::MatrixX3d functional_joint_centre(const std::vector<Eigen::MatrixX3d>& pr
     Eigen::Vector3d o1, o2;
   };
   std::vector<Seen> frames;
+  const std::vector<Eigen::Vector3d> shape1 = cluster_shape(prox), shape2 = cluster_shape(dist);
   for (Eigen::Index i = 0; i < n; ++i) {
     Seen f{i, {}, {}, {}, {}};
-    if (!cluster_frame(prox, i, f.R1, f.o1) || !cluster_frame(dist, i, f.R2, f.o2)) continue;
+    if (!fit_cluster(prox, i, shape1, f.R1, f.o1) || !fit_cluster(dist, i, shape2, f.R2, f.o2)) continue;
     const auto &R1 = f.R1, &R2 = f.R2;
     const auto &o1 = f.o1, &o2 = f.o2;
     Eigen::Matrix<double, 3, 6> A;
@@ -434,7 +481,8 @@ std::vector<int> last_landmark_use(const MarkerSet& set, const MarkerTrajectorie
 }
 
 /// A virtual point calibrated on the static trial (RuleKind::Static): its place in the cluster's
-/// frame, the median over the static frames, then carried by the cluster through the trial.
+/// frame (the static cluster's shape fitted to each frame, fit_cluster), the median over the
+/// static frames, then carried by the cluster, fitted the same way, through the trial.
 Eigen::MatrixX3d static_landmark(const MarkerSet& set, const LandmarkRule& r, int id, const MarkerTrajectories& m,
                                  const MarkerTrajectories* st, const std::string& path) {
   const std::string what = std::string("landmark ") + kNames[id];
@@ -449,11 +497,12 @@ Eigen::MatrixX3d static_landmark(const MarkerSet& set, const LandmarkRule& r, in
     cm.push_back(marker(m, c, path, what));
   }
   const Eigen::MatrixX3d sp = mean_of(*st, r.markers, path + " (static)", what);
+  const std::vector<Eigen::Vector3d> shape = cluster_shape(cs);  // the cluster as the static trial shows it
   std::vector<double> lx, ly, lz;
   for (Eigen::Index i = 0; i < st->frames(); ++i) {
     Eigen::Matrix3d R;
     Eigen::Vector3d o;
-    if (!sp.row(i).allFinite() || !cluster_frame(cs, i, R, o)) continue;
+    if (!sp.row(i).allFinite() || !fit_cluster(cs, i, shape, R, o)) continue;
     const Eigen::Vector3d l = R.transpose() * (sp.row(i).transpose() - o);
     lx.push_back(l.x()); ly.push_back(l.y()); lz.push_back(l.z());
   }
@@ -463,7 +512,7 @@ Eigen::MatrixX3d static_landmark(const MarkerSet& set, const LandmarkRule& r, in
   for (Eigen::Index i = 0; i < m.frames(); ++i) {
     Eigen::Matrix3d R;
     Eigen::Vector3d o;
-    if (cluster_frame(cm, i, R, o)) P.row(i) = (o + R * local).transpose();
+    if (fit_cluster(cm, i, shape, R, o)) P.row(i) = (o + R * local).transpose();
   }
   return P;
 }

@@ -204,13 +204,13 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
   return j;
 }
 
-const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, MarkerSet& custom, std::string* why) {
+const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, MarkerSet& custom, std::string* why, const Trial* static_trial) {
   std::vector<std::string> presets;
   for (const auto& s : builtin_marker_sets()) presets.push_back(s.name);
   // A mapping made from the file's own labels (io/marker_labels.hpp): every rule is said in `why`,
   // and a landmark no label gives is named in the error.
   const auto from_labels = [&](const std::string& because) -> const MarkerSet& {
-    const LabelMapping lm = map_marker_labels(trial.markers);
+    const LabelMapping lm = map_marker_labels(trial.markers, static_trial ? &static_trial->markers : nullptr);
     if (!lm.mapping) {
       std::string found, lacking;
       for (const auto& r : lm.rules) found += "\n  " + r;
@@ -297,7 +297,7 @@ EstimateResult estimate_trial_impl(const Settings& s, const EstimateOptions& opt
                                    const std::optional<Trial>& st) {
   MarkerSet custom;
   std::string why;
-  const MarkerSet& set = resolve_marker_set(s, trial, custom, &why);
+  const MarkerSet& set = resolve_marker_set(s, trial, custom, &why, st ? &*st : nullptr);
   try {
     auto r = release ? estimate(std::move(*release), st ? &*st : nullptr, set, options)
                      : estimate(trial, st ? &*st : nullptr, set, options);

@@ -159,7 +159,7 @@ std::vector<StudyTrial> study_trials(const std::vector<TrialListEntry>& entries)
       if (!source->plates || source->plates->plates.empty()) throw InputError(source->path + ": no force plates; give --plates");
       d.plates = &*source->plates;
       MarkerSet custom;
-      held->set = resolve_marker_set(settings, held->trial, custom);
+      held->set = resolve_marker_set(settings, held->trial, custom, nullptr, held->static_trial ? &*held->static_trial : nullptr);
       d.marker_set = &held->set;
       d.held = held;
       return d;

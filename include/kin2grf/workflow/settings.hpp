@@ -63,9 +63,12 @@ LoadOptions load_options(const std::string& zero_offset);
 /// "X", "Y", "Z" (either case) or "" (none); InputError otherwise.
 std::optional<Axis> parse_axis(const std::string& text);
 
-/// The marker set: `s.markers` (a preset name or a mapping file), else recognised from the
-/// trial's markers (`why` says how). `custom` holds a mapping file's set.
-const MarkerSet& resolve_marker_set(const Settings& s, const Trial& trial, MarkerSet& custom, std::string* why = nullptr);
+/// The marker set: `s.markers` (a preset name, a mapping file, or "labels"), else recognised from
+/// the trial's markers, else made from its labels (io/marker_labels.hpp; `static_trial`'s labels
+/// give the joints whose markers are on it only). `why` says how; `custom` holds a mapping file's
+/// or the labels' set.
+const MarkerSet& resolve_marker_set(const Settings& s, const Trial& trial, MarkerSet& custom, std::string* why = nullptr,
+                                    const Trial* static_trial = nullptr);
 
 /// The files a run with these settings reads (no output may be one of them).
 std::vector<std::string> input_files(const Settings& s);
