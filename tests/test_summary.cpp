@@ -44,3 +44,22 @@ TEST(Summary, ExampleWalkIsDescribed) {
   ASSERT_EQ(t.plates->plates.size(), 2u);
   for (const auto& p : t.plates->plates) EXPECT_EQ(loaded_intervals(*t.plates, p, 20.0).size(), 1u) << p.name;
 }
+
+// info says which marker set estimate would take: the preset it recognises, else the mapping made
+// from the labels (its rules), else what no label gives.
+TEST(Summary, InfoSaysWhichMarkerSetEstimateWouldTake) {
+  Trial t = make_example_walk();
+  EXPECT_EQ(trial_summary(t)["marker_set"]["preset"], "kin2grf-example");
+  for (auto& n : t.markers.names)
+    if (n.size() == 4) n = n.substr(0, 1) + "_" + n.substr(1);  // RKJC -> R_KJC: no preset knows it
+  const nlohmann::json s = trial_summary(t);
+  EXPECT_TRUE(s["marker_set"]["preset"].is_null());
+  EXPECT_TRUE(s["marker_set"]["missing"].empty()) << s["marker_set"].dump();
+  const std::string text = format_summary(s);
+  EXPECT_NE(text.find("no preset recognised; made from the labels"), std::string::npos) << text;
+  EXPECT_NE(text.find("knee_r = R_KJC (joint centre)"), std::string::npos) << text;
+  for (auto& n : t.markers.names)
+    if (n == "R_KJC") n = "R_XYZ";
+  const std::string missing = format_summary(trial_summary(t));
+  EXPECT_NE(missing.find("missing knee_r: no joint centre"), std::string::npos) << missing;
+}

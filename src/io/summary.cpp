@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/marker_labels.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
@@ -67,6 +69,21 @@ nlohmann::json trial_summary(const Trial& t, double thr) {
   }
   s["missing"] = missing;
   s["model_outputs"] = t.model_outputs.size();
+  // The marker set estimate would take without --markers: a preset, else the labels' mapping
+  // (its rules, or the landmarks no label gives). Joints that need the static trial are not
+  // mapped here (info reads one file).
+  if (!m.names.empty()) {
+    json set;
+    if (const MarkerSet* p = recognise_marker_set(m)) {
+      set = {{"preset", p->name}};
+    } else {
+      const LabelMapping lm = map_marker_labels(m);
+      set = {{"preset", nullptr}, {"labels", lm.rules}, {"notes", lm.notes}, {"missing", lm.missing}};
+    }
+    s["marker_set"] = set;
+  } else {
+    s["marker_set"] = nullptr;
+  }
   json plates = json::array();
   if (t.plates) {
     for (const auto& p : t.plates->plates) {
@@ -146,6 +163,17 @@ std::string format_summary(const nlohmann::json& s) {
     }
   } else {
     os << "  markers:     none\n";
+  }
+  if (s.contains("marker_set") && s["marker_set"].is_object()) {
+    const auto& set = s["marker_set"];
+    if (set["preset"].is_string()) {
+      os << "  marker set:  " << set["preset"].get<std::string>() << " (preset recognised)\n";
+    } else {
+      os << "  marker set:  no preset recognised; " << (set["missing"].empty() ? "made from the labels" : "from the labels, missing") << ":\n";
+      for (const auto& x : set["missing"]) os << "    missing " << x.get<std::string>() << "\n";
+      for (const auto& x : set["labels"]) os << "    " << x.get<std::string>() << "\n";
+      for (const auto& x : set["notes"]) os << "    (" << x.get<std::string>() << ")\n";
+    }
   }
   os << "  force plates: " << s["force_plates"].size() << "\n";
   for (const auto& p : s["force_plates"]) {

@@ -5,6 +5,7 @@
 //   rate_hz: number|null (marker rate), frames: {first, last, count}, duration_s,
 //   up_axis: "X"|"Y"|"Z", markers: [names], missing: [{marker, frames: count,
 //   intervals: [[first_frame, last_frame], ...]}], model_outputs: count,
+//   marker_set: {preset: name} | {preset: null, labels: [rules], notes: [..], missing: [..]} | null,
 //   force_plates: [{name, type, rate_hz, size_m: [w, l]|null, centre_m: [x,y,z]|null,
 //                   side_hint, loaded: [{start_s, end_s, peak_vertical_N}]}],
 //   events: [{label, side, time_s}], body_mass_kg: number|null, height_m: number|null,
