@@ -327,3 +327,23 @@ TEST(Batch, TheCsvKeepsFullPrecision) {
   EXPECT_EQ(std::stod(cells[9]), row.mass_kg);
   EXPECT_GT(cells[12].size(), 6u) << "more than 4 significant figures";
 }
+
+// The marker-labels study runs every trial with its preset and with the mapping made from its own
+// labels: on the example walk, whose labels give the preset's very landmarks, the two rows agree
+// stance for stance.
+TEST(Study, MarkerLabelsStudyRunsTheMappingFromTheLabelsBesideThePreset) {
+  const Trial walk = make_example_walk();
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  StudyTrial t;
+  t.name = "walk", t.activity = "walking", t.lab = "lab", t.trial = &walk, t.plates = &*walk.plates, t.marker_set = &set;
+  const StudyResult s = run_study("marker-labels", {t});
+  ASSERT_EQ(s.rows.size(), 2u);
+  ASSERT_TRUE(s.failures.empty());
+  EXPECT_TRUE(s.rows[0].is_default);
+  const auto& preset = s.per_trial[0][0].stances;
+  const auto& labels = s.per_trial[1][0].stances;
+  ASSERT_GT(preset.size(), 0u);
+  ASSERT_EQ(labels.size(), preset.size());
+  for (std::size_t k = 0; k < preset.size(); ++k)
+    EXPECT_DOUBLE_EQ(labels[k].metrics.vertical->rrmse_percent, preset[k].metrics.vertical->rrmse_percent) << "stance " << k;
+}

@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/marker_labels.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/option_table.hpp"
 
 namespace kin2grf {
@@ -24,6 +26,7 @@ struct Setting {
   bool is_default = false;      ///< leaves kin2grf's default options as they are
   bool without_trunk = false;   ///< the `trunk-ablation` study: the trial's trunk and arm markers unused
   double marker_rate_hz = 0.0;  ///< the `marker-rate` study: markers decimated to about this rate (0: as recorded)
+  bool from_labels = false;     ///< the `marker-labels` study: the set made from the file's labels, not the trial's preset
 };
 
 /// Marks the settings that leave the fields `get` reads at kin2grf's defaults (the added marker
@@ -170,6 +173,16 @@ std::vector<Setting> marker_rate_settings() {
   return s;
 }
 
+/// Robustness to a marker set no preset knows: every trial with its preset (or mapping file) and
+/// with the mapping made from its own labels (io/marker_labels.hpp, the static trial's labels
+/// included), as a held-out lab with an unknown set gets it. A trial whose labels do not give every
+/// landmark fails that row, naming them.
+std::vector<Setting> marker_labels_settings() {
+  std::vector<Setting> s{{"preset", 0, [](EstimateOptions&) {}, 0.0, true}, {"labels", 1, [](EstimateOptions&) {}}};
+  s[1].from_labels = true;
+  return s;
+}
+
 std::vector<Setting> torso_length_settings() {
   std::vector<Setting> s{{"fixed (the paper)", 0, [](EstimateOptions& o) { o.torso_length = TorsoLength::Fixed; }},
                          {"measured", 1, [](EstimateOptions& o) { o.torso_length = TorsoLength::Measured; }}};
@@ -202,6 +215,7 @@ const std::vector<StudyKind>& special_studies() {
       {"mediolateral-ablation", [] { return trunk_ablation_settings(true); }},
       {"noise", noise_settings},
       {"marker-rate", marker_rate_settings},
+      {"marker-labels", marker_labels_settings},
       {"torso-length", torso_length_settings},
       {"foot-model", foot_model_settings},
   };
@@ -273,6 +287,15 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
         std::string why;
         ablated = without_trunk_markers(*d.marker_set, why);
         if (!ablated) throw InputError(why);
+      }
+      if (s.from_labels) {
+        const LabelMapping lm = map_marker_labels(d.trial->markers, d.static_trial ? &d.static_trial->markers : nullptr);
+        if (!lm.mapping) {
+          std::string missing;
+          for (const auto& x : lm.missing) missing += (missing.empty() ? "" : "; ") + x;
+          throw InputError(t.name + ": its labels give no mapping: " + missing);
+        }
+        ablated = parse_marker_set(*lm.mapping, t.name + " (its labels)");
       }
       const EstimateResult e = estimate(changed ? working : *d.trial, d.static_trial, ablated ? *ablated : *d.marker_set, o);
       const ValidationResult v = validate(e, *d.plates);
