@@ -717,3 +717,36 @@ TEST(CliExample, TheGrfMotIsInOpenSimsFrameLikeTheOpenSimSet) {
   const kin2grf::Trial t = kin2grf::load_trial(c3d);
   EXPECT_EQ(table.data.rows(), t.markers.frames());
 }
+
+// A marker set no preset knows (the example walk's labels written the CAST way, R_KJC): estimate
+// takes the mapping made from its labels and says so, and info --write-mapping writes that mapping
+// as a file to edit, which estimate then reads as any mapping file, to the same forces.
+TEST(CliFiles, AnUnknownMarkerSetIsMappedFromItsLabelsAndInfoWritesTheMapping) {
+  const auto dir = kin2grf::test::temp_dir("cli_labels");
+  std::ifstream in(example_dir() / "example_walk.trc");
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::string trc = text.str();
+  for (const char* name : {"SHO", "HJC", "KJC", "AJC", "HEE", "MT1", "HLX"})
+    for (const char* side : {"R", "L"}) {
+      const std::string from = std::string("\t") + side + name + "\t", to = std::string("\t") + side + "_" + name + "\t";
+      const auto at = trc.find(from);
+      ASSERT_NE(at, std::string::npos) << from;
+      trc.replace(at, from.size(), to);
+    }
+  const auto renamed = dir / "cast.trc";
+  std::ofstream(renamed) << trc;
+  const CliRun r = run("estimate " + renamed.string() + " --mass 70 --csv " + (dir / "a.csv").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("made from the file's labels (no preset recognised"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("knee_r = R_KJC (joint centre)"), std::string::npos) << r.out;
+  const auto mapping = dir / "mapping.json";
+  ASSERT_EQ(run("info " + renamed.string() + " --write-mapping " + mapping.string()).status, 0);
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(mapping));
+  EXPECT_EQ(j["landmarks"]["knee_r"]["marker"], "R_KJC");
+  ASSERT_EQ(run("estimate " + renamed.string() + " --mass 70 --markers " + mapping.string() + " --csv " + (dir / "b.csv").string()).status, 0);
+  std::ifstream a(dir / "a.csv"), b(dir / "b.csv");
+  std::ostringstream sa, sb;
+  sa << a.rdbuf(), sb << b.rdbuf();
+  EXPECT_EQ(sa.str(), sb.str());
+}

@@ -614,6 +614,9 @@ TEST(MarkerLabels, AMissingLandmarkIsNamedWithTheFileAndTheSpellingsLookedFor) {
   ASSERT_EQ(lm.missing.size(), 2u);
   EXPECT_EQ(lm.missing[0].rfind("knee_r: no joint centre (kjc", 0), 0u) << lm.missing[0];
   EXPECT_EQ(lm.missing[1].rfind("shoulder: no acromion markers", 0), 0u) << lm.missing[1];
+  // The draft to complete by hand: what was found, and a placeholder naming what was not.
+  EXPECT_EQ(lm.draft["landmarks"]["ankle_r"]["marker"], "R_AJC");
+  EXPECT_EQ(lm.draft["landmarks"]["knee_r"]["marker"].get<std::string>().rfind("FILL IN: knee_r: no joint centre", 0), 0u);
   Settings s;
   s.trial = "isb.c3d";
   MarkerSet custom;

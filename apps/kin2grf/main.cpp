@@ -63,13 +63,16 @@ int main(int argc, char** argv) {
   CLI::App *info = nullptr, *estimate = nullptr, *validate = nullptr, *study = nullptr, *fit_cop = nullptr, *batch = nullptr,
            *make_example = nullptr;
 
-  std::string info_file, info_zero = "none", info_up_axis;
+  std::string info_file, info_zero = "none", info_up_axis, info_mapping;
   bool info_json = false;
   double info_threshold = 20.0;
   if (wanted("info")) {
     info = app.add_subcommand("info", "Describe a recording (C3D, TRC, MOT/STO) before processing it");
     info->add_option("FILE", info_file, "The recording")->required();
     info->add_flag("--json", info_json, "Write the description as JSON (schema in docs/FORMATS.md)");
+    info->add_option("--write-mapping", info_mapping,
+                     "Write the mapping made from the file's marker labels as a mapping file to edit (docs/MARKERSETS.md; "
+                     "a \"FILL IN\" marker names each landmark no label gives)");
     info->add_option("--zero-offset", info_zero,
                      "C3D plate offsets: none, zero (FORCE_PLATFORM:ZERO frames) or unloaded (median of unloaded samples)")
         ->check(CLI::IsMember({"none", "zero", "unloaded"}))->capture_default_str();
@@ -178,7 +181,7 @@ int main(int argc, char** argv) {
     auto chosen = [](const CLI::App* c) { return c && c->parsed(); };
     auto& out = std::cout;
     auto& log = std::cerr;
-    if (chosen(info)) rc = kin2grf::info_job(info_file, info_json, info_threshold, info_zero, info_up_axis, out);
+    if (chosen(info)) rc = kin2grf::info_job(info_file, info_json, info_threshold, info_zero, info_up_axis, out, info_mapping);
     else if (chosen(estimate)) rc = kin2grf::estimate_job(est, out, log);
     else if (chosen(validate)) rc = kin2grf::validate_job(val, out, log);
     else if (chosen(study)) rc = kin2grf::study_job(study_args, out, log);

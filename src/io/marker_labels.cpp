@@ -256,8 +256,10 @@ LabelMapping map_marker_labels(const MarkerTrajectories& m, const MarkerTrajecto
       // The segment above the joint carries a static trial's markers (the knee's epicondyles on
       // the thigh, the malleoli on the shank); for a functional centre, the segment below moves
       // against it.
-      const std::vector<std::string> carrier = f.all(side, knee ? "thigh_cluster" : "shank_cluster");
-      const std::vector<std::string> below = knee ? f.all(side, "shank_cluster") : foot;
+      std::vector<std::string> carrier = f.all(side, knee ? "thigh_cluster" : "shank_cluster");
+      std::vector<std::string> below = knee ? f.all(side, "shank_cluster") : foot;
+      std::sort(carrier.begin(), carrier.end());  // for the reader: the fit does not depend on the order
+      if (knee) std::sort(below.begin(), below.end());
       std::string slat, smed;
       bool carried = carrier.size() >= 3 && static_markers;
       if (carried) {
@@ -337,11 +339,17 @@ LabelMapping map_marker_labels(const MarkerTrajectories& m, const MarkerTrajecto
     out.rules.push_back("upper body (3D model): " + said);
   }
 
-  if (out.missing.empty()) {
-    nlohmann::json j = {{"name", "labels"}, {"description", "made from the file's marker labels (kin2grf --markers labels)"}, {"landmarks", lm}};
-    if (!upper.empty()) j["upper_body"] = upper;
-    out.mapping = std::move(j);
+  // The draft: what was found, and a placeholder that names each missing landmark (a mapping file
+  // with one still in it is refused, naming it, when read).
+  nlohmann::json draft_landmarks = lm;
+  for (const auto& x : out.missing) {
+    const std::string landmark = x.substr(0, x.find(':'));
+    draft_landmarks[landmark] = {{"marker", "FILL IN: " + x}};
   }
+  out.draft = {{"name", "labels"}, {"description", "made from the file's marker labels (kin2grf --markers labels)"},
+               {"landmarks", draft_landmarks}};
+  if (!upper.empty()) out.draft["upper_body"] = upper;
+  if (out.missing.empty()) out.mapping = out.draft;
   return out;
 }
 

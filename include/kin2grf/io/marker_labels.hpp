@@ -47,6 +47,9 @@ MarkerLabel read_marker_label(const std::string& label);
 /// The mapping made from the labels of `m`.
 struct LabelMapping {
   std::optional<nlohmann::json> mapping;  ///< a mapping file's JSON (docs/MARKERSETS.md) when every landmark has a rule
+  /// The same with a "FILL IN: ..." marker for each missing landmark: a mapping file to complete
+  /// by hand (`kin2grf info FILE --write-mapping OUT.json`).
+  nlohmann::json draft;
   std::vector<std::string> rules;         ///< one line a landmark: what it was made from
   std::vector<std::string> notes;         ///< choices between labels, fallbacks taken
   std::vector<std::string> missing;       ///< a landmark that no label gives, with the spellings looked for

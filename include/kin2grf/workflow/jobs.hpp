@@ -51,9 +51,10 @@ struct BatchJob {
 /// Registers estimate's settings and, with `outputs`, its output options on `app`.
 void add_estimate_options(CLI::App* app, EstimateJob& job, bool outputs = true);
 
-/// info: a recording described (text, or JSON with `json`).
+/// info: a recording described (text, or JSON with `json`); with `write_mapping`, the mapping made
+/// from its labels written there as a mapping file to edit (a "FILL IN" marker for what no label gives).
 int info_job(const std::string& file, bool json, double threshold_N, const std::string& zero_offset, const std::string& up_axis,
-             std::ostream& out);
+             std::ostream& out, const std::string& write_mapping = {});
 /// estimate: one trial's GRF, COP, GRM and joint torques into the asked outputs.
 int estimate_job(const EstimateJob& job, std::ostream& out, std::ostream& log);
 /// validate: estimate, then compare with the trial's plates (or --plates).
