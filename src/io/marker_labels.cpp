@@ -77,7 +77,7 @@ std::string lookup(const std::string& word) {
       if (word == s) return w.key;
   // Technical clusters: numbered (RTH1-3, RTB1-3, RSK1-4) or named by place on the segment
   // (R.Thigh.Upper, R.Shank.Top.Lateral). A single wand (RTHI, RTIB) is not a cluster.
-  if (numbered(word, "th") || numbered(word, "thi") || numbered(word, "thigh") || starts_with(word, "thigh")) return "thigh_cluster";
+  if (numbered(word, "th") || numbered(word, "thi") || starts_with(word, "thigh")) return "thigh_cluster";
   if (numbered(word, "tb") || numbered(word, "tib") || numbered(word, "sk") || starts_with(word, "shank") || starts_with(word, "shin"))
     return "shank_cluster";
   return {};
@@ -140,7 +140,6 @@ namespace {
 /// The labels found for each (side, landmark word), with the frames each holds data in.
 struct Found {
   std::map<std::pair<char, std::string>, std::vector<std::pair<std::string, long>>> by_place;
-  long frames = 0;
 
   /// The label for a place: the one holding data in the most frames; `notes` says when there were several.
   [[nodiscard]] std::string one(char side, const std::string& key, std::vector<std::string>& notes) const {
@@ -181,14 +180,9 @@ std::string join(const std::vector<std::string>& v) {
   return out;
 }
 
-}  // namespace
-
-namespace {
-
 /// Every label of `m` that reads as a landmark and holds data.
 Found find_labels(const MarkerTrajectories& m) {
   Found f;
-  f.frames = m.frames();
   std::vector<long> held(m.names.size(), 0);
   for (std::size_t i = 0; i < m.names.size(); ++i)
     for (Eigen::Index k = 0; k < m.frames(); ++k) held[i] += m.positions_m[i].row(k).allFinite();
@@ -242,13 +236,14 @@ LabelMapping map_marker_labels(const MarkerTrajectories& m, const MarkerTrajecto
 
   for (const char side : {'r', 'l'}) {
     const std::string s(1, side);
-    // Knee and ankle: the joint centre, else the mean of the lateral and medial markers, else the lateral one.
-    // The foot's markers, for a functional ankle (the foot as the distal segment).
+    // The foot's markers (also the distal segment of a functional ankle).
     const std::string heel = f.one(side, "heel", notes), mt1 = f.one(side, "mt1", notes), mt2 = f.one(side, "mt2", notes),
                       mt5 = f.one(side, "mt5", notes), toe = f.one(side, "toe", notes), hallux = f.one(side, "hallux", notes);
     std::vector<std::string> foot;
     for (const auto* x : {&heel, &mt1, &mt2, &mt5, &toe, &hallux})
       if (!x->empty()) foot.push_back(*x);
+    // Knee and ankle: the joint centre, else the mean of the lateral and medial markers, else the
+    // lateral one, else the static trial's carried by a cluster, else a functional centre.
     for (const auto& [joint, centre] : std::array<std::pair<const char*, const char*>, 2>{{{"knee", "kjc"}, {"ankle", "ajc"}}}) {
       const std::string name = std::string(joint) + "_" + s, lateral = std::string(joint) + "_lateral", medial = std::string(joint) + "_medial";
       const std::string jc = f.one(side, centre, notes), lat = f.one(side, lateral, notes), med = f.one(side, medial, notes);
@@ -325,7 +320,7 @@ LabelMapping map_marker_labels(const MarkerTrajectories& m, const MarkerTrajecto
   nlohmann::json upper = nlohmann::json::object();
   for (const char side : {'r', 'l'}) {
     const std::string s(1, side);
-    if (const std::string sho = f.one(side, "shoulder", notes); !sho.empty()) upper["shoulder_" + s] = nlohmann::json::array({sho});
+    if (const std::string& sho = side == 'r' ? rsho : lsho; !sho.empty()) upper["shoulder_" + s] = nlohmann::json::array({sho});
     if (const std::string e = f.one(side, "elbow", notes); !e.empty()) upper["elbow_" + s] = nlohmann::json::array({e});
     if (const auto w = f.all(side, "wrist"); !w.empty()) upper["wrist_" + s] = w;
   }

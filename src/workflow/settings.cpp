@@ -209,17 +209,17 @@ const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, Marke
   for (const auto& s : builtin_marker_sets()) presets.push_back(s.name);
   // A mapping made from the file's own labels (io/marker_labels.hpp): every rule is said in `why`,
   // and a landmark no label gives is named in the error.
-  const auto from_labels = [&](const std::string& because) -> const MarkerSet& {
+  const auto from_labels = [&](const std::string& because, const std::string& presets_tried) -> const MarkerSet& {
     const LabelMapping lm = map_marker_labels(trial.markers, static_trial ? &static_trial->markers : nullptr);
     if (!lm.mapping) {
       std::string found, lacking;
       for (const auto& r : lm.rules) found += "\n  " + r;
       for (const auto& r : lm.missing) lacking += "\n  " + r;
-      throw InputError(a.trial + ": " + because + "; from the file's labels no mapping could be made. Missing:" + lacking +
+      throw InputError(a.trial + ": " + because + presets_tried + "; from the file's labels no mapping could be made. Missing:" + lacking +
                        (found.empty() ? std::string() : "\nFound:" + found) +
                        "\nGive a mapping file (--markers FILE.json, docs/MARKERSETS.md) with a rule for each landmark: shoulder, hip, knee_r, "
-                       "ankle_r, heel_r, mt_r, hallux_r and the same _l (a set whose joint markers are on the static trial only, "
-                       "or whose joints are found from clusters, needs its static or functional rules)");
+                       "ankle_r, heel_r, mt_r, hallux_r and the same _l; `kin2grf info " + a.trial +
+                       " --write-mapping FILE.json` writes what the labels give, to complete");
     }
     custom = parse_marker_set(*lm.mapping, a.trial + " (its labels)");
     if (why) {
@@ -229,7 +229,7 @@ const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, Marke
     }
     return custom;
   };
-  if (a.markers == "labels") return from_labels("--markers labels");
+  if (a.markers == "labels") return from_labels("--markers labels", "");
   if (!a.markers.empty()) {
     if (const auto* set = find_marker_set(a.markers)) return *set;
     std::error_code ec;
@@ -252,7 +252,7 @@ const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, Marke
   if (!set) {
     std::string names;
     for (const auto& s : builtin_marker_sets()) names += " " + s.name;
-    return from_labels("no preset recognised: presets" + names);
+    return from_labels("no preset recognised", " (presets:" + names + ")");
   }
   if (why) *why = set->name + " (" + reason + ")";
   return *set;
