@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/summary.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/output/opensim_export.hpp"
 #include "kin2grf/output/results.hpp"
@@ -140,6 +141,18 @@ PYBIND11_MODULE(_kin2grf, m) {
   m.def("validate", &validate, py::arg("trial"), py::arg("words"), py::arg("plates"), py::arg("threshold_N"),
         py::arg("zero_offset"), py::arg("sync"));
   m.def("batch_lines", &batch_lines, py::arg("lines"), py::arg("jobs"), py::arg("out_dir"));
+  // What `kin2grf info --json` prints (docs/FORMATS.md), the marker set estimate would take included.
+  m.def(
+      "info",
+      [](const std::string& path, double threshold_N, const std::string& zero_offset) {
+        nlohmann::json j;
+        {
+          py::gil_scoped_release release;
+          j = kin2grf::describe_file(path, threshold_N, kin2grf::load_options(zero_offset), std::nullopt);
+        }
+        return to_python(j);
+      },
+      py::arg("path"), py::arg("threshold_N") = 20.0, py::arg("zero_offset") = std::string("none"));
   m.def("settings_help", &settings_help);
   m.def("batch_columns", [] { return kin2grf::batch_csv_columns(); });
 }

@@ -30,7 +30,7 @@ from . import _kin2grf
 from ._kin2grf import InputError
 
 __version__ = _kin2grf.__version__
-__all__ = ["estimate", "validate", "batch", "settings", "read_trial_list", "Estimate", "InputError", "__version__"]
+__all__ = ["estimate", "validate", "batch", "info", "settings", "read_trial_list", "Estimate", "InputError", "__version__"]
 
 
 def settings() -> list[dict]:
@@ -144,6 +144,13 @@ def validate(trial: str | os.PathLike, plates: str | os.PathLike | None = None, 
     out = d["validation"]
     out["estimate"] = Estimate(d["estimate"], os.fspath(trial), _words(settings))
     return out
+
+
+def info(path: str | os.PathLike, threshold: float = 20.0, zero_offset: str = "none") -> dict:
+    """What ``kin2grf info FILE --json`` reports (docs/FORMATS.md): rates, frames, markers and their
+    gaps, force plates and their loaded intervals, events, body mass, and the marker set ``estimate``
+    would take (``info(f)["marker_set"]``: the preset recognised, or the mapping made from the labels)."""
+    return _kin2grf.info(os.fspath(path), float(threshold), zero_offset)
 
 
 def read_trial_list(path: str | os.PathLike) -> list[str]:

@@ -192,3 +192,12 @@ def test_the_readme_example_runs_as_written(tmp_path):
     assert "grf_vertical_r_N" in done.stdout
     assert (tmp_path / "out" / "python-opensim" / "walking2_grf.mot").exists()
     assert (tmp_path / "out" / "python-grf.mot").read_text() == (tmp_path / "out" / "python-opensim" / "walking2_grf.mot").read_text()
+
+
+def test_info_describes_a_file_and_names_its_marker_set(example):
+    d = kin2grf.info(example / "example_walk.c3d")
+    assert d["format"] == "C3D"
+    assert d["marker_set"] == {"preset": "kin2grf-example"}
+    assert len(d["force_plates"]) == 2
+    with pytest.raises(kin2grf.InputError, match="nothing.c3d"):
+        kin2grf.info(example / "nothing.c3d")
