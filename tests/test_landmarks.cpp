@@ -767,3 +767,16 @@ TEST(MarkerLabels, JointsOffTheMotionTrialComeFromTheStaticTrialOrFromTheirClust
   EXPECT_EQ(F["ankle_r"]["functional"]["distal"], nlohmann::json({"RCAL", "RMT1", "RMT5"}));
   EXPECT_NO_THROW((void)parse_marker_set(*without.mapping, "labels"));
 }
+
+// Labels are the file's, so anything: empty, a lone side letter, separators only, non-ASCII
+// bytes, a label of 100,000 characters. None is read as a landmark, and none throws.
+TEST(MarkerLabels, ALabelOfAnyShapeIsReadWithoutGuessing) {
+  for (const std::string& label : {std::string(), std::string("R"), std::string("L."), std::string("_"), std::string("..::--"),
+                                   std::string("RL"), std::string("\xC5\x94KNE"), std::string("R\xFFKNE"), std::string(100000, 'R'),
+                                   std::string("Right"), std::string("Left_"), std::string("R#2")}) {
+    MarkerLabel l;
+    EXPECT_NO_THROW(l = read_marker_label(label));
+    EXPECT_TRUE(l.landmark.empty()) << label.substr(0, 20);
+  }
+  EXPECT_EQ(read_marker_label("R.KNE.").landmark, "knee_lateral");  // trailing separators are separators
+}

@@ -95,6 +95,9 @@ char side_word(const std::string& token) {
 MarkerLabel read_marker_label(const std::string& label) {
   MarkerLabel out;
   if (label.find('#') != std::string::npos) return out;  // a repeated label's k-th occurrence: a preset's business
+  // A byte outside ASCII (an accented letter, a byte the file mangled) is not dropped to make a
+  // word: the label is left out.
+  if (std::any_of(label.begin(), label.end(), [](char c) { return static_cast<unsigned char>(c) >= 0x80; })) return out;
   std::vector<std::string> tokens;
   std::string cur;
   for (const char c : label) {
