@@ -728,9 +728,10 @@ TEST(Landmarks, AStaticPointIsCarriedByItsWholeClusterInAnyOrder) {
   }
 }
 
-// Where the motion trial has no knee or ankle markers, the labels' mapping takes the static
-// trial's (carried by the thigh's or the shank's cluster) and, without a static trial, the
-// functional centre of the clusters on either side of the joint.
+// Where the motion trial has no joint centre and no lateral-medial pair, the labels' mapping takes
+// the static trial's pair (carried by the thigh's or the shank's cluster), even over a lateral
+// marker, and, without a static trial, the lateral marker or else the functional centre of the
+// clusters on either side of the joint.
 TEST(MarkerLabels, JointsOffTheMotionTrialComeFromTheStaticTrialOrFromTheirClusters) {
   const auto trajectories = [](const std::vector<std::string>& names) {
     MarkerTrajectories m;
@@ -743,11 +744,12 @@ TEST(MarkerLabels, JointsOffTheMotionTrialComeFromTheStaticTrialOrFromTheirClust
     }
     return m;
   };
-  std::vector<std::string> motion = {"RASI", "LASI", "RPSI", "LPSI", "RACR", "LACR"};
+  std::vector<std::string> motion = {"RASI", "LASI", "RPSI", "LPSI", "RACR", "LACR", "RKNE"};
   for (const char* s : {"R", "L"})
     for (const char* x : {"TH1", "TH2", "TH3", "TB1", "TB2", "TB3", "CAL", "MT1", "MT5"}) motion.push_back(std::string(s) + x);
   const MarkerTrajectories m = trajectories(motion);
   std::vector<std::string> still = motion;
+  still.erase(std::find(still.begin(), still.end(), "RKNE"));  // the static trial has the epicondyles instead
   for (const char* x : {"R_FLE", "R_FME", "R_FAL", "R_TAM", "L_FLE", "L_FME", "L_FAL", "L_TAM"}) still.push_back(x);
   const MarkerTrajectories st = trajectories(still);
 
@@ -762,7 +764,9 @@ TEST(MarkerLabels, JointsOffTheMotionTrialComeFromTheStaticTrialOrFromTheirClust
   const LabelMapping without = map_marker_labels(m);
   ASSERT_TRUE(without.mapping);
   const auto& F = (*without.mapping)["landmarks"];
-  EXPECT_EQ(F["knee_r"]["functional"]["distal"], nlohmann::json({"RTB1", "RTB2", "RTB3"}));
+  EXPECT_EQ(F["knee_r"]["marker"], "RKNE");  // a lateral marker beats a functional centre; the static pair beats both (above)
+  EXPECT_EQ(F["knee_r"]["surface"], "lateral");
+  EXPECT_EQ(F["knee_l"]["functional"]["distal"], nlohmann::json({"LTB1", "LTB2", "LTB3"}));
   EXPECT_EQ(F["ankle_r"]["functional"]["proximal"], nlohmann::json({"RTB1", "RTB2", "RTB3"}));
   EXPECT_EQ(F["ankle_r"]["functional"]["distal"], nlohmann::json({"RCAL", "RMT1", "RMT5"}));
   EXPECT_NO_THROW((void)parse_marker_set(*without.mapping, "labels"));

@@ -264,12 +264,14 @@ LabelMapping map_marker_labels(const MarkerTrajectories& m, const MarkerTrajecto
         slat = fs->one(side, lateral, notes), smed = fs->one(side, medial, notes);
         for (const auto& c : carrier) carried = carried && static_markers->find(c) >= 0;
       }
+      // Both epicondyles (malleoli) on the static trial beat one lateral skin marker on the motion
+      // trial: their mean is the joint centre, the lateral marker's is a width estimate.
       if (!jc.empty()) rule(name, {{"marker", jc}}, jc + " (joint centre)");
       else if (!lat.empty() && !med.empty()) rule(name, {{"mean", {lat, med}}}, "mean of " + lat + " and " + med + " (lateral and medial)");
-      else if (!lat.empty()) rule(name, {{"marker", lat}, {"surface", "lateral"}}, lat + " (lateral marker; moved to the joint centre in 3D)");
       else if (carried && !slat.empty() && !smed.empty())
         rule(name, {{"static", {slat, smed}}, {"cluster", carrier}},
              "mean of the static trial's " + slat + " and " + smed + ", carried by " + join(carrier));
+      else if (!lat.empty()) rule(name, {{"marker", lat}, {"surface", "lateral"}}, lat + " (lateral marker; moved to the joint centre in 3D)");
       else if (carried && !slat.empty())
         rule(name, {{"static", {slat}}, {"cluster", carrier}, {"surface", "lateral"}},
              "the static trial's lateral " + slat + ", carried by " + join(carrier));

@@ -9,10 +9,9 @@
 //   - hip: the mean of the hip joint centres where the file has them, else Harrington et al. 2007
 //     from both ASIS and both PSIS (or the sacrum);
 //   - knee and ankle: the joint centre marker, else the mean of the lateral and medial markers
-//     (epicondyles, malleoli), else the lateral marker alone (`"surface": "lateral"`); where the
-//     motion trial has none of them, the static trial's, carried by the thigh's (knee) or the
-//     shank's (ankle) cluster, else the functional centre of the two clusters (or the shank's and
-//     the foot's markers);
+//     (epicondyles, malleoli), else the static trial's pair carried by the thigh's (knee) or the
+//     shank's (ankle) cluster, else the lateral marker alone (`"surface": "lateral"`), else the
+//     functional centre of the two clusters (or the shank's and the foot's markers);
 //   - MT head: the mean of the metatarsal-head markers (1st, 2nd, 5th) where there are two or
 //     more, else the 2nd, else the 5th (lateral surface), else a Plug-in Gait TOE (which sits on
 //     the 2nd MT head), else the 1st;
