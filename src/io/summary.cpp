@@ -116,7 +116,8 @@ nlohmann::json trial_summary(const Trial& t, double thr) {
   return s;
 }
 
-nlohmann::json describe_file(const std::string& path, double threshold, const LoadOptions& load, std::optional<Axis> up_axis) {
+nlohmann::json describe_file(const std::string& path, double threshold, const LoadOptions& load, std::optional<Axis> up_axis,
+                             Trial* loaded) {
   if (!(std::isfinite(threshold) && threshold > 0))
     throw InputError("setting load threshold (N) = " + std::to_string(threshold) + ": must be a force above 0 N");
   Trial t = load_trial(path, load);
@@ -124,7 +125,9 @@ nlohmann::json describe_file(const std::string& path, double threshold, const Lo
     t.markers.up_axis = *up_axis;
     if (t.plates) t.plates->up_axis = *up_axis;
   }
-  return trial_summary(t, threshold);
+  nlohmann::json s = trial_summary(t, threshold);
+  if (loaded) *loaded = std::move(t);
+  return s;
 }
 
 std::string format_summary(const nlohmann::json& s) {

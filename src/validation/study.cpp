@@ -272,30 +272,32 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
     const int draws = s.marker_noise_m > 0 ? kNoiseRealizations : 1;
     double grm_sum = 0;
     int grm_n = 0;
+    // The marker set (the trial's, its trunk ablated, or made from its labels) and the capture
+    // rate are the trial's, the same for every draw of noise.
+    std::optional<MarkerSet> ablated;
+    if (s.without_trunk) {
+      std::string why;
+      ablated = without_trunk_markers(*d.marker_set, why);
+      if (!ablated) throw InputError(why);
+    }
+    if (s.from_labels) {
+      const LabelMapping lm = map_marker_labels(d.trial->markers, d.static_trial ? &d.static_trial->markers : nullptr);
+      if (!lm.mapping) {
+        std::string missing;
+        for (const auto& x : lm.missing) missing += (missing.empty() ? "" : "; ") + x;
+        throw InputError(t.name + ": its labels give no mapping: " + missing);
+      }
+      ablated = parse_marker_set(*lm.mapping, t.name + " (its labels)");
+    }
+    const int factor = s.marker_rate_hz > 0 ? decimation_factor(d.trial->markers.rate_hz, s.marker_rate_hz) : 1;
+    const bool changed = s.marker_noise_m > 0 || factor > 1;
     for (int seed = 1; seed <= draws; ++seed) {
       // The trial as recorded, or a copy with the setting's noise or capture rate.
-      const int factor = s.marker_rate_hz > 0 ? decimation_factor(d.trial->markers.rate_hz, s.marker_rate_hz) : 1;
-      const bool changed = s.marker_noise_m > 0 || factor > 1;
       Trial working;
       if (changed) {
         working = *d.trial;
         if (factor > 1) working.markers = decimated(std::move(working.markers), factor);
         if (s.marker_noise_m > 0) add_marker_noise(working.markers, s.marker_noise_m, static_cast<unsigned>(seed));
-      }
-      std::optional<MarkerSet> ablated;
-      if (s.without_trunk) {
-        std::string why;
-        ablated = without_trunk_markers(*d.marker_set, why);
-        if (!ablated) throw InputError(why);
-      }
-      if (s.from_labels) {
-        const LabelMapping lm = map_marker_labels(d.trial->markers, d.static_trial ? &d.static_trial->markers : nullptr);
-        if (!lm.mapping) {
-          std::string missing;
-          for (const auto& x : lm.missing) missing += (missing.empty() ? "" : "; ") + x;
-          throw InputError(t.name + ": its labels give no mapping: " + missing);
-        }
-        ablated = parse_marker_set(*lm.mapping, t.name + " (its labels)");
       }
       const EstimateResult e = estimate(changed ? working : *d.trial, d.static_trial, ablated ? *ablated : *d.marker_set, o);
       const ValidationResult v = validate(e, *d.plates);

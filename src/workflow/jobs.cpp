@@ -48,14 +48,12 @@ void check_outputs(const std::vector<std::string>& outputs, const std::vector<st
 int info_job(const std::string& file, bool json, double threshold, const std::string& zero, const std::string& up_axis, std::ostream& out,
              const std::string& write_mapping) {
   if (!write_mapping.empty()) check_outputs({write_mapping}, {file}, {"--write-mapping"});
-  const auto s = describe_file(file, threshold, load_options(zero), parse_axis(up_axis));
+  Trial t;
+  const auto s = describe_file(file, threshold, load_options(zero), parse_axis(up_axis), write_mapping.empty() ? nullptr : &t);
   if (json) out << json_text(s);
   else out << format_summary(s);
-  if (!write_mapping.empty()) {
-    // The mapping made from the labels, whatever the preset: a mapping file to start from.
-    const Trial t = load_trial(file, load_options(zero));
-    write_file_text(write_mapping, map_marker_labels(t.markers).draft.dump(1) + "\n");
-  }
+  // The mapping made from the labels, whatever the preset: a mapping file to start from.
+  if (!write_mapping.empty()) write_file_text(write_mapping, map_marker_labels(t.markers).draft.dump(1) + "\n");
   return 0;
 }
 

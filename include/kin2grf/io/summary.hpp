@@ -34,8 +34,9 @@ std::vector<LoadedInterval> loaded_intervals(const ForcePlateRecording& rec, con
 nlohmann::json trial_summary(const Trial& t, double load_threshold_N = 20.0);
 /// `kin2grf info`: the file read with `load`, the up axis set to `up_axis` when given (the user's
 /// word over the data's), then trial_summary. InputError for a threshold that is not above 0 N.
+/// `loaded`, when given, receives the trial read (info --write-mapping maps its labels).
 nlohmann::json describe_file(const std::string& path, double load_threshold_N, const LoadOptions& load,
-                             std::optional<Axis> up_axis = std::nullopt);
+                             std::optional<Axis> up_axis = std::nullopt, Trial* loaded = nullptr);
 std::string format_summary(const nlohmann::json& s);
 
 }  // namespace kin2grf
