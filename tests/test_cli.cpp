@@ -750,3 +750,18 @@ TEST(CliFiles, AnUnknownMarkerSetIsMappedFromItsLabelsAndInfoWritesTheMapping) {
   sa << a.rdbuf(), sb << b.rdbuf();
   EXPECT_EQ(sa.str(), sb.str());
 }
+
+// info --write-mapping is an output like any other: never the recording itself, by name or through a link.
+TEST(CliInput, WriteMappingNeverOverwritesTheRecording) {
+  const auto dir = kin2grf::test::temp_dir("cli_mapping_clobber");
+  const auto trc = dir / "trial.trc";
+  std::filesystem::copy_file(example_trc(), trc);
+  std::filesystem::create_symlink(trc, dir / "link.json");
+  const auto before = std::filesystem::file_size(trc);
+  for (const auto& out : {trc, dir / "link.json"}) {
+    const CliRun r = run("info " + trc.string() + " --write-mapping " + out.string());
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find("is an input of this run"), std::string::npos) << r.out;
+  }
+  EXPECT_EQ(std::filesystem::file_size(trc), before);
+}
