@@ -32,6 +32,10 @@ const std::vector<NumericOption>& numeric_options() {
        "A landing foot takes no load before its descent speed, past the final approach's peak, has fallen to this fraction of the "
        "peak (1: from the peak on; 0 = off, the default and the paper)",
        {0.0, 0.5, 0.7, 0.8, 0.9, 1.0}, "%.1f of the peak", 1.0, "off"},
+      {"touchdown-stop", "touchdown_stop_fraction", [](O& o) -> double& { return o.touchdown_stop_fraction; }, 0.0, 1.0, 0.0,
+       "A landing foot carries no load before its heel or MT head, seen at 15 Hz, has stopped descending: its descent fallen to "
+       "this fraction of its recent peak (0 = off, the paper); the load the kinematics ask for before is dropped",
+       {0.0, 0.1, 0.2, 0.3, 0.5}, "%.1f of the peak", 1.0, "off"},
       {"split-distance", "min_split_distance_m", [](O& o) -> double& { return o.solver.min_split_distance_m; }, 0.0, 1.0, 0.0,
        "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)",
        {0.0, 0.05, 0.1, 0.15, 0.2}, "%.2f m", 1.0, "off"},

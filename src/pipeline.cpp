@@ -135,6 +135,8 @@ void check_options(const EstimateOptions& o) {
           "between 0 (none, the paper) and 0.2");
   require(finite(o.double_support_sta_weight) && o.double_support_sta_weight >= 0 && o.double_support_sta_weight <= 1,
           "double-support transition weight", o.double_support_sta_weight, "between 0 (none, the paper) and 1");
+  require(finite(o.touchdown_stop_fraction) && o.touchdown_stop_fraction >= 0 && o.touchdown_stop_fraction <= 1,
+          "touchdown stop fraction", o.touchdown_stop_fraction, "between 0 (off, the paper) and 1");
   require(o.grm_reference_m.allFinite(), "GRM reference (m)", o.grm_reference_m.x() + o.grm_reference_m.y(), "finite");
   if (o.mass_kg)
     require(finite(*o.mass_kg) && *o.mass_kg > 0 && (o.allow_unusual_mass || (*o.mass_kg >= kMassRangeKg[0] && *o.mass_kg <= kMassRangeKg[1])),
@@ -377,7 +379,7 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
   // squares of a landing's bilateral stance (EstimateOptions::lateral_least_squares).
   const SpeedGateRule& gate = co.speed_gate;
   const bool lateral = o.lateral_force() && ((o.lateral_torso_lag && o.torso_lag_s > 0) || o.lateral_least_squares);
-  if (running_cop || lateral || (gate.ratio > 0 && gate.floor_mps != gate.standstill_mps))
+  if (running_cop || lateral || (gate.ratio > 0 && gate.floor_mps != gate.standstill_mps) || o.touchdown_stop_fraction > 0)
     plan.near_flight = flight_frames(model, motion, soles);
   if (running_cop) {
     plan.running = plan.near_flight;
@@ -471,6 +473,12 @@ struct RawSolve {
   std::vector<double> both_feet_torque_map;
   std::vector<int> iterations;  ///< semi-smooth Newton iterations per frame
   int cycled_frames = 0, capped_frames = 0;
+  // The touchdown rule (EstimateOptions::touchdown_stop_fraction; touchdown_stage): per side, the
+  // frames the foot is in contact before it has landed; the frames where either is, in order, and
+  // for each the solve's torque_per_normal then torque_per_tangent (2 x kJointCount x np).
+  std::array<std::vector<bool>, 2> before_touchdown;
+  std::vector<Eigen::Index> touchdown_frames;
+  std::vector<double> touchdown_torque_map;
 };
 
 /// What the per-foot results take of one solved frame i: its contact points' places and gaps, each
@@ -609,6 +617,115 @@ DynamicsPass dynamics_pass(const EstimateOptions& o, const Model& model, const C
   return pass;
 }
 
+/// Each foot's contact state per frame from the solve: any of its points active.
+std::array<std::vector<bool>, 2> foot_contact_states(const RawSolve& raw, Eigen::Index n) {
+  std::array<std::vector<bool>, 2> contact{std::vector<bool>(static_cast<std::size_t>(n)), std::vector<bool>(static_cast<std::size_t>(n))};
+  const auto np = raw.point_side.size();
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < np; ++j)
+      if (raw.active[static_cast<std::size_t>(i)][j]) contact[static_cast<std::size_t>(raw.point_side[j])][static_cast<std::size_t>(i)] = true;
+  return contact;
+}
+
+/// The landmarks' heights the touchdown rule reads (per side: heel, MT head), copied before the
+/// landmarks are let go; empty with the rule off.
+using FootHeights = std::array<std::array<Eigen::VectorXd, 2>, 2>;
+FootHeights foot_heights(const EstimateOptions& o, const SagittalLandmarks& lm) {
+  FootHeights h;
+  if (o.touchdown_stop_fraction > 0)
+    for (int side = 0; side < 2; ++side) {
+      h[side][0] = lm.p[landmark(side, kHeel)].col(1);
+      h[side][1] = lm.p[landmark(side, kMt)].col(1);
+    }
+  return h;
+}
+
+/// The touchdown rule (EstimateOptions::touchdown_stop_fraction): each foot's frames in contact
+/// before it has landed (frames_before_touchdown, on the solve's contact states), and for each
+/// such frame the solve's torque maps, from the frame solved again (the solve is deterministic;
+/// a few per cent of a walk's frames, so the per-frame solve keeps no map it would rarely need).
+Messages touchdown_stage(const EstimateOptions& o, const Model& model, const ContactPlan& plan, const ModelMotion& motion,
+                         const FootHeights& heights, RawSolve& raw) {
+  Messages out;
+  if (!(o.touchdown_stop_fraction > 0) || heights[0][0].size() != motion.frames()) return out;
+  const Eigen::Index n = raw.lambda.rows();
+  const auto contact = foot_contact_states(raw, n);
+  TouchdownStopRule rule;
+  rule.fraction = o.touchdown_stop_fraction;
+  long landings = 0, frames = 0;
+  for (int side = 0; side < 2; ++side) {
+    auto& before = raw.before_touchdown[static_cast<std::size_t>(side)];
+    before = frames_before_touchdown(contact[static_cast<std::size_t>(side)], heights[side][0], heights[side][1], motion.rate_hz, rule);
+    // A landing from a flight phase (a run's, a jump's) is left as solved: in flight the whole
+    // body's kinematics ask for no load until the impact, so its contact does not begin early
+    // (the runs' onsets are 3-10 ms early), and a runner's heel and MT head go on sinking into
+    // the shoe and the heel pad for 20-30 ms after it.
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (before[static_cast<std::size_t>(i)] && (i == 0 || !before[static_cast<std::size_t>(i - 1)]) && flag_at(plan.near_flight, i))
+        for (Eigen::Index k = i; k < n && before[static_cast<std::size_t>(k)]; ++k) before[static_cast<std::size_t>(k)] = false;
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (before[static_cast<std::size_t>(i)]) {
+        ++frames;
+        if (i == 0 || !before[static_cast<std::size_t>(i - 1)]) ++landings;
+      }
+  }
+  if (frames == 0) return out;
+  const int np = static_cast<int>(raw.point_side.size());
+  ContactSolver solver(model, plan.calibration, o.solver);
+  MotionFrame f;
+  FrameContacts fc;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!flag_at(raw.before_touchdown[0], i) && !flag_at(raw.before_touchdown[1], i)) continue;
+    motion.frame(i, f);
+    contact_frame(model, plan.calibration.contact, o.contact, is_running_frame(plan.running, i), f, fc);
+    for (int side = 0; side < 2; ++side) fc.landing[side] = flag_at(plan.landing[side], i);
+    fc.near_flight = flag_at(plan.near_flight, i);
+    const FrameSolution s = solver.solve(f.q, f.qdd, fc);
+    raw.touchdown_frames.push_back(i);
+    raw.touchdown_torque_map.insert(raw.touchdown_torque_map.end(), s.torque_per_normal.data(), s.torque_per_normal.data() + kJointCount * np);
+    raw.touchdown_torque_map.insert(raw.touchdown_torque_map.end(), s.torque_per_tangent.data(), s.torque_per_tangent.data() + kJointCount * np);
+  }
+  char b[320];
+  std::snprintf(b, sizeof b,
+                "touchdown: %ld landing(s) carry no load for their first %ld frames (%.0f ms in all), before the foot's heel or MT head "
+                "had stopped descending; the 6 Hz kinematics' spread of the impact there is dropped (the residual shows it)",
+                landings, frames, 1000.0 * static_cast<double>(frames) / motion.rate_hz);
+  out.emplace_back(b);
+  return out;
+}
+
+/// The touchdown rule's frames (touchdown_stage) lose their foot's load: its points turn inactive
+/// (before the contact states are read) and, once the multipliers are post-filtered (`lamf`,
+/// filtered with the dropped load, so that the stance after touchdown is as solved), the joint
+/// torques lose what that load gave them (the solve's maps, linear in the multipliers).
+/// Returns the dropped (frame, point) pairs; `lamf` and the torques are changed by
+/// drop_touchdown_load.
+std::vector<std::pair<Eigen::Index, int>> touchdown_points(RawSolve& raw) {
+  std::vector<std::pair<Eigen::Index, int>> dropped;
+  const int np = static_cast<int>(raw.point_side.size());
+  for (Eigen::Index i : raw.touchdown_frames)
+    for (int j = 0; j < np; ++j) {
+      auto& active = raw.active[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
+      if (active && flag_at(raw.before_touchdown[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])], i)) {
+        active = false;
+        dropped.emplace_back(i, j);
+      }
+    }
+  return dropped;
+}
+void drop_touchdown_load(const std::vector<std::pair<Eigen::Index, int>>& dropped, RawSolve& raw, Eigen::MatrixXd& lamf,
+                         Eigen::MatrixXd& joint_torque_Nm) {
+  const int np = static_cast<int>(raw.point_side.size());
+  for (const auto& [i, j] : dropped) {
+    const auto it = std::lower_bound(raw.touchdown_frames.begin(), raw.touchdown_frames.end(), i);
+    const double* G = raw.touchdown_torque_map.data() + (it - raw.touchdown_frames.begin()) * 2 * kJointCount * np;
+    for (int q = 0; q < kJointCount; ++q)
+      joint_torque_Nm(i, q) -= lamf(i, 2 * j) * G[j * kJointCount + q] + lamf(i, 2 * j + 1) * G[(np + j) * kJointCount + q];
+    lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;
+    raw.lambda(i, 2 * j) = raw.lambda(i, 2 * j + 1) = 0.0;  // the raw forces say the same
+  }
+}
+
 /// The double-support transition (EstimateOptions::double_support_sta_weight) on the
 /// post-filtered multipliers: in each walking double support the trailing foot's share of the
 /// vertical force becomes (1 - w) x its share + w x smooth_transition_share(u); each foot's
@@ -652,16 +769,6 @@ Messages double_support_transition(double w, const std::array<std::vector<bool>,
     out.emplace_back(b);
   }
   return out;
-}
-
-/// Each foot's contact state per frame from the solve: any of its points active.
-std::array<std::vector<bool>, 2> foot_contact_states(const RawSolve& raw, Eigen::Index n) {
-  std::array<std::vector<bool>, 2> contact{std::vector<bool>(static_cast<std::size_t>(n)), std::vector<bool>(static_cast<std::size_t>(n))};
-  const auto np = raw.point_side.size();
-  for (Eigen::Index i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < np; ++j)
-      if (raw.active[static_cast<std::size_t>(i)][j]) contact[static_cast<std::size_t>(raw.point_side[j])][static_cast<std::size_t>(i)] = true;
-  return contact;
 }
 
 /// Stances near the window's ends: the zero-lag filters see data on one side only there.
@@ -765,9 +872,12 @@ FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, dou
   FeetStage out;
   const Eigen::Index n = raw.lambda.rows();
   const int np = static_cast<int>(raw.point_side.size());
+  // The stance duration the post-filter scales with is the solve's (the touchdown rule's few
+  // frames do not move every frame's filter); the contact states are those after the rule.
+  const std::optional<double> stance = median_stance_s(foot_contact_states(raw, n), rate_hz);
+  const auto dropped = touchdown_points(raw);
   const std::array<std::vector<bool>, 2> contact = foot_contact_states(raw, n);
   out.messages = window_edge_messages(contact, rate_hz, kinematic_cutoff_hz, first_frame_number);
-  const std::optional<double> stance = median_stance_s(contact, rate_hz);
   // Final filtering (Sect. 2.6): all multipliers at the post-filter cut-off, then inactive ones
   // back to zero.
   std::string why;
@@ -777,6 +887,7 @@ FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, dou
   Eigen::MatrixXd lamf = post > 0 ? butterworth_filtfilt(raw.lambda, rate_hz, post) : raw.lambda;
   // In place (nothing below reads the raw torques): a long trial holds them once.
   out.joint_torque_Nm = post > 0 ? butterworth_filtfilt(std::move(raw.torque), rate_hz, post) : std::move(raw.torque);
+  drop_touchdown_load(dropped, raw, lamf, out.joint_torque_Nm);
   for (Eigen::Index i = 0; i < n; ++i)
     for (int j = 0; j < np; ++j)
       if (!raw.active[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;
@@ -981,7 +1092,8 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   ModelStage mod = model_stage(o, sag.landmarks, mass_kg);
   KinematicsStage kin = kinematics_stage(o, mod.model, sag.landmarks);
   const double hip_speed_mps = sag.frame.treadmill ? 0.0 : progression_speed(sag.landmarks);
-  if (!o.keep_all_series) sag.landmarks.p = {};  // the hip's speed was the last use of them
+  const FootHeights heights = foot_heights(o, sag.landmarks);
+  if (!o.keep_all_series) sag.landmarks.p = {};  // the hip's speed and the feet's heights were the last use of them
   // The solve's progress over both passes when a second may follow: the first reports the first
   // half, the second the rest (or the first completes it), so a progress line never restarts.
   const bool two_pass_progress = kin.unfiltered.size() > 0 && o.progress;
@@ -1017,6 +1129,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
     o.progress(2 * kin.motion.frames(), 2 * kin.motion.frames());  // one pass was enough: done
   }
   kin.unfiltered = Eigen::MatrixXd();
+  append(dyn.plan.messages, touchdown_stage(o, *mod.model, dyn.plan, kin.motion, heights, dyn.raw));
   const std::vector<int> iterations = std::move(dyn.raw.iterations);
   const int cycled_frames = dyn.raw.cycled_frames, capped_frames = dyn.raw.capped_frames;
   const double ground_level_m = dyn.plan.calibration.contact.ground_level_m;

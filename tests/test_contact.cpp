@@ -291,3 +291,70 @@ TEST(Contact, APlantedFootsDescentsAreNotLandings) {
   const Eigen::Index landed = landed_frame(landing);
   EXPECT_NEAR(static_cast<double>(landed), 100.0, 3.0);  // the drop, not the settling or the slap
 }
+
+namespace {
+// A heel that comes down at 0.6 m/s from 6 cm and stops on the floor (5 cm up, the marker's
+// height) at `impact`, the MT head 2 cm up and still; 200 Hz. Raw: the rule filters them itself.
+struct Heights {
+  Eigen::VectorXd heel, mt;
+};
+Heights landing_heights(Eigen::Index n, Eigen::Index impact) {
+  Heights h{Eigen::VectorXd(n), Eigen::VectorXd::Constant(n, 0.02)};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i - impact) / 200.0;
+    h.heel[i] = 0.05 + (t < 0 ? std::min(0.6 * -t, 0.06) : 0.0);
+  }
+  return h;
+}
+std::vector<bool> contact_from(Eigen::Index n, Eigen::Index first, Eigen::Index last) {
+  std::vector<bool> c(static_cast<std::size_t>(n), false);
+  for (Eigen::Index i = first; i <= last; ++i) c[static_cast<std::size_t>(i)] = true;
+  return c;
+}
+}  // namespace
+
+// Issue 29: a contact the solve begins 40 ms before the heel arrives carries nothing until the
+// heel, seen at 15 Hz, has stopped; frames after the stop, and a contact that begins after it,
+// keep what the solve gave them.
+TEST(Contact, AFootInContactBeforeItsHeelHasStoppedHasNotLandedYet) {
+  const Eigen::Index n = 400, impact = 200;
+  const Heights h = landing_heights(n, impact);
+  TouchdownStopRule rule;
+  rule.fraction = 0.1;
+  const auto before = frames_before_touchdown(contact_from(n, impact - 8, impact + 120), h.heel, h.mt, 200.0, rule);
+  const auto flagged = std::count(before.begin(), before.end(), true);
+  EXPECT_TRUE(before[static_cast<std::size_t>(impact - 8)]);
+  EXPECT_GE(flagged, 6);   // the filtered stop lies within a few frames of the impact
+  EXPECT_LE(flagged, 12);
+  for (Eigen::Index i = impact + 5; i < n; ++i) EXPECT_FALSE(before[static_cast<std::size_t>(i)]) << i;
+  // Contact beginning once the heel is down: nothing to hold back.
+  const auto late = frames_before_touchdown(contact_from(n, impact + 6, impact + 120), h.heel, h.mt, 200.0, rule);
+  EXPECT_EQ(std::count(late.begin(), late.end(), true), 0);
+  // Off: nothing.
+  rule.fraction = 0.0;
+  const auto off = frames_before_touchdown(contact_from(n, impact - 8, impact + 120), h.heel, h.mt, 200.0, rule);
+  EXPECT_EQ(std::count(off.begin(), off.end(), true), 0);
+}
+
+// A foot that did not come down (a standing foot, a stance at the window's first frame, a foot
+// set down slower than a landing) is never held back, however high its landmarks: with no
+// descent seen there is no evidence that it has not landed.
+TEST(Contact, AFootThatDidNotComeDownIsNeverHeldBack) {
+  const Eigen::Index n = 300;
+  TouchdownStopRule rule;
+  rule.fraction = 0.1;
+  const Eigen::VectorXd still = Eigen::VectorXd::Constant(n, 0.05), mt = Eigen::VectorXd::Constant(n, 0.02);
+  const auto a = frames_before_touchdown(contact_from(n, 0, 150), still, mt, 200.0, rule);
+  const auto b = frames_before_touchdown(contact_from(n, 100, 250), still, mt, 200.0, rule);
+  EXPECT_EQ(std::count(a.begin(), a.end(), true) + std::count(b.begin(), b.end(), true), 0);
+  // Set down at 5 cm/s: below the least descent of a landing.
+  Eigen::VectorXd slow(n);
+  for (Eigen::Index i = 0; i < n; ++i) slow[i] = 0.05 + std::max(0.0, 0.05 * static_cast<double>(150 - i) / 200.0);
+  const auto c = frames_before_touchdown(contact_from(n, 140, 250), slow, mt, 200.0, rule);
+  EXPECT_EQ(std::count(c.begin(), c.end(), true), 0);
+  // Heights with a gap (NaN) give no flags rather than a guess.
+  Eigen::VectorXd gap = landing_heights(n, 150).heel;
+  gap[20] = std::numeric_limits<double>::quiet_NaN();
+  const auto d = frames_before_touchdown(contact_from(n, 142, 250), gap, mt, 200.0, rule);
+  EXPECT_EQ(std::count(d.begin(), d.end(), true), 0);
+}

@@ -544,6 +544,57 @@ TEST(Estimate, TheDoubleSupportTransitionMovesOnlyTheSplitAndByItsWeight) {
   EXPECT_TRUE(said);
 }
 
+// The touchdown rule (issue 29) on a walk whose contact the solve begins 40-50 ms before the
+// plates load: the landing foot's first frames carry nothing, the load dropped there is exactly
+// what the feet's sum loses, the residual shows it, and frames the rule does not touch keep their
+// forces and torques.
+TEST(SharedEstimate, ALandingFootsLoadBeforeItsHeelHasStoppedIsDroppedNotMoved) {
+  KIN2GRF_REQUIRE_DATA();
+  const Trial t = load_trial(test::data_file("btk_plugingait_walk/PiG_Motion3_FF.c3d"));
+  EstimateOptions off, on;
+  off.keep_all_series = on.keep_all_series = true;
+  off.double_support_sta_weight = on.double_support_sta_weight = 0.0;  // the drop alone (the handover would move the split too)
+  on.touchdown_stop_fraction = 0.1;
+  const MarkerSet& set = *recognise_marker_set(t.markers);
+  const EstimateResult a = estimate(t, nullptr, set, off), b = estimate(t, nullptr, set, on);
+  const Eigen::Index n = a.time_s.size();
+  ASSERT_EQ(b.time_s.size(), n);
+  int dropped = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    double lost = 0.0;
+    for (int s = 0; s < 2; ++s) {
+      ASSERT_FALSE(b.feet[s].contact[k] && !a.feet[s].contact[k]) << "frame " << i << ": the rule only ends contact";
+      if (a.feet[s].contact[k] && !b.feet[s].contact[k]) {
+        ++dropped;
+        lost += a.feet[s].force_N(i, 1);
+        EXPECT_EQ(b.feet[s].force_N(i, 1), 0.0);
+        EXPECT_EQ(b.feet[s].raw_force_N(i, 1), 0.0);
+      }
+    }
+    for (int s = 0; s < 2; ++s) {
+      if (b.feet[s].contact[k]) {
+        EXPECT_EQ(a.feet[s].force_N.row(i), b.feet[s].force_N.row(i)) << "frame " << i;
+      }
+    }
+    const double sum_a = a.feet[0].force_N(i, 1) + a.feet[1].force_N(i, 1), sum_b = b.feet[0].force_N(i, 1) + b.feet[1].force_N(i, 1);
+    ASSERT_NEAR(sum_a - sum_b, lost, 1e-6 * std::max(1.0, sum_a)) << "frame " << i;
+    EXPECT_NEAR(b.residual(i, 1) - a.residual(i, 1), lost, 1e-6 * std::max(1.0, sum_a)) << "frame " << i;
+    for (int j = 0; j < kJointCount; ++j) {
+      if (lost == 0.0) {
+        EXPECT_EQ(a.joint_torque_Nm(i, j), b.joint_torque_Nm(i, j)) << "frame " << i;
+      }
+    }
+    if (lost > 1.0) {
+      EXPECT_NE(a.joint_torque_Nm.row(i), b.joint_torque_Nm.row(i)) << "frame " << i << ": the torques lose the load too";
+    }
+  }
+  EXPECT_GE(dropped, 12);  // 6 landings, 40-50 ms early at 100 Hz
+  EXPECT_LE(dropped, 40);
+  const bool said = std::any_of(b.messages.begin(), b.messages.end(), [](const std::string& m) { return m.find("touchdown:") != std::string::npos; });
+  EXPECT_TRUE(said);
+}
+
 TEST(Estimate, ADoubleSupportWeightOrStanceFloorOutsideItsRangeIsRefusedNamingTheSetting) {
   expect_refused_naming([](EstimateOptions& o, double v) { o.double_support_sta_weight = v; }, {-0.1, 1.5, std::nan("")},
                         "double-support");

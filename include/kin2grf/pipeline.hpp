@@ -87,6 +87,13 @@ struct EstimateOptions {
   /// default 0.2, chosen leave-one-lab-out (`kin2grf study double-support-sta`; its grid stops at
   /// 0.2, above which a 1 cm ground-level error costs a walk more than 0.2 points).
   double double_support_sta_weight = 0.2;
+  /// Touchdown from the foot's own motion (kin2grf, issue 29; frames_before_touchdown): a foot
+  /// the solve has in contact before its heel or MT head has stopped descending (its descent
+  /// fallen to this fraction of its recent peak, seen at 15 Hz) carries no load there. The load is
+  /// dropped, not handed to the other foot: it is the 6 Hz kinematics' spread of the impact, not a
+  /// force either foot carries; the joint torques lose what it gave them (the solve's
+  /// torque_per_normal and torque_per_tangent) and the residual shows it. 0: off (the paper).
+  double touchdown_stop_fraction = 0.0;
   std::optional<double> ground_level_m;    ///< else estimate_ground_level
   ContactModelOptions contact;
   SolverOptions solver;

@@ -1,5 +1,6 @@
 #include "kin2grf/dynamics/contact.hpp"
 
+#include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/numeric.hpp"
 
 #include <algorithm>
@@ -191,6 +192,52 @@ std::vector<bool> landing_frames(const Eigen::VectorXd& gap, const Eigen::Vector
     for (Eigen::Index i = run.first; i < landed; ++i) out[static_cast<std::size_t>(i)] = true;
     away = false;
     seen = landed;
+  }
+  return out;
+}
+
+std::vector<bool> frames_before_touchdown(const std::vector<bool>& contact, const Eigen::VectorXd& heel_height_m, const Eigen::VectorXd& mt_height_m,
+                                          double rate_hz, const TouchdownStopRule& rule) {
+  const auto n = static_cast<Eigen::Index>(contact.size());
+  std::vector<bool> out(contact.size(), false);
+  if (!(rule.fraction > 0) || !(rate_hz > 0) || n < 3 || heel_height_m.size() != n || mt_height_m.size() != n) return out;
+  const double cutoff = std::min(rule.cutoff_hz, 0.9 * max_zero_lag_cutoff_hz(rate_hz));
+  const auto w = std::max<Eigen::Index>(1, static_cast<Eigen::Index>(std::lround(rule.window_s * rate_hz)));
+  struct Landmark {
+    Eigen::VectorXd y, descent;  // height (filtered) and descent speed (m/s, + down)
+    double floor = 0.0;
+  };
+  std::array<Landmark, 2> lm;
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::VectorXd& raw = k == 0 ? heel_height_m : mt_height_m;
+    if (!raw.allFinite()) return out;
+    Landmark& l = lm[static_cast<std::size_t>(k)];
+    l.y = butterworth_filtfilt(raw, rate_hz, cutoff);
+    l.descent.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index a = std::max<Eigen::Index>(0, i - 1), b = std::min<Eigen::Index>(n - 1, i + 1);
+      l.descent[i] = -(l.y[b] - l.y[a]) * rate_hz / static_cast<double>(b - a);
+    }
+    std::vector<double> h(l.y.data(), l.y.data() + n);
+    std::nth_element(h.begin(), h.begin() + n / 10, h.end());
+    l.floor = h[static_cast<std::size_t>(n / 10)];
+  }
+  const auto landed = [&](Eigen::Index i) {
+    for (const Landmark& l : lm) {
+      if (l.y[i] > l.floor + rule.height_band_m) continue;
+      const double peak = l.descent.segment(std::max<Eigen::Index>(0, i - w), std::min(w, i) + 1).maxCoeff();
+      if (peak >= rule.min_descent_mps && l.descent[i] <= rule.fraction * peak) return true;
+    }
+    return false;
+  };
+  for (Eigen::Index a = 1; a < n; ++a) {
+    if (!contact[static_cast<std::size_t>(a)] || contact[static_cast<std::size_t>(a - 1)]) continue;
+    Eigen::Index end = a;  // the run's end, or the window's
+    while (end < n && end - a <= w && contact[static_cast<std::size_t>(end)]) ++end;
+    Eigen::Index i = a;
+    while (i < end && !landed(i)) ++i;
+    if (i == end) continue;  // no landing seen: the solve's contact stands
+    for (Eigen::Index k = a; k < i; ++k) out[static_cast<std::size_t>(k)] = true;
   }
   return out;
 }

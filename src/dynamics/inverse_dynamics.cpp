@@ -59,15 +59,19 @@ unsigned activation(const SmallVector& lamC, const FrameContacts& fc, unsigned a
 }
 
 /// The bilateral multipliers lambda_B = B^+ (b - C lambda_C), whose rheonomic ones are the joint
-/// torques, and the torques per unit normal multiplier of each point (the double-support
-/// transition moves the torques with the normal multipliers through them).
+/// torques, and the torques per unit normal and tangential multiplier of each point (the
+/// double-support transition and the touchdown rule move the torques with the multipliers).
 void bilateral_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& BpX, const SmallVector& lamC, int np, FrameSolution& sol) {
   Eigen::Matrix<double, kBilateralCount, 1> lamB = BpX.col(0);
   for (int c = 0; c < 2 * np; ++c)
     if (lamC[c] != 0.0) lamB -= BpX.col(1 + c) * lamC[c];
   sol.joint_torque_Nm = lamB.segment<kJointCount>(row::kDriving);
   sol.torque_per_normal.resize(kJointCount, np);
-  for (int j = 0; j < np; ++j) sol.torque_per_normal.col(j) = -BpX.block<kJointCount, 1>(row::kDriving, 1 + 2 * j);
+  sol.torque_per_tangent.resize(kJointCount, np);
+  for (int j = 0; j < np; ++j) {
+    sol.torque_per_normal.col(j) = -BpX.block<kJointCount, 1>(row::kDriving, 1 + 2 * j);
+    sol.torque_per_tangent.col(j) = -BpX.block<kJointCount, 1>(row::kDriving, 2 + 2 * j);
+  }
 }
 
 /// The structure of N = Phi Phi^T's factor: an AMD order of N's pattern (`order`: constraint

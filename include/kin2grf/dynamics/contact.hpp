@@ -234,6 +234,35 @@ struct LandingRule {
 std::vector<bool> landing_frames(const Eigen::VectorXd& gap_m, const Eigen::VectorXd& gap_rate_mps, const Eigen::VectorXd& ground_speed_mps,
                                  const std::vector<int>& lowest_point, const LandingRule& rule);
 
+/// Touchdown from the foot's own motion (issue 29; kin2grf, not the paper): the rule of
+/// frames_before_touchdown. Off (fraction 0) unless EstimateOptions::touchdown_stop_fraction.
+struct TouchdownStopRule {
+  double fraction = 0.0;  ///< a landmark has stopped once its descent is this fraction of its recent peak; 0: off
+  /// The heel's and MT head's heights are differentiated at this cut-off (at most what the rate
+  /// allows): sharp enough that a stop is placed within about +-15 ms (the dynamics' 6 Hz spreads
+  /// it over +-40 ms), low enough that 2 mm of marker noise moves a 1 m/s descent by a few cm/s.
+  double cutoff_hz = 15.0;
+  double window_s = 0.15;        ///< the recent peak is the fastest descent within this before; the stop is looked for this long after activation
+  double height_band_m = 0.02;   ///< and only where the landmark is this close to its own floor height (its 10th percentile)
+  double min_descent_mps = 0.1;  ///< a recent peak slower than this is no landing (a planted foot settling)
+};
+
+/// The frames, per foot, in which the solve has the foot in contact before it has landed
+/// (kin2grf, not the paper). `contact`: the foot's contact state per frame (the solve's);
+/// `heel_height_m`, `mt_height_m`: its heel's and MT head's landmark heights (unfiltered). For each
+/// contact run that follows a frame without contact, scanned from its first frame for at most
+/// rule.window_s: the foot has landed at the first frame where its heel or its MT head lies within
+/// rule.height_band_m of its floor height and descends no faster than rule.fraction of its fastest
+/// descent over the window before (at least rule.min_descent_mps); the run's frames before that are
+/// returned. A run in which no landmark lands within the window (no descent: a foot set down
+/// slowly, a trial's first stance) returns none. Why: a zero-lag 6 Hz filter spreads the impact's
+/// deceleration over about +-40 ms, so the whole body's kinematics ask for a ground force before
+/// the foot arrives and the least squares hands it to the landing foot. On the development walks
+/// with raw plate signals the solve's contact began 13-48 ms before the plates' onsets (32 ms mean
+/// |onset|), and the heel's own stop, seen at 15 Hz, lies within 0-25 ms of them.
+std::vector<bool> frames_before_touchdown(const std::vector<bool>& contact, const Eigen::VectorXd& heel_height_m, const Eigen::VectorXd& mt_height_m,
+                                          double rate_hz, const TouchdownStopRule& rule);
+
 /// Running frames: those within `window_s` of a flight frame, where the whole body's vertical
 /// kinematic force sum m (a_y + g) is below `flight_fraction` of body weight and no sole point of
 /// either foot is within `clearance_m` of the ground. In flight the body is in free fall (0) with

@@ -72,6 +72,9 @@ struct FrameSolution {
   /// d(joint torques) / d(normal multiplier) per contact point (column j: point j), so that a
   /// split of the normal forces changed after the solve changes the torques with it.
   Eigen::Matrix<double, kJointCount, Eigen::Dynamic, 0, kJointCount, kMaxContactPoints> torque_per_normal;
+  /// The same per unit tangential multiplier (a landing foot's load dropped before its touchdown,
+  /// frames_before_touchdown, takes its torques out with it).
+  Eigen::Matrix<double, kJointCount, Eigen::Dynamic, 0, kJointCount, kMaxContactPoints> torque_per_tangent;
   int iterations = 0;
   bool cycled = false;
   bool capped = false;
