@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <random>
 #include <memory>
 #include <string>
 
@@ -13,6 +14,7 @@
 #include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/markers/landmarks.hpp"
 #include "kin2grf/output/report.hpp"
@@ -406,4 +408,56 @@ TEST(SharedValidate, APlateClockShiftedBy40msIsFoundOnARecordedWalk) {
       EXPECT_GT(mean_rrmse(v.stances).vertical, recorded + 2.0) << shift;
     }
   }
+}
+
+// Step 7: a raw plate's foot strike rises through the threshold in a few ms; the same signal
+// low-pass filtered before export creeps there over tens of ms and is said to; an export set to
+// zero below 20 N steps from exact zeros and is said to be thresholded. Nothing else changes.
+TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
+  const double rate = 1000.0;
+  const Eigen::Index n = 2000;
+  ForcePlateRecording rec;
+  rec.rate_hz = rate;
+  rec.time_s = Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1) / rate);
+  // A soft heel strike at 0.5 s and 1.5 s: 3 N/ms up to 700 N, then off; 1 N of noise.
+  Eigen::VectorXd raw(n);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / rate;
+    const double a = std::min(700.0, std::max(0.0, 3000.0 * (t - 0.5))) * (t < 1.1 ? 1.0 : 0.0);
+    const double b = std::min(700.0, std::max(0.0, 3000.0 * (t - 1.5))) * (t < 1.95 ? 1.0 : 0.0);
+    raw[i] = a + b + noise(rng);
+  }
+  // The exports as the development data have them: the plate's own zeroing of its unloaded noise
+  // (below 5 N), then a 6 Hz zero-lag low-pass (Rajagopal's .mot, whose onsets creep 25-28 ms); or that, then everything under
+  // 20 N set to zero (OpenCap's).
+  const Eigen::VectorXd zeroed = raw.unaryExpr([](double x) { return x < 5.0 ? 0.0 : x; });
+  const Eigen::VectorXd filtered = butterworth_filtfilt(zeroed, rate, 6.0);
+  Eigen::VectorXd thresholded = filtered;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (thresholded[i] < 20.0) thresholded[i] = 0.0;
+  for (const auto& [name, f] : {std::pair{"raw", raw}, {"filtered", filtered}, {"thresholded", thresholded}}) {
+    ForcePlate p;
+    p.name = name;
+    p.force_N = Eigen::MatrixX3d::Zero(n, 3);
+    p.force_N.col(2) = f;
+    rec.plates.push_back(p);
+  }
+  const auto r = plate_onset_rises(rec, Eigen::Vector3d::UnitZ(), 20.0);
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r[0].onsets, 2);
+  EXPECT_LT(r[0].rise_ms, 10.0);
+  EXPECT_FALSE(r[0].filtered());
+  EXPECT_FALSE(r[0].zero_below_threshold);
+  EXPECT_EQ(r[1].onsets, 2);
+  EXPECT_GT(r[1].rise_ms, kFilteredRiseMs);
+  EXPECT_TRUE(r[1].filtered());
+  EXPECT_EQ(r[2].onsets, 2);
+  EXPECT_TRUE(r[2].zero_below_threshold);
+  EXPECT_FALSE(r[2].filtered());
+  // Upside down (a plate whose up is -z in its lab): no onsets, nothing claimed.
+  const auto flipped = plate_onset_rises(rec, -Eigen::Vector3d::UnitZ(), 20.0);
+  EXPECT_EQ(flipped[0].onsets, 0);
+  EXPECT_FALSE(flipped[0].filtered());
 }

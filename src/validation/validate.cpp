@@ -667,6 +667,32 @@ ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateR
 
 }  // namespace
 
+std::vector<PlateOnsetRise> plate_onset_rises(const ForcePlateRecording& rec, const Eigen::Vector3d& up, double threshold_N) {
+  std::vector<PlateOnsetRise> out;
+  const double floor_N = 0.01 * threshold_N;
+  for (const ForcePlate& p : rec.plates) {
+    PlateOnsetRise r;
+    r.plate = p.name;
+    std::vector<double> rises;
+    bool all_zero_steps = true;
+    const Eigen::VectorXd f = p.force_N * up;
+    for (Eigen::Index i = 1; i < f.size(); ++i) {
+      if (!(f[i - 1] < threshold_N && f[i] >= threshold_N)) continue;
+      Eigen::Index k = i - 1;
+      while (k > 0 && f[k] > floor_N) --k;
+      rises.push_back(1000.0 * static_cast<double>(i - k) / rec.rate_hz);
+      all_zero_steps = all_zero_steps && k == i - 1 && f[k] == 0.0 && (k == 0 || f[k - 1] == 0.0);
+    }
+    r.onsets = static_cast<int>(rises.size());
+    if (!rises.empty()) {
+      r.rise_ms = median(rises);
+      r.zero_below_threshold = all_zero_steps;
+    }
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
 ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& rec, const ValidationOptions& o) {
   ValidationResult v = validate_as_recorded(e, rec, o);
   const std::optional<SyncEstimate> sync = estimate_sync(e, v, o.threshold_N);
@@ -686,6 +712,27 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
   }
   v.sync = sync;
   v.plate_shift_s = shift;
+  // Step 7: a plate whose export moved its onsets (only the plates a kept stance stands on).
+  v.plate_onsets = plate_onset_rises(rec, e.frame.up, o.threshold_N);
+  for (const PlateOnsetRise& r : v.plate_onsets) {
+    const bool used = std::any_of(v.stances.begin(), v.stances.end(), [&](const StanceValidation& s) { return s.plate == r.plate; });
+    if (!used) continue;
+    if (r.filtered()) {
+      std::snprintf(b, sizeof b,
+                    "plate %s: its vertical force takes a median %.0f ms to rise from %.1f to %.0f N at its %d onset(s) (a raw plate's "
+                    "signal takes a few ms at a foot strike): it looks low-pass filtered before export, so its onsets lead the "
+                    "foot's contact and the estimate's onset errors against it read late by up to that much",
+                    r.plate.c_str(), r.rise_ms, 0.01 * o.threshold_N, o.threshold_N, r.onsets);
+      v.notes.emplace_back(b);
+    } else if (r.zero_below_threshold) {
+      std::snprintf(b, sizeof b,
+                    "plate %s: its vertical force is exactly 0 N before each onset and then steps past %.0f N: it was set to zero "
+                    "below a threshold before export, so its onsets are that threshold's crossing (of a signal that may have "
+                    "been filtered)",
+                    r.plate.c_str(), o.threshold_N);
+      v.notes.emplace_back(b);
+    }
+  }
   // An offset beyond a frame and 10 ms that the data pin down is worth a word when not applied.
   if (sync && shift == 0.0 && std::abs(sync->offset_s) > std::max(0.010, 1.0 / e.motion.rate_hz) &&
       sync->uncertainty_s < std::abs(sync->offset_s)) {
@@ -902,6 +949,11 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
                  {"applied_shift_ms", 1000 * v.plate_shift_s}};
   else
     j["sync"] = {{"estimated_offset_ms", nullptr}, {"applied_shift_ms", 1000 * v.plate_shift_s}};
+  nlohmann::json rises = nlohmann::json::array();
+  for (const PlateOnsetRise& r : v.plate_onsets)
+    rises.push_back({{"plate", r.plate}, {"onsets", r.onsets}, {"rise_ms", num(r.rise_ms)}, {"zero_below_threshold", r.zero_below_threshold},
+                     {"filtered", r.filtered()}});
+  j["plate_onsets"] = rises;
   j["excluded"] = v.excluded;
   j["notes"] = v.notes;
   return j;

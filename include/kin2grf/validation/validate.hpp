@@ -38,6 +38,9 @@
 //    centre on a treadmill).
 // 6. The marker-plate time offset (SyncEstimate, below), reported always; applied only when
 //    asked (ValidationOptions::sync).
+// 7. How each plate's signal rises at its onsets (PlateOnsetRise, below): a plate exported after
+//    low-pass filtering, or set to zero below a threshold, moves the onsets the estimate's are
+//    compared with; said in `notes`, never corrected.
 #pragma once
 
 #include <Eigen/Dense>
@@ -116,6 +119,31 @@ struct SyncEstimate {
   double error_as_recorded_N = 0.0, error_at_offset_N = 0.0;  ///< median |plates - kinematics| at shift 0 and at the offset
   int frames = 0;  ///< frames compared
 };
+
+/// Step 7: how a plate's vertical force rises through the stance threshold, from its own samples.
+/// A raw plate's signal leaves its noise (about 1 N) for the threshold within a few ms at a foot
+/// strike: from a hundredth of the threshold to the threshold in 1-10.5 ms on the development
+/// trials' C3D analog channels and Camargo's export (the impact loads a plate at several N/ms). A
+/// signal low-pass filtered before export has no noise left and creeps there from its smoothed
+/// tail: 25-28.5 ms on Rajagopal's and subject01's GRF .mot files. Its threshold crossing then
+/// leads the foot's contact, and an onset compared with it reads late by up to that much. Only a
+/// spread beyond kFilteredRiseMs is told: a 6 Hz filter over a sharp foot strike (8 N/ms) spreads
+/// it by about 11 ms and passes for raw, over a soft one (3 N/ms) by more than 15. A signal exactly zero before its onsets
+/// and stepping to at least the threshold was set to zero below some level before export (OpenCap's
+/// GRF .mot files: 0 N, then 20.7 N): its onsets are that level's crossing, whatever the signal's
+/// filtering was.
+inline constexpr double kFilteredRiseMs = 15.0;
+struct PlateOnsetRise {
+  std::string plate;
+  int onsets = 0;  ///< rising crossings of the threshold in the recording
+  /// Median time (ms) from the last sample at or below a hundredth of the threshold to the crossing.
+  double rise_ms = std::numeric_limits<double>::quiet_NaN();
+  /// Every onset comes from exact zeros with a step to at least the threshold (a thresholded export).
+  bool zero_below_threshold = false;
+  [[nodiscard]] bool filtered() const { return onsets > 0 && rise_ms > kFilteredRiseMs; }
+};
+/// Each plate's onsets in `rec` (vertical: the force along `up`, lab frame).
+std::vector<PlateOnsetRise> plate_onset_rises(const ForcePlateRecording& rec, const Eigen::Vector3d& up, double threshold_N);
 
 struct ComponentMetrics {
   std::optional<SeriesMetrics> vertical, anterior, cop, moment;
@@ -201,6 +229,8 @@ struct ValidationResult {
   /// Step 6, from the plates as recorded (none with fewer than 10 loaded frames clear of the
   /// recording's ends by the search's reach, or when the best shift lies at the search's limit).
   std::optional<SyncEstimate> sync;
+  /// Step 7, per plate of the recording (as recorded): how its vertical force rises at its onsets.
+  std::vector<PlateOnsetRise> plate_onsets;
   double plate_shift_s = 0.0;  ///< the shift the comparison above was made with (0 unless Sync::Auto or Fixed)
   /// ModelKind::ThreeD: the 3D joint moments driven by each foot's kept stances' plates (zero
   /// ground reaction elsewhere, so only the kept stances' frames are meaningful).
