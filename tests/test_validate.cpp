@@ -412,7 +412,8 @@ TEST(SharedValidate, APlateClockShiftedBy40msIsFoundOnARecordedWalk) {
 
 // Step 7: a raw plate's foot strike rises through the threshold in a few ms; the same signal
 // low-pass filtered before export creeps there over tens of ms and is said to; an export set to
-// zero below 20 N steps from exact zeros and is said to be thresholded. Nothing else changes.
+// zero below 20 N steps from exact zeros and is said to be thresholded; a plate never at its floor
+// (an offset) has no rise to measure.
 TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
   const double rate = 1000.0;
   const Eigen::Index n = 2000;
@@ -437,7 +438,8 @@ TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
   Eigen::VectorXd thresholded = filtered;
   for (Eigen::Index i = 0; i < n; ++i)
     if (thresholded[i] < 20.0) thresholded[i] = 0.0;
-  for (const auto& [name, f] : {std::pair{"raw", raw}, {"filtered", filtered}, {"thresholded", thresholded}}) {
+  const Eigen::VectorXd offset = (raw.array() + 5.0).matrix();  // an unzeroed plate: 5 N before any contact
+  for (const auto& [name, f] : {std::pair{"raw", raw}, {"filtered", filtered}, {"thresholded", thresholded}, {"offset", offset}}) {
     ForcePlate p;
     p.name = name;
     p.force_N = Eigen::MatrixX3d::Zero(n, 3);
@@ -445,7 +447,7 @@ TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
     rec.plates.push_back(p);
   }
   const auto r = plate_onset_rises(rec, Eigen::Vector3d::UnitZ(), 20.0);
-  ASSERT_EQ(r.size(), 3u);
+  ASSERT_EQ(r.size(), 4u);
   EXPECT_EQ(r[0].onsets, 2);
   EXPECT_LT(r[0].rise_ms, 10.0);
   EXPECT_FALSE(r[0].filtered());
@@ -456,6 +458,10 @@ TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
   EXPECT_EQ(r[2].onsets, 2);
   EXPECT_TRUE(r[2].zero_below_threshold);
   EXPECT_FALSE(r[2].filtered());
+  // Never at its floor: no rise to measure, nothing claimed.
+  EXPECT_EQ(r[3].onsets, 0);
+  EXPECT_FALSE(r[3].filtered());
+  EXPECT_FALSE(r[3].zero_below_threshold);
   // Upside down (a plate whose up is -z in its lab): no onsets, nothing claimed.
   const auto flipped = plate_onset_rises(rec, -Eigen::Vector3d::UnitZ(), 20.0);
   EXPECT_EQ(flipped[0].onsets, 0);

@@ -670,6 +670,10 @@ ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateR
 std::vector<PlateOnsetRise> plate_onset_rises(const ForcePlateRecording& rec, const Eigen::Vector3d& up, double threshold_N) {
   std::vector<PlateOnsetRise> out;
   const double floor_N = 0.01 * threshold_N;
+  // A rise is looked for over at most 0.1 s: a plate whose signal sits above the floor longer
+  // (an offset, someone standing on it) gives no rise there, and a long trial's many onsets
+  // cost one short look each.
+  const auto reach = static_cast<Eigen::Index>(std::ceil(0.1 * rec.rate_hz));
   for (const ForcePlate& p : rec.plates) {
     PlateOnsetRise r;
     r.plate = p.name;
@@ -679,7 +683,8 @@ std::vector<PlateOnsetRise> plate_onset_rises(const ForcePlateRecording& rec, co
     for (Eigen::Index i = 1; i < f.size(); ++i) {
       if (!(f[i - 1] < threshold_N && f[i] >= threshold_N)) continue;
       Eigen::Index k = i - 1;
-      while (k > 0 && f[k] > floor_N) --k;
+      while (k > 0 && i - k < reach && f[k] > floor_N) --k;
+      if (!(f[k] <= floor_N)) continue;  // no rise from the floor within reach
       rises.push_back(1000.0 * static_cast<double>(i - k) / rec.rate_hz);
       all_zero_steps = all_zero_steps && k == i - 1 && f[k] == 0.0 && (k == 0 || f[k - 1] == 0.0);
     }

@@ -259,7 +259,7 @@ struct TouchdownStopRule {
 /// deceleration over about +-40 ms, so the whole body's kinematics ask for a ground force before
 /// the foot arrives and the least squares hands it to the landing foot. On the development walks
 /// with raw plate signals the solve's contact began 13-48 ms before the plates' onsets (32 ms mean
-/// |onset|), and the heel's own stop, seen at 15 Hz, lies within 0-25 ms of them.
+/// |onset|), and the heel's own stop, seen at 12-20 Hz, lies within -20..+10 ms of them.
 std::vector<bool> frames_before_touchdown(const std::vector<bool>& contact, const Eigen::VectorXd& heel_height_m, const Eigen::VectorXd& mt_height_m,
                                           double rate_hz, const TouchdownStopRule& rule);
 

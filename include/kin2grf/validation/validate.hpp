@@ -128,15 +128,16 @@ struct SyncEstimate {
 /// tail: 25-28.5 ms on Rajagopal's and subject01's GRF .mot files. Its threshold crossing then
 /// leads the foot's contact, and an onset compared with it reads late by up to that much. Only a
 /// spread beyond kFilteredRiseMs is told: a 6 Hz filter over a sharp foot strike (8 N/ms) spreads
-/// it by about 11 ms and passes for raw, over a soft one (3 N/ms) by more than 15. A signal exactly zero before its onsets
-/// and stepping to at least the threshold was set to zero below some level before export (OpenCap's
-/// GRF .mot files: 0 N, then 20.7 N): its onsets are that level's crossing, whatever the signal's
-/// filtering was.
+/// it by about 11 ms and passes for raw, over a soft one (3 N/ms) by more than 15. A signal exactly
+/// zero before its onsets and stepping to at least the threshold was set to zero below some level
+/// before export (OpenCap's GRF .mot files: 0 N, then 20.7 N): its onsets are that level's
+/// crossing, whatever the signal's filtering was.
 inline constexpr double kFilteredRiseMs = 15.0;
 struct PlateOnsetRise {
   std::string plate;
-  int onsets = 0;  ///< rising crossings of the threshold in the recording
-  /// Median time (ms) from the last sample at or below a hundredth of the threshold to the crossing.
+  int onsets = 0;  ///< rising crossings of the threshold in the recording that rise from the floor within 0.1 s
+  /// Median time (ms) from the last sample at or below a hundredth of the threshold (the floor) to
+  /// the crossing.
   double rise_ms = std::numeric_limits<double>::quiet_NaN();
   /// Every onset comes from exact zeros with a step to at least the threshold (a thresholded export).
   bool zero_below_threshold = false;
