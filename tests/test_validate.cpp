@@ -467,3 +467,15 @@ TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
   EXPECT_EQ(flipped[0].onsets, 0);
   EXPECT_FALSE(flipped[0].filtered());
 }
+
+// The means carry the contact timing beside the rRMSEs (which start at the plate's onset and so
+// do not see it): the mean |onset| over the stances that have one, per foot or all.
+TEST(Validate, TheMeansCarryTheMeanAbsoluteOnsetOverTheStancesThatHaveOne) {
+  std::vector<StanceValidation> s(3);
+  s[0].foot = 0, s[0].onset_error_ms = -30.0;
+  s[1].foot = 1, s[1].onset_error_ms = 10.0;
+  s[2].foot = 1;  // none measurable (the estimate was loaded at the search's start)
+  EXPECT_DOUBLE_EQ(mean_rrmse(s).onset_abs_ms, 20.0);
+  EXPECT_DOUBLE_EQ(mean_rrmse(s, 1).onset_abs_ms, 10.0);
+  EXPECT_TRUE(std::isnan(mean_rrmse({s[2]}).onset_abs_ms));
+}

@@ -436,8 +436,8 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
     os << b;
   }
   os << "\n";
-  std::snprintf(b, sizeof b, "%-14s %-10s %9s %9s %9s %10s   %s\n", "activity", "", "vertical", "anterior", "COP", "total GRM",
-                "worst trial (vertical)");
+  std::snprintf(b, sizeof b, "%-14s %-10s %9s %9s %9s %10s %10s   %s\n", "activity", "", "vertical", "anterior", "COP", "total GRM",
+                "|onset| ms", "worst trial (vertical)");
   os << b;
   auto tot = [](double x) {
     char t[32];
@@ -445,11 +445,12 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
     return std::string(t);
   };
   for (const auto& c : cv.cells) {
-    std::snprintf(b, sizeof b, "%-14s %-10s %9.1f %9.1f %9.1f %10s\n", c.activity.c_str(), "in-sample", c.in_sample.vertical,
-                  c.in_sample.anterior, c.in_sample.cop, tot(c.in_sample_total_grm).c_str());
+    std::snprintf(b, sizeof b, "%-14s %-10s %9.1f %9.1f %9.1f %10s %10s\n", c.activity.c_str(), "in-sample", c.in_sample.vertical,
+                  c.in_sample.anterior, c.in_sample.cop, tot(c.in_sample_total_grm).c_str(), tot(c.in_sample.onset_abs_ms).c_str());
     os << b;
-    std::snprintf(b, sizeof b, "%-14s %-10s %9.1f %9.1f %9.1f %10s   %s %.1f\n", "", "held-out", c.held_out.vertical,
-                  c.held_out.anterior, c.held_out.cop, tot(c.held_out_total_grm).c_str(), c.worst_trial.c_str(), c.worst_vertical);
+    std::snprintf(b, sizeof b, "%-14s %-10s %9.1f %9.1f %9.1f %10s %10s   %s %.1f\n", "", "held-out", c.held_out.vertical,
+                  c.held_out.anterior, c.held_out.cop, tot(c.held_out_total_grm).c_str(), tot(c.held_out.onset_abs_ms).c_str(),
+                  c.worst_trial.c_str(), c.worst_vertical);
     os << b;
   }
   return os.str();
@@ -458,8 +459,8 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
 nlohmann::json cross_validation_json(const CrossValidation& cv) {
   auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
   auto metrics = [&](const MeanMetrics& m, double grm) {
-    return nlohmann::json{{"stances", m.n}, {"vertical", num(m.vertical)}, {"anterior", num(m.anterior)},
-                          {"cop", num(m.cop)}, {"total_grm", num(grm)}};
+    return nlohmann::json{{"stances", m.n},   {"vertical", num(m.vertical)}, {"anterior", num(m.anterior)},
+                          {"cop", num(m.cop)}, {"total_grm", num(grm)},      {"onset_abs_ms", num(m.onset_abs_ms)}};
   };
   nlohmann::json j;
   j["criterion"] = "mean over labs of the lab's mean per-stance (vertical + anterior + COP) / 3 rRMSE, all activities pooled";

@@ -788,9 +788,10 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
 MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   MeanMetrics mm;
   std::array<std::vector<double>, 5> vals;
-  std::vector<double> lateral_rmse, cop_lateral_rmse;
+  std::vector<double> lateral_rmse, cop_lateral_rmse, onset_abs;
   for (const auto& s : stances) {
     if (foot >= 0 && s.foot != foot) continue;
+    if (s.onset_error_ms && std::isfinite(*s.onset_error_ms)) onset_abs.push_back(std::abs(*s.onset_error_ms));
     const std::array<const std::optional<SeriesMetrics>*, 5> c = {&s.metrics.vertical, &s.metrics.anterior, &s.metrics.cop,
                                                                    &s.metrics.moment, &s.metrics.lateral};
     for (std::size_t k = 0; k < 5; ++k)
@@ -806,6 +807,9 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   double cop_lateral_sum = 0;
   for (double x : cop_lateral_rmse) cop_lateral_sum += x;
   mm.cop_lateral_rmse_mm = cop_lateral_rmse.empty() ? kNaN : cop_lateral_sum / static_cast<double>(cop_lateral_rmse.size());
+  double onset_sum = 0;
+  for (double x : onset_abs) onset_sum += x;
+  mm.onset_abs_ms = onset_abs.empty() ? kNaN : onset_sum / static_cast<double>(onset_abs.size());
   double lateral_sum = 0;
   for (double x : lateral_rmse) lateral_sum += x;
   mm.lateral_rmse_percent_bw = lateral_rmse.empty() ? kNaN : lateral_sum / static_cast<double>(lateral_rmse.size());

@@ -260,6 +260,9 @@ struct MeanMetrics {
   /// by a range of 10-15 % body weight, so a few newtons read large.
   double lateral_rmse_percent_bw = 0;
   double cop_lateral_rmse_mm = 0;  ///< mean over the stances (NaN without --mediolateral)
+  /// Mean |onset error| (ms) over the stances that have one (NaN without): the contact timing,
+  /// which the rRMSEs, scored from the plate's onset on, do not see.
+  double onset_abs_ms = 0;
   /// ModelKind::ThreeD (NaN otherwise): mean rRMSE of the knee's sagittal moment and of the
   /// external knee adduction moment, and the KAM's first and second peaks' mean |estimate -
   /// plates| in % of the plate-driven peaks' mean |value| (a ratio of means: one stance's
