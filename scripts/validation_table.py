@@ -131,6 +131,12 @@ if cv_kinds:
             onset = lambda m: "-" if m.get("onset_abs_ms") is None else f"{m['onset_abs_ms']:.0f}"
             print(f"| {label} | {cv['in_sample_choice']} | {act} | {fmt(c['in_sample'])} | {fmt(c['held_out'])} | "
                   f"{onset(c['in_sample'])} / {onset(c['held_out'])} | {c['worst_trial']['name']} {f1(c['worst_trial']['vertical'])} |")
+    held = []
+    for k in cv_kinds:
+        with open(os.path.join(out, f"cv-{k}.json")) as f:
+            cv = json.load(f)["cross_validation"]
+        if cv.get("criterion_held_out") is not None and cv.get("criterion_default") is not None:
+            held.append(f"{k} {cv['criterion_held_out']:.3f} against {cv['criterion_default']:.3f}")
     cop_cv = os.path.join(out, "cv-cop-function.json")
     if os.path.exists(cop_cv):
         with open(cop_cv) as f:
@@ -141,6 +147,9 @@ if cv_kinds:
             mean = lambda k: statistics.mean(x[k] for x in loo)
             print(f"| cop-function | built in (7 walking trials, session 3) | walking | - / - / {mean('builtin'):.1f}, - | "
                   f"- / - / {mean('other_labs'):.1f}, - | - | {worst['trial']} {worst['other_labs']:.1f} (COP) |")
+    if held:
+        print("\nThe figure a default changes by, the criterion with each lab at the choice made without it, against "
+              "kin2grf's default on every lab (%): " + "; ".join(held) + ".")
     print()
 
 def br(s, k):

@@ -59,6 +59,13 @@ TEST(Study, LeaveOneLabOutScoresEachLabAtTheOthersChoice) {
   EXPECT_NEAR(cv.cells[0].in_sample.vertical, (8 + 4 + 4) / 3.0, 1e-12);
   EXPECT_NEAR(cv.cells[0].held_out.vertical, (8 + 10 + 10) / 3.0, 1e-12);  // worse than in-sample, as it should be
   EXPECT_EQ(cv.cells[0].worst_trial, "b1");
+  // The figure a default changes by: each lab's criterion at its held-out choice, the mean over
+  // labs (here one stance a lab, all three components alike); no row is the default here.
+  EXPECT_NEAR(cv.held_out_criterion, (8 + 10 + 10) / 3.0, 1e-12);
+  EXPECT_TRUE(std::isnan(cv.default_criterion));
+  s.rows[1].is_default = true;
+  EXPECT_NEAR(cross_validate(s).default_criterion, (8 + 4 + 4) / 3.0, 1e-12);
+  EXPECT_NE(format_cross_validation(s, cross_validate(s)).find("held-out criterion"), std::string::npos);
   // One lab only: refused with a message that says how to name labs.
   StudyResult one = s;
   for (auto& row : one.per_trial)

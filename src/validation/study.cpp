@@ -360,13 +360,14 @@ CrossValidation cross_validate(const StudyResult& s) {
   if (activities.size() > 1) activities.push_back("all");
   // The criterion of setting r over the trials `use` accepts; NaN when a trial failed (a setting
   // that breaks a trial is never chosen) or none has a stance.
-  auto criterion = [&](std::size_t r, const std::function<bool(const StudyTrialResult&)>& use) {
+  // The criterion over the trials `use` accepts among `trials`.
+  auto criterion_of = [&](const std::vector<StudyTrialResult>& trials, const std::function<bool(const StudyTrialResult&)>& use) {
     // Each lab weighs the same, whatever its number of stances (a 30 s treadmill run has 80).
     double score = 0;
     int nlabs = 0;
     for (const auto& lab : labs) {
       std::vector<StanceValidation> st;
-      for (const auto& t : s.per_trial[r])
+      for (const auto& t : trials)
         if (t.lab == lab && use(t)) {
           if (t.failed) return std::numeric_limits<double>::quiet_NaN();
           st.insert(st.end(), t.stances.begin(), t.stances.end());
@@ -377,6 +378,7 @@ CrossValidation cross_validate(const StudyResult& s) {
     }
     return nlabs ? score / nlabs : std::numeric_limits<double>::quiet_NaN();
   };
+  auto criterion = [&](std::size_t r, const std::function<bool(const StudyTrialResult&)>& use) { return criterion_of(s.per_trial[r], use); };
   // The lowest criterion; a tie keeps kin2grf's default (a default changes only when the figure
   // improves: labs on which the setting changes nothing, e.g. the split distance on trials where
   // the feet are never side by side, carry no evidence against it), else the first (lowest) setting.
@@ -405,6 +407,10 @@ CrossValidation cross_validate(const StudyResult& s) {
     for (const auto& t : s.per_trial[r])
       if (t.lab == lab) held.push_back(t);
   }
+  // The figure a default changes by: each lab at the choice made without it, against the default.
+  cv.held_out_criterion = criterion_of(held, [](const StudyTrialResult&) { return true; });
+  for (std::size_t r = 0; r < s.rows.size() && r < cv.criterion.size(); ++r)
+    if (s.rows[r].is_default) cv.default_criterion = cv.criterion[r].second;
   for (const auto& a : activities) {
     CrossValidation::Cell c;
     c.activity = a;
@@ -436,6 +442,15 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
     os << b;
   }
   os << "\n";
+  if (std::isfinite(cv.held_out_criterion)) {
+    std::snprintf(b, sizeof b, "held-out criterion (each lab at the choice made without it): %.3f %%", cv.held_out_criterion);
+    os << b;
+    if (std::isfinite(cv.default_criterion)) {
+      std::snprintf(b, sizeof b, "; kin2grf's default on every lab: %.3f %%", cv.default_criterion);
+      os << b;
+    }
+    os << "\n";
+  }
   std::snprintf(b, sizeof b, "%-14s %-10s %9s %9s %9s %10s %10s   %s\n", "activity", "", "vertical", "anterior", "COP", "total GRM",
                 "|onset| ms", "worst trial (vertical)");
   os << b;
@@ -466,6 +481,8 @@ nlohmann::json cross_validation_json(const CrossValidation& cv) {
   j["criterion"] = "mean over labs of the lab's mean per-stance (vertical + anterior + COP) / 3 rRMSE, all activities pooled";
   j["in_sample_choice"] = cv.in_sample_choice;
   for (const auto& [label, c] : cv.criterion) j["criterion_all_trials"][label] = num(c);
+  j["criterion_held_out"] = num(cv.held_out_criterion);
+  j["criterion_default"] = num(cv.default_criterion);
   for (const auto& [lab, choice] : cv.lab_choice) j["choice_without_lab"][lab] = choice;
   for (const auto& c : cv.cells)
     j["activities"][c.activity] = {{"in_sample", metrics(c.in_sample, c.in_sample_total_grm)},

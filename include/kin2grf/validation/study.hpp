@@ -92,6 +92,10 @@ struct CrossValidation {
   std::string in_sample_choice;                   ///< the setting chosen on every trial
   std::vector<std::pair<std::string, double>> criterion;  ///< per setting, on every trial
   std::vector<std::pair<std::string, std::string>> lab_choice;  ///< held lab -> setting chosen without it
+  /// The criterion with each lab at the choice made without it (the figure a default changes by),
+  /// and the default setting's on every trial (NaN when no row is the default).
+  double held_out_criterion = std::numeric_limits<double>::quiet_NaN();
+  double default_criterion = std::numeric_limits<double>::quiet_NaN();
   /// Per activity, then "all": in-sample (every trial at the in-sample choice) and held-out (each
   /// lab's trials at the choice made without that lab), and the worst trial's vertical rRMSE.
   struct Cell {
