@@ -33,7 +33,7 @@ study_json() { "$K" study "$1" --trial-list "$2" --json "$3" >/dev/null 2>&1; }
   echo "with its sign: + is worse). Differences of the unrounded figures (the study JSON)."
   echo "Targets (issue 10): noise < 1 point, ground shift < 0.2 points, on every trial."
   echo "Held out: the same 2 mm of noise with the stance floor of the noise-lowered kinematic cut-off"
-  echo "(\`--min-kinematic-cycles\`, default 3.5, the one default chosen on noisy trials) at the value"
+  echo "(\`--min-kinematic-cycles\`, default 3.0, the one default chosen on noisy trials) at the value"
   echo "\`kin2grf study min-kinematic-cycles --cross-validate lab\` chooses without the trial's lab (in brackets)."
   echo
   echo "| trial | vertical | anterior | COP | 2 mm noise: vertical | anterior | COP | +-1 cm ground: vertical | anterior | COP | 2 mm noise, held out: vertical | anterior | COP |"

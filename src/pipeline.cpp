@@ -111,7 +111,7 @@ void check_options(const EstimateOptions& o) {
   require(finite(o.post_cutoff_floor_ratio) && o.post_cutoff_floor_ratio >= 0 && o.post_cutoff_floor_ratio <= 10,
           "post-filter floor (x the kinematic cut-off)", o.post_cutoff_floor_ratio, "between 0 (none) and 10");
   require(finite(o.min_kinematic_cycles) && o.min_kinematic_cycles >= 0 && o.min_kinematic_cycles <= 20, "kinematic cycles per stance",
-          o.min_kinematic_cycles, "between 0 (no floor) and 20 (kin2grf: 3.5)");
+          o.min_kinematic_cycles, "between 0 (no floor) and 20 (kin2grf: 3.0)");
   require(finite(o.solver.r_N_per_m) && o.solver.r_N_per_m > 0, "activation parameter r (N/m)", o.solver.r_N_per_m,
           "a number above 0 (kin2grf: 1000, paper: 10000)");
   require(finite(o.contact.ground_shift_m) && std::abs(o.contact.ground_shift_m) <= 1.0, "ground shift (m)", o.contact.ground_shift_m,

@@ -122,8 +122,12 @@ TEST(NoisyMarkers, TheDynamicsKeepTheStancesHarmonicsAndTheCopAngleTheLoweredCut
   const auto* set = kin2grf::find_marker_set("kin2grf-example");
   kin2grf::EstimateOptions no_floor;
   no_floor.min_kinematic_cycles = 0;
-  const kin2grf::EstimateOptions defaults;
-  ASSERT_EQ(defaults.min_kinematic_cycles, 3.5);
+  // The mechanism at 3.5 cycles (the default until session 25, now 3.0, which the development
+  // trials with 2 mm of noise choose held out): on this exact synthetic walk with 3 mm of white
+  // noise 3.0 cycles' floor lies within a few tenths of a hertz of the lowered cut-off.
+  EXPECT_EQ(kin2grf::EstimateOptions{}.min_kinematic_cycles, 3.0);
+  kin2grf::EstimateOptions with_floor;
+  with_floor.min_kinematic_cycles = 3.5;
   std::array<double, 2> dynamics_hz{};
   int walk = 0;
   for (const double stride_s : {1.0, 1.3}) {  // a brisk walk and a slow one, the same step length
@@ -132,7 +136,7 @@ TEST(NoisyMarkers, TheDynamicsKeepTheStancesHarmonicsAndTheCopAngleTheLoweredCut
     wo.speed_mps = 1.32 / stride_s;
     wo.duration_s = 6.0;
     const kin2grf::SyntheticWalk w = kin2grf::make_synthetic_walk(wo);
-    const kin2grf::EstimateResult clean = kin2grf::estimate(w.trial, nullptr, *set, defaults);
+    const kin2grf::EstimateResult clean = kin2grf::estimate(w.trial, nullptr, *set, with_floor);
     // Clean markers: nothing lowered, so nothing raised; the COP reads the foot's own angle.
     EXPECT_EQ(clean.kinematic_cutoff_hz, 6.0);
     EXPECT_EQ(clean.position_cutoff_hz, 6.0);
@@ -142,7 +146,7 @@ TEST(NoisyMarkers, TheDynamicsKeepTheStancesHarmonicsAndTheCopAngleTheLoweredCut
       const kin2grf::Trial noisy = with_noise(w.trial, 0.003, seed);
       const kin2grf::EstimateResult a = kin2grf::estimate(noisy, nullptr, *set, no_floor);
       // The progress: one count over both passes (twice the frames), which ends complete.
-      kin2grf::EstimateOptions with_progress = defaults;
+      kin2grf::EstimateOptions with_progress = with_floor;
       std::vector<std::pair<long, long>> progress;
       std::mutex mu;
       with_progress.progress = [&](long done, long total) {
@@ -161,14 +165,14 @@ TEST(NoisyMarkers, TheDynamicsKeepTheStancesHarmonicsAndTheCopAngleTheLoweredCut
       EXPECT_EQ(progress.front().second, 2 * b.time_s.size());
       EXPECT_LT(a.kinematic_cutoff_hz, 5.0);
       EXPECT_EQ(a.kinematic_cutoff_hz, a.position_cutoff_hz);
-      // The same positions' cut-off; the dynamics' raised to 3.5 cycles over the first solve's
+      // The same positions' cut-off; the dynamics' raised to 3 cycles over the first solve's
       // median stance (0.6-0.9 s here), never above the 6 Hz the user asked for.
       EXPECT_EQ(b.position_cutoff_hz, a.position_cutoff_hz);
       EXPECT_GT(b.kinematic_cutoff_hz, b.position_cutoff_hz + 0.2);
       EXPECT_LE(b.kinematic_cutoff_hz, 6.0);
       const auto stance = kin2grf::median_stance_s({a.feet[0].contact, a.feet[1].contact}, a.motion.rate_hz);
       ASSERT_TRUE(stance);
-      EXPECT_NEAR(b.kinematic_cutoff_hz, std::min(6.0, 3.5 / *stance), 0.15) << "median stance " << *stance << " s";
+      EXPECT_NEAR(b.kinematic_cutoff_hz, std::min(6.0, with_floor.min_kinematic_cycles / *stance), 0.15) << "median stance " << *stance << " s";
       EXPECT_EQ(b.motion.cop_foot_angle_rad.rows(), b.motion.frames());
       const bool said = std::any_of(b.messages.begin(), b.messages.end(),
                                     [](const std::string& m) { return m.find("raised to") != std::string::npos; });
