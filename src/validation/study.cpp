@@ -358,9 +358,8 @@ CrossValidation cross_validate(const StudyResult& s) {
   }
   if (labs.size() < 2) throw InputError("cross-validation: the trials come from one lab; give each trial its lab (trial list: activity|lab|name|TRIAL)");
   if (activities.size() > 1) activities.push_back("all");
-  // The criterion of setting r over the trials `use` accepts; NaN when a trial failed (a setting
-  // that breaks a trial is never chosen) or none has a stance.
-  // The criterion over the trials `use` accepts among `trials`.
+  // The criterion over the trials of `trials` that `use` accepts (criterion: those of setting r);
+  // NaN when a trial failed (a setting that breaks a trial is never chosen) or none has a stance.
   auto criterion_of = [&](const std::vector<StudyTrialResult>& trials, const std::function<bool(const StudyTrialResult&)>& use) {
     // Each lab weighs the same, whatever its number of stances (a 30 s treadmill run has 80).
     double score = 0;
