@@ -655,14 +655,9 @@ Messages touchdown_stage(const EstimateOptions& o, const Model& model, const Con
   long landings = 0, frames = 0;
   for (int side = 0; side < 2; ++side) {
     auto& before = raw.before_touchdown[static_cast<std::size_t>(side)];
-    before = frames_before_touchdown(contact[static_cast<std::size_t>(side)], heights[side][0], heights[side][1], motion.rate_hz, rule);
-    // A landing from a flight phase (a run's, a jump's) is left as solved: in flight the whole
-    // body's kinematics ask for no load until the impact, so its contact does not begin early
-    // (the runs' onsets are 3-10 ms early), and a runner's heel and MT head go on sinking into
-    // the shoe and the heel pad for 20-30 ms after it.
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (before[static_cast<std::size_t>(i)] && (i == 0 || !before[static_cast<std::size_t>(i - 1)]) && flag_at(plan.near_flight, i))
-        for (Eigen::Index k = i; k < n && before[static_cast<std::size_t>(k)]; ++k) before[static_cast<std::size_t>(k)] = false;
+    // A landing from a flight phase (a run's, a jump's) is left as solved.
+    before = frames_before_touchdown(contact[static_cast<std::size_t>(side)], heights[side][0], heights[side][1], motion.rate_hz, rule,
+                                     plan.near_flight);
     for (Eigen::Index i = 0; i < n; ++i)
       if (before[static_cast<std::size_t>(i)]) {
         ++frames;

@@ -327,6 +327,10 @@ TEST(Contact, AFootInContactBeforeItsHeelHasStoppedHasNotLandedYet) {
   EXPECT_GE(flagged, 6);   // the filtered stop lies within a few frames of the impact
   EXPECT_LE(flagged, 12);
   for (Eigen::Index i = impact + 5; i < n; ++i) EXPECT_FALSE(before[static_cast<std::size_t>(i)]) << i;
+  // A landing from a flight phase is left as solved.
+  const std::vector<bool> flight(static_cast<std::size_t>(n), true);
+  const auto ran = frames_before_touchdown(contact_from(n, impact - 8, impact + 120), h.heel, h.mt, 200.0, rule, flight);
+  EXPECT_EQ(std::count(ran.begin(), ran.end(), true), 0);
   // Contact beginning once the heel is down: nothing to hold back.
   const auto late = frames_before_touchdown(contact_from(n, impact + 6, impact + 120), h.heel, h.mt, 200.0, rule);
   EXPECT_EQ(std::count(late.begin(), late.end(), true), 0);

@@ -197,7 +197,7 @@ std::vector<bool> landing_frames(const Eigen::VectorXd& gap, const Eigen::Vector
 }
 
 std::vector<bool> frames_before_touchdown(const std::vector<bool>& contact, const Eigen::VectorXd& heel_height_m, const Eigen::VectorXd& mt_height_m,
-                                          double rate_hz, const TouchdownStopRule& rule) {
+                                          double rate_hz, const TouchdownStopRule& rule, const std::vector<bool>& near_flight) {
   const auto n = static_cast<Eigen::Index>(contact.size());
   std::vector<bool> out(contact.size(), false);
   if (!(rule.fraction > 0) || !(rate_hz > 0) || n < 3 || heel_height_m.size() != n || mt_height_m.size() != n) return out;
@@ -231,7 +231,7 @@ std::vector<bool> frames_before_touchdown(const std::vector<bool>& contact, cons
     return false;
   };
   for (Eigen::Index a = 1; a < n; ++a) {
-    if (!contact[static_cast<std::size_t>(a)] || contact[static_cast<std::size_t>(a - 1)]) continue;
+    if (!contact[static_cast<std::size_t>(a)] || contact[static_cast<std::size_t>(a - 1)] || flag_at(near_flight, a)) continue;
     Eigen::Index end = a;  // the run's end, or the window's
     while (end < n && end - a <= w && contact[static_cast<std::size_t>(end)]) ++end;
     Eigen::Index i = a;

@@ -255,13 +255,17 @@ struct TouchdownStopRule {
 /// rule.height_band_m of its floor height and descends no faster than rule.fraction of its fastest
 /// descent over the window before (at least rule.min_descent_mps); the run's frames before that are
 /// returned. A run in which no landmark lands within the window (no descent: a foot set down
-/// slowly, a trial's first stance) returns none. Why: a zero-lag 6 Hz filter spreads the impact's
+/// slowly, a trial's first stance) returns none, nor does one that begins on a frame of
+/// `near_flight` (flight_frames; empty: none): in flight the whole body's kinematics ask for no
+/// load until the impact, so a run's or a jump's contact does not begin early (the runs' onsets are
+/// 3-10 ms early), and a runner's heel and MT head go on sinking into the shoe and the heel pad for
+/// 20-30 ms after it. Why: a zero-lag 6 Hz filter spreads the impact's
 /// deceleration over about +-40 ms, so the whole body's kinematics ask for a ground force before
 /// the foot arrives and the least squares hands it to the landing foot. On the development walks
 /// with raw plate signals the solve's contact began 13-48 ms before the plates' onsets (32 ms mean
 /// |onset|), and the heel's own stop, seen at 12-20 Hz, lies within -20..+10 ms of them.
 std::vector<bool> frames_before_touchdown(const std::vector<bool>& contact, const Eigen::VectorXd& heel_height_m, const Eigen::VectorXd& mt_height_m,
-                                          double rate_hz, const TouchdownStopRule& rule);
+                                          double rate_hz, const TouchdownStopRule& rule, const std::vector<bool>& near_flight = {});
 
 /// Running frames: those within `window_s` of a flight frame, where the whole body's vertical
 /// kinematic force sum m (a_y + g) is below `flight_fraction` of body weight and no sole point of
