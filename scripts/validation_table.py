@@ -227,7 +227,11 @@ def trial_3d(j, mass):
     if not st:
         return None
     m = lambda xs: statistics.mean(xs) if xs else None
-    jm = [s["joint_moments_3d"] for s in st if s.get("joint_moments_3d")]
+    # What takes the plate's COP (its lateral place, the plate-driven joint moments, the free moment
+    # about it) leaves out the stances whose plate fails validate's registration check, as the
+    # sagittal COP and moment do; the lateral force does not depend on where the plate is.
+    placed = [s for s in st if not s.get("cop_reference_suspect", False)]
+    jm = [s["joint_moments_3d"] for s in placed if s.get("joint_moments_3d")]
     kam = [x["knee_adduction_moment"] for x in jm if x.get("knee_adduction_moment")]
     first = [(k["peaks_estimated_Nm"][0], k["peaks_measured_Nm"][0]) for k in kam
              if k["peaks_estimated_Nm"][0] is not None and k["peaks_measured_Nm"][0] is not None]
@@ -236,7 +240,7 @@ def trial_3d(j, mass):
         "lateral": m([s["rrmse_percent"]["lateral"] for s in st]),
         "lateral_bw": m([s["rmse_percent_bw"]["lateral"] for s in st]),
         "r": m([s["r"]["lateral"] for s in st if s["r"]["lateral"] is not None]),
-        "cop_mm": m([s["rmse"]["cop_lateral_mm"] for s in st if s["rmse"].get("cop_lateral_mm") is not None]),
+        "cop_mm": m([s["rmse"]["cop_lateral_mm"] for s in placed if s["rmse"].get("cop_lateral_mm") is not None]),
         "kam": m([k["rrmse_percent"] for k in kam if k.get("rrmse_percent") is not None]),
         "knee_sagittal": m([x["knee"]["sagittal"]["rrmse_percent"] for x in jm if x["knee"]["sagittal"].get("rrmse_percent") is not None]),
         "hip_frontal": m([x["hip"]["frontal"]["rrmse_percent"] for x in jm
@@ -245,7 +249,7 @@ def trial_3d(j, mass):
         "kam1_plates": m([p / mass for _, p in first]),
         "kam1_error": m([abs(e - p) / mass for e, p in first]),
         "frontal": total_moment(j, "frontal_moment"),
-        "free": m([s["rmse"]["free_moment_Nm"] for s in st if s["rmse"].get("free_moment_Nm") is not None]),
+        "free": m([s["rmse"]["free_moment_Nm"] for s in placed if s["rmse"].get("free_moment_Nm") is not None]),
         "transverse": total_moment(j, "transverse_moment"),
     }
 
@@ -285,7 +289,9 @@ print("The sagittal figures above are the 3D model's too: it adds to them, per f
       "value in the stance's first half) in N m/kg; the knee's sagittal moment's and the hip's frontal moment's rRMSE %; per trial, the total ground "
       "reaction's frontal and transverse moments about the GRM reference on the walker's midline, where every loaded "
       "foot is on a plate (the estimate's free moment is zero, the plates' is in theirs); per stance, the free moment's RMSE, which with the estimate's zero is the plate's own RMS "
-      "(a .mot without torque columns reads 0). No value of the 3D model "
+      "(a .mot without torque columns reads 0). The lateral COP, the joint moments and the free moment leave out the "
+      "stances whose plate fails the registration check, as the sagittal COP does (their plate-driven moments take the "
+      "misplaced COP as their lever: Camargo's four, since session 26); the lateral force keeps them. No value of the 3D model "
       "was fitted except the lateral cut-off, the split's rule, the arms' and head's segments, the torso's lateral lag (on or off; its delay is the fore-aft one's) and a landing's bilateral split, chosen leave-one-lab-out (below); the joint and foot geometry are anatomical ratios.\n")
 print("| activity | trial | lab | stances | lateral force rRMSE % | RMSE %BW | r | lateral COP RMSE mm | "
       "KAM rRMSE % | KAM 1st peak est / plates N m/kg | knee sagittal rRMSE % | hip frontal rRMSE % | total frontal / transverse moment rRMSE % | free moment RMSE N m |")

@@ -348,6 +348,55 @@ TEST(SyntheticWalk3D, TheFeetSplitTheModelsOwnLateralTotal) {
   EXPECT_LT(v.total->frontal_moment->rrmse_percent, 12.0);
 }
 
+// A plate registered 20 cm off along progression under a 3D walk: its plate-driven joint moments
+// take the misplaced COP as their lever (20 cm at 700 N is 140 N m of knee sagittal moment), so,
+// like its COP, they are kept for the record and left out of the means, and the text table puts
+// them in brackets; the lateral force, which does not depend on where the plate is, is scored.
+TEST(Validate, AMisregisteredPlatesJointMomentsAreKeptButNotScored) {
+  SyntheticWalkOptions wo;
+  wo.step_width_m = 0.16;
+  wo.lateral_sway_m = 0.025;
+  wo.toe_out_rad = 0.12;
+  Trial t = make_example_walk(wo);
+  EstimateOptions eo;
+  eo.model = ModelKind::ThreeD;
+  const EstimateResult r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
+  const ValidationResult placed = validate(r, *t.plates);
+  ForcePlate& fp1 = t.plates->plates[0];
+  ASSERT_EQ(fp1.name, "FP1");
+  for (Eigen::Index k = 0; k < fp1.cop_m.rows(); ++k) fp1.cop_m(k, 0) += 0.2;  // the synthetic walk goes along +x
+  fp1.moment_centre_Nm.setConstant(NAN);  // so that the moved COP makes the plate's moment
+  const ValidationResult v = validate(r, *t.plates);
+  ASSERT_EQ(v.stances.size(), 2u);
+  const StanceValidation& bad = v.stances[0].plate == "FP1" ? v.stances[0] : v.stances[1];
+  const StanceValidation& good = v.stances[0].plate == "FP1" ? v.stances[1] : v.stances[0];
+  ASSERT_TRUE(bad.cop_reference_suspect);
+  ASSERT_FALSE(good.cop_reference_suspect);
+  ASSERT_TRUE(bad.moments_3d && bad.moments_3d->knee[0] && bad.moments_3d->knee_adduction && good.moments_3d &&
+              good.moments_3d->knee[0] && good.moments_3d->knee_adduction);
+  // Kept for the record: the misplaced lever shows in the knee's sagittal moment.
+  const StanceValidation& before = placed.stances[0].plate == "FP1" ? placed.stances[0] : placed.stances[1];
+  ASSERT_TRUE(before.moments_3d && before.moments_3d->knee[0]);
+  EXPECT_GT(bad.moments_3d->knee[0]->rmse, before.moments_3d->knee[0]->rmse + 20.0);
+  // Left out of the means: they are the other stance's alone.
+  const MeanMetrics m = mean_rrmse(v.stances);
+  EXPECT_EQ(m.knee_sagittal, good.moments_3d->knee[0]->rrmse_percent);
+  EXPECT_EQ(m.knee_adduction, good.moments_3d->knee_adduction->rrmse_percent);
+  EXPECT_DOUBLE_EQ(m.kam_peak_error_percent[0], 100 * std::abs(good.moments_3d->kam_peak_estimated_Nm[0] - good.moments_3d->kam_peak_measured_Nm[0]) /
+                                                    std::abs(good.moments_3d->kam_peak_measured_Nm[0]));
+  ASSERT_TRUE(good.metrics.cop_lateral && bad.metrics.lateral && good.metrics.lateral);
+  EXPECT_DOUBLE_EQ(m.cop_lateral_rmse_mm, 1000 * good.metrics.cop_lateral->rmse);
+  EXPECT_DOUBLE_EQ(m.lateral, 0.5 * (bad.metrics.lateral->rrmse_percent + good.metrics.lateral->rrmse_percent));
+  // The text table brackets what it leaves out.
+  const std::string table = format_validation_table("walk", v);
+  const auto row = table.find("3D knee moments");
+  ASSERT_NE(row, std::string::npos) << table;
+  const auto fp1_row = table.find("foot on FP1", row);
+  ASSERT_NE(fp1_row, std::string::npos) << table;
+  const std::string line = table.substr(fp1_row, table.find('\n', fp1_row) - fp1_row);
+  EXPECT_NE(line.find('['), std::string::npos) << line;
+}
+
 // The marker-plate time offset (step 6): plates whose clock runs 30 ms late are found 30 ms
 // behind from the whole body's vertical force, said in a note, and compared after alignment
 // only when asked.

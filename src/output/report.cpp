@@ -114,6 +114,13 @@ std::string fmt(const nlohmann::json& x, const char* f = "%.1f") {
 
 std::vector<double> to_vec(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
 
+/// A figure that takes the plate's COP, in brackets where the plate fails validate's registration
+/// check (StanceValidation::cop_reference_suspect: kept for the record, left out of the means).
+std::string fmt_cop(const nlohmann::json& stance, const nlohmann::json& x, const char* f = "%.1f") {
+  const std::string text = fmt(x, f);
+  return stance.value("cop_reference_suspect", false) && text != "-" ? "[" + text + "]" : text;
+}
+
 }  // namespace
 
 std::string validation_report_html(const std::string& trial, const EstimateResult& e, const ValidationResult& v,
@@ -124,16 +131,18 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   t << "<h2>Errors against the force plates</h2>\n<p>rRMSE and RMSE as in the paper's Eqs. 11-12, per plate stance "
        "(measured vertical force above the threshold) and in total where every loaded foot stands on a plate. "
        "COP compared where the plate carries at least 5 % of body weight; moment about the plate centre (total: GRM about "
-       "the midpoint of the plates in use). Timing: estimate minus plate, + = late.</p>\n";
+       "the midpoint of the plates in use). Timing: estimate minus plate, + = late. In brackets: a plate whose COP is "
+       "not where the markers put the foot (validate's registration check), kept for the record, left out of the "
+       "means.</p>\n";
   t << "<table><tr><th class=l>foot</th><th class=l>plate</th><th>frames</th><th>vertical rRMSE %</th><th>anterior rRMSE %</th>"
        "<th>COP rRMSE %</th><th>moment rRMSE %</th><th>vertical RMSE N</th><th>anterior RMSE N</th><th>COP RMSE mm</th>"
        "<th>vertical r</th><th>onset ms</th><th>offset ms</th></tr>\n";
   for (const auto& s : j["per_foot"]) {
     t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>())
       << "</td><td>" << s["frames"][0] << "-" << s["frames"][1] << "</td><td>" << fmt(s["rrmse_percent"]["vertical"]) << "</td><td>"
-      << fmt(s["rrmse_percent"]["anterior"]) << "</td><td>" << fmt(s["rrmse_percent"]["cop"]) << "</td><td>"
-      << fmt(s["rrmse_percent"]["moment"]) << "</td><td>" << fmt(s["rmse"]["vertical_N"]) << "</td><td>"
-      << fmt(s["rmse"]["anterior_N"]) << "</td><td>" << fmt(s["rmse"]["cop_mm"]) << "</td><td>" << fmt(s["r"]["vertical"], "%.3f")
+      << fmt(s["rrmse_percent"]["anterior"]) << "</td><td>" << fmt_cop(s, s["rrmse_percent"]["cop"]) << "</td><td>"
+      << fmt_cop(s, s["rrmse_percent"]["moment"]) << "</td><td>" << fmt(s["rmse"]["vertical_N"]) << "</td><td>"
+      << fmt(s["rmse"]["anterior_N"]) << "</td><td>" << fmt_cop(s, s["rmse"]["cop_mm"]) << "</td><td>" << fmt(s["r"]["vertical"], "%.3f")
       << "</td><td>" << fmt(s["timing_ms"]["onset"], "%.0f") << "</td><td>" << fmt(s["timing_ms"]["offset"], "%.0f") << "</td></tr>\n";
   }
   if (!j["total"].is_null()) {
@@ -154,7 +163,8 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   if (e.legs_3d) {
     t << "<h3>3D model</h3>\n<p>Mediolateral force and the COP's lateral place against the plates; the external knee "
          "adduction moment (KAM) by inverse dynamics with kin2grf's GRF against with the plates' GRF, on the same "
-         "kinematics: rRMSE, and its first and second peaks (largest value in each half of the stance).</p>\n"
+         "kinematics: rRMSE, and its first and second peaks (largest value in each half of the stance). In brackets: "
+         "a plate that fails the registration check (its moments take its COP as their lever).</p>\n"
          "<table><tr><th class=l>foot</th><th class=l>plate</th><th>lateral rRMSE %</th><th>lateral RMSE N</th>"
          "<th>lateral COP RMSE mm</th><th>KAM rRMSE %</th><th>KAM peaks, kin2grf N m</th><th>KAM peaks, plates N m</th>"
          "<th>knee sagittal rRMSE %</th></tr>\n";
@@ -163,13 +173,17 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
       const auto& jm = s.contains("joint_moments_3d") ? s["joint_moments_3d"] : none;
       const auto& kam = jm.is_null() ? none : jm["knee_adduction_moment"];
       const auto peaks = [&](const char* key) {
-        return kam.is_null() ? std::string("-") : fmt(kam[key][0], "%.0f") + " / " + fmt(kam[key][1], "%.0f");
+        if (kam.is_null()) return std::string("-");
+        const std::string text = fmt(kam[key][0], "%.0f") + " / " + fmt(kam[key][1], "%.0f");
+        return s.value("cop_reference_suspect", false) ? "[" + text + "]" : text;
       };
       t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>())
         << "</td><td>" << fmt(s["rrmse_percent"].value("lateral", nlohmann::json())) << "</td><td>"
-        << fmt(s["rmse"].value("lateral_N", nlohmann::json())) << "</td><td>" << fmt(s["rmse"].value("cop_lateral_mm", nlohmann::json()), "%.0f")
-        << "</td><td>" << fmt(kam.is_null() ? none : kam["rrmse_percent"]) << "</td><td>" << peaks("peaks_estimated_Nm") << "</td><td>"
-        << peaks("peaks_measured_Nm") << "</td><td>" << fmt(jm.is_null() ? none : jm["knee"]["sagittal"]["rrmse_percent"]) << "</td></tr>\n";
+        << fmt(s["rmse"].value("lateral_N", nlohmann::json())) << "</td><td>"
+        << fmt_cop(s, s["rmse"].value("cop_lateral_mm", nlohmann::json()), "%.0f") << "</td><td>"
+        << fmt_cop(s, kam.is_null() ? none : kam["rrmse_percent"]) << "</td><td>" << peaks("peaks_estimated_Nm") << "</td><td>"
+        << peaks("peaks_measured_Nm") << "</td><td>" << fmt_cop(s, jm.is_null() ? none : jm["knee"]["sagittal"]["rrmse_percent"])
+        << "</td></tr>\n";
     }
     t << "</table>\n";
   }

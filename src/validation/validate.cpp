@@ -756,10 +756,12 @@ namespace {
 void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, MeanMetrics& mm) {
   // Knee sagittal rRMSE, KAM rRMSE; per peak (first, second) the |error| and the plates' |peak|:
   // a ratio of means, since a stance whose plate-driven peak is near 0 N m would make a per-stance
-  // percentage meaningless.
+  // percentage meaningless. A stance whose plate fails the registration check is left out: its
+  // plate-driven moments take the plate's COP, which is not where the foot is (4-7 cm of lever on
+  // Camargo's export are 0.3-0.7 N m/kg of knee adduction moment at 800 N).
   std::array<std::vector<double>, 6> x;
   for (const auto& s : stances) {
-    if ((foot >= 0 && s.foot != foot) || !s.moments_3d) continue;
+    if ((foot >= 0 && s.foot != foot) || !s.moments_3d || s.cop_reference_suspect) continue;
     const JointMomentValidation& j = *s.moments_3d;
     if (j.knee[0] && std::isfinite(j.knee[0]->rrmse_percent)) x[0].push_back(j.knee[0]->rrmse_percent);
     if (j.knee_adduction && std::isfinite(j.knee_adduction->rrmse_percent)) x[1].push_back(j.knee_adduction->rrmse_percent);
@@ -1006,7 +1008,8 @@ void format_lateral_rows(std::ostream& os, const ValidationResult& v, const Mean
     std::snprintf(pct, sizeof pct, "%.1f", 100 * s.metrics.lateral->rmse / s.body_weight_N);
     std::snprintf(r, sizeof r, "%.2f", s.metrics.lateral->pearson_r);
     char cop[40] = "-";
-    if (s.metrics.cop_lateral) std::snprintf(cop, sizeof cop, "%.0f", 1000 * s.metrics.cop_lateral->rmse);
+    if (s.metrics.cop_lateral)
+      std::snprintf(cop, sizeof cop, s.cop_reference_suspect ? "[%.0f]" : "%.0f", 1000 * s.metrics.cop_lateral->rmse);
     os << table_label(std::string(side_name(s.foot)) + " foot on " + s.plate) << table_cell(s.metrics.lateral) << table_text(pct)
        << table_text(r) << table_text(cop) << "\n";
   }
@@ -1016,7 +1019,8 @@ void format_lateral_rows(std::ostream& os, const ValidationResult& v, const Mean
   os << table_text(buf) << "\n";
 }
 /// The 3D joint moments' rows (--model 3d): per stance the knee's sagittal and adduction moments'
-/// rRMSE and the KAM's two peaks, estimate-driven / plate-driven, then the means.
+/// rRMSE and the KAM's two peaks, estimate-driven / plate-driven, then the means; in brackets (not
+/// in the means) where the plate fails the registration check, since its moments take its COP.
 void format_joint_moment_rows(std::ostream& os, const ValidationResult& v, const MeanMetrics& m, double mass_kg) {
   char a[40], b[40];
   os << table_label("3D knee moments") << table_text("sagittal %") << table_text("KAM %") << table_text("KAM peak 1") << table_text("KAM peak 2")
@@ -1024,10 +1028,11 @@ void format_joint_moment_rows(std::ostream& os, const ValidationResult& v, const
   for (const auto& s : v.stances) {
     if (!s.moments_3d) continue;
     const JointMomentValidation& j = *s.moments_3d;
-    std::snprintf(a, sizeof a, "%.2f/%.2f", j.kam_peak_estimated_Nm[0] / mass_kg, j.kam_peak_measured_Nm[0] / mass_kg);
-    std::snprintf(b, sizeof b, "%.2f/%.2f", j.kam_peak_estimated_Nm[1] / mass_kg, j.kam_peak_measured_Nm[1] / mass_kg);
-    os << table_label(std::string(side_name(s.foot)) + " foot on " + s.plate) << table_cell(j.knee[0]) << table_cell(j.knee_adduction)
-       << table_text(a) << table_text(b) << "\n";
+    const char* peak = s.cop_reference_suspect ? "[%.2f/%.2f]" : "%.2f/%.2f";
+    std::snprintf(a, sizeof a, peak, j.kam_peak_estimated_Nm[0] / mass_kg, j.kam_peak_measured_Nm[0] / mass_kg);
+    std::snprintf(b, sizeof b, peak, j.kam_peak_estimated_Nm[1] / mass_kg, j.kam_peak_measured_Nm[1] / mass_kg);
+    os << table_label(std::string(side_name(s.foot)) + " foot on " + s.plate) << table_cell(j.knee[0], s.cop_reference_suspect)
+       << table_cell(j.knee_adduction, s.cop_reference_suspect) << table_text(a) << table_text(b) << "\n";
   }
   const auto cell = [](double x, const char* unit) {
     char c[40];

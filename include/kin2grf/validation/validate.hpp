@@ -180,7 +180,8 @@ struct StanceValidation {
   /// COP's distance beyond the foot's heel-toe landmark span (0: inside); NaN without such frames.
   double cop_beyond_foot_m = 0.0;
   /// cop_beyond_foot_m > max_cop_beyond_foot_m: metrics.cop and metrics.moment are kept for the
-  /// record but left out of mean_rrmse and of the COP fit.
+  /// record but left out of mean_rrmse and of the COP fit; so are metrics.cop_lateral and
+  /// moments_3d, whose plate-driven joint moments take the plate's COP as their lever.
   bool cop_reference_suspect = false;
   /// The foot's sole length, heel to toe sole point (median over the stance; NaN without the
   /// sole series): the COP's RMSE is also given in % of it.
