@@ -43,6 +43,12 @@ const std::vector<NumericOption>& numeric_options() {
        "The upper body's fore-aft lag behind the pelvis, s: the HAT's fore-aft inertial force is delayed by this time, less what "
        "the trunk markers already lag the hip by (0 = none, the paper)",
        {0.0, 0.01, 0.02, 0.025, 0.03, 0.035, 0.04, 0.05}, "%.0f ms", 1000.0, "off"},
+      // Measured on the run with trunk markers (kTrunkSwayGainRunning), not fitted: only a run
+      // without trunk markers (the RBDS runs' lab) feels it, so held out that lab's choice ties.
+      {"running-sway-gain", "running_sway_gain", [](O& o) -> double& { return o.running_sway_gain; }, 0.0, 1.5, std::nullopt,
+       "A model torso's fore-aft sway (a set without trunk markers) in a trial with flight phases (a run, a jump), as a share of "
+       "the hip centre's fore-aft oscillation: a runner's, measured; the set's own walking share (0.5 in the presets) turns it off",
+       {0.0, 0.05, 0.1, 0.2, 0.3, 0.5}, "%.2f x the hip's"},
       // Up to 0.2: above it a 1 cm error of the ground level moves a walk by 0.3-0.4 points of
       // vertical (the robustness limit, docs/ROBUSTNESS.md): the double supports' ends move with
       // the ground, and the prior's timing with them.

@@ -133,6 +133,8 @@ void check_options(const EstimateOptions& o) {
           "split distance (m)", o.solver.min_split_distance_m, "between 0 (none) and 1");
   require(finite(o.torso_lag_s) && o.torso_lag_s >= 0 && o.torso_lag_s <= 0.2, "torso lag (s)", o.torso_lag_s,
           "between 0 (none, the paper) and 0.2");
+  require(finite(o.running_sway_gain) && o.running_sway_gain >= 0 && o.running_sway_gain <= 1.5, "running torso sway gain",
+          o.running_sway_gain, "between 0 (the shoulders still) and 1.5");
   require(finite(o.double_support_sta_weight) && o.double_support_sta_weight >= 0 && o.double_support_sta_weight <= 1,
           "double-support transition weight", o.double_support_sta_weight, "between 0 (none, the paper) and 1");
   require(finite(o.touchdown_stop_fraction) && o.touchdown_stop_fraction >= 0 && o.touchdown_stop_fraction <= 1,
@@ -176,6 +178,7 @@ struct SagittalStage {
   std::array<Eigen::MatrixX4d, 2> foot_line;                    ///< with EstimateOptions::lateral_force()
   std::optional<double> hip_half_width_m;                       ///< the hip rule's (Landmarks3D)
   bool trunk_measured = true;  ///< the shoulder point from upper-body markers, not the model torso (pelvis_up)
+  double torso_sway_gain = 1.0;  ///< the model torso's fore-aft sway (its rule's sway_gain; trunk_measured: unused)
   std::array<Eigen::MatrixX3d, kLandmarkCount> landmark_lab_m;  ///< with EstimateOptions::mediolateral
   Eigen::MatrixX3d lateral_axis;                                ///< likewise, per frame
   std::array<Eigen::MatrixX3d, kUpperBodyCount> upper_body_lab_m;  ///< likewise (SagittalWindow's)
@@ -230,6 +233,7 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   out.foot_line = std::move(win.foot_line);
   out.hip_half_width_m = win.hip_half_width_m;
   out.trunk_measured = set.rules[kShoulder].kind != RuleKind::PelvisUp;
+  out.torso_sway_gain = set.rules[kShoulder].sway_gain;
   out.landmarks = std::move(win.landmarks);
   const SagittalLandmarks& lm = out.landmarks;
   // The zero-lag filter's single pass runs at cut-off / 0.802 (Winter's correction), which must
@@ -335,6 +339,24 @@ KinematicsStage kinematics_stage(const EstimateOptions& o, const std::shared_ptr
   if (o.min_kinematic_cycles > 0 && out.kinematic_cutoff_hz < o.kinematic_cutoff_hz) out.unfiltered = x;
   out.motion = motion_from_coordinates(model, std::move(x), lm.rate_hz, lm.time_s, out.kinematic_cutoff_hz);
   return out;
+}
+
+/// A model torso in a trial with flight phases (a run, a jump) takes the runner's fore-aft sway
+/// (EstimateOptions::running_sway_gain) instead of the marker set's walking one. The flight test
+/// (flight_frames) reads the whole body's vertical acceleration and the soles, which the torso's
+/// fore-aft sway does not move, so the first pass's motion decides it. True when the landmarks
+/// changed (the kinematics are then made again); a measured trunk is never touched.
+bool running_torso_stage(const EstimateOptions& o, const ModelStage& mod, const ModelMotion& motion, SagittalStage& sag) {
+  if (sag.trunk_measured || o.running_sway_gain == sag.torso_sway_gain) return false;
+  const std::vector<bool> near_flight = flight_frames(*mod.model, motion, mod.soles);
+  if (std::find(near_flight.begin(), near_flight.end(), true) == near_flight.end()) return false;
+  sway_model_torso(sag.landmarks, sag.torso_sway_gain, o.running_sway_gain);
+  char b[240];
+  std::snprintf(b, sizeof b, "shoulder: the trial has flight phases, so the model torso sways by %.2f x the hip's fore-aft oscillation "
+                "(a runner's, --running-sway-gain) instead of %.2f (a walker's)", o.running_sway_gain, sag.torso_sway_gain);
+  sag.messages.emplace_back(b);
+  sag.torso_sway_gain = o.running_sway_gain;
+  return true;
 }
 
 /// The upper body's fore-aft lag: what the trunk markers do not already show of it
@@ -1086,6 +1108,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   SagittalStage sag = sagittal_stage(trial, release, static_trial, set, o);
   ModelStage mod = model_stage(o, sag.landmarks, mass_kg);
   KinematicsStage kin = kinematics_stage(o, mod.model, sag.landmarks);
+  if (running_torso_stage(o, mod, kin.motion, sag)) kin = kinematics_stage(o, mod.model, sag.landmarks);
   const double hip_speed_mps = sag.frame.treadmill ? 0.0 : progression_speed(sag.landmarks);
   const FootHeights heights = foot_heights(o, sag.landmarks);
   if (!o.keep_all_series) sag.landmarks.p = {};  // the hip's speed and the feet's heights were the last use of them

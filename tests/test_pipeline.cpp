@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
@@ -349,6 +350,51 @@ TEST(Pipeline, MedianStanceBridgesFlickersAndLeavesOutRunsCutByTheWindow) {
   EXPECT_FALSE(median_stance_s({std::vector<bool>(300, true), std::vector<bool>(300, true)}, 100.0));
   EXPECT_FALSE(median_stance_s({runs({{0, 100}}, 300), runs({{200, 300}}, 300)}, 100.0));
   EXPECT_FALSE(median_stance_s({std::vector<bool>{}, std::vector<bool>{}}, 100.0));
+}
+
+// A model torso (no trunk markers) sways fore-aft by the runner's measured share of the hip's
+// oscillation (kTrunkSwayGainRunning) in a trial with flight phases, by the walker's elsewhere;
+// a measured trunk is never touched. Here a jump whose whole body also oscillates fore-aft.
+TEST(Estimate, AModelTorsoSwaysAsARunnersInATrialWithFlightPhases) {
+  SyntheticOptions so;
+  so.squat_depth = 0.0;
+  so.flight_height_m = 0.3;
+  Trial jump = make_synthetic_trial(so);
+  for (auto& p : jump.markers.positions_m)
+    for (Eigen::Index i = 0; i < p.rows(); ++i) p(i, 0) += 0.01 * std::sin(2 * std::numbers::pi * 2.5 * jump.markers.time_s[i]);
+  const MarkerSet& measured = *find_marker_set("kin2grf-example");
+  std::string why;
+  const std::optional<MarkerSet> model_torso = without_trunk_markers(measured, why);
+  ASSERT_TRUE(model_torso) << why;
+  EstimateOptions runner;
+  runner.keep_all_series = true;
+  EstimateOptions walker = runner;
+  walker.running_sway_gain = kTrunkSwayGain;  // the set's own: no change
+  const EstimateResult r = estimate(jump, nullptr, *model_torso, runner), w = estimate(jump, nullptr, *model_torso, walker);
+  const SagittalLandmarks& lm = r.landmarks;
+  ASSERT_EQ(lm.frames(), w.landmarks.frames());
+  const Eigen::VectorXd hx = lm.p[kHip].col(0);
+  const Eigen::VectorXd oscillation = hx - butterworth_filtfilt(hx, lm.rate_hz, 0.5);
+  EXPECT_GT(oscillation.cwiseAbs().maxCoeff(), 0.005);
+  for (Eigen::Index i = 0; i < lm.frames(); ++i)
+    EXPECT_NEAR(lm.p[kShoulder](i, 0) - w.landmarks.p[kShoulder](i, 0), (kTrunkSwayGainRunning - kTrunkSwayGain) * oscillation[i], 1e-9)
+        << "frame " << i;
+  double moved = 0;
+  for (int f = 0; f < 2; ++f) moved = std::max(moved, (r.feet[f].force_N - w.feet[f].force_N).cwiseAbs().maxCoeff());
+  EXPECT_GT(moved, 1.0);  // N: the heavy HAT's fore-aft inertia
+  const auto said = [](const EstimateResult& e) {
+    return std::any_of(e.messages.begin(), e.messages.end(), [](const std::string& m) { return m.find("runner's") != std::string::npos; });
+  };
+  EXPECT_TRUE(said(r));
+  EXPECT_FALSE(said(w));
+  // A measured trunk, and a walk (no flight phase), are not touched: the same forces bit for bit.
+  const auto same = [&](const Trial& t, const MarkerSet& set) {
+    const EstimateResult a = estimate(t, nullptr, set, runner), b = estimate(t, nullptr, set, walker);
+    EXPECT_FALSE(said(a));
+    for (int f = 0; f < 2; ++f) EXPECT_EQ(a.feet[f].force_N, b.feet[f].force_N) << set.name << " " << side_name(f);
+  };
+  same(jump, measured);
+  same(make_example_walk({}), *model_torso);
 }
 
 TEST(Estimate, ThePostFilterFollowsTheStanceDuration) {

@@ -74,6 +74,12 @@ struct EstimateOptions {
   /// acceleration is delayed (lag_torso_fore_aft) by this time less what the trunk
   /// markers already lag the hip by (measured_torso_lag_s), never below 0. 0: none (the paper).
   double torso_lag_s = 0.03;
+  /// A model torso's fore-aft sway (no trunk markers: the marker set's pelvis_up shoulder rule)
+  /// in a trial with flight phases (flight_frames: a run, a jump), as a fraction of the hip
+  /// centre's fore-aft oscillation (kin2grf): the runner's measured kTrunkSwayGainRunning instead
+  /// of the set's walking one (kTrunkSwayGain). A trial without flight phases, or a measured
+  /// trunk, is not touched. The set's own sway_gain: as the set has it everywhere.
+  double running_sway_gain = kTrunkSwayGainRunning;
   /// Double support's load transfer (kin2grf; after Ren et al. 2008's smooth transition
   /// assumption, J Biomech 41:2750): in each double support of a walk (the leading foot lands
   /// while the trailing foot stands, and the trailing foot leaves while the leading one stands),

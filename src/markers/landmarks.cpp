@@ -989,18 +989,17 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
     check_toes(s, set, side, w.messages);
   }
   // Torso without trunk markers: the shoulder point sways fore-aft by sway_gain times the hip
-  // centre's oscillation about its own slow progression (a 0.5 Hz zero-lag trend, below the
-  // step frequency), instead of rigidly with the hip. The trunk's attenuation of the pelvis's
-  // fore-aft accelerations is measured (kTrunkSwayGain); its vertical motion is the hip's (a
-  // gain of 0.97-1.03 on the same trials), so only x changes.
+  // centre's oscillation instead of rigidly with the hip (kTrunkSwayGain, measured).
   const LandmarkRule& sr = set.rules[kShoulder];
-  if (sr.kind == RuleKind::PelvisUp && sr.sway_gain != 1.0) {
-    auto& S = s.p[kShoulder];
-    const Eigen::VectorXd hx = s.p[kHip].col(0);
-    const Eigen::VectorXd trend = butterworth_filtfilt(hx, s.rate_hz, kTrunkTrendCutoffHz);
-    S.col(0) += (sr.sway_gain - 1.0) * (hx - trend);
-  }
+  if (sr.kind == RuleKind::PelvisUp) sway_model_torso(s, 1.0, sr.sway_gain);
   return w;
+}
+
+void sway_model_torso(SagittalLandmarks& s, double from_gain, double to_gain) {
+  if (to_gain == from_gain || s.frames() == 0) return;
+  const Eigen::VectorXd hx = s.p[kHip].col(0);
+  const Eigen::VectorXd trend = butterworth_filtfilt(hx, s.rate_hz, kTrunkTrendCutoffHz);
+  s.p[kShoulder].col(0) += (to_gain - from_gain) * (hx - trend);
 }
 
 }  // namespace kin2grf

@@ -73,6 +73,14 @@ struct LandmarkRule {
 /// upright torso (gain 1) gives the heavy HAT segment the pelvis's whole fore-aft oscillation,
 /// which over-brakes the body at heel strike and moves load to the leading foot too early.
 inline constexpr double kTrunkSwayGain = 0.5;
+/// The same fraction in running: 0.04 on the one development run with trunk markers (Rajagopal's
+/// treadmill run, 3.9 m/s; least squares of the shoulder point's fore-aft acceleration on the hip
+/// centre's, both at 6 Hz), against 0.26-0.63 on the 8 walks with them (docs/METHOD-NOTES.md). A
+/// runner's pelvis oscillates fore-aft at 2.6-3 steps a second, a walker's at 1.6-2.3, and the
+/// trunk's mass on its compliant spine follows the faster oscillation less; why it follows it
+/// hardly at all was not measured apart. Measured, not fitted to any outcome; the pipeline gives it
+/// to a model torso in a trial with flight phases (EstimateOptions::running_sway_gain).
+inline constexpr double kTrunkSwayGainRunning = 0.05;
 /// Toes (sagittal_landmarks): the presets' virtual toes are 0.3 x the ankle-MT length (the hallux
 /// tip about a third of that ahead of the MT head); a toe marker nearer the MT head than half
 /// of it is not on the toe and is replaced by them, with a message.
@@ -109,6 +117,14 @@ struct MarkerSet {
 /// centre is made otherwise (`why` says so); a set without trunk markers already is returned as it
 /// is, without upper_body.
 std::optional<MarkerSet> without_trunk_markers(const MarkerSet& set, std::string& why);
+
+/// The model torso's fore-aft sway (a pelvis_up shoulder rule): the shoulder point's fore-aft
+/// coordinate moves by (to_gain - from_gain) times the hip centre's fore-aft oscillation, the hip's
+/// position less its own 0.5 Hz zero-lag trend (below the step frequency, so that the torso's mean
+/// lean and the progression are untouched). sagittal_landmarks applies the set's sway_gain (from 1,
+/// the rigidly upright torso); the pipeline changes it to the runner's (kTrunkSwayGainRunning) in a
+/// trial with flight phases. The vertical is the hip's (a gain of 0.97-1.03 on trunk markers).
+void sway_model_torso(SagittalLandmarks& lm, double from_gain, double to_gain);
 
 /// A landmark's name in marker-set files ("shoulder", "hip", "knee_r", ...).
 const char* landmark_name(int id);
