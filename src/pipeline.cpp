@@ -319,12 +319,19 @@ struct KinematicsStage {
   Eigen::MatrixXd unfiltered;
   Messages messages;
 };
-KinematicsStage kinematics_stage(const EstimateOptions& o, const std::shared_ptr<const Model>& model, const SagittalLandmarks& lm) {
+/// `noise_from`: a first pass on the same markers, whose noise-limited cut-off (and its message) is
+/// taken as it is rather than measured again (the running torso stage moves one landmark by a
+/// smooth sway, not by noise).
+KinematicsStage kinematics_stage(const EstimateOptions& o, const std::shared_ptr<const Model>& model, const SagittalLandmarks& lm,
+                                 const KinematicsStage* noise_from = nullptr) {
   KinematicsStage out;
   // The kinematic cut-off: the user's (6 Hz), lowered where the markers' own noise needs it
   // (Winter's residual analysis on the landmarks, noise_limited_cutoff).
   out.kinematic_cutoff_hz = o.kinematic_cutoff_hz;
-  if (o.cutoff_from_noise) {
+  if (noise_from) {
+    out.kinematic_cutoff_hz = noise_from->kinematic_cutoff_hz;
+    out.messages = noise_from->messages;
+  } else if (o.cutoff_from_noise) {
     const double fc = noise_limited_cutoff(lm, o.kinematic_cutoff_hz);
     if (fc < o.kinematic_cutoff_hz) {
       out.kinematic_cutoff_hz = fc;
@@ -1108,7 +1115,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   SagittalStage sag = sagittal_stage(trial, release, static_trial, set, o);
   ModelStage mod = model_stage(o, sag.landmarks, mass_kg);
   KinematicsStage kin = kinematics_stage(o, mod.model, sag.landmarks);
-  if (running_torso_stage(o, mod, kin.motion, sag)) kin = kinematics_stage(o, mod.model, sag.landmarks);
+  if (running_torso_stage(o, mod, kin.motion, sag)) kin = kinematics_stage(o, mod.model, sag.landmarks, &kin);
   const double hip_speed_mps = sag.frame.treadmill ? 0.0 : progression_speed(sag.landmarks);
   const FootHeights heights = foot_heights(o, sag.landmarks);
   if (!o.keep_all_series) sag.landmarks.p = {};  // the hip's speed and the feet's heights were the last use of them
