@@ -395,13 +395,6 @@ TEST(Validate, AMisregisteredPlatesJointMomentsAreKeptButNotScored) {
   ASSERT_NE(fp1_row, std::string::npos) << table;
   const std::string line = table.substr(fp1_row, table.find('\n', fp1_row) - fp1_row);
   EXPECT_NE(line.find('['), std::string::npos) << line;
-  // So does the report: FP1's KAM rRMSE cell in brackets, FP2's plain.
-  const std::string html = validation_report_html("walk", r, v, validation_json("walk", r, v, nlohmann::json::object()));
-  char bad_cell[40], good_cell[40];
-  std::snprintf(bad_cell, sizeof bad_cell, "<td>[%.1f]</td>", bad.moments_3d->knee_adduction->rrmse_percent);
-  std::snprintf(good_cell, sizeof good_cell, "<td>%.1f</td>", good.moments_3d->knee_adduction->rrmse_percent);
-  EXPECT_NE(html.find(bad_cell), std::string::npos) << bad_cell;
-  EXPECT_NE(html.find(good_cell), std::string::npos) << good_cell;
 }
 
 // The marker-plate time offset (step 6): plates whose clock runs 30 ms late are found 30 ms
