@@ -898,9 +898,10 @@ FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, dou
   const int np = static_cast<int>(raw.point_side.size());
   // The stance duration the post-filter scales with is the solve's (the touchdown rule's few
   // frames do not move every frame's filter); the contact states are those after the rule.
-  const std::optional<double> stance = median_stance_s(foot_contact_states(raw, n), rate_hz);
+  std::array<std::vector<bool>, 2> contact = foot_contact_states(raw, n);
+  const std::optional<double> stance = median_stance_s(contact, rate_hz);
   const auto dropped = touchdown_points(raw);
-  const std::array<std::vector<bool>, 2> contact = foot_contact_states(raw, n);
+  if (!dropped.empty()) contact = foot_contact_states(raw, n);
   out.messages = window_edge_messages(contact, rate_hz, kinematic_cutoff_hz, first_frame_number);
   // Final filtering (Sect. 2.6): all multipliers at the post-filter cut-off, then inactive ones
   // back to zero.

@@ -138,18 +138,12 @@ TEST(Report, TheThreeDReportPlotsTheLateralForceAndTheKneeAdductionMoment) {
 // The report brackets, as the text table does, the figures of a plate that fails the registration
 // check (here FP1 registered 20 cm off under a 3D walk): its KAM cell in brackets, FP2's plain.
 TEST(Report, AMisregisteredPlatesFiguresAreBracketed) {
-  SyntheticWalkOptions wo;
-  wo.step_width_m = 0.16;
-  wo.lateral_sway_m = 0.025;
-  wo.toe_out_rad = 0.12;
-  Trial t = make_example_walk(wo);
+  Trial t = make_example_walk(kin2grf::test::walk_3d_options());
   EstimateOptions eo;
   eo.model = ModelKind::ThreeD;
   eo.keep_all_series = true;
   const EstimateResult r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
-  ForcePlate& fp1 = t.plates->plates[0];
-  for (Eigen::Index k = 0; k < fp1.cop_m.rows(); ++k) fp1.cop_m(k, 0) += 0.2;
-  fp1.moment_centre_Nm.setConstant(NAN);
+  kin2grf::test::misregister_plate(t.plates->plates[0], 0.2);
   const ValidationResult v = validate(r, *t.plates);
   ASSERT_EQ(v.stances.size(), 2u);
   const std::string html = validation_report_html("walk", r, v, validation_json("walk", r, v, nlohmann::json::object()));

@@ -1,6 +1,7 @@
 #include "test_support.hpp"
 #include "kin2grf/io/marker_presets.hpp"
 
+#include <limits>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -66,6 +67,19 @@ SagittalLandmarks synthetic_landmarks(const Trial& t) {
 EstimateResult run(const SyntheticOptions& so, EstimateOptions eo) {
   const Trial t = make_synthetic_trial(so);
   return estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
+}
+
+SyntheticWalkOptions walk_3d_options() {
+  SyntheticWalkOptions wo;
+  wo.step_width_m = 0.16;
+  wo.lateral_sway_m = 0.025;
+  wo.toe_out_rad = 0.12;
+  return wo;
+}
+
+void misregister_plate(ForcePlate& plate, double dx_m) {
+  plate.cop_m.col(0).array() += dx_m;
+  plate.moment_centre_Nm.setConstant(std::numeric_limits<double>::quiet_NaN());
 }
 
 SyntheticWithPlates synthetic_with_exact_plates() {

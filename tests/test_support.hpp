@@ -46,6 +46,12 @@ struct SyntheticWithPlates {
   ForcePlateRecording plates;
 };
 SyntheticWithPlates synthetic_with_exact_plates();
+/// The synthetic 3D walk of the lateral tests (issue 28): a 16 cm step, 2.5 cm of sway toward the
+/// stance foot and 0.12 rad of toe-out.
+SyntheticWalkOptions walk_3d_options();
+/// A plate registered `dx_m` off along the lab's x (the synthetic walks' progression): its COP
+/// moved and its centre moments dropped, so that the moved COP makes its moment.
+void misregister_plate(ForcePlate& plate, double dx_m);
 /// One foot's (anterior, vertical) force of a frame's solve: its contact points' multipliers.
 Eigen::Vector2d foot_force(const FrameSolution& s, const FrameContacts& fc, int side);
 /// Whether any of the foot's contact points is active.

@@ -94,9 +94,7 @@ namespace {
 /// dropped (so that the COP speaks): a plate registered in the wrong place.
 kin2grf::test::SyntheticWithPlates with_fp1_cop_moved(double dx_m) {
   auto s = synthetic_with_exact_plates();
-  auto& p = s.plates.plates[0];
-  for (Eigen::Index i = 0; i < p.cop_m.rows(); ++i) p.cop_m(i, 0) += dx_m;
-  p.moment_centre_Nm.setConstant(NAN);
+  kin2grf::test::misregister_plate(s.plates.plates[0], dx_m);
   return s;
 }
 }  // namespace
@@ -302,10 +300,7 @@ TEST(SyntheticWalk3D, OnlyAMeasuredTrunkTakesTheLateralLag) {
 }
 
 TEST(SyntheticWalk3D, TheFeetSplitTheModelsOwnLateralTotal) {
-  SyntheticWalkOptions wo;
-  wo.step_width_m = 0.16;
-  wo.lateral_sway_m = 0.025;
-  wo.toe_out_rad = 0.12;
+  const SyntheticWalkOptions wo = kin2grf::test::walk_3d_options();
   const Trial t = make_example_walk(wo);
   EstimateOptions eo;
   eo.model = ModelKind::ThreeD;
@@ -353,19 +348,14 @@ TEST(SyntheticWalk3D, TheFeetSplitTheModelsOwnLateralTotal) {
 // like its COP, they are kept for the record and left out of the means, and the text table puts
 // them in brackets; the lateral force, which does not depend on where the plate is, is scored.
 TEST(Validate, AMisregisteredPlatesJointMomentsAreKeptButNotScored) {
-  SyntheticWalkOptions wo;
-  wo.step_width_m = 0.16;
-  wo.lateral_sway_m = 0.025;
-  wo.toe_out_rad = 0.12;
+  const SyntheticWalkOptions wo = kin2grf::test::walk_3d_options();
   Trial t = make_example_walk(wo);
   EstimateOptions eo;
   eo.model = ModelKind::ThreeD;
   const EstimateResult r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
   const ValidationResult placed = validate(r, *t.plates);
-  ForcePlate& fp1 = t.plates->plates[0];
-  ASSERT_EQ(fp1.name, "FP1");
-  for (Eigen::Index k = 0; k < fp1.cop_m.rows(); ++k) fp1.cop_m(k, 0) += 0.2;  // the synthetic walk goes along +x
-  fp1.moment_centre_Nm.setConstant(NAN);  // so that the moved COP makes the plate's moment
+  ASSERT_EQ(t.plates->plates[0].name, "FP1");
+  kin2grf::test::misregister_plate(t.plates->plates[0], 0.2);
   const ValidationResult v = validate(r, *t.plates);
   ASSERT_EQ(v.stances.size(), 2u);
   const StanceValidation& bad = v.stances[0].plate == "FP1" ? v.stances[0] : v.stances[1];
