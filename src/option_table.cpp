@@ -43,6 +43,10 @@ const std::vector<NumericOption>& numeric_options() {
        "The upper body's fore-aft lag behind the pelvis, s: the HAT's fore-aft inertial force is delayed by this time, less what "
        "the trunk markers already lag the hip by (0 = none, the paper)",
        {0.0, 0.01, 0.02, 0.025, 0.03, 0.035, 0.04, 0.05}, "%.0f ms", 1000.0, "off"},
+      {"thigh-lag", "thigh_lag_s", [](O& o) -> double& { return o.thigh_lag_s; }, 0.0, 0.2, 0.0,
+       "Each thigh's fore-aft lag behind its femur, s: the thigh's fore-aft inertial force is delayed by this time where its knee "
+       "point is a marker on the bone (not where a thigh cluster carries it; 0 = none, the paper)",
+       {0.0, 0.01, 0.015, 0.02, 0.025, 0.03, 0.04}, "%.0f ms", 1000.0, "off"},
       // Measured on the run with trunk markers (kTrunkSwayGainRunning), not fitted: only a run
       // without trunk markers (the RBDS runs' lab) feels it, so held out that lab's choice ties.
       {"running-sway-gain", "running_sway_gain", [](O& o) -> double& { return o.running_sway_gain; }, 0.0, 1.5, std::nullopt,

@@ -133,6 +133,8 @@ void check_options(const EstimateOptions& o) {
           "split distance (m)", o.solver.min_split_distance_m, "between 0 (none) and 1");
   require(finite(o.torso_lag_s) && o.torso_lag_s >= 0 && o.torso_lag_s <= 0.2, "torso lag (s)", o.torso_lag_s,
           "between 0 (none, the paper) and 0.2");
+  require(finite(o.thigh_lag_s) && o.thigh_lag_s >= 0 && o.thigh_lag_s <= 0.2, "thigh lag (s)", o.thigh_lag_s,
+          "between 0 (none, the paper) and 0.2");
   require(finite(o.running_sway_gain) && o.running_sway_gain >= 0 && o.running_sway_gain <= 1.5, "running torso sway gain",
           o.running_sway_gain, "between 0 (the shoulders still) and 1.5");
   require(finite(o.double_support_sta_weight) && o.double_support_sta_weight >= 0 && o.double_support_sta_weight <= 1,
@@ -179,6 +181,9 @@ struct SagittalStage {
   std::optional<double> hip_half_width_m;                       ///< the hip rule's (Landmarks3D)
   bool trunk_measured = true;  ///< the shoulder point from upper-body markers, not the model torso (pelvis_up)
   double torso_sway_gain = 1.0;  ///< the model torso's fore-aft sway (its rule's sway_gain; trunk_measured: unused)
+  /// Per side: the knee point is a marker on the bone (the set's knee rule a marker or a mean of
+  /// markers), not a point a thigh cluster carries (EstimateOptions::thigh_lag_s).
+  std::array<bool, 2> knee_on_bone{false, false};
   std::array<Eigen::MatrixX3d, kLandmarkCount> landmark_lab_m;  ///< with EstimateOptions::mediolateral
   Eigen::MatrixX3d lateral_axis;                                ///< likewise, per frame
   std::array<Eigen::MatrixX3d, kUpperBodyCount> upper_body_lab_m;  ///< likewise (SagittalWindow's)
@@ -234,6 +239,8 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   out.hip_half_width_m = win.hip_half_width_m;
   out.trunk_measured = set.rules[kShoulder].kind != RuleKind::PelvisUp;
   out.torso_sway_gain = set.rules[kShoulder].sway_gain;
+  for (int side = 0; side < 2; ++side)
+    out.knee_on_bone[static_cast<std::size_t>(side)] = follows_the_bone(set.rules[landmark(side, kKnee)].kind);
   out.landmarks = std::move(win.landmarks);
   const SagittalLandmarks& lm = out.landmarks;
   // The zero-lag filter's single pass runs at cut-off / 0.802 (Winter's correction), which must
@@ -385,6 +392,36 @@ Messages lag_torso_stage(const EstimateOptions& o, ModelMotion& motion, double& 
   return out;
 }
 
+/// The thighs' fore-aft lag (lag_thigh_fore_aft) on the sides whose knee point is a marker on
+/// the bone; a knee a thigh cluster carries already moves with the thigh's soft tissue. The
+/// motion is changed in place.
+Messages lag_thigh_stage(const EstimateOptions& o, ModelMotion& motion, const std::array<bool, 2>& knee_on_bone,
+                         const std::vector<bool>& near_flight) {
+  Messages out;
+  if (!(o.thigh_lag_s > 0) || !(knee_on_bone[0] || knee_on_bone[1])) return out;
+  if (std::find(near_flight.begin(), near_flight.end(), true) != near_flight.end()) {
+    out.emplace_back("thigh lag: none, the trial has flight phases (measured on walks; the one landing with knee markers on the bone "
+                     "lost with it)");
+    return out;
+  }
+  int lagged = 0;
+  for (int side = 0; side < 2; ++side)
+    if (knee_on_bone[static_cast<std::size_t>(side)]) {
+      lag_thigh_fore_aft(motion, side, o.thigh_lag_s);
+      ++lagged;
+    }
+  char b[240];
+  if (lagged == 2)
+    std::snprintf(b, sizeof b, "thigh lag: each thigh's fore-aft inertial force delayed by %.0f ms (its knee marker is on the bone)",
+                  1000 * o.thigh_lag_s);
+  else if (lagged == 1)
+    std::snprintf(b, sizeof b, "thigh lag: the %s thigh's fore-aft inertial force delayed by %.0f ms (its knee marker is on the bone); "
+                  "the %s knee point rides on a thigh cluster, whose soft tissue already lags", knee_on_bone[0] ? "right" : "left",
+                  1000 * o.thigh_lag_s, knee_on_bone[0] ? "left" : "right");
+  out.emplace_back(b);
+  return out;
+}
+
 /// Which frames take the running COP function, the rest of the trial's calibration (the belt
 /// velocity, always, on a treadmill, from every frame's contact points; the progression speed and
 /// the speed gate) and, with the touchdown rule, each foot's landing frames (landing_frames).
@@ -404,11 +441,13 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
   const bool running_cop = co.foot_model == FootModel::Cop && co.running_cop;
   // The flight phases: for the running COP function, for the speed gate where its floor near a
   // flight differs from its gate elsewhere (SpeedGateRule::floor_mps), and for the lateral force:
-  // its torso lag, which they do not take (EstimateOptions::lateral_torso_lag), and the least
-  // squares of a landing's bilateral stance (EstimateOptions::lateral_least_squares).
+  // its torso lag, which they do not take (EstimateOptions::lateral_torso_lag), the least
+  // squares of a landing's bilateral stance (EstimateOptions::lateral_least_squares), and the
+  // thighs' lag, which a trial with flight phases does not take (lag_thigh_stage).
   const SpeedGateRule& gate = co.speed_gate;
   const bool lateral = o.lateral_force() && ((o.lateral_torso_lag && o.torso_lag_s > 0) || o.lateral_least_squares);
-  if (running_cop || lateral || (gate.ratio > 0 && gate.floor_mps != gate.standstill_mps) || o.touchdown_stop_fraction > 0)
+  if (running_cop || lateral || (gate.ratio > 0 && gate.floor_mps != gate.standstill_mps) || o.touchdown_stop_fraction > 0 ||
+      o.thigh_lag_s > 0)
     plan.near_flight = flight_frames(model, motion, soles);
   if (running_cop) {
     plan.running = plan.near_flight;
@@ -631,13 +670,16 @@ struct DynamicsPass {
   double torso_lag_added_s = 0;  ///< the upper body's delay lag_torso_stage added (the lateral force takes it too)
 };
 DynamicsPass dynamics_pass(const EstimateOptions& o, const Model& model, const ContactCalibration& soles, bool treadmill,
-                           double hip_speed_mps, ModelMotion& motion, const std::function<void(long, long)>& progress,
-                           const std::string& path, int first_frame_number) {
+                           double hip_speed_mps, const std::array<bool, 2>& knee_on_bone, ModelMotion& motion,
+                           const std::function<void(long, long)>& progress, const std::string& path, int first_frame_number) {
   using clock = std::chrono::steady_clock;
   const auto ta = clock::now();
   DynamicsPass pass;
   Messages lag = lag_torso_stage(o, motion, pass.torso_lag_added_s);
   pass.plan = contact_stage(o, model, soles, treadmill, hip_speed_mps, motion);
+  // The contact plan reads no fore-aft acceleration (the flight test reads the vertical), so the
+  // thighs' lag may follow it and take its flight phases.
+  append(lag, lag_thigh_stage(o, motion, knee_on_bone, pass.plan.near_flight));
   pass.plan.messages.insert(pass.plan.messages.begin(), std::make_move_iterator(lag.begin()), std::make_move_iterator(lag.end()));
   const auto tb = clock::now();
   pass.raw = solve_stage(o, model, pass.plan.calibration, motion, pass.plan, progress, path, first_frame_number);
@@ -1129,7 +1171,8 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   };
   double seconds_kinematics = std::chrono::duration<double>(clock::now() - t0).count();
   const auto pass = [&](ModelMotion& motion, long index) {
-    DynamicsPass p = dynamics_pass(o, *mod.model, mod.soles, sag.frame.treadmill, hip_speed_mps, motion, pass_progress(index), trial.path,
+    DynamicsPass p = dynamics_pass(o, *mod.model, mod.soles, sag.frame.treadmill, hip_speed_mps, sag.knee_on_bone, motion,
+                                   pass_progress(index), trial.path,
                                    sag.first_frame_number);
     seconds_kinematics += p.seconds_kinematics;
     return p;

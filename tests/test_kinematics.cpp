@@ -8,6 +8,7 @@
 #include "kin2grf/dynamics/inverse_dynamics.hpp"
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/load.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
@@ -143,6 +144,36 @@ TEST(Kinematics, TorsoLagDelaysOnlyTheTorsosForeAftAcceleration) {
   const auto a = run({}, none), b = run({}, lagged);
   EXPECT_EQ(a.kinematic_total.col(1), b.kinematic_total.col(1));
   EXPECT_GT((a.kinematic_total.col(0) - b.kinematic_total.col(0)).cwiseAbs().maxCoeff(), 1.0);  // N
+}
+
+// The thigh's fore-aft lag (lag_thigh_fore_aft): that side's thigh COM fore-aft acceleration
+// becomes the chain's own, delayed whole (a delay: the series shifted by tau), and nothing else
+// of the frame moves: the other thigh, the torso, the vertical and angular accelerations, q, qd.
+TEST(Kinematics, ThighLagDelaysOnlyThatThighsForeAftAcceleration) {
+  SyntheticWalkOptions wo;
+  const SyntheticWalk w = make_synthetic_walk(wo);
+  const auto r = estimate(w.trial, nullptr, *find_marker_set("kin2grf-example"), {});
+  const ModelMotion base = compute_motion(r.model(), r.landmarks, 6.0);
+  ASSERT_EQ(base.rate_hz, 100.0);
+  ModelMotion lagged = base;
+  lag_thigh_fore_aft(lagged, 1, 0.02);  // the left thigh, 2 frames
+  EXPECT_TRUE(lagged.thigh_ax_mps2[0].size() == 0);
+  const int left = coord::com_x(segment(1, kThigh));
+  double swing = 0;
+  for (Eigen::Index i = 2; i < base.frames(); ++i) {
+    const MotionFrame a = lagged.frame(i), b = base.frame(i), early = base.frame(i - 2);
+    ASSERT_NEAR(a.qdd(left), early.qdd(left), 1e-9) << i;
+    swing = std::max(swing, std::abs(b.qdd(left) - early.qdd(left)));
+    Eigen::VectorXd others = a.qdd - b.qdd;
+    others(left) = 0.0;
+    ASSERT_EQ(others.cwiseAbs().maxCoeff(), 0.0) << i;
+    ASSERT_EQ(a.q, b.q) << i;
+    ASSERT_EQ(a.qd, b.qd) << i;
+  }
+  EXPECT_GT(swing, 0.5);  // m/s^2: a swinging thigh's acceleration changes within 20 ms
+  ModelMotion same = base;
+  lag_thigh_fore_aft(same, 0, 0.0);
+  EXPECT_TRUE(same.thigh_ax_mps2[0].size() == 0);
 }
 
 // How late the trunk already follows the hip (measured_torso_lag_s): a HAT whose fore-aft

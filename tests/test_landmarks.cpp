@@ -784,3 +784,20 @@ TEST(MarkerLabels, ALabelOfAnyShapeIsReadWithoutGuessing) {
   }
   EXPECT_EQ(read_marker_label("R.KNE.").landmark, "knee_lateral");  // trailing separators are separators
 }
+
+// Which presets' knee points follow the bone (the thigh lag's condition, EstimateOptions::
+// thigh_lag_s): a marker on an epicondyle, or a joint centre made of markers, does; a point a thigh
+// cluster carries (static calibration, a functional centre) does not.
+TEST(Landmarks, AKneePointFollowsTheBoneUnlessAClusterCarriesIt) {
+  for (const char* name : {"plug-in-gait", "plug-in-gait-lower", "camargo2021", "rajagopal2016-walk", "opencap-lab", "fullbody-2009",
+                           "kin2grf-example"}) {
+    const MarkerSet* set = find_marker_set(name);
+    ASSERT_NE(set, nullptr) << name;
+    for (int side = 0; side < 2; ++side) EXPECT_TRUE(follows_the_bone(set->rules[landmark(side, kKnee)].kind)) << name;
+  }
+  for (const char* name : {"opensim-gait2354", "rajagopal2016-run", "fukuchi2017-running", "uwa-fullbody"}) {
+    const MarkerSet* set = find_marker_set(name);
+    ASSERT_NE(set, nullptr) << name;
+    for (int side = 0; side < 2; ++side) EXPECT_FALSE(follows_the_bone(set->rules[landmark(side, kKnee)].kind)) << name;
+  }
+}

@@ -397,6 +397,48 @@ TEST(Estimate, AModelTorsoSwaysAsARunnersInATrialWithFlightPhases) {
   same(make_example_walk({}), *model_torso);
 }
 
+// The thighs' fore-aft lag (EstimateOptions::thigh_lag_s) in a walk whose knee points are markers
+// on the bone (the example set's KJC): the whole body's fore-aft inertial force changes by exactly
+// each thigh's m (a(t - tau) - a(t)), its vertical force not at all, the feet's forces follow, and
+// the message says so. A trial with flight phases (a jump) keeps the thighs' timing, bit for bit.
+TEST(Estimate, AThighOnTheBoneBrakesLateInAWalkButNotInAJump) {
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  const Trial walk = make_example_walk({});
+  EstimateOptions none, lagged;
+  none.keep_all_series = lagged.keep_all_series = true;
+  none.thigh_lag_s = 0.0;
+  lagged.thigh_lag_s = 0.02;
+  const EstimateResult a = estimate(walk, nullptr, set, none), b = estimate(walk, nullptr, set, lagged);
+  ASSERT_EQ(a.motion.rate_hz, 100.0);
+  EXPECT_EQ(a.kinematic_total.col(1), b.kinematic_total.col(1));
+  double swing = 0;
+  for (Eigen::Index i = 2; i < a.motion.frames(); ++i) {
+    double expected = 0;
+    for (int side = 0; side < 2; ++side) {
+      const int c = coord::com_x(segment(side, kThigh));
+      expected += a.model().bodies[static_cast<std::size_t>(segment(side, kThigh))].mass_kg * (a.motion.frame(i - 2).qdd(c) - a.motion.frame(i).qdd(c));
+    }
+    ASSERT_NEAR(b.kinematic_total(i, 0) - a.kinematic_total(i, 0), expected, 1e-6) << i;
+    swing = std::max(swing, std::abs(expected));
+  }
+  EXPECT_GT(swing, 5.0);  // N: a thigh's braking moved by 20 ms
+  double moved = 0;
+  for (int f = 0; f < 2; ++f) moved = std::max(moved, (a.feet[f].force_N - b.feet[f].force_N).cwiseAbs().maxCoeff());
+  EXPECT_GT(moved, 2.0);
+  const auto said = [](const EstimateResult& e, const char* what) {
+    return std::any_of(e.messages.begin(), e.messages.end(), [what](const std::string& m) { return m.find(what) != std::string::npos; });
+  };
+  EXPECT_TRUE(said(b, "each thigh's fore-aft inertial force delayed by 20 ms"));
+  EXPECT_FALSE(said(a, "thigh lag"));
+  SyntheticOptions so;
+  so.squat_depth = 0.0;
+  so.flight_height_m = 0.3;
+  const Trial jump = make_synthetic_trial(so);
+  const EstimateResult c = estimate(jump, nullptr, set, none), d = estimate(jump, nullptr, set, lagged);
+  for (int f = 0; f < 2; ++f) EXPECT_EQ(c.feet[f].force_N, d.feet[f].force_N) << side_name(f);
+  EXPECT_TRUE(said(d, "thigh lag: none, the trial has flight phases"));
+}
+
 TEST(Estimate, ThePostFilterFollowsTheStanceDuration) {
   // A slow and a brisk synthetic walk: each post-filter cut-off is 4 cycles over its own median
   // stance, close to the walk's stance by construction, so the brisk walk's is higher in

@@ -431,6 +431,12 @@ TEST(SharedValidate, APlateClockShiftedBy40msIsFoundOnARecordedWalk) {
   ASSERT_TRUE(v0.sync.has_value());
   EXPECT_LT(std::abs(v0.sync->offset_s), 0.006);  // the file's own clocks agree
   const double recorded = mean_rrmse(v0.stances).vertical;
+  // Aligned, the shifted plates score as the recorded ones aligned by the same rule (the file's
+  // own few ms included: a stance's window moves by a frame with them, and its first or last
+  // frame, where the estimate and the plate part, weighs in the rRMSE).
+  ValidationOptions automatic;
+  automatic.sync = ValidationOptions::Sync::Auto;
+  const double recorded_aligned = mean_rrmse(validate(e, *t.plates, automatic).stances).vertical;
   for (double shift : {0.04, -0.04}) {
     ForcePlateRecording plates = *t.plates;
     plates.time_s.array() += shift;
@@ -441,7 +447,7 @@ TEST(SharedValidate, APlateClockShiftedBy40msIsFoundOnARecordedWalk) {
     o.sync = ValidationOptions::Sync::Auto;
     const auto aligned = validate(e, plates, o);
     ASSERT_FALSE(aligned.stances.empty()) << shift;
-    EXPECT_NEAR(mean_rrmse(aligned.stances).vertical, recorded, 0.5) << shift;
+    EXPECT_NEAR(mean_rrmse(aligned.stances).vertical, recorded_aligned, 0.5) << shift;
     // As recorded (the default), the shifted plates score worse or lose the stance to the window.
     if (!v.stances.empty()) {
       EXPECT_GT(mean_rrmse(v.stances).vertical, recorded + 2.0) << shift;

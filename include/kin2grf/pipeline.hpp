@@ -74,6 +74,14 @@ struct EstimateOptions {
   /// acceleration is delayed (lag_torso_fore_aft) by this time less what the trunk
   /// markers already lag the hip by (measured_torso_lag_s), never below 0. 0: none (the paper).
   double torso_lag_s = 0.03;
+  /// Each thigh's fore-aft lag behind its femur, s (kin2grf): the thigh COM's fore-aft
+  /// acceleration is delayed (lag_thigh_fore_aft) by this time where the thigh's knee point is a
+  /// marker on the bone (a marker or the mean of markers: the epicondyles, a joint centre of
+  /// them); a knee point that a thigh cluster carries (static calibration, functional centre)
+  /// moves with the thigh's skin and soft tissue, which already lag the bone, and is not delayed.
+  /// A trial with flight phases (a run, a jump) keeps the thighs' timing (lag_thigh_stage). 0:
+  /// none (the paper). 20 ms: chosen leave-one-lab-out (`kin2grf study thigh-lag`).
+  double thigh_lag_s = 0.02;
   /// A model torso's fore-aft sway (no trunk markers: the marker set's pelvis_up shoulder rule)
   /// in a trial with flight phases (flight_frames: a run, a jump), as a fraction of the hip
   /// centre's fore-aft oscillation (kin2grf): the runner's measured kTrunkSwayGainRunning instead

@@ -167,6 +167,8 @@ void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
   }
   if (torso_ax_mps2.size() > i) f.qdd(coord::com_x(kTorso)) = torso_ax_mps2[i];
   for (int s = 0; s < 2; ++s)
+    if (const Eigen::VectorXd& a = thigh_ax_mps2[static_cast<std::size_t>(s)]; a.size() > i) f.qdd(coord::com_x(segment(s, kThigh))) = a[i];
+  for (int s = 0; s < 2; ++s)
     f.cop_foot_angle_rad[static_cast<std::size_t>(s)] =
         cop_foot_angle_rad.rows() > i ? cop_foot_angle_rad(i, s) : std::numeric_limits<double>::quiet_NaN();
   // D* (Sect. 2.3) is the contact stage's: contact_frame fills it in as the frame is solved.
@@ -230,24 +232,49 @@ ModelMotion compute_motion(std::shared_ptr<const Model> model, const SagittalLan
   return motion_from_coordinates(std::move(model), model_coordinates(lm, torso), lm.rate_hz, lm.time_s, cutoff_hz, cop_angle_cutoff_hz);
 }
 
-void lag_torso_fore_aft(ModelMotion& m, double tau_s) {
-  if (!(tau_s > 0) || m.frames() == 0) return;
-  Eigen::VectorXd& ax = m.torso_ax_mps2;
-  const Eigen::Index n = ax.size();
-  // Frame i takes the acceleration of (fractional) frame i - d, linearly interpolated; frames
-  // before the trial's first take its first. Backwards, so that each frame reads only the
-  // earlier ones, not yet overwritten.
-  const double d = tau_s * m.rate_hz;
+namespace {
+/// `a` delayed in place by `d` frames: frame i takes (fractional) frame i - d, linearly
+/// interpolated; frames before the trial's first take its first. Backwards, so that each frame
+/// reads only the earlier ones, not yet overwritten.
+void delay_in_place(Eigen::VectorXd& a, double d) {
+  const Eigen::Index n = a.size();
   for (Eigen::Index i = n - 1; i >= 0; --i) {
     const double t = static_cast<double>(i) - d;
     if (t <= 0) {
-      ax[i] = ax[0];
+      a[i] = a[0];
       continue;
     }
     const auto i0 = static_cast<Eigen::Index>(t);  // t < i: i0 + 1 <= i
     const double f = t - static_cast<double>(i0);
-    ax[i] = (1 - f) * ax[i0] + f * ax[i0 + 1];
+    a[i] = (1 - f) * a[i0] + f * a[i0 + 1];
   }
+}
+}  // namespace
+
+void lag_torso_fore_aft(ModelMotion& m, double tau_s) {
+  if (!(tau_s > 0) || m.frames() == 0) return;
+  delay_in_place(m.torso_ax_mps2, tau_s * m.rate_hz);
+}
+
+void lag_thigh_fore_aft(ModelMotion& m, int side, double tau_s) {
+  if (!(tau_s > 0) || m.frames() == 0 || (side != 0 && side != 1)) return;
+  const Eigen::Index n = m.frames();
+  // The thigh COM's fore-aft acceleration as frame() places it: the hip's, with the thigh's
+  // absolute angle (the torso's plus the hip joint's) and its fixed COM offset.
+  const int thigh = segment(side, kThigh), hip_joint = 4 * side;
+  const Eigen::Vector2d& rho = m.model->bodies[static_cast<std::size_t>(thigh)].com_local;
+  Eigen::VectorXd ax(n);
+  std::array<double, kMaxIndependent> d1{}, d2{};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    m.derivatives_at(i, d1.data(), d2.data());
+    const PointKinematics hip{Eigen::Vector2d(m.x(i, 0), m.x(i, 1)), Eigen::Vector2d(d1[0], d1[1]), Eigen::Vector2d(d2[0], d2[1])};
+    const int c = 3 + hip_joint;
+    ax[i] = place(hip, m.x(i, 2) + m.x(i, c), d1[2] + d1[static_cast<std::size_t>(c)], d2[2] + d2[static_cast<std::size_t>(c)], rho, 1.0,
+                  0.0, 0.0)
+                .a.x();
+  }
+  delay_in_place(ax, tau_s * m.rate_hz);
+  m.thigh_ax_mps2[static_cast<std::size_t>(side)] = std::move(ax);
 }
 
 double measured_torso_lag_s(const ModelMotion& m) {

@@ -80,6 +80,9 @@ struct ModelMotion {
   /// same numbers either way, bit for bit.
   Eigen::MatrixXd xd, xdd;
   Eigen::VectorXd torso_ax_mps2;       ///< N: the HAT COM's fore-aft acceleration (lag_torso_fore_aft)
+  /// Per side (right, left): the thigh COM's fore-aft acceleration as lag_thigh_fore_aft delays
+  /// it (N), or empty: the chain's, in frame().
+  std::array<Eigen::VectorXd, 2> thigh_ax_mps2;
   /// N x 2 (right, left), or empty: the feet's absolute angles (rad) filtered at the positions'
   /// cut-off, for the COP function, when the dynamics take a higher one (compute_motion's
   /// cop_angle_cutoff_hz). The COP function maps an angle to a place: a position, whose noise
@@ -148,6 +151,18 @@ inline ModelMotion compute_motion(const Model& model, const SagittalLandmarks& l
 /// vertical and angular accelerations and every other segment are unchanged (torso_ax_mps2 is
 /// the one series it writes). tau_s = 0 leaves the motion as it is (the paper).
 void lag_torso_fore_aft(ModelMotion& m, double tau_s);
+
+/// The thigh's fore-aft lag (kin2grf, not in the paper; EstimateOptions::thigh_lag_s). A thigh is
+/// mostly muscle and fat on the femur (the bone is a sixth of its mass), a wobbling mass: at a
+/// heel strike the femur stops, its soft tissue follows late, and the ground sees the thigh's
+/// braking late. With the skeleton's timing (knee markers on the bone) the model's braking leads
+/// the plates in double support, after the torso's lag, and load moves to the landing foot early
+/// (docs/METHOD-NOTES.md). The thigh COM's fore-aft acceleration (its m a_x in paper Eq. 5) is
+/// replaced by itself delayed by tau, as lag_torso_fore_aft does the HAT's:
+///   a(t) = a_x(t - tau), linearly interpolated between frames; a_x(0) before the first frame.
+/// Into m.thigh_ax_mps2[side] (0 right, 1 left); every other acceleration is unchanged.
+/// tau_s = 0 leaves the motion as it is.
+void lag_thigh_fore_aft(ModelMotion& m, int side, double tau_s);
 
 /// How late the HAT COM's fore-aft acceleration already follows the hip's in `m`, s: the lag of
 /// the peak of their cross-correlation within +-80 ms over the middle 80 % of the frames (at most

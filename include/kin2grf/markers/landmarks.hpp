@@ -53,6 +53,11 @@ enum class RuleKind { Marker, Mean, Harrington, Static, Functional, PelvisUp, Vi
 /// The mapping file's name of a rule kind ("marker", "mean", "harrington", "static", "functional",
 /// "pelvis_up", "virtual_hallux").
 const char* rule_kind_name(RuleKind kind);
+/// The landmark follows the bone: a marker, or the mean of markers, placed on the skin over it
+/// (an epicondyle, a malleolus) or a joint centre made of such markers. Not a point a cluster
+/// carries (static calibration, a functional centre): a cluster rides on a segment's skin and
+/// soft tissue, which move late against the bone (EstimateOptions::thigh_lag_s).
+constexpr bool follows_the_bone(RuleKind kind) { return kind == RuleKind::Marker || kind == RuleKind::Mean; }
 
 struct LandmarkRule {
   RuleKind kind = RuleKind::Marker;
