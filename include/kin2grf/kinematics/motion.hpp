@@ -153,7 +153,7 @@ inline ModelMotion compute_motion(const Model& model, const SagittalLandmarks& l
 void lag_torso_fore_aft(ModelMotion& m, double tau_s);
 
 /// The thigh's fore-aft lag (kin2grf, not in the paper; EstimateOptions::thigh_lag_s). A thigh is
-/// mostly muscle and fat on the femur (the bone is a sixth of its mass), a wobbling mass: at a
+/// mostly muscle and fat around the femur, a wobbling mass (Gruber et al. 1998): at a
 /// heel strike the femur stops, its soft tissue follows late, and the ground sees the thigh's
 /// braking late. With the skeleton's timing (knee markers on the bone) the model's braking leads
 /// the plates in double support, after the torso's lag, and load moves to the landing foot early
