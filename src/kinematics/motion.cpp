@@ -36,6 +36,31 @@ std::array<double, 3> torso_scale(const ModelMotion& m, Eigen::Index i, const do
 /// The most independent coordinates a motion has (the torso's length as the 12th).
 constexpr Eigen::Index kMaxIndependent = 12;
 
+/// The fore-aft acceleration of a segment's COM hanging from the hip (the torso or a thigh) as
+/// frame() places it, every frame: the hip's, with the segment's absolute angle (a thigh's the
+/// torso's plus its hip joint's) and its COM offset (the torso's scaled with its length). The
+/// series the torso and thigh lags delay.
+Eigen::VectorXd chain_com_fore_aft_mps2(const ModelMotion& m, int segment_index) {
+  const Eigen::Index n = m.frames();
+  const bool torso = segment_index == kTorso;
+  const int hip_column = torso ? -1 : 3 + 4 * (segment_index == segment(0, kThigh) ? 0 : 1);  // the hip joint's angle
+  const Eigen::Vector2d& rho = m.model->bodies[static_cast<std::size_t>(segment_index)].com_local;
+  Eigen::VectorXd ax(n);
+  std::array<double, kMaxIndependent> d1{}, d2{};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    m.derivatives_at(i, d1.data(), d2.data());
+    const PointKinematics hip{Eigen::Vector2d(m.x(i, 0), m.x(i, 1)), Eigen::Vector2d(d1[0], d1[1]), Eigen::Vector2d(d2[0], d2[1])};
+    double th = m.x(i, 2), w = d1[2], al = d2[2];
+    if (!torso) {
+      const auto c = static_cast<std::size_t>(hip_column);
+      th += m.x(i, hip_column), w += d1[c], al += d2[c];
+    }
+    const auto [k0, k1, k2] = torso ? torso_scale(m, i, d1.data(), d2.data()) : std::array<double, 3>{1.0, 0.0, 0.0};
+    ax[i] = place(hip, th, w, al, rho, k0, k1, k2).a.x();
+  }
+  return ax;
+}
+
 }  // namespace
 
 BodyGeometry measure_geometry(const SagittalLandmarks& lm) {
@@ -179,7 +204,6 @@ void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
 
 ModelMotion reconstruct_motion(std::shared_ptr<const Model> model, Eigen::MatrixXd x, Eigen::MatrixXd xd, Eigen::MatrixXd xdd,
                                double rate_hz, Eigen::VectorXd time_s) {
-  const Eigen::Index n = x.rows();
   ModelMotion mm;
   mm.rate_hz = rate_hz;
   mm.time_s = std::move(time_s);
@@ -187,18 +211,8 @@ ModelMotion reconstruct_motion(std::shared_ptr<const Model> model, Eigen::Matrix
   mm.x = std::move(x);
   mm.xd = std::move(xd);
   mm.xdd = std::move(xdd);
-  // The HAT COM's fore-aft acceleration as the chain gives it (as frame() places it), the series
-  // the torso lag delays.
-  Eigen::VectorXd ax(n);
-  const Eigen::Vector2d& rho = mm.model->bodies[kTorso].com_local;
-  std::array<double, kMaxIndependent> d1{}, d2{};
-  for (Eigen::Index i = 0; i < n; ++i) {
-    mm.derivatives_at(i, d1.data(), d2.data());
-    const PointKinematics hip{Eigen::Vector2d(mm.x(i, 0), mm.x(i, 1)), Eigen::Vector2d(d1[0], d1[1]), Eigen::Vector2d(d2[0], d2[1])};
-    const auto [k0, k1, k2] = torso_scale(mm, i, d1.data(), d2.data());
-    ax[i] = place(hip, mm.x(i, 2), d1[2], d2[2], rho, k0, k1, k2).a.x();
-  }
-  mm.torso_ax_mps2 = std::move(ax);
+  // The HAT COM's fore-aft acceleration as the chain gives it, the series the torso lag delays.
+  mm.torso_ax_mps2 = chain_com_fore_aft_mps2(mm, kTorso);
   return mm;
 }
 
@@ -258,21 +272,7 @@ void lag_torso_fore_aft(ModelMotion& m, double tau_s) {
 
 void lag_thigh_fore_aft(ModelMotion& m, int side, double tau_s) {
   if (!(tau_s > 0) || m.frames() == 0 || (side != 0 && side != 1)) return;
-  const Eigen::Index n = m.frames();
-  // The thigh COM's fore-aft acceleration as frame() places it: the hip's, with the thigh's
-  // absolute angle (the torso's plus the hip joint's) and its fixed COM offset.
-  const int thigh = segment(side, kThigh), hip_joint = 4 * side;
-  const Eigen::Vector2d& rho = m.model->bodies[static_cast<std::size_t>(thigh)].com_local;
-  Eigen::VectorXd ax(n);
-  std::array<double, kMaxIndependent> d1{}, d2{};
-  for (Eigen::Index i = 0; i < n; ++i) {
-    m.derivatives_at(i, d1.data(), d2.data());
-    const PointKinematics hip{Eigen::Vector2d(m.x(i, 0), m.x(i, 1)), Eigen::Vector2d(d1[0], d1[1]), Eigen::Vector2d(d2[0], d2[1])};
-    const int c = 3 + hip_joint;
-    ax[i] = place(hip, m.x(i, 2) + m.x(i, c), d1[2] + d1[static_cast<std::size_t>(c)], d2[2] + d2[static_cast<std::size_t>(c)], rho, 1.0,
-                  0.0, 0.0)
-                .a.x();
-  }
+  Eigen::VectorXd ax = chain_com_fore_aft_mps2(m, segment(side, kThigh));
   delay_in_place(ax, tau_s * m.rate_hz);
   m.thigh_ax_mps2[static_cast<std::size_t>(side)] = std::move(ax);
 }

@@ -806,15 +806,14 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
     ++mm.n;
   }
   mean_joint_moments(stances, foot, mm);
-  double cop_lateral_sum = 0;
-  for (double x : cop_lateral_rmse) cop_lateral_sum += x;
-  mm.cop_lateral_rmse_mm = cop_lateral_rmse.empty() ? kNaN : cop_lateral_sum / static_cast<double>(cop_lateral_rmse.size());
-  double onset_sum = 0;
-  for (double x : onset_abs) onset_sum += x;
-  mm.onset_abs_ms = onset_abs.empty() ? kNaN : onset_sum / static_cast<double>(onset_abs.size());
-  double lateral_sum = 0;
-  for (double x : lateral_rmse) lateral_sum += x;
-  mm.lateral_rmse_percent_bw = lateral_rmse.empty() ? kNaN : lateral_sum / static_cast<double>(lateral_rmse.size());
+  const auto mean_of = [](const std::vector<double>& x) {
+    double sum = 0;
+    for (double a : x) sum += a;
+    return x.empty() ? kNaN : sum / static_cast<double>(x.size());
+  };
+  mm.cop_lateral_rmse_mm = mean_of(cop_lateral_rmse);
+  mm.onset_abs_ms = mean_of(onset_abs);
+  mm.lateral_rmse_percent_bw = mean_of(lateral_rmse);
   std::array<double*, 5> mean = {&mm.vertical, &mm.anterior, &mm.cop, &mm.moment, &mm.lateral};
   std::array<double*, 5> sd = {&mm.vertical_sd, &mm.anterior_sd, &mm.cop_sd, &mm.moment_sd, &mm.lateral_sd};
   for (std::size_t k = 0; k < 5; ++k) {
@@ -823,9 +822,7 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
       *mean[k] = *sd[k] = kNaN;
       continue;
     }
-    double s = 0;
-    for (double a : x) s += a;
-    *mean[k] = s / static_cast<double>(x.size());
+    *mean[k] = mean_of(x);
     double ss = 0;
     for (double a : x) ss += (a - *mean[k]) * (a - *mean[k]);
     *sd[k] = x.size() > 1 ? std::sqrt(ss / static_cast<double>(x.size() - 1)) : 0.0;
