@@ -47,6 +47,10 @@ const std::vector<NumericOption>& numeric_options() {
        "Each thigh's fore-aft lag behind its femur, s: the thigh's fore-aft inertial force is delayed by this time where its knee "
        "point is a marker on the bone (not where a thigh cluster carries it; 0 = none, the paper)",
        {0.0, 0.01, 0.015, 0.02, 0.025, 0.03, 0.04}, "%.0f ms", 1000.0, "off"},
+      {"torso-vertical-cutoff", "torso_vertical_cutoff_hz", [](O& o) -> double& { return o.torso_vertical_cutoff_hz; }, 0.0, 100.0, 0.0,
+       "The HAT's vertical inertial force is low-passed at this cut-off, Hz (the upper body does not pass on the pelvis markers' "
+       "heel-strike jolt), in a trial without flight phases, below the kinematic cut-off (0 = none, the paper)",
+       {0.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0}, "%.1f Hz", 1.0, "off"},
       // Measured on the run with trunk markers (kTrunkSwayGainRunning), not fitted: only a run
       // without trunk markers (the RBDS runs' lab) feels it, so held out that lab's choice ties.
       {"running-sway-gain", "running_sway_gain", [](O& o) -> double& { return o.running_sway_gain; }, 0.0, 1.5, std::nullopt,

@@ -176,6 +176,35 @@ TEST(Kinematics, ThighLagDelaysOnlyThatThighsForeAftAcceleration) {
   EXPECT_TRUE(same.thigh_ax_mps2[0].size() == 0);
 }
 
+// The upper body's vertical smoothing (smooth_torso_vertical): the HAT COM's vertical
+// acceleration becomes the zero-lag low-pass of the chain's, and nothing else of any frame moves.
+TEST(Kinematics, TorsoVerticalSmoothingLowPassesOnlyTheHatsVerticalAcceleration) {
+  const SyntheticWalk w = make_synthetic_walk({});
+  const auto r = estimate(w.trial, nullptr, *find_marker_set("kin2grf-example"), {});
+  const ModelMotion base = compute_motion(r.model(), r.landmarks, 6.0);
+  ModelMotion smoothed = base;
+  smooth_torso_vertical(smoothed, 2.0);
+  const int hat_y = coord::com_x(kTorso) + 1;
+  Eigen::VectorXd chain(base.frames());
+  for (Eigen::Index i = 0; i < base.frames(); ++i) chain[i] = base.frame(i).qdd(hat_y);
+  const Eigen::VectorXd expected = butterworth_filtfilt(chain, base.rate_hz, 2.0);
+  double moved = 0;
+  for (Eigen::Index i = 0; i < base.frames(); ++i) {
+    const MotionFrame a = smoothed.frame(i), b = base.frame(i);
+    ASSERT_NEAR(a.qdd(hat_y), expected[i], 1e-12) << i;
+    moved = std::max(moved, std::abs(a.qdd(hat_y) - b.qdd(hat_y)));
+    Eigen::VectorXd others = a.qdd - b.qdd;
+    others(hat_y) = 0.0;
+    ASSERT_EQ(others.cwiseAbs().maxCoeff(), 0.0) << i;
+    ASSERT_EQ(a.q, b.q) << i;
+    ASSERT_EQ(a.qd, b.qd) << i;
+  }
+  EXPECT_GT(moved, 0.05);  // m/s^2: the walk's vertical acceleration has content above 2 Hz
+  ModelMotion same = base;
+  smooth_torso_vertical(same, 0.0);
+  EXPECT_EQ(same.torso_ay_mps2.size(), 0);
+}
+
 // How late the trunk already follows the hip (measured_torso_lag_s): a HAT whose fore-aft
 // acceleration is the hip's 20 ms later (a trunk-marker set whose shoulders lag the pelvis) is
 // measured at 20 ms, between frames too; in phase 0, ahead negative; too short a trial 0. The

@@ -82,6 +82,13 @@ struct EstimateOptions {
   /// A trial with flight phases (a run, a jump) keeps the thighs' timing (lag_thigh_stage). 0:
   /// none (the paper). 20 ms: chosen leave-one-lab-out (`kin2grf study thigh-lag`).
   double thigh_lag_s = 0.02;
+  /// The upper body's vertical smoothing, Hz (kin2grf): the HAT COM's vertical acceleration is
+  /// low-passed at this cut-off (smooth_torso_vertical), since the pelvis markers carry the heel
+  /// strike's jolt that the upper body's mass does not pass on. A trial with flight phases (a
+  /// run, a jump), whose vertical force is a pulse with real content above it, keeps the chain's
+  /// (smooth_torso_vertical_stage). Only below the dynamics' kinematic cut-off. 0: none (the
+  /// paper). 4 Hz: chosen leave-one-lab-out (`kin2grf study torso-vertical-cutoff`).
+  double torso_vertical_cutoff_hz = 4.0;
   /// A model torso's fore-aft sway (no trunk markers: the marker set's pelvis_up shoulder rule)
   /// in a trial with flight phases (flight_frames: a run, a jump), as a fraction of the hip
   /// centre's fore-aft oscillation (kin2grf): the runner's measured kTrunkSwayGainRunning instead

@@ -36,11 +36,11 @@ std::array<double, 3> torso_scale(const ModelMotion& m, Eigen::Index i, const do
 /// The most independent coordinates a motion has (the torso's length as the 12th).
 constexpr Eigen::Index kMaxIndependent = 12;
 
-/// The fore-aft acceleration of a segment's COM hanging from the hip (the torso or a thigh) as
+/// The acceleration along `axis` (0 fore-aft, 1 vertical) of a segment's COM hanging from the hip (the torso or a thigh) as
 /// frame() places it, every frame: the hip's, with the segment's absolute angle (a thigh's the
 /// torso's plus its hip joint's) and its COM offset (the torso's scaled with its length). The
-/// series the torso and thigh lags delay.
-Eigen::VectorXd chain_com_fore_aft_mps2(const ModelMotion& m, int segment_index) {
+/// series the torso and thigh lags delay and the torso's vertical smoothing filters.
+Eigen::VectorXd chain_com_acceleration_mps2(const ModelMotion& m, int segment_index, int axis) {
   const Eigen::Index n = m.frames();
   const bool torso = segment_index == kTorso;
   const int hip_column = torso ? -1 : 3 + 4 * (segment_index == segment(0, kThigh) ? 0 : 1);  // the hip joint's angle
@@ -56,7 +56,7 @@ Eigen::VectorXd chain_com_fore_aft_mps2(const ModelMotion& m, int segment_index)
       th += m.x(i, hip_column), w += d1[c], al += d2[c];
     }
     const auto [k0, k1, k2] = torso ? torso_scale(m, i, d1.data(), d2.data()) : std::array<double, 3>{1.0, 0.0, 0.0};
-    ax[i] = place(hip, th, w, al, rho, k0, k1, k2).a.x();
+    ax[i] = place(hip, th, w, al, rho, k0, k1, k2).a[axis];
   }
   return ax;
 }
@@ -191,6 +191,7 @@ void ModelMotion::frame(Eigen::Index i, MotionFrame& f) const {
     f.qdd(coord::phi(j)) = d2[static_cast<std::size_t>(3 + j)];
   }
   if (torso_ax_mps2.size() > i) f.qdd(coord::com_x(kTorso)) = torso_ax_mps2[i];
+  if (torso_ay_mps2.size() > i) f.qdd(coord::com_x(kTorso) + 1) = torso_ay_mps2[i];
   for (int s = 0; s < 2; ++s)
     if (const Eigen::VectorXd& a = thigh_ax_mps2[static_cast<std::size_t>(s)]; a.size() > i) f.qdd(coord::com_x(segment(s, kThigh))) = a[i];
   for (int s = 0; s < 2; ++s)
@@ -212,7 +213,7 @@ ModelMotion reconstruct_motion(std::shared_ptr<const Model> model, Eigen::Matrix
   mm.xd = std::move(xd);
   mm.xdd = std::move(xdd);
   // The HAT COM's fore-aft acceleration as the chain gives it, the series the torso lag delays.
-  mm.torso_ax_mps2 = chain_com_fore_aft_mps2(mm, kTorso);
+  mm.torso_ax_mps2 = chain_com_acceleration_mps2(mm, kTorso, 0);
   return mm;
 }
 
@@ -272,9 +273,14 @@ void lag_torso_fore_aft(ModelMotion& m, double tau_s) {
 
 void lag_thigh_fore_aft(ModelMotion& m, int side, double tau_s) {
   if (!(tau_s > 0) || m.frames() == 0 || (side != 0 && side != 1)) return;
-  Eigen::VectorXd ax = chain_com_fore_aft_mps2(m, segment(side, kThigh));
+  Eigen::VectorXd ax = chain_com_acceleration_mps2(m, segment(side, kThigh), 0);
   delay_in_place(ax, tau_s * m.rate_hz);
   m.thigh_ax_mps2[static_cast<std::size_t>(side)] = std::move(ax);
+}
+
+void smooth_torso_vertical(ModelMotion& m, double cutoff_hz) {
+  if (!(cutoff_hz > 0) || m.frames() == 0) return;
+  m.torso_ay_mps2 = butterworth_filtfilt(chain_com_acceleration_mps2(m, kTorso, 1), m.rate_hz, cutoff_hz);
 }
 
 double measured_torso_lag_s(const ModelMotion& m) {

@@ -83,6 +83,9 @@ struct ModelMotion {
   /// Per side (right, left): the thigh COM's fore-aft acceleration as lag_thigh_fore_aft delays
   /// it (N), or empty: the chain's, in frame().
   std::array<Eigen::VectorXd, 2> thigh_ax_mps2;
+  /// The HAT COM's vertical acceleration as smooth_torso_vertical low-passes it (N), or empty:
+  /// the chain's, in frame().
+  Eigen::VectorXd torso_ay_mps2;
   /// N x 2 (right, left), or empty: the feet's absolute angles (rad) filtered at the positions'
   /// cut-off, for the COP function, when the dynamics take a higher one (compute_motion's
   /// cop_angle_cutoff_hz). The COP function maps an angle to a place: a position, whose noise
@@ -163,6 +166,24 @@ void lag_torso_fore_aft(ModelMotion& m, double tau_s);
 /// Into m.thigh_ax_mps2[side] (0 right, 1 left); every other acceleration is unchanged.
 /// tau_s = 0 leaves the motion as it is.
 void lag_thigh_fore_aft(ModelMotion& m, int side, double tau_s);
+
+/// The upper body's vertical smoothing (kin2grf, not in the paper; EstimateOptions::
+/// torso_vertical_cutoff_hz). The HAT rides on the hip centre, which the pelvis markers place:
+/// skin over the iliac crests, which at each heel strike moves with the soft tissue (the hip
+/// centre's vertical acceleration is 1.1-1.5 x the centre of mass's that the plates imply on the
+/// development walks), while the upper body's mass (viscera, arms, head on a compliant spine)
+/// passes on less of the heel strike's jolt the higher its frequency (gait accelerometry: the
+/// head's vertical acceleration is the pelvis's attenuated, Menz et al. 2003, J Gerontol A
+/// 58:M1034; the standing body's vertical resonance lies at 4-6 Hz, Matsumoto and Griffin 1998,
+/// J Sound Vib 212:85). The walks' plates see the model's vertical inertial force above 3 Hz at
+/// about 0.45 of its size (docs/METHOD-NOTES.md). The HAT COM's vertical acceleration (its m a_y
+/// in paper Eq. 5's M qdd) is replaced by itself low-passed at cutoff_hz (butterworth_filtfilt:
+/// zero-lag, as the walks' vertical timing is right; delaying it was measured worse). A body
+/// property, not a gait one: a fixed frequency, not cycles over the stance, which in a slow walk
+/// would clip the loading peak. Its position, velocity, fore-aft and angular accelerations and
+/// every other segment are unchanged (torso_ay_mps2 is the one series it writes). cutoff_hz <= 0
+/// leaves the motion as it is.
+void smooth_torso_vertical(ModelMotion& m, double cutoff_hz);
 
 /// How late the HAT COM's fore-aft acceleration already follows the hip's in `m`, s: the lag of
 /// the peak of their cross-correlation within +-80 ms over the middle 80 % of the frames (at most
