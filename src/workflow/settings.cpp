@@ -94,7 +94,7 @@ void add_settings_options(CLI::App* c, Settings& a) {
                 "COP function near flight phases (running): builtin (kin2grf's running fit), off, or a JSON file")
       ->capture_default_str();
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
-  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length, no torso or thigh lag");
+  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length, no torso or thigh lag, no vertical smoothing of the torso");
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
   for (const NumericOption& s : numeric_options()) {
     CLI::Option* opt = c->add_option(std::string("--") + s.flag, s.field(a.numeric), s.help)->capture_default_str();
