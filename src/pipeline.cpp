@@ -703,8 +703,8 @@ DynamicsPass dynamics_pass(const EstimateOptions& o, const Model& model, const C
   Messages lag = lag_torso_stage(o, motion, pass.torso_lag_added_s);
   pass.plan = contact_stage(o, model, soles, treadmill, hip_speed_mps, motion);
   // The contact plan reads no fore-aft acceleration, so the thighs' lag may follow it and take its
-  // flight phases. The flight test reads the vertical: it sees the chain's, which the smoothing
-  // below, away from the flights it finds, replaces for the solve.
+  // flight phases. Its flight test reads the vertical, the chain's; the torso's vertical smoothing,
+  // only in a trial where that test finds no flight, then replaces the HAT's for the solve.
   append(lag, lag_thigh_stage(o, motion, knee_on_bone, pass.plan.near_flight));
   append(lag, smooth_torso_vertical_stage(o, motion, kinematic_cutoff_hz, pass.plan.near_flight));
   pass.plan.messages.insert(pass.plan.messages.begin(), std::make_move_iterator(lag.begin()), std::make_move_iterator(lag.end()));

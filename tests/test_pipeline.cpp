@@ -500,6 +500,7 @@ TEST(Estimate, APelvisMarkersHeelStrikeJoltDoesNotReachTheBodysVerticalForce) {
   const Trial jump = make_synthetic_trial(so);
   const EstimateResult d = estimate(jump, nullptr, set, none), e = estimate(jump, nullptr, set, smoothed);
   for (int f = 0; f < 2; ++f) EXPECT_EQ(d.feet[f].force_N, e.feet[f].force_N) << side_name(f);
+  EXPECT_TRUE(said(e, "torso: its vertical inertial force as the markers give it, the trial has flight phases"));
 }
 
 TEST(Estimate, ThePostFilterFollowsTheStanceDuration) {

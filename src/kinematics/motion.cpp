@@ -36,10 +36,11 @@ std::array<double, 3> torso_scale(const ModelMotion& m, Eigen::Index i, const do
 /// The most independent coordinates a motion has (the torso's length as the 12th).
 constexpr Eigen::Index kMaxIndependent = 12;
 
-/// The acceleration along `axis` (0 fore-aft, 1 vertical) of a segment's COM hanging from the hip (the torso or a thigh) as
-/// frame() places it, every frame: the hip's, with the segment's absolute angle (a thigh's the
-/// torso's plus its hip joint's) and its COM offset (the torso's scaled with its length). The
-/// series the torso and thigh lags delay and the torso's vertical smoothing filters.
+/// The acceleration along `axis` (0 fore-aft, 1 vertical) of a segment's COM hanging from the hip
+/// (the torso or a thigh) as frame() places it, every frame: the hip's, with the segment's
+/// absolute angle (a thigh's the torso's plus its hip joint's) and its COM offset (the torso's
+/// scaled with its length). The series the torso and thigh lags delay and the torso's vertical
+/// smoothing filters.
 Eigen::VectorXd chain_com_acceleration_mps2(const ModelMotion& m, int segment_index, int axis) {
   const Eigen::Index n = m.frames();
   const bool torso = segment_index == kTorso;
