@@ -464,16 +464,15 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
   ContactPlan plan;
   const ContactModelOptions& co = o.contact;
   const bool running_cop = co.foot_model == FootModel::Cop && co.running_cop;
-  // The flight phases: for the running COP function, for the speed gate where its floor near a
-  // flight differs from its gate elsewhere (SpeedGateRule::floor_mps), and for the lateral force:
-  // its torso lag, which they do not take (EstimateOptions::lateral_torso_lag), the least
-  // squares of a landing's bilateral stance (EstimateOptions::lateral_least_squares), and the
-  // thighs' lag, which a trial with flight phases does not take (lag_thigh_stage).
+  // The flight phases, always: the running COP function, the speed gate's floor near a flight
+  // (SpeedGateRule::floor_mps), the touchdown rule, the lateral force's torso lag and a landing's
+  // least squares, the thighs' lag and the torso's vertical smoothing all read them, each under
+  // its own option. A list of those options here had to be kept in step with every new reader
+  // (the vertical smoothing, missing from it, would have smoothed a jump with --thigh-lag 0
+  // --running-cop off and the speed gate's floor at its standstill value); with the defaults the
+  // flight test ran anyway.
   const SpeedGateRule& gate = co.speed_gate;
-  const bool lateral = o.lateral_force() && ((o.lateral_torso_lag && o.torso_lag_s > 0) || o.lateral_least_squares);
-  if (running_cop || lateral || (gate.ratio > 0 && gate.floor_mps != gate.standstill_mps) || o.touchdown_stop_fraction > 0 ||
-      o.thigh_lag_s > 0)
-    plan.near_flight = flight_frames(model, motion, soles);
+  plan.near_flight = flight_frames(model, motion, soles);
   if (running_cop) {
     plan.running = plan.near_flight;
     const auto nrun = std::count(plan.running.begin(), plan.running.end(), true);
