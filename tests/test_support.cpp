@@ -1,6 +1,7 @@
 #include "test_support.hpp"
 #include "kin2grf/io/marker_presets.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <cmath>
 #include <cstdlib>
@@ -114,6 +115,10 @@ TrialContacts contact_frames(const Model& model, const ContactCalibration& soles
     contact_frame(model, soles, options, false, out.frames[i], out.contacts[i]);
   }
   return out;
+}
+
+bool said(const EstimateResult& e, const std::string& what) {
+  return std::any_of(e.messages.begin(), e.messages.end(), [&what](const std::string& m) { return m.find(what) != std::string::npos; });
 }
 
 }  // namespace kin2grf::test

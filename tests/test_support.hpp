@@ -25,6 +25,9 @@ std::filesystem::path temp_dir(const std::string& name);
 ::testing::AssertionResult matrices_near(const Eigen::Ref<const Eigen::MatrixXd>& actual,
                                          const Eigen::Ref<const Eigen::MatrixXd>& expected, double tol);
 
+/// Whether any of the estimate's messages contains `what`.
+bool said(const EstimateResult& e, const std::string& what);
+
 /// The synthetic trial's markers are the landmarks themselves (x forward, z up).
 SagittalLandmarks synthetic_landmarks(const Trial& t);
 /// estimate() on a synthetic trial with the example marker set.
