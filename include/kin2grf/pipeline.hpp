@@ -108,8 +108,8 @@ struct EstimateOptions {
   /// longer than half the median stance (standing, shuffling) are left as solved. kin2grf's
   /// default 0.4, chosen leave-one-lab-out (`kin2grf study double-support-sta`; 0.2 until session
   /// 29, when a grid that stopped there for the ground-level sensitivity was widened: a 1 cm
-  /// ground error then costs Rajagopal's walk 0.3 points instead of 0.2, but leaves every walk but
-  /// two below the old default's figure on the true ground).
+  /// ground error then costs Rajagopal's walk 0.3 points instead of 0.2, but leaves each of the
+  /// five walks that gain below its figure at 0.2 on the true ground).
   double double_support_sta_weight = 0.4;
   /// Touchdown from the foot's own motion (kin2grf, issue 29; frames_before_touchdown): a foot
   /// the solve has in contact before its heel or MT head has stopped descending (its descent
