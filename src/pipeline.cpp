@@ -397,11 +397,10 @@ Messages lag_torso_stage(const EstimateOptions& o, ModelMotion& motion, double& 
 /// The thighs' fore-aft lag (lag_thigh_fore_aft) on the sides whose knee point is a marker on
 /// the bone; a knee a thigh cluster carries already moves with the thigh's soft tissue. The
 /// motion is changed in place.
-Messages lag_thigh_stage(const EstimateOptions& o, ModelMotion& motion, const std::array<bool, 2>& knee_on_bone,
-                         const std::vector<bool>& near_flight) {
+Messages lag_thigh_stage(const EstimateOptions& o, ModelMotion& motion, const std::array<bool, 2>& knee_on_bone, bool has_flight) {
   Messages out;
   if (!(o.thigh_lag_s > 0) || !(knee_on_bone[0] || knee_on_bone[1])) return out;
-  if (std::find(near_flight.begin(), near_flight.end(), true) != near_flight.end()) {
+  if (has_flight) {
     out.emplace_back("thigh lag: none, the trial has flight phases (measured on walks; the one landing with knee markers on the bone "
                      "lost with it)");
     return out;
@@ -429,12 +428,11 @@ Messages lag_thigh_stage(const EstimateOptions& o, ModelMotion& motion, const st
 /// with real content above the cut-off (measured: the runs' vertical 4.7 -> 6.1 % and the drop
 /// jump's 13.6 -> 14.9 % with it at 4 Hz), and a trial that has them keeps its timing throughout,
 /// as the thighs' lag does, rather than switching filters mid-trial. The motion is changed in place.
-Messages smooth_torso_vertical_stage(const EstimateOptions& o, ModelMotion& motion, double kinematic_cutoff_hz,
-                                     const std::vector<bool>& near_flight) {
+Messages smooth_torso_vertical_stage(const EstimateOptions& o, ModelMotion& motion, double kinematic_cutoff_hz, bool has_flight) {
   Messages out;
   const double hz = o.torso_vertical_cutoff_hz;
   if (!(hz > 0) || !(hz < kinematic_cutoff_hz)) return out;
-  if (std::find(near_flight.begin(), near_flight.end(), true) != near_flight.end()) {
+  if (has_flight) {
     out.emplace_back("torso: its vertical inertial force as the markers give it, the trial has flight phases (a run's or a "
                      "landing's force has content above the smoothing's cut-off)");
     return out;
@@ -451,7 +449,7 @@ Messages smooth_torso_vertical_stage(const EstimateOptions& o, ModelMotion& moti
 /// velocity, always, on a treadmill, from every frame's contact points; the progression speed and
 /// the speed gate) and, with the touchdown rule, each foot's landing frames (landing_frames).
 struct ContactPlan {
-  std::vector<bool> near_flight;              ///< frames near a flight phase (flight_frames), where it matters
+  std::vector<bool> near_flight;              ///< frames near a flight phase (flight_frames), on every trial
   std::vector<bool> running;                  ///< frames that take the running COP function
   std::array<std::vector<bool>, 2> landing;   ///< per side, frames where the foot is still landing (landing_frames)
   TrialCalibration calibration;
@@ -704,8 +702,10 @@ DynamicsPass dynamics_pass(const EstimateOptions& o, const Model& model, const C
   // The contact plan reads no fore-aft acceleration, so the thighs' lag may follow it and take its
   // flight phases. Its flight test reads the vertical, the chain's; the torso's vertical smoothing,
   // only in a trial where that test finds no flight, then replaces the HAT's for the solve.
-  append(lag, lag_thigh_stage(o, motion, knee_on_bone, pass.plan.near_flight));
-  append(lag, smooth_torso_vertical_stage(o, motion, kinematic_cutoff_hz, pass.plan.near_flight));
+  const auto& flight = pass.plan.near_flight;
+  const bool has_flight = std::find(flight.begin(), flight.end(), true) != flight.end();
+  append(lag, lag_thigh_stage(o, motion, knee_on_bone, has_flight));
+  append(lag, smooth_torso_vertical_stage(o, motion, kinematic_cutoff_hz, has_flight));
   pass.plan.messages.insert(pass.plan.messages.begin(), std::make_move_iterator(lag.begin()), std::make_move_iterator(lag.end()));
   const auto tb = clock::now();
   pass.raw = solve_stage(o, model, pass.plan.calibration, motion, pass.plan, progress, path, first_frame_number);

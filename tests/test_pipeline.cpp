@@ -395,6 +395,22 @@ TEST(Estimate, AModelTorsoSwaysAsARunnersInATrialWithFlightPhases) {
   same(make_example_walk({}), *model_torso);
 }
 
+namespace {
+/// The synthetic jump (a 30 cm flight) estimated with `off` and with `on`, for a rule that does not
+/// act on a trial with flight phases: every foot's force is the same bit for bit, and `on`'s
+/// messages say why (`message`).
+void expect_jump_untouched(const MarkerSet& set, const EstimateOptions& off, const EstimateOptions& on, const std::string& message) {
+  SyntheticOptions so;
+  so.squat_depth = 0.0;
+  so.flight_height_m = 0.3;
+  const Trial jump = make_synthetic_trial(so);
+  SCOPED_TRACE("the jump, for: " + message);
+  const EstimateResult a = estimate(jump, nullptr, set, off), b = estimate(jump, nullptr, set, on);
+  for (int f = 0; f < 2; ++f) EXPECT_EQ(a.feet[f].force_N, b.feet[f].force_N) << side_name(f);
+  EXPECT_TRUE(said(b, message));
+}
+}  // namespace
+
 // The thighs' fore-aft lag (EstimateOptions::thigh_lag_s) in a walk whose knee points are markers
 // on the bone (the example set's KJC): the whole body's fore-aft inertial force changes by exactly
 // each thigh's m (a(t - tau) - a(t)), its vertical force not at all, the feet's forces follow, and
@@ -425,13 +441,7 @@ TEST(Estimate, AThighOnTheBoneBrakesLateInAWalkButNotInAJump) {
   EXPECT_GT(moved, 2.0);
   EXPECT_TRUE(said(b, "each thigh's fore-aft inertial force delayed by 20 ms"));
   EXPECT_FALSE(said(a, "thigh lag"));
-  SyntheticOptions so;
-  so.squat_depth = 0.0;
-  so.flight_height_m = 0.3;
-  const Trial jump = make_synthetic_trial(so);
-  const EstimateResult c = estimate(jump, nullptr, set, none), d = estimate(jump, nullptr, set, lagged);
-  for (int f = 0; f < 2; ++f) EXPECT_EQ(c.feet[f].force_N, d.feet[f].force_N) << side_name(f);
-  EXPECT_TRUE(said(d, "thigh lag: none, the trial has flight phases"));
+  expect_jump_untouched(set, none, lagged, "thigh lag: none, the trial has flight phases");
 }
 
 // The upper body's vertical smoothing (EstimateOptions::torso_vertical_cutoff_hz), the failure
@@ -486,13 +496,7 @@ TEST(Estimate, APelvisMarkersHeelStrikeJoltDoesNotReachTheBodysVerticalForce) {
                 1e-6) << i;
   EXPECT_TRUE(said(b, "torso: its vertical inertial force low-passed at 4.0 Hz"));
   EXPECT_FALSE(said(a, "low-passed"));
-  SyntheticOptions so;
-  so.squat_depth = 0.0;
-  so.flight_height_m = 0.3;
-  const Trial jump = make_synthetic_trial(so);
-  const EstimateResult d = estimate(jump, nullptr, set, none), e = estimate(jump, nullptr, set, smoothed);
-  for (int f = 0; f < 2; ++f) EXPECT_EQ(d.feet[f].force_N, e.feet[f].force_N) << side_name(f);
-  EXPECT_TRUE(said(e, "torso: its vertical inertial force as the markers give it, the trial has flight phases"));
+  expect_jump_untouched(set, none, smoothed, "torso: its vertical inertial force as the markers give it, the trial has flight phases");
   // The flight test does not depend on another rule wanting it: without the thighs' lag, the
   // running COP function and a speed-gate floor of its own near flights (whose options once
   // decided whether it ran) the jump is kept too.
@@ -501,9 +505,7 @@ TEST(Estimate, APelvisMarkersHeelStrikeJoltDoesNotReachTheBodysVerticalForce) {
     eo->contact.running_cop.reset();
     eo->contact.speed_gate.floor_mps = eo->contact.speed_gate.standstill_mps;
   }
-  const EstimateResult g = estimate(jump, nullptr, set, none), h = estimate(jump, nullptr, set, smoothed);
-  for (int f = 0; f < 2; ++f) EXPECT_EQ(g.feet[f].force_N, h.feet[f].force_N) << side_name(f);
-  EXPECT_TRUE(said(h, "the trial has flight phases"));
+  expect_jump_untouched(set, none, smoothed, "the trial has flight phases");
 }
 
 TEST(Estimate, ThePostFilterFollowsTheStanceDuration) {
