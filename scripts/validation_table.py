@@ -86,7 +86,7 @@ print("\nMean (SD) over stances; total GRM: mean (SD) over the trials that have 
 
 cv_kinds = [k for k in ("speed-gate-ratio", "r", "split-distance", "torso-length", "torso-lag", "post-cutoff-cycles", "double-support-sta",
                                 "min-kinematic-cycles", "touchdown-fraction", "touchdown-stop", "post-cutoff-floor", "speed-gate-floor",
-                                "speed-gate-standstill", "running-sway-gain", "thigh-lag", "torso-vertical-cutoff")
+                                "speed-gate-standstill", "running-sway-gain", "thigh-lag", "torso-vertical-cutoff", "double-support-angle")
             if os.path.exists(os.path.join(out, f"cv-{k}.json"))]
 if cv_kinds:
     print("## Leave-one-lab-out (the settings chosen from data)\n")

@@ -64,6 +64,10 @@ const std::vector<NumericOption>& numeric_options() {
        "Weight (0-1) of the smooth transition towards which each walking double support's split between the feet is blended "
        "(0 = none, the paper)",
        {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6}, "%.1f", 1.0, "off"},
+      {"double-support-angle", "double_support_angle", [](O& o) -> double& { return o.double_support_angle; }, 0.0, 1.0, 0.0,
+       "With --double-support-sta: how far each foot's fore-aft force follows its vertical force's new share in a double support "
+       "(1: each foot keeps the solve's force angle; 0 = the fore-aft forces as solved, the paper)",
+       {0.0, 0.25, 0.5, 0.75, 1.0}, "%.2f", 1.0, "off"},
       // Chosen leave-one-lab-out on the mediolateral force (scripts/validate-all.sh's 3d-lc runs,
       // VALIDATION.md's table), not by `kin2grf study`, whose criterion is the sagittal one: no grid here.
       {"lateral-cutoff", "lateral_cutoff_hz", [](O& o) -> double& { return o.lateral_cutoff_hz; }, 0.0, 100.0, std::nullopt,

@@ -141,6 +141,8 @@ void check_options(const EstimateOptions& o) {
           o.running_sway_gain, "between 0 (the shoulders still) and 1.5");
   require(finite(o.double_support_sta_weight) && o.double_support_sta_weight >= 0 && o.double_support_sta_weight <= 1,
           "double-support transition weight", o.double_support_sta_weight, "between 0 (none, the paper) and 1");
+  require(finite(o.double_support_angle) && o.double_support_angle >= 0 && o.double_support_angle <= 1,
+          "double-support force angle share", o.double_support_angle, "between 0 (none, the paper) and 1");
   require(finite(o.touchdown_stop_fraction) && o.touchdown_stop_fraction >= 0 && o.touchdown_stop_fraction <= 1,
           "touchdown stop fraction", o.touchdown_stop_fraction, "between 0 (off, the paper) and 1");
   require(o.grm_reference_m.allFinite(), "GRM reference (m)", o.grm_reference_m.x() + o.grm_reference_m.y(), "finite");
@@ -558,7 +560,8 @@ struct RawSolve {
   std::array<Eigen::MatrixXd, 2> sole_m;           ///< per side, N x 6: A, B, C (x, y)
   // For the double-support transition (EstimateOptions::double_support_sta_weight): the frames
   // where both feet are active, in order, and for each the solve's torque_per_normal (kJointCount
-  // x np, column-major). Only those frames: a long walk holds a fifth of its frames' worth.
+  // x np, column-major), then with EstimateOptions::double_support_angle its torque_per_tangent.
+  // Only those frames: a long walk holds a fifth of its frames' worth.
   std::vector<Eigen::Index> both_feet_frames;
   std::vector<double> both_feet_torque_map;
   std::vector<int> iterations;  ///< semi-smooth Newton iterations per frame
@@ -640,6 +643,7 @@ RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCa
   // Each chunk keeps its own frames' torque maps (for_chunks makes at most thread_count() chunks),
   // joined in chunk order after the loop.
   const bool keep_torque_map = o.double_support_sta_weight > 0;
+  const bool keep_tangent_map = keep_torque_map && o.double_support_angle > 0;
   std::vector<std::pair<std::vector<Eigen::Index>, std::vector<double>>> chunk_maps(
       keep_torque_map ? static_cast<std::size_t>(std::max(1, thread_count())) : 0);
   for_chunks(static_cast<std::size_t>(n), min_chunk_for(10e-6), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
@@ -665,6 +669,8 @@ RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCa
           auto& [frames, values] = chunk_maps[chunk];
           frames.push_back(i);
           values.insert(values.end(), s.torque_per_normal.data(), s.torque_per_normal.data() + s.torque_per_normal.size());
+          if (keep_tangent_map)
+            values.insert(values.end(), s.torque_per_tangent.data(), s.torque_per_tangent.data() + s.torque_per_tangent.size());
         }
       }
       cycled[k] = s.cycled;
@@ -823,8 +829,10 @@ void drop_touchdown_load(const std::vector<std::pair<Eigen::Index, int>>& droppe
 /// vertical force becomes (1 - w) x its share + w x smooth_transition_share(u); each foot's
 /// normal multipliers are scaled to their new total (a foot's COP does not move), the sum is
 /// kept, and the joint torques move with the multipliers (the solve's torque_per_normal, linear
-/// in them). The tangential multipliers are left as solved.
-Messages double_support_transition(double w, const std::array<std::vector<bool>, 2>& contact, double stance_s, double rate_hz,
+/// in them). Each foot's tangential multipliers follow (transition_tangent: scaled by
+/// 1 + `angle` (f - 1), f its normal multipliers' factor; EstimateOptions::double_support_angle,
+/// 0: left as solved), their torques with them (torque_per_tangent).
+Messages double_support_transition(double w, double angle, const std::array<std::vector<bool>, 2>& contact, double stance_s, double rate_hz,
                                    const RawSolve& raw, Eigen::MatrixXd& lamf, Eigen::MatrixXd& joint_torque_Nm) {
   const auto max_frames = static_cast<Eigen::Index>(0.5 * stance_s * rate_hz);
   const int np = static_cast<int>(raw.point_side.size());
@@ -846,11 +854,18 @@ Messages double_support_transition(double w, const std::array<std::vector<bool>,
       // Every frame of a double support has both feet active in the solve (the contact states
       // are the solve's), so it has its map; the test is a guard, not a case.
       if (it == raw.both_feet_frames.end() || *it != k) continue;
-      const double* G = raw.both_feet_torque_map.data() + (it - raw.both_feet_frames.begin()) * kJointCount * np;
+      const Eigen::Index per_frame = (angle > 0 ? 2 : 1) * kJointCount * np;
+      const double* G = raw.both_feet_torque_map.data() + (it - raw.both_feet_frames.begin()) * per_frame;
       for (int j = 0; j < np; ++j) {
-        const double d = (factor[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] - 1) * lamf(k, 2 * j);
+        const double normal = lamf(k, 2 * j);
+        const double d = (factor[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] - 1) * normal;
         lamf(k, 2 * j) += d;
         for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += d * G[j * kJointCount + q];
+        if (angle > 0) {
+          const double dt = transition_tangent(lamf(k, 2 * j + 1), normal, lamf(k, 2 * j), angle) - lamf(k, 2 * j + 1);
+          lamf(k, 2 * j + 1) += dt;
+          for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += dt * G[(np + j) * kJointCount + q];
+        }
       }
     }
   }
@@ -986,7 +1001,8 @@ FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, dou
       if (!raw.active[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) lamf(i, 2 * j) = lamf(i, 2 * j + 1) = 0.0;
   if (o.double_support_sta_weight > 0 && stance)
     append(out.messages,
-           double_support_transition(o.double_support_sta_weight, contact, *stance, rate_hz, raw, lamf, out.joint_torque_Nm));
+           double_support_transition(o.double_support_sta_weight, o.double_support_angle, contact, *stance, rate_hz, raw, lamf,
+                                     out.joint_torque_Nm));
   bool any = false;
   for (int side = 0; side < 2; ++side) {
     out.feet[side] = foot_result(side, contact[static_cast<std::size_t>(side)], lamf, raw);

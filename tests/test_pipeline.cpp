@@ -658,6 +658,7 @@ TEST(Estimate, TheDoubleSupportTransitionMovesOnlyTheSplitAndByItsWeight) {
   EstimateOptions off, on;
   off.double_support_sta_weight = 0.0;
   on.double_support_sta_weight = 0.2;
+  off.double_support_angle = on.double_support_angle = 0.0;  // the vertical split alone (its angle rule: the next test)
   const EstimateResult a = estimate(walk.trial, nullptr, set, off), b = estimate(walk.trial, nullptr, set, on);
   const Eigen::Index n = a.time_s.size();
   ASSERT_EQ(b.time_s.size(), n);
@@ -699,6 +700,63 @@ TEST(Estimate, TheDoubleSupportTransitionMovesOnlyTheSplitAndByItsWeight) {
   EXPECT_GT(moved, 10);
   const bool said = std::any_of(b.messages.begin(), b.messages.end(), [](const std::string& m) { return m.find("double support") != std::string::npos; });
   EXPECT_TRUE(said);
+}
+
+// The transition moves load between the feet; with double_support_angle 1 it does not turn either
+// foot's force: each foot's fore-aft force is scaled with its vertical one, so in every double
+// support frame each foot's force angle is the solve's (the run without the transition), the
+// vertical split is the previous test's, and frames outside a double support are untouched. At
+// 0.5 the fore-aft force moves half as far.
+TEST(Estimate, TheDoubleSupportTransitionKeepsEachFootsForceAngle) {
+  const SyntheticWalk walk = make_synthetic_walk({});
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  EstimateOptions solved, vertical_only, kept, half;
+  solved.double_support_sta_weight = 0.0;
+  vertical_only.double_support_sta_weight = kept.double_support_sta_weight = half.double_support_sta_weight = 0.4;
+  vertical_only.double_support_angle = 0.0;
+  kept.double_support_angle = 1.0;
+  half.double_support_angle = 0.5;
+  const EstimateResult s = estimate(walk.trial, nullptr, set, solved), v = estimate(walk.trial, nullptr, set, vertical_only),
+                       k = estimate(walk.trial, nullptr, set, kept), h = estimate(walk.trial, nullptr, set, half);
+  const Eigen::Index n = s.time_s.size();
+  ASSERT_EQ(k.time_s.size(), n);
+  int turned = 0;
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int f = 0; f < 2; ++f) {
+      const double fy_s = s.feet[f].force_N(i, 1), fx_s = s.feet[f].force_N(i, 0);
+      const double fy_k = k.feet[f].force_N(i, 1), fx_k = k.feet[f].force_N(i, 0);
+      ASSERT_EQ(fy_k, v.feet[f].force_N(i, 1)) << "the vertical split is the transition's, frame " << i;
+      if (v.feet[f].force_N(i, 1) == fy_s) {
+        ASSERT_EQ(fx_k, fx_s) << "a frame the transition left alone, frame " << i;
+        continue;
+      }
+      ASSERT_GT(fy_s, 1.0);
+      // The angle: fx / fy as solved (to rounding).
+      EXPECT_NEAR(fx_k / fy_k, fx_s / fy_s, 1e-9 * std::max(1.0, std::abs(fx_s / fy_s))) << "frame " << i << " foot " << f;
+      // Half the rule: half the change of the fore-aft force.
+      EXPECT_NEAR(h.feet[f].force_N(i, 0) - fx_s, 0.5 * (fx_k - fx_s), 1e-9 * std::max(1.0, std::abs(fx_k))) << "frame " << i;
+      if (std::abs(fx_k - fx_s) > 1.0) {
+        ++turned;
+        // The torques follow the fore-aft multipliers too (the solve's torque_per_tangent).
+        EXPECT_NE(k.joint_torque_Nm.row(i), v.joint_torque_Nm.row(i)) << "frame " << i;
+      }
+    }
+  EXPECT_GT(turned, 10) << "the synthetic walk's double supports move fore-aft force by more than 1 N on a few frames";
+}
+
+// The angle rule's arithmetic, and its guard: a lightly loaded foot whose solved force leans
+// further than any walking foot's friction allows (here 1.5 N fore-aft on 1 N) is not carried onto
+// the 60 N the transition gives it; growing, the fore-aft force stops at the new vertical force
+// (45 degrees) unless the solve's own was larger. Shrinking is never bounded.
+TEST(Estimate, TheTransitionsForeAftForceKeepsTheAngleButNeverLeansPast45Degrees) {
+  EXPECT_DOUBLE_EQ(transition_tangent(-30.0, 300.0, 450.0, 1.0), -45.0);   // the angle kept
+  EXPECT_DOUBLE_EQ(transition_tangent(-30.0, 300.0, 450.0, 0.5), -37.5);   // half the change
+  EXPECT_DOUBLE_EQ(transition_tangent(-30.0, 300.0, 450.0, 0.0), -30.0);   // as solved
+  EXPECT_DOUBLE_EQ(transition_tangent(50.0, 500.0, 300.0, 1.0), 30.0);     // unloading: the angle kept
+  EXPECT_DOUBLE_EQ(transition_tangent(1.5, 1.0, 60.0, 1.0), 60.0);         // capped at the new normal force
+  EXPECT_DOUBLE_EQ(transition_tangent(-1.5, 1.0, 60.0, 1.0), -60.0);
+  EXPECT_DOUBLE_EQ(transition_tangent(80.0, 10.0, 40.0, 1.0), 80.0);       // never below the solve's own
+  EXPECT_DOUBLE_EQ(transition_tangent(5.0, 0.0, 40.0, 1.0), 5.0);          // no normal force to scale by
 }
 
 // The touchdown rule (issue 29) on a walk whose contact the solve begins 40-50 ms before the
@@ -755,6 +813,8 @@ TEST(SharedEstimate, ALandingFootsLoadBeforeItsHeelHasStoppedIsDroppedNotMoved) 
 TEST(Estimate, ADoubleSupportWeightOrStanceFloorOutsideItsRangeIsRefusedNamingTheSetting) {
   expect_refused_naming([](EstimateOptions& o, double v) { o.double_support_sta_weight = v; }, {-0.1, 1.5, std::nan("")},
                         "double-support");
+  expect_refused_naming([](EstimateOptions& o, double v) { o.double_support_angle = v; }, {-0.1, 1.5, std::nan("")},
+                        "double-support force angle");
   expect_refused_naming([](EstimateOptions& o, double v) { o.min_kinematic_cycles = v; }, {-1.0, 25.0, std::nan("")},
                         "kinematic cycles per stance");
 }

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <string>
@@ -111,6 +113,16 @@ struct EstimateOptions {
   /// ground error then costs Rajagopal's walk 0.3 points instead of 0.2, but leaves each of the
   /// five walks that gain below its figure at 0.2 on the true ground).
   double double_support_sta_weight = 0.4;
+  /// With the transition above: how far each foot's fore-aft force follows its vertical force's
+  /// new share (each foot's tangential multipliers scaled by 1 + a (f - 1), f its normal ones'
+  /// factor). 1 (kin2grf's default, session 30): each foot keeps the force angle the solve found
+  /// for it; the transition moves load from one foot to the other, it does not turn either foot's
+  /// force (the landing foot's braking and the trailing foot's push-off grow and shrink with their
+  /// load). 0 (the paper; the transition's rule until session 30): the fore-aft forces as solved,
+  /// so a foot the transition unloads kept its whole solved braking or propulsion, the two feet's
+  /// sum that the kinematics ask for. Measured leave-one-lab-out (`kin2grf study
+  /// double-support-angle`): walking anterior 7.6 -> 7.3 % (docs/METHOD-NOTES.md).
+  double double_support_angle = 1.0;
   /// Touchdown from the foot's own motion (kin2grf, issue 29; frames_before_touchdown): a foot
   /// the solve has in contact before its heel or MT head has stopped descending (its descent
   /// fallen to this fraction of its recent peak, seen at 15 Hz) carries no load there. The load is
@@ -293,6 +305,19 @@ std::vector<DoubleSupport> walking_double_supports(const std::array<std::vector<
 inline double smooth_transition_share(double u) {
   u = u < 0 ? 0 : u > 1 ? 1 : u;
   return 1 - u * u * (3 - 2 * u);
+}
+
+/// A contact point's tangential multiplier after the double-support transition scaled its normal
+/// one from `normal_N` to `new_normal_N` (EstimateOptions::double_support_angle = `angle`): the
+/// tangential one scaled by 1 + angle (f - 1), f = new_normal_N / normal_N, so at 1 the point's
+/// force angle is kept. Growing, it stops at the new normal force (a 45-degree lean, beyond any
+/// walking foot's friction; a lightly loaded point's solved angle is not trusted further) or at
+/// the solved tangential force, whichever is larger; shrinking needs no bound.
+inline double transition_tangent(double tangent_N, double normal_N, double new_normal_N, double angle) {
+  if (!(normal_N > 0) || angle <= 0) return tangent_N;
+  const double t = tangent_N * (1 + angle * (new_normal_N / normal_N - 1));
+  const double limit = std::max(std::abs(tangent_N), std::abs(new_normal_N));
+  return std::abs(t) <= limit ? t : std::copysign(limit, t);
 }
 
 /// The hip's horizontal speed (m/s), median over the window of its displacement over +-0.25 s.
