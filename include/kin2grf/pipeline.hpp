@@ -82,8 +82,10 @@ struct EstimateOptions {
   /// them); a knee point that a thigh cluster carries (static calibration, functional centre)
   /// moves with the thigh's skin and soft tissue, which already lag the bone, and is not delayed.
   /// A trial with flight phases (a run, a jump) keeps the thighs' timing (lag_thigh_stage). 0:
-  /// none (the paper). 20 ms: chosen leave-one-lab-out (`kin2grf study thigh-lag`).
-  double thigh_lag_s = 0.02;
+  /// none (the paper). 30 ms: chosen leave-one-lab-out (`kin2grf study thigh-lag`; 20 ms until
+  /// session 30, when each foot's force angle kept through the double support moved every lab's
+  /// held-out choice to 30 ms).
+  double thigh_lag_s = 0.03;
   /// The upper body's vertical smoothing, Hz (kin2grf): the HAT COM's vertical acceleration is
   /// low-passed at this cut-off (smooth_torso_vertical), since the pelvis markers carry the heel
   /// strike's jolt that the upper body's mass does not pass on. A trial with flight phases (a
