@@ -745,10 +745,11 @@ TEST(Estimate, TheDoubleSupportTransitionKeepsEachFootsForceAngle) {
 }
 
 // The angle rule's arithmetic, and its guard: a lightly loaded foot whose solved force leans
-// further than any walking foot's friction allows (here 1.5 N fore-aft on 1 N) is not carried onto
-// the 60 N the transition gives it; growing, the fore-aft force stops at the new vertical force
-// (45 degrees) unless the solve's own was larger. Shrinking is never bounded.
-TEST(Estimate, TheTransitionsForeAftForceKeepsTheAngleButNeverLeansPast45Degrees) {
+// further than any walking foot's friction allows (here 1.5 N fore-aft on 1 N) does not carry that
+// angle onto the 60 N the transition gives it; growing, the fore-aft force stops at the new
+// vertical force (a 45-degree lean) unless the solve's own was larger, which it keeps. Shrinking
+// is never bounded.
+TEST(Estimate, TheTransitionsForeAftForceKeepsTheAngleButGrowsNoFurtherThanItsNewVerticalForce) {
   EXPECT_DOUBLE_EQ(transition_tangent(-30.0, 300.0, 450.0, 1.0), -45.0);   // the angle kept
   EXPECT_DOUBLE_EQ(transition_tangent(-30.0, 300.0, 450.0, 0.5), -37.5);   // half the change
   EXPECT_DOUBLE_EQ(transition_tangent(-30.0, 300.0, 450.0, 0.0), -30.0);   // as solved
