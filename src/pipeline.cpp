@@ -560,10 +560,11 @@ struct RawSolve {
   std::array<Eigen::MatrixXd, 2> sole_m;           ///< per side, N x 6: A, B, C (x, y)
   // For the double-support transition (EstimateOptions::double_support_sta_weight): the frames
   // where both feet are active, in order, and for each the solve's torque_per_normal (kJointCount
-  // x np, column-major), then with EstimateOptions::double_support_angle its torque_per_tangent.
-  // Only those frames: a long walk holds a fifth of its frames' worth.
+  // x np, column-major), then, when both_feet_tangent_map (EstimateOptions::double_support_angle),
+  // its torque_per_tangent. Only those frames: a long walk holds a fifth of its frames' worth.
   std::vector<Eigen::Index> both_feet_frames;
   std::vector<double> both_feet_torque_map;
+  bool both_feet_tangent_map = false;
   std::vector<int> iterations;  ///< semi-smooth Newton iterations per frame
   int cycled_frames = 0, capped_frames = 0;
   // The touchdown rule (EstimateOptions::touchdown_stop_fraction; touchdown_stage): per side, the
@@ -643,7 +644,7 @@ RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCa
   // Each chunk keeps its own frames' torque maps (for_chunks makes at most thread_count() chunks),
   // joined in chunk order after the loop.
   const bool keep_torque_map = o.double_support_sta_weight > 0;
-  const bool keep_tangent_map = keep_torque_map && o.double_support_angle > 0;
+  raw.both_feet_tangent_map = keep_torque_map && o.double_support_angle > 0;
   std::vector<std::pair<std::vector<Eigen::Index>, std::vector<double>>> chunk_maps(
       keep_torque_map ? static_cast<std::size_t>(std::max(1, thread_count())) : 0);
   for_chunks(static_cast<std::size_t>(n), min_chunk_for(10e-6), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
@@ -669,7 +670,7 @@ RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCa
           auto& [frames, values] = chunk_maps[chunk];
           frames.push_back(i);
           values.insert(values.end(), s.torque_per_normal.data(), s.torque_per_normal.data() + s.torque_per_normal.size());
-          if (keep_tangent_map)
+          if (raw.both_feet_tangent_map)
             values.insert(values.end(), s.torque_per_tangent.data(), s.torque_per_tangent.data() + s.torque_per_tangent.size());
         }
       }
@@ -836,6 +837,10 @@ Messages double_support_transition(double w, double angle, const std::array<std:
                                    const RawSolve& raw, Eigen::MatrixXd& lamf, Eigen::MatrixXd& joint_torque_Nm) {
   const auto max_frames = static_cast<Eigen::Index>(0.5 * stance_s * rate_hz);
   const int np = static_cast<int>(raw.point_side.size());
+  // The maps' layout is the solve's (RawSolve::both_feet_tangent_map), which kept the tangential
+  // ones when `angle` asked for them.
+  const bool tangent = angle > 0 && raw.both_feet_tangent_map;
+  const Eigen::Index per_frame = (tangent ? 2 : 1) * kJointCount * np;
   const auto supports = walking_double_supports(contact, max_frames);
   for (const DoubleSupport& ds : supports) {
     const auto t = static_cast<std::size_t>(ds.trailing);
@@ -854,14 +859,13 @@ Messages double_support_transition(double w, double angle, const std::array<std:
       // Every frame of a double support has both feet active in the solve (the contact states
       // are the solve's), so it has its map; the test is a guard, not a case.
       if (it == raw.both_feet_frames.end() || *it != k) continue;
-      const Eigen::Index per_frame = (angle > 0 ? 2 : 1) * kJointCount * np;
       const double* G = raw.both_feet_torque_map.data() + (it - raw.both_feet_frames.begin()) * per_frame;
       for (int j = 0; j < np; ++j) {
         const double normal = lamf(k, 2 * j);
         const double d = (factor[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] - 1) * normal;
         lamf(k, 2 * j) += d;
         for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += d * G[j * kJointCount + q];
-        if (angle > 0) {
+        if (tangent) {
           const double dt = transition_tangent(lamf(k, 2 * j + 1), normal, lamf(k, 2 * j), angle) - lamf(k, 2 * j + 1);
           lamf(k, 2 * j + 1) += dt;
           for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += dt * G[(np + j) * kJointCount + q];
