@@ -143,6 +143,8 @@ void check_options(const EstimateOptions& o) {
           "double-support transition weight", o.double_support_sta_weight, "between 0 (none, the paper) and 1");
   require(finite(o.double_support_angle) && o.double_support_angle >= 0 && o.double_support_angle <= 1,
           "double-support force angle share", o.double_support_angle, "between 0 (none, the paper) and 1");
+  require(finite(o.frontal_split_weight) && o.frontal_split_weight >= 0 && o.frontal_split_weight <= 1,
+          "frontal split weight", o.frontal_split_weight, "between 0 (off, the paper) and 1");
   require(finite(o.touchdown_stop_fraction) && o.touchdown_stop_fraction >= 0 && o.touchdown_stop_fraction <= 1,
           "touchdown stop fraction", o.touchdown_stop_fraction, "between 0 (off, the paper) and 1");
   require(o.grm_reference_m.allFinite(), "GRM reference (m)", o.grm_reference_m.x() + o.grm_reference_m.y(), "finite");
@@ -611,6 +613,12 @@ void join_torque_maps(std::vector<std::pair<std::vector<Eigen::Index>, std::vect
   }
 }
 
+/// Whether the frontal split (EstimateOptions::frontal_split_weight) can act: it needs the lateral
+/// model's coordinates and the solver's side-by-side fade.
+bool frontal_split_on(const EstimateOptions& o) {
+  return o.lateral_force() && o.frontal_split_weight > 0 && o.solver.min_split_distance_m > 0;
+}
+
 /// Eqs. 5-10 on every frame (least squares, activation, semi-smooth iterations). `path` and
 /// `first_frame_number` name a frame the solve could not make finite.
 RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCalibration& calibration, const ModelMotion& motion,
@@ -643,7 +651,9 @@ RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCa
   // the progress.
   // Each chunk keeps its own frames' torque maps (for_chunks makes at most thread_count() chunks),
   // joined in chunk order after the loop.
-  const bool keep_torque_map = o.double_support_sta_weight > 0;
+  // The double-support transition and the frontal split (EstimateOptions::frontal_split_weight)
+  // move load between the feet after the post-filter: their torques move through these maps.
+  const bool keep_torque_map = o.double_support_sta_weight > 0 || frontal_split_on(o);
   raw.both_feet_tangent_map = keep_torque_map && o.double_support_angle > 0;
   std::vector<std::pair<std::vector<Eigen::Index>, std::vector<double>>> chunk_maps(
       keep_torque_map ? static_cast<std::size_t>(std::max(1, thread_count())) : 0);
@@ -882,6 +892,80 @@ Messages double_support_transition(double w, double angle, const std::array<std:
   return out;
 }
 
+/// What the frontal split needs of the whole body (frontal_split): its COM's lateral place (m) and
+/// lateral inertial force (N, mediolateral_forces' total), each foot's lateral place (the heel-MT
+/// midpoint, m), per frame; the motion for the COM's height and the floor it stands on.
+struct FrontalBalance {
+  Eigen::VectorXd com_lateral_m, lateral_total_N;
+  std::array<Eigen::VectorXd, 2> foot_lateral_m;
+  const ModelMotion* motion = nullptr;
+  double ground_level_m = 0.0;
+};
+
+/// The frontal split (EstimateOptions::frontal_split_weight = w) on the post-filtered
+/// multipliers: where both feet carry load and their active points lie within `split_distance_m`
+/// along progression, the right foot's share of the two feet's vertical force becomes (1 - w f) x
+/// its share + w f x frontal_balance_right_share, f = 1 - the solver's sagittal weight there
+/// (ContactSolver::moment_direction_weight's smoothstep: 1 within half the distance, 0 beyond
+/// it). As in the double-support transition, each foot's normal multipliers are scaled (its COP
+/// stays), the sum is kept, the tangential ones follow by `angle` (transition_tangent) and the
+/// torques through the solve's maps.
+Messages frontal_split(double w, double split_distance_m, double angle, const FrontalBalance& fb, const RawSolve& raw, Eigen::MatrixXd& lamf,
+                       Eigen::MatrixXd& joint_torque_Nm) {
+  const int np = static_cast<int>(raw.point_side.size());
+  const bool tangent = angle > 0 && raw.both_feet_tangent_map;
+  const Eigen::Index per_frame = (tangent ? 2 : 1) * kJointCount * np;
+  const Model& model = *fb.motion->model;
+  long frames = 0;
+  MotionFrame f;
+  for (std::size_t m = 0; m < raw.both_feet_frames.size(); ++m) {
+    const Eigen::Index k = raw.both_feet_frames[m];
+    std::array<double, 2> fy{0.0, 0.0};
+    double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
+    for (int j = 0; j < np; ++j) {
+      if (!(lamf(k, 2 * j) > 0)) continue;
+      fy[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] += lamf(k, 2 * j);
+      xmin = std::min(xmin, raw.point_x_m(k, j)), xmax = std::max(xmax, raw.point_x_m(k, j));
+    }
+    if (!(fy[0] > 1.0 && fy[1] > 1.0)) continue;
+    const double u = std::clamp(2.0 * (xmax - xmin) / split_distance_m - 1.0, 0.0, 1.0);
+    const double weight = w * (1 - u * u * (3 - 2 * u));
+    if (!(weight > 0)) continue;
+    fb.motion->frame(k, f);
+    double com_y = 0;
+    for (int b = 0; b < kSegmentCount; ++b) com_y += model.bodies[static_cast<std::size_t>(b)].mass_kg * f.q[coord::com_x(b) + 1];
+    com_y /= model.body_mass_kg;
+    const double total = fy[0] + fy[1];
+    const double share = frontal_balance_right_share(fb.com_lateral_m[k], com_y - fb.ground_level_m, fb.lateral_total_N[k], total,
+                                                     fb.foot_lateral_m[0][k], fb.foot_lateral_m[1][k]);
+    if (!std::isfinite(share)) continue;
+    const double right = (1 - weight) * fy[0] + weight * share * total;
+    const std::array<double, 2> factor{right / fy[0], (total - right) / fy[1]};
+    const double* G = raw.both_feet_torque_map.data() + static_cast<Eigen::Index>(m) * per_frame;
+    for (int j = 0; j < np; ++j) {
+      const double normal = lamf(k, 2 * j);
+      if (!(normal > 0)) continue;
+      const double d = (factor[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] - 1) * normal;
+      lamf(k, 2 * j) += d;
+      for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += d * G[j * kJointCount + q];
+      if (tangent) {
+        const double dt = transition_tangent(lamf(k, 2 * j + 1), normal, lamf(k, 2 * j), angle) - lamf(k, 2 * j + 1);
+        lamf(k, 2 * j + 1) += dt;
+        for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += dt * G[(np + j) * kJointCount + q];
+      }
+    }
+    ++frames;
+  }
+  Messages out;
+  if (frames > 0) {
+    char b[240];
+    std::snprintf(b, sizeof b, "feet side by side: %ld frames' vertical split between the feet from the whole body's frontal balance (weight %g)",
+                  frames, w);
+    out.emplace_back(b);
+  }
+  return out;
+}
+
 /// Stances near the window's ends: the zero-lag filters see data on one side only there.
 /// Measured by cutting development walks short: the total vertical force is 12-53 %
 /// body weight RMS off at the cut, 4-10 % 40 ms in and 1-4 % by 60 ms, at a 6 Hz kinematic
@@ -979,7 +1063,7 @@ FootResult foot_result(int side, const std::vector<bool>& contact, const Eigen::
 
 /// The post-filter (Sect. 2.6), the double-support transition and each foot's result.
 FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, double kinematic_cutoff_hz, int first_frame_number,
-                     double ground_level_m) {
+                     double ground_level_m, const FrontalBalance* frontal = nullptr) {
   FeetStage out;
   const Eigen::Index n = raw.lambda.rows();
   const int np = static_cast<int>(raw.point_side.size());
@@ -1007,6 +1091,9 @@ FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, dou
     append(out.messages,
            double_support_transition(o.double_support_sta_weight, o.double_support_angle, contact, *stance, rate_hz, raw, lamf,
                                      out.joint_torque_Nm));
+  if (frontal && frontal_split_on(o))
+    append(out.messages, frontal_split(o.frontal_split_weight, o.solver.min_split_distance_m, o.double_support_angle, *frontal, raw, lamf,
+                                       out.joint_torque_Nm));
   bool any = false;
   for (int side = 0; side < 2; ++side) {
     out.feet[side] = foot_result(side, contact[static_cast<std::size_t>(side)], lamf, raw);
@@ -1248,10 +1335,26 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   const std::vector<int> iterations = std::move(dyn.raw.iterations);
   const int cycled_frames = dyn.raw.cycled_frames, capped_frames = dyn.raw.capped_frames;
   const double ground_level_m = dyn.plan.calibration.contact.ground_level_m;
-  FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m);
+  const double lateral_cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kin.kinematic_cutoff_hz) : kin.kinematic_cutoff_hz;
+  const double lateral_lag_s = o.lateral_torso_lag && sag.trunk_measured ? dyn.torso_lag_added_s : 0.0;
+  // The frontal split's whole-body balance: the lateral model's COM and total, before any foot
+  // carries its share (the feet's vertical forces it splits are the post-filter's).
+  std::optional<FrontalBalance> frontal;
+  if (frontal_split_on(o)) {
+    const Eigen::Index n = kin.motion.frames();
+    const Eigen::VectorXd unloaded = Eigen::VectorXd::Zero(n);
+    const std::vector<bool> off(static_cast<std::size_t>(n), false);
+    const std::array<FootLoad, 2> none{FootLoad{&unloaded, &off}, FootLoad{&unloaded, &off}};
+    const UpperBodySegments upper = upper_body_segments(sag.upper_body_lab_m, anthropometric_table(o.anthropometry));
+    MediolateralForces ml = mediolateral_forces(kin.motion, sag.landmark_lab_m, sag.lateral_axis, lateral_cutoff, none, kin.kinematic_cutoff_hz,
+                                                o.lateral_own_leg_inertia, &upper, lateral_lag_s, &dyn.plan.near_flight);
+    frontal = FrontalBalance{std::move(ml.com_lateral_m), std::move(ml.total_N), sag.foot_lateral_m, &kin.motion, ground_level_m};
+  }
+  FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m,
+                              frontal ? &*frontal : nullptr);
+  frontal.reset();
   if (o.lateral_force()) {
-    const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kin.kinematic_cutoff_hz) : kin.kinematic_cutoff_hz;
-    const double lateral_lag_s = o.lateral_torso_lag && sag.trunk_measured ? dyn.torso_lag_added_s : 0.0;
+    const double cutoff = lateral_cutoff;
     mediolateral_stage(kin.motion, sag, cutoff, kin.kinematic_cutoff_hz, o.lateral_own_leg_inertia, lateral_lag_s, dyn.plan.near_flight,
                        anthropometric_table(o.anthropometry),
                        feet.feet, kin.messages);

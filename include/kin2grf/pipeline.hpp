@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -125,6 +126,16 @@ struct EstimateOptions {
   /// sum that the kinematics ask for. Measured leave-one-lab-out (`kin2grf study
   /// double-support-angle`): walking anterior 7.6 -> 7.3 % (docs/METHOD-NOTES.md).
   double double_support_angle = 1.0;
+  /// Feet side by side (within SolverOptions::min_split_distance_m along progression), with the
+  /// lateral model (lateral_force(): --mediolateral, --model 3d): the two feet's vertical forces
+  /// are blended with this weight (times the solver's fade of its sagittal split) towards the
+  /// split the whole body's frontal balance gives (frontal_balance_right_share). Why: side by
+  /// side, the sagittal moment cannot tell the feet apart and the solve shares the load by the
+  /// minimum norm, equally for a symmetric posture; the frontal plane can, the feet being a hip
+  /// width apart across it (the drop jump's landing: 860 against 536 N on its plates). 0: off
+  /// (the paper, and the sagittal model, which has no lateral coordinates). The total, each foot's
+  /// COP and (double_support_angle) each foot's force angle are kept; the torques follow.
+  double frontal_split_weight = 1.0;
   /// Touchdown from the foot's own motion (kin2grf, issue 29; frames_before_touchdown): a foot
   /// the solve has in contact before its heel or MT head has stopped descending (its descent
   /// fallen to this fraction of its recent peak, seen at 15 Hz) carries no load there. The load is
@@ -307,6 +318,22 @@ std::vector<DoubleSupport> walking_double_supports(const std::array<std::vector<
 inline double smooth_transition_share(double u) {
   u = u < 0 ? 0 : u > 1 ? 1 : u;
   return 1 - u * u * (3 - 2 * u);
+}
+
+/// The right foot's share of two feet's vertical force from the whole body's frontal balance
+/// (EstimateOptions::frontal_split_weight): the ground reaction's line passes through the centre
+/// of mass (the whole body's angular momentum about it neglected), so its centre of pressure
+/// lies at z_P = z_G - h F_z / F_y (z lateral, h the COM's height above the floor, F_z the whole
+/// body's lateral inertial force M a_Gz, F_y the feet's vertical total), and two feet at z_R
+/// and z_L carry F_y (z_L - z_P) / (z_L - z_R) and the rest. Clamped to [0, 1]; NaN where the
+/// feet stand less than `min_width_m` apart across the plane, or F_y is not positive.
+inline double frontal_balance_right_share(double com_lateral_m, double com_height_m, double lateral_total_N, double vertical_total_N,
+                                          double right_lateral_m, double left_lateral_m, double min_width_m = 0.05) {
+  const double width = left_lateral_m - right_lateral_m;
+  if (!(vertical_total_N > 0) || !(std::abs(width) >= min_width_m)) return std::numeric_limits<double>::quiet_NaN();
+  const double z_p = com_lateral_m - com_height_m * lateral_total_N / vertical_total_N;
+  const double share = (left_lateral_m - z_p) / width;
+  return share < 0 ? 0.0 : share > 1 ? 1.0 : share;
 }
 
 /// A contact point's tangential multiplier after the double-support transition scaled its normal
