@@ -68,12 +68,12 @@ const std::vector<NumericOption>& numeric_options() {
        "With --double-support-sta: how far each foot's fore-aft force follows its vertical force's new share in a double support "
        "(1: each foot keeps the solve's force angle; 0 = the fore-aft forces as solved, the paper)",
        {0.0, 0.25, 0.5, 0.75, 1.0}, "%.2f", 1.0, "off"},
-      // No value fitted (1: the frontal balance where the solver's sagittal split fades out). It acts
-      // with the lateral model only, which `kin2grf study` does not run: measured with `validate
-      // --model 3d` (docs/METHOD-NOTES.md), no grid here.
+      // No value fitted (1: the frontal balance wherever the solver's sagittal split fades out). It
+      // acts only on feet side by side (a landing, standing), which no development walk or run has
+      // on its plates: measured with `validate` on the drop jump (docs/METHOD-NOTES.md), no grid.
       {"frontal-split", "frontal_split_weight", [](O& o) -> double& { return o.frontal_split_weight; }, 0.0, 1.0, 0.0,
-       "With --mediolateral or --model 3d: feet side by side (within --split-distance along progression) share the vertical "
-       "load by the whole body's frontal balance, with this weight (0 = off: the sagittal minimum norm's shares, the paper)"},
+       "Feet side by side (within --split-distance along progression) share the vertical load by the whole body's frontal "
+       "balance (its centre of mass across the feet), with this weight; 0 = off: the sagittal minimum norm's shares, the paper"},
       // Chosen leave-one-lab-out on the mediolateral force (scripts/validate-all.sh's 3d-lc runs,
       // VALIDATION.md's table), not by `kin2grf study`, whose criterion is the sagittal one: no grid here.
       {"lateral-cutoff", "lateral_cutoff_hz", [](O& o) -> double& { return o.lateral_cutoff_hz; }, 0.0, 100.0, std::nullopt,

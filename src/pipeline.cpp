@@ -177,6 +177,10 @@ void append(Messages& to, Messages&& from) {
 
 /// What the sagittal stage makes of the markers: the frame, the processed window's landmarks and
 /// where that window lies in the trial.
+/// Whether the frontal split (EstimateOptions::frontal_split_weight) acts: where the solver fades
+/// its sagittal split of feet side by side (SolverOptions::min_split_distance_m).
+bool frontal_split_on(const EstimateOptions& o) { return o.frontal_split_weight > 0 && o.solver.min_split_distance_m > 0; }
+
 struct SagittalStage {
   SagittalFrame frame;
   SagittalLandmarks landmarks;
@@ -215,7 +219,9 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   // caller gave it up).
   MarkerTrajectories* releasable = release ? &release->markers : nullptr;
   LandmarkOptions lo = o.landmarks;
-  lo.upper_body = o.lateral_force() && o.upper_body_segments;
+  // The arms and the head as segments of their own: the lateral model's, and the frontal balance's
+  // (an arm held out sideways moves the centre of mass across the feet).
+  lo.upper_body = (o.lateral_force() || frontal_split_on(o)) && o.upper_body_segments;
   Landmarks3D lm3 = compute_landmarks(set, cleaned ? *cleaned : trial.markers, static_trial ? &static_trial->markers : nullptr, lo,
                                       trial.path, releasable);
   // Every sample is released now (compute_landmarks lets go of unread markers too). From here on,
@@ -233,7 +239,8 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   append(msg, std::move(cleaning));
   append(msg, std::move(lm3.messages));
   out.frame = detect_sagittal_frame(lm3, markers, o.landmarks);
-  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, out.frame, markers, lo, trial.path, o.lateral_force());
+  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, out.frame, markers, lo, trial.path, o.lateral_force() || frontal_split_on(o),
+                                          o.lateral_force());
   out.landmark_lab_m = std::move(win.lab_m);
   out.upper_body_lab_m = std::move(win.upper_body_lab_m);
   out.lateral_axis = std::move(win.lateral_axis);
@@ -613,12 +620,6 @@ void join_torque_maps(std::vector<std::pair<std::vector<Eigen::Index>, std::vect
   }
 }
 
-/// Whether the frontal split (EstimateOptions::frontal_split_weight) can act: it needs the lateral
-/// model's coordinates and the solver's side-by-side fade.
-bool frontal_split_on(const EstimateOptions& o) {
-  return o.lateral_force() && o.frontal_split_weight > 0 && o.solver.min_split_distance_m > 0;
-}
-
 /// Eqs. 5-10 on every frame (least squares, activation, semi-smooth iterations). `path` and
 /// `first_frame_number` name a frame the solve could not make finite.
 RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCalibration& calibration, const ModelMotion& motion,
@@ -901,6 +902,22 @@ struct FrontalBalance {
   const ModelMotion* motion = nullptr;
   double ground_level_m = 0.0;
 };
+
+/// The whole body's frontal balance from the lab landmarks (mediolateral_forces' COM and total,
+/// with no foot loaded: only the whole body's part is read), at the lateral force's cut-off
+/// (EstimateOptions::lateral_cutoff_hz: the body's sway is slow, the skin markers' noise is not).
+/// The torso's lateral lag is not applied: the split acts on a landing, near its flight, where the
+/// lateral model does not lag either, and on standing, where the lateral force is about nil.
+FrontalBalance frontal_balance(const EstimateOptions& o, const SagittalStage& sag, const ModelMotion& motion, double kinematic_cutoff_hz) {
+  const Eigen::Index n = motion.frames();
+  const Eigen::VectorXd unloaded = Eigen::VectorXd::Zero(n);
+  const std::vector<bool> off(static_cast<std::size_t>(n), false);
+  const std::array<FootLoad, 2> none{FootLoad{&unloaded, &off}, FootLoad{&unloaded, &off}};
+  const UpperBodySegments upper = upper_body_segments(sag.upper_body_lab_m, anthropometric_table(o.anthropometry));
+  const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kinematic_cutoff_hz) : kinematic_cutoff_hz;
+  MediolateralForces ml = mediolateral_forces(motion, sag.landmark_lab_m, sag.lateral_axis, cutoff, none, 0.0, false, &upper);
+  return FrontalBalance{std::move(ml.com_lateral_m), std::move(ml.total_N), sag.foot_lateral_m, &motion, 0.0};
+}
 
 /// The frontal split (EstimateOptions::frontal_split_weight = w) on the post-filtered
 /// multipliers: where both feet carry load and their active points lie within `split_distance_m`
@@ -1292,6 +1309,17 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   ModelStage mod = model_stage(o, sag.landmarks, mass_kg);
   KinematicsStage kin = kinematics_stage(o, mod.model, sag.landmarks);
   if (running_torso_stage(o, mod, kin.motion, sag)) kin = kinematics_stage(o, mod.model, sag.landmarks, &kin);
+  // The frontal split's whole-body balance (its COM's lateral place and lateral inertial force),
+  // made while the lab landmarks are at hand; the sagittal model lets them go then.
+  std::optional<FrontalBalance> frontal;
+  if (frontal_split_on(o)) {
+    frontal = frontal_balance(o, sag, kin.motion, kin.kinematic_cutoff_hz);
+    if (!o.lateral_force()) {
+      sag.landmark_lab_m = {};
+      sag.lateral_axis = Eigen::MatrixX3d();
+      sag.upper_body_lab_m = {};
+    }
+  }
   const double hip_speed_mps = sag.frame.treadmill ? 0.0 : progression_speed(sag.landmarks);
   const FootHeights heights = foot_heights(o, sag.landmarks);
   if (!o.keep_all_series) sag.landmarks.p = {};  // the hip's speed and the feet's heights were the last use of them
@@ -1335,26 +1363,13 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   const std::vector<int> iterations = std::move(dyn.raw.iterations);
   const int cycled_frames = dyn.raw.cycled_frames, capped_frames = dyn.raw.capped_frames;
   const double ground_level_m = dyn.plan.calibration.contact.ground_level_m;
-  const double lateral_cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kin.kinematic_cutoff_hz) : kin.kinematic_cutoff_hz;
-  const double lateral_lag_s = o.lateral_torso_lag && sag.trunk_measured ? dyn.torso_lag_added_s : 0.0;
-  // The frontal split's whole-body balance: the lateral model's COM and total, before any foot
-  // carries its share (the feet's vertical forces it splits are the post-filter's).
-  std::optional<FrontalBalance> frontal;
-  if (frontal_split_on(o)) {
-    const Eigen::Index n = kin.motion.frames();
-    const Eigen::VectorXd unloaded = Eigen::VectorXd::Zero(n);
-    const std::vector<bool> off(static_cast<std::size_t>(n), false);
-    const std::array<FootLoad, 2> none{FootLoad{&unloaded, &off}, FootLoad{&unloaded, &off}};
-    const UpperBodySegments upper = upper_body_segments(sag.upper_body_lab_m, anthropometric_table(o.anthropometry));
-    MediolateralForces ml = mediolateral_forces(kin.motion, sag.landmark_lab_m, sag.lateral_axis, lateral_cutoff, none, kin.kinematic_cutoff_hz,
-                                                o.lateral_own_leg_inertia, &upper, lateral_lag_s, &dyn.plan.near_flight);
-    frontal = FrontalBalance{std::move(ml.com_lateral_m), std::move(ml.total_N), sag.foot_lateral_m, &kin.motion, ground_level_m};
-  }
+  if (frontal) frontal->ground_level_m = ground_level_m;
   FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m,
                               frontal ? &*frontal : nullptr);
   frontal.reset();
   if (o.lateral_force()) {
-    const double cutoff = lateral_cutoff;
+    const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kin.kinematic_cutoff_hz) : kin.kinematic_cutoff_hz;
+    const double lateral_lag_s = o.lateral_torso_lag && sag.trunk_measured ? dyn.torso_lag_added_s : 0.0;
     mediolateral_stage(kin.motion, sag, cutoff, kin.kinematic_cutoff_hz, o.lateral_own_leg_inertia, lateral_lag_s, dyn.plan.near_flight,
                        anthropometric_table(o.anthropometry),
                        feet.feet, kin.messages);

@@ -126,15 +126,16 @@ struct EstimateOptions {
   /// sum that the kinematics ask for. Measured leave-one-lab-out (`kin2grf study
   /// double-support-angle`): walking anterior 7.6 -> 7.3 % (docs/METHOD-NOTES.md).
   double double_support_angle = 1.0;
-  /// Feet side by side (within SolverOptions::min_split_distance_m along progression), with the
-  /// lateral model (lateral_force(): --mediolateral, --model 3d): the two feet's vertical forces
-  /// are blended with this weight (times the solver's fade of its sagittal split) towards the
-  /// split the whole body's frontal balance gives (frontal_balance_right_share). Why: side by
-  /// side, the sagittal moment cannot tell the feet apart and the solve shares the load by the
-  /// minimum norm, equally for a symmetric posture; the frontal plane can, the feet being a hip
-  /// width apart across it (the drop jump's landing: 860 against 536 N on its plates). 0: off
-  /// (the paper, and the sagittal model, which has no lateral coordinates). The total, each foot's
-  /// COP and (double_support_angle) each foot's force angle are kept; the torques follow.
+  /// Feet side by side (within SolverOptions::min_split_distance_m along progression; kin2grf, not
+  /// the paper): the two feet's vertical forces are blended with this weight (times the solver's
+  /// fade of its sagittal split) towards the split the whole body's frontal balance gives
+  /// (frontal_balance_right_share; the COM's lateral place from the lab landmarks, filtered at
+  /// lateral_cutoff_hz). Why: side by side, the sagittal moment cannot tell the feet apart and the
+  /// solve shares the load by the minimum norm, equally for a symmetric posture; across the plane
+  /// the feet stand a hip width apart, and where the COM stands between them decides (the drop
+  /// jump's landing: 860 against 536 N on its plates; per-foot vertical 13.6 -> 7.5 %). No value
+  /// fitted. 0: off (the paper). The total, each foot's COP and (double_support_angle) each foot's
+  /// force angle are kept; the joint torques follow (frontal_split).
   double frontal_split_weight = 1.0;
   /// Touchdown from the foot's own motion (kin2grf, issue 29; frames_before_touchdown): a foot
   /// the solve has in contact before its heel or MT head has stopped descending (its descent

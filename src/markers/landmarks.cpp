@@ -911,7 +911,8 @@ void check_toes(SagittalLandmarks& s, const MarkerSet& set, int side, std::vecto
 }  // namespace
 
 SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const SagittalFrame& fr,
-                                  const MarkerTrajectories& m, const LandmarkOptions& o, const std::string& path, bool keep_lateral) {
+                                  const MarkerTrajectories& m, const LandmarkOptions& o, const std::string& path, bool keep_lateral,
+                                  bool foot_lines) {
   SagittalWindow w;
   w.hip_half_width_m = lm3.hip_half_width_m;
   const Eigen::Index n = m.frames();
@@ -966,19 +967,20 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
     // lateral of it.
     const bool lateral_mt = set.rules[static_cast<std::size_t>(landmark(side, kMt))].lateral_surface;
     const double to_medial = side == kRight ? -1.0 : 1.0;
-    if (keep_lateral) w.foot_line[side].resize(best_len, 4);
+    const bool line = keep_lateral && foot_lines;
+    if (line) w.foot_line[side].resize(best_len, 4);
     std::vector<double> shift_m;
     for (Eigen::Index i = 0; i < best_len; ++i) {
       const Eigen::RowVector3d heel = p[landmark(side, kHeel)].row(best_a + i), mt = p[landmark(side, kMt)].row(best_a + i);
       const Eigen::RowVector3d lat = fr.lateral_at(best_a + i).transpose();
       w.foot_lateral_m[side][i] = 0.5 * (heel + mt).dot(lat);
-      if (!keep_lateral) continue;
+      if (!line) continue;
       const double shift = lateral_mt ? to_medial * kLateralMtToMidline * (mt - heel).norm() : 0.0;
       if (lateral_mt) shift_m.push_back(std::abs(shift));
       w.foot_line[side].row(i) << fr.to_sagittal(heel.transpose(), best_a + i).x(), heel.dot(lat),
           fr.to_sagittal(mt.transpose(), best_a + i).x(), mt.dot(lat) + shift;
     }
-    if (lateral_mt && keep_lateral) {
+    if (lateral_mt && line) {
       char b[240];
       std::snprintf(b, sizeof b, "mt_%s: a 5th-metatarsal marker; the COP's lateral line ends a median %.0f mm medial of it (%.2f x the "
                     "heel-MT length, the foot's midline)", side_letter(side), 1000 * median(shift_m), kLateralMtToMidline);

@@ -252,9 +252,12 @@ struct SagittalWindow {
 
 /// Gap filling, the longest fully defined window, projection on the sagittal plane, and the
 /// virtual hallux when the set has none. `lm` is taken (gaps are filled in it): moved in, it is
-/// not copied. Of `m` only the frame count, numbers, times and rate are read.
+/// not copied. Of `m` only the frame count, numbers, times and rate are read. `keep_lateral`: the
+/// lab positions and lateral axes (SagittalWindow::lab_m); `foot_lines`: with them the COP's
+/// lateral lines (SagittalWindow::foot_line, the lateral model's), else only the lab positions
+/// the whole body's frontal balance needs (EstimateOptions::frontal_split_weight).
 SagittalWindow sagittal_landmarks(Landmarks3D lm, const MarkerSet& set, const SagittalFrame& frame,
                                   const MarkerTrajectories& motion, const LandmarkOptions& options,
-                                  const std::string& path, bool keep_lateral = false);
+                                  const std::string& path, bool keep_lateral = false, bool foot_lines = true);
 
 }  // namespace kin2grf
