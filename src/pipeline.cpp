@@ -188,6 +188,7 @@ struct SagittalStage {
   int first_frame_number = 1;
   std::array<Eigen::VectorXd, 2> foot_lateral_m;
   std::array<Eigen::MatrixX4d, 2> foot_line;                    ///< with EstimateOptions::lateral_force()
+  std::vector<Eigen::MatrixX3d> com_sums_m;  ///< with the frontal split: com_landmark_weights' sums (frontal_balance)
   std::optional<double> hip_half_width_m;                       ///< the hip rule's (Landmarks3D)
   bool trunk_measured = true;  ///< the shoulder point from upper-body markers, not the model torso (pelvis_up)
   double torso_sway_gain = 1.0;  ///< the model torso's fore-aft sway (its rule's sway_gain; trunk_measured: unused)
@@ -239,8 +240,13 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   append(msg, std::move(cleaning));
   append(msg, std::move(lm3.messages));
   out.frame = detect_sagittal_frame(lm3, markers, o.landmarks);
-  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, out.frame, markers, lo, trial.path, o.lateral_force() || frontal_split_on(o),
-                                          o.lateral_force());
+  // The frontal split's centre of mass: two weighted sums of the landmarks (com_landmark_weights;
+  // the table's fractions, not the lengths, enter, so a model of any lengths gives them).
+  const std::vector<std::array<double, kLandmarkCount>> sums =
+      frontal_split_on(o) ? com_landmark_weights(build_model(BodyGeometry{}, 1.0, anthropometric_table(o.anthropometry)))
+                          : std::vector<std::array<double, kLandmarkCount>>{};
+  SagittalWindow win = sagittal_landmarks(std::move(lm3), set, out.frame, markers, lo, trial.path, o.lateral_force(), sums);
+  out.com_sums_m = std::move(win.lab_sums_m);
   out.landmark_lab_m = std::move(win.lab_m);
   out.upper_body_lab_m = std::move(win.upper_body_lab_m);
   out.lateral_axis = std::move(win.lateral_axis);
@@ -903,20 +909,19 @@ struct FrontalBalance {
   double ground_level_m = 0.0;
 };
 
-/// The whole body's frontal balance from the lab landmarks (mediolateral_forces' COM and total,
-/// with no foot loaded: only the whole body's part is read), at the lateral force's cut-off
-/// (EstimateOptions::lateral_cutoff_hz: the body's sway is slow, the skin markers' noise is not).
-/// The torso's lateral lag is not applied: the split acts on a landing, near its flight, where the
-/// lateral model does not lag either, and on standing, where the lateral force is about nil.
-FrontalBalance frontal_balance(const EstimateOptions& o, const SagittalStage& sag, const ModelMotion& motion, double kinematic_cutoff_hz) {
-  const Eigen::Index n = motion.frames();
-  const Eigen::VectorXd unloaded = Eigen::VectorXd::Zero(n);
-  const std::vector<bool> off(static_cast<std::size_t>(n), false);
-  const std::array<FootLoad, 2> none{FootLoad{&unloaded, &off}, FootLoad{&unloaded, &off}};
+/// The whole body's frontal balance from the landmarks' sums (whole_body_lateral: the lateral
+/// model's centre of mass and whole-body lateral force), at the lateral force's cut-off
+/// (EstimateOptions::lateral_cutoff_hz: the body's sway is slow, the skin markers' noise is not),
+/// at most the kinematic one asked for (the noise rule's, made later, is not known yet; it lies
+/// below 3 Hz only on markers noisier than any development trial's). The torso's lateral lag is
+/// not applied: the split acts on a landing, near its flight, where the lateral model does not
+/// lag either, and on standing, where the lateral force is about nil. FrontalBalance::motion and
+/// ground_level_m are the caller's to set once the motion and the floor are made.
+FrontalBalance frontal_balance(const EstimateOptions& o, const SagittalStage& sag, const Model& model) {
   const UpperBodySegments upper = upper_body_segments(sag.upper_body_lab_m, anthropometric_table(o.anthropometry));
-  const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kinematic_cutoff_hz) : kinematic_cutoff_hz;
-  MediolateralForces ml = mediolateral_forces(motion, sag.landmark_lab_m, sag.lateral_axis, cutoff, none, 0.0, false, &upper);
-  return FrontalBalance{std::move(ml.com_lateral_m), std::move(ml.total_N), sag.foot_lateral_m, &motion, 0.0};
+  const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, o.kinematic_cutoff_hz) : o.kinematic_cutoff_hz;
+  WholeBodyLateral wb = whole_body_lateral(model, sag.com_sums_m, &upper, sag.lateral_axis, sag.landmarks.rate_hz, cutoff);
+  return FrontalBalance{std::move(wb.com_lateral_m), std::move(wb.total_N), sag.foot_lateral_m, nullptr, 0.0};
 }
 
 /// The frontal split (EstimateOptions::frontal_split_weight = w) on the post-filtered
@@ -1307,19 +1312,20 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   const double mass_kg = resolve_mass(trial, o);
   SagittalStage sag = sagittal_stage(trial, release, static_trial, set, o);
   ModelStage mod = model_stage(o, sag.landmarks, mass_kg);
-  KinematicsStage kin = kinematics_stage(o, mod.model, sag.landmarks);
-  if (running_torso_stage(o, mod, kin.motion, sag)) kin = kinematics_stage(o, mod.model, sag.landmarks, &kin);
   // The frontal split's whole-body balance (its COM's lateral place and lateral inertial force),
-  // made while the lab landmarks are at hand; the sagittal model lets them go then.
+  // made once the model's masses are known; the landmarks' sums and (the sagittal model) the
+  // lateral axes go then, before the kinematics (a long trial's peak memory is there).
   std::optional<FrontalBalance> frontal;
   if (frontal_split_on(o)) {
-    frontal = frontal_balance(o, sag, kin.motion, kin.kinematic_cutoff_hz);
+    frontal = frontal_balance(o, sag, *mod.model);
+    sag.com_sums_m = {};
     if (!o.lateral_force()) {
-      sag.landmark_lab_m = {};
       sag.lateral_axis = Eigen::MatrixX3d();
       sag.upper_body_lab_m = {};
     }
   }
+  KinematicsStage kin = kinematics_stage(o, mod.model, sag.landmarks);
+  if (running_torso_stage(o, mod, kin.motion, sag)) kin = kinematics_stage(o, mod.model, sag.landmarks, &kin);
   const double hip_speed_mps = sag.frame.treadmill ? 0.0 : progression_speed(sag.landmarks);
   const FootHeights heights = foot_heights(o, sag.landmarks);
   if (!o.keep_all_series) sag.landmarks.p = {};  // the hip's speed and the feet's heights were the last use of them
@@ -1363,7 +1369,10 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   const std::vector<int> iterations = std::move(dyn.raw.iterations);
   const int cycled_frames = dyn.raw.cycled_frames, capped_frames = dyn.raw.capped_frames;
   const double ground_level_m = dyn.plan.calibration.contact.ground_level_m;
-  if (frontal) frontal->ground_level_m = ground_level_m;
+  if (frontal) {
+    frontal->motion = &kin.motion;
+    frontal->ground_level_m = ground_level_m;
+  }
   FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m,
                               frontal ? &*frontal : nullptr);
   frontal.reset();

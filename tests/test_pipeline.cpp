@@ -942,6 +942,42 @@ TEST(Mediolateral, TheFeetCarryTheBodysLateralAccelerationSharedByLoad) {
   EXPECT_LT((single.foot_N[0] - single.total_N).cwiseAbs().maxCoeff(), 1e-9 * peak);
 }
 
+// The frontal split's whole-body balance (whole_body_lateral, from com_landmark_weights' sums, which
+// sagittal_landmarks makes without holding each landmark's lab position) is the lateral model's:
+// the same centre of mass and lateral force as mediolateral_forces', each landmark swaying with its
+// own amplitude and phase so that every weight counts.
+TEST(Mediolateral, TheFrontalBalancesCentreOfMassIsTheLateralModels) {
+  const auto r = run({});
+  const Eigen::Index n = r.time_s.size();
+  std::array<Eigen::MatrixX3d, kLandmarkCount> lab;
+  for (int id = 0; id < kLandmarkCount; ++id) {
+    lab[static_cast<std::size_t>(id)] = Eigen::MatrixX3d::Zero(n, 3);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double t = r.time_s[i];
+      lab[static_cast<std::size_t>(id)].row(i) << 0.1 * id + 0.2 * t, (0.01 + 0.005 * id) * std::sin(2 * M_PI * t + 0.3 * id), 0.05 * id;
+    }
+  }
+  const Eigen::MatrixX3d lateral = Eigen::RowVector3d(0, 1, 0).replicate(n, 1);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  const std::vector<bool> off(static_cast<std::size_t>(n), false);
+  const std::array<FootLoad, 2> none{FootLoad{&zero, &off}, FootLoad{&zero, &off}};
+  const MediolateralForces ml = mediolateral_forces(r.motion, lab, lateral, 3.0, none);
+  // The sums as sagittal_landmarks makes them, with the weights of a model of other lengths (the
+  // table's fractions alone enter).
+  const auto weights = com_landmark_weights(build_model(BodyGeometry{}, 1.0, anthropometric_table(EstimateOptions{}.anthropometry)));
+  ASSERT_EQ(weights.size(), 2u);
+  double hat = 0;
+  for (double w : weights[1]) hat += w;
+  EXPECT_NEAR(hat, 1.0, 1e-12);  // the HAT's own COM
+  std::vector<Eigen::MatrixX3d> sums(2, Eigen::MatrixX3d::Zero(n, 3));
+  for (std::size_t k = 0; k < 2; ++k)
+    for (int id = 0; id < kLandmarkCount; ++id) sums[k] += weights[k][static_cast<std::size_t>(id)] * lab[static_cast<std::size_t>(id)];
+  const WholeBodyLateral wb = whole_body_lateral(r.model(), sums, nullptr, lateral, r.motion.rate_hz, 3.0);
+  EXPECT_LT((wb.com_lateral_m - ml.com_lateral_m).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((wb.total_N - ml.total_N).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_GT(ml.total_N.cwiseAbs().maxCoeff(), 1.0);  // a force there is to compare
+}
+
 // The torso's lateral lag (EstimateOptions::lateral_torso_lag): the body sways at 1 Hz, every
 // landmark alike; with a delay tau the trunk's share of the mass (the HAT, here with no arm or
 // head of its own) accelerates tau late, the rest on time, so the total is

@@ -30,7 +30,32 @@ UpperBodySegments upper_body_segments(const std::array<Eigen::MatrixX3d, kUpperB
   return out;
 }
 
+std::vector<std::array<double, kLandmarkCount>> com_landmark_weights(const Model& model) {
+  double mass = 0;
+  for (const Body& b : model.bodies) mass += b.mass_kg;
+  std::vector<std::array<double, kLandmarkCount>> w(2, std::array<double, kLandmarkCount>{});
+  for (int s = 0; s < kSegmentCount; ++s) {
+    const Body& b = model.bodies[static_cast<std::size_t>(s)];
+    const double f = b.com_fraction(), share = s == kTorso ? 1.0 : b.mass_kg / mass;
+    auto& sum = w[s == kTorso ? 1 : 0];
+    sum[static_cast<std::size_t>(b.proximal)] += share * (1 - f);
+    sum[static_cast<std::size_t>(b.points[0])] += share * f;
+  }
+  return w;
+}
+
 namespace {
+
+/// The HAT's share of the body mass less the upper body's parts of their own (their mass leaves
+/// the HAT's COM, which keeps the rest).
+double hat_share(const Model& model, const UpperBodySegments* upper) {
+  double mass = 0;
+  for (const Body& b : model.bodies) mass += b.mass_kg;
+  double share = model.bodies[kTorso].mass_kg / mass;
+  if (upper)
+    for (const auto& part : upper->parts) share -= part.mass_fraction;
+  return share;
+}
 
 /// x delayed by d frames (row i takes x at i - d, linearly interpolated; the first row before
 /// the first frame).
@@ -72,12 +97,11 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
   // The upper body: the HAT's COM with its share of the mass, less the parts of their own (arms,
   // head), each at its own COM.
   const Eigen::MatrixXd hat_com = first_moment(kTorso) / model.bodies[kTorso].mass_kg;
-  double trunk_share = model.bodies[kTorso].mass_kg / mass;
+  const double trunk_share = hat_share(model, upper);
   if (upper)
     for (const auto& part : upper->parts) {
       if (part.com_m.rows() != n) throw InputError("mediolateral force: an upper-body segment does not match the motion's frames");
       com += part.mass_fraction * part.com_m;
-      trunk_share -= part.mass_fraction;
     }
   const auto filtered = [&](Eigen::MatrixXd x) { return cutoff_hz > 0 ? butterworth_filtfilt(std::move(x), motion.rate_hz, cutoff_hz) : x; };
   const auto total_of = [&](const Eigen::MatrixXd& filtered_com) -> Eigen::VectorXd {
@@ -122,6 +146,26 @@ MediolateralForces mediolateral_forces(const ModelMotion& motion, const std::arr
       if (fy[static_cast<std::size_t>(k)] > 0)
         out.foot_N[static_cast<std::size_t>(k)][i] = out.lower_leg_N[static_cast<std::size_t>(k)][i] + rest * fy[static_cast<std::size_t>(k)] / sum_fy;
   }
+  return out;
+}
+
+WholeBodyLateral whole_body_lateral(const Model& model, const std::vector<Eigen::MatrixX3d>& lab_sums, const UpperBodySegments* upper,
+                                    const Eigen::MatrixX3d& lateral_axis, double rate_hz, double cutoff_hz) {
+  const Eigen::Index n = lateral_axis.rows();
+  if (lab_sums.size() != 2 || lab_sums[0].rows() != n || lab_sums[1].rows() != n)
+    throw InputError("whole body's lateral balance: the landmarks' sums do not match the lateral axes' frames");
+  double mass = 0;
+  for (const Body& b : model.bodies) mass += b.mass_kg;
+  Eigen::MatrixXd com = lab_sums[0] + hat_share(model, upper) * lab_sums[1];
+  if (upper)
+    for (const auto& part : upper->parts) {
+      if (part.com_m.rows() != n) throw InputError("whole body's lateral balance: an upper-body segment does not match the frames");
+      com += part.mass_fraction * part.com_m;
+    }
+  if (cutoff_hz > 0) com = butterworth_filtfilt(std::move(com), rate_hz, cutoff_hz);
+  WholeBodyLateral out;
+  out.com_lateral_m = (com.array() * lateral_axis.array()).rowwise().sum().matrix();
+  out.total_N = mass * (second_difference(com, 1.0 / rate_hz).array() * lateral_axis.array()).rowwise().sum().matrix();
   return out;
 }
 

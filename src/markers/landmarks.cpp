@@ -912,7 +912,7 @@ void check_toes(SagittalLandmarks& s, const MarkerSet& set, int side, std::vecto
 
 SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const SagittalFrame& fr,
                                   const MarkerTrajectories& m, const LandmarkOptions& o, const std::string& path, bool keep_lateral,
-                                  bool foot_lines) {
+                                  const std::vector<std::array<double, kLandmarkCount>>& lab_sums) {
   SagittalWindow w;
   w.hip_half_width_m = lm3.hip_half_width_m;
   const Eigen::Index n = m.frames();
@@ -937,12 +937,26 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
       if (id == landmark(side, kHeel) || id == landmark(side, kMt)) return true;
     return false;
   };
-  if (keep_lateral) {
+  if (keep_lateral || !lab_sums.empty()) {
     w.lateral_axis.resize(best_len, 3);
     for (Eigen::Index i = 0; i < best_len; ++i) w.lateral_axis.row(i) = fr.lateral_at(best_a + i).transpose();
     w.upper_body_lab_m = upper_body_window(lm3.upper_body, best_a, best_len, m, o, w.messages);
   }
+  w.lab_sums_m.assign(lab_sums.size(), Eigen::MatrixX3d::Zero(lab_sums.empty() ? 0 : best_len, 3));
   for (int id = 0; id < kLandmarkCount; ++id) {
+    // The weighted sums, as each landmark passes (its lab positions are let go below); a virtual
+    // hallux has no 3D place and counts at its MT head (kept until the feet's loop), as in lab_m.
+    for (std::size_t k = 0; k < lab_sums.size(); ++k) {
+      const double weight = lab_sums[k][static_cast<std::size_t>(id)];
+      if (weight == 0) continue;
+      const auto& P = p[static_cast<std::size_t>(id)];
+      const bool toes = id == landmark(kRight, kHallux) || id == landmark(kLeft, kHallux);
+      const auto& M = p[static_cast<std::size_t>(toes ? id - 1 : id)];
+      for (Eigen::Index i = 0; i < best_len; ++i) {
+        const bool own = P.rows() >= best_a + best_len && P.row(best_a + i).allFinite();
+        w.lab_sums_m[k].row(i) += weight * (own ? P.row(best_a + i) : M.row(best_a + i));
+      }
+    }
     s.p[static_cast<std::size_t>(id)].resize(best_len, 2);
     if (keep_lateral && p[static_cast<std::size_t>(id)].rows() >= best_a + best_len)
       w.lab_m[static_cast<std::size_t>(id)] = p[static_cast<std::size_t>(id)].middleRows(best_a, best_len);
@@ -967,20 +981,19 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
     // lateral of it.
     const bool lateral_mt = set.rules[static_cast<std::size_t>(landmark(side, kMt))].lateral_surface;
     const double to_medial = side == kRight ? -1.0 : 1.0;
-    const bool line = keep_lateral && foot_lines;
-    if (line) w.foot_line[side].resize(best_len, 4);
+    if (keep_lateral) w.foot_line[side].resize(best_len, 4);
     std::vector<double> shift_m;
     for (Eigen::Index i = 0; i < best_len; ++i) {
       const Eigen::RowVector3d heel = p[landmark(side, kHeel)].row(best_a + i), mt = p[landmark(side, kMt)].row(best_a + i);
       const Eigen::RowVector3d lat = fr.lateral_at(best_a + i).transpose();
       w.foot_lateral_m[side][i] = 0.5 * (heel + mt).dot(lat);
-      if (!line) continue;
+      if (!keep_lateral) continue;
       const double shift = lateral_mt ? to_medial * kLateralMtToMidline * (mt - heel).norm() : 0.0;
       if (lateral_mt) shift_m.push_back(std::abs(shift));
       w.foot_line[side].row(i) << fr.to_sagittal(heel.transpose(), best_a + i).x(), heel.dot(lat),
           fr.to_sagittal(mt.transpose(), best_a + i).x(), mt.dot(lat) + shift;
     }
-    if (lateral_mt && line) {
+    if (lateral_mt && keep_lateral) {
       char b[240];
       std::snprintf(b, sizeof b, "mt_%s: a 5th-metatarsal marker; the COP's lateral line ends a median %.0f mm medial of it (%.2f x the "
                     "heel-MT length, the foot's midline)", side_letter(side), 1000 * median(shift_m), kLateralMtToMidline);

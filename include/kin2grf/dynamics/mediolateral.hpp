@@ -71,6 +71,25 @@ struct MediolateralForces {
   std::array<Eigen::VectorXd, 2> foot_N;    ///< per foot (right, left), zero without contact
 };
 
+/// The whole body's centre of mass as two weighted sums of the landmarks (sagittal_landmarks'
+/// lab_sums): [0] every segment but the HAT, each at its COM fraction between its proximal and
+/// distal landmarks with m_s / M, [1] the HAT's own COM (weights summing to 1). The COM is [0] +
+/// s [1] + the upper body's parts (whole_body_lateral), s the HAT's share of the mass less theirs:
+/// mediolateral_forces' COM, made without holding every landmark's lab position. The weights
+/// depend on the table's fractions only (the model's lengths do not enter).
+std::vector<std::array<double, kLandmarkCount>> com_landmark_weights(const Model& model);
+
+/// The whole body's lateral place and lateral inertial force (the frontal balance's,
+/// EstimateOptions::frontal_split_weight): the COM of com_landmark_weights' two sums, the HAT's
+/// at its share, and `upper`'s parts, low-pass filtered at `cutoff_hz`, its lateral coordinate
+/// (z_G, m) and M a_Gz (N), each frame's lateral axis taken as mediolateral_forces takes it (the
+/// acceleration in the lab, then projected). No lag.
+struct WholeBodyLateral {
+  Eigen::VectorXd com_lateral_m, total_N;
+};
+WholeBodyLateral whole_body_lateral(const Model& model, const std::vector<Eigen::MatrixX3d>& lab_sums, const UpperBodySegments* upper,
+                                    const Eigen::MatrixX3d& lateral_axis, double rate_hz, double cutoff_hz);
+
 /// `landmark_lab_m`: each landmark's lab position (unfiltered), N x 3; `lateral_axis`: each
 /// frame's lateral axis, N x 3 (a turning walk's rotates: the acceleration is taken in the lab and
 /// projected, so the frame's rotation adds nothing); `motion`: the sagittal motion (its model's

@@ -244,6 +244,9 @@ struct SagittalWindow {
   /// N x 3. Empty otherwise.
   std::array<Eigen::MatrixX3d, kLandmarkCount> lab_m;
   Eigen::MatrixX3d lateral_axis;
+  /// When asked (sagittal_landmarks' lab_sums): each weighted sum of the landmarks' lab positions,
+  /// N x 3, m.
+  std::vector<Eigen::MatrixX3d> lab_sums_m;
   /// Likewise the upper-body landmarks (lab, m) defined on every frame of the window (short gaps
   /// filled); empty where not (the part is then lumped into the HAT, and `messages` says so).
   std::array<Eigen::MatrixX3d, kUpperBodyCount> upper_body_lab_m;
@@ -253,11 +256,14 @@ struct SagittalWindow {
 /// Gap filling, the longest fully defined window, projection on the sagittal plane, and the
 /// virtual hallux when the set has none. `lm` is taken (gaps are filled in it): moved in, it is
 /// not copied. Of `m` only the frame count, numbers, times and rate are read. `keep_lateral`: the
-/// lab positions and lateral axes (SagittalWindow::lab_m); `foot_lines`: with them the COP's
-/// lateral lines (SagittalWindow::foot_line, the lateral model's), else only the lab positions
-/// the whole body's frontal balance needs (EstimateOptions::frontal_split_weight).
+/// lab positions, lateral axes and the COP's lateral lines (SagittalWindow::lab_m, lateral_axis,
+/// foot_line; the lateral model's). `lab_sums`: each a weight per landmark, of which
+/// SagittalWindow::lab_sums_m holds the weighted sum of the landmarks' lab positions (the whole
+/// body's centre of mass, made without holding every landmark's lab position), with the lateral
+/// axes and the upper body's lab positions beside it (a virtual hallux counts at its MT head).
 SagittalWindow sagittal_landmarks(Landmarks3D lm, const MarkerSet& set, const SagittalFrame& frame,
                                   const MarkerTrajectories& motion, const LandmarkOptions& options,
-                                  const std::string& path, bool keep_lateral = false, bool foot_lines = true);
+                                  const std::string& path, bool keep_lateral = false,
+                                  const std::vector<std::array<double, kLandmarkCount>>& lab_sums = {});
 
 }  // namespace kin2grf
