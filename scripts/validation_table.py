@@ -119,7 +119,7 @@ if cv_kinds:
           "contact, and held out the labs that gained most chose off without themselves (walking vertical 6.5 against 6.3 %, mean "
           "|onset| over the walking stances 28 against 25 ms); since the thigh lag it loses on all trials too (8.33 against 8.30 % since session 28). speed-gate-floor (the speed gate's floor "
           "under 0.7 x the progression speed on frames near a flight phase, since session 23) acts on the drop jump alone, whose "
-          "progression speed is 0.31 m/s: its vertical goes 13.6 -> 19.6 / 22.1 % at 0.3 / 0.2 m/s; its choice on all trials (1.0 m/s) is no "
+          "progression speed is 0.31 m/s: its vertical goes 7.5 -> 16.7 / 19.7 % at 0.3 / 0.2 m/s (6.8 % at 1.0 m/s; since session 31's frontal split of feet side by side, 13.6 -> 19.6 / 22.1 % before); its choice on all trials (1.0 m/s) is no "
           "better held out than the default 0.75 m/s. speed-gate-standstill (the gate's floor elsewhere) acts on none of these trials "
           "(no walk is slower than 1.07 m/s, where 0.7 x speed meets 0.75 m/s): its default, 0.1 m/s, is physical (a foot at rest "
           "seen through marker noise), and measured on every walk slowed 2.5 times (markers and plates on one stretched clock) it "
