@@ -842,6 +842,27 @@ void drop_touchdown_load(const std::vector<std::pair<Eigen::Index, int>>& droppe
   }
 }
 
+/// Frame k's load moved between the feet (the double-support transition, the frontal split): each
+/// foot's normal multipliers scaled by its `factor` (its COP does not move), its tangential ones
+/// following by `angle` (transition_tangent; 0: as they are), and the joint torques with them
+/// through the solve's maps `G` (torque_per_normal, then with `angle` torque_per_tangent), which
+/// are linear in the multipliers.
+void move_load(const std::array<double, 2>& factor, double angle, const double* G, const std::vector<int>& point_side, Eigen::Index k,
+               Eigen::MatrixXd& lamf, Eigen::MatrixXd& joint_torque_Nm) {
+  const int np = static_cast<int>(point_side.size());
+  for (int j = 0; j < np; ++j) {
+    const double normal = lamf(k, 2 * j);
+    const double d = (factor[static_cast<std::size_t>(point_side[static_cast<std::size_t>(j)])] - 1) * normal;
+    lamf(k, 2 * j) += d;
+    for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += d * G[j * kJointCount + q];
+    if (angle > 0) {
+      const double dt = transition_tangent(lamf(k, 2 * j + 1), normal, lamf(k, 2 * j), angle) - lamf(k, 2 * j + 1);
+      lamf(k, 2 * j + 1) += dt;
+      for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += dt * G[(np + j) * kJointCount + q];
+    }
+  }
+}
+
 /// The double-support transition (EstimateOptions::double_support_sta_weight) on the
 /// post-filtered multipliers: in each walking double support the trailing foot's share of the
 /// vertical force becomes (1 - w) x its share + w x smooth_transition_share(u); each foot's
@@ -877,17 +898,7 @@ Messages double_support_transition(double w, double angle, const std::array<std:
       // are the solve's), so it has its map; the test is a guard, not a case.
       if (it == raw.both_feet_frames.end() || *it != k) continue;
       const double* G = raw.both_feet_torque_map.data() + (it - raw.both_feet_frames.begin()) * per_frame;
-      for (int j = 0; j < np; ++j) {
-        const double normal = lamf(k, 2 * j);
-        const double d = (factor[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] - 1) * normal;
-        lamf(k, 2 * j) += d;
-        for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += d * G[j * kJointCount + q];
-        if (tangent) {
-          const double dt = transition_tangent(lamf(k, 2 * j + 1), normal, lamf(k, 2 * j), angle) - lamf(k, 2 * j + 1);
-          lamf(k, 2 * j + 1) += dt;
-          for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += dt * G[(np + j) * kJointCount + q];
-        }
-      }
+      move_load(factor, tangent ? angle : 0.0, G, raw.point_side, k, lamf, joint_torque_Nm);
     }
   }
   Messages out;
@@ -942,11 +953,13 @@ Messages frontal_split(double w, double split_distance_m, double angle, const Fr
   MotionFrame f;
   for (std::size_t m = 0; m < raw.both_feet_frames.size(); ++m) {
     const Eigen::Index k = raw.both_feet_frames[m];
+    // Each foot's load as the transition takes it; the points' spread along progression as the
+    // solver's fade takes it (its active points).
     std::array<double, 2> fy{0.0, 0.0};
     double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
     for (int j = 0; j < np; ++j) {
-      if (!(lamf(k, 2 * j) > 0)) continue;
       fy[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] += lamf(k, 2 * j);
+      if (!raw.active[static_cast<std::size_t>(k)][static_cast<std::size_t>(j)]) continue;
       xmin = std::min(xmin, raw.point_x_m(k, j)), xmax = std::max(xmax, raw.point_x_m(k, j));
     }
     if (!(fy[0] > 1.0 && fy[1] > 1.0)) continue;
@@ -963,19 +976,8 @@ Messages frontal_split(double w, double split_distance_m, double angle, const Fr
     if (!std::isfinite(share)) continue;
     const double right = (1 - weight) * fy[0] + weight * share * total;
     const std::array<double, 2> factor{right / fy[0], (total - right) / fy[1]};
-    const double* G = raw.both_feet_torque_map.data() + static_cast<Eigen::Index>(m) * per_frame;
-    for (int j = 0; j < np; ++j) {
-      const double normal = lamf(k, 2 * j);
-      if (!(normal > 0)) continue;
-      const double d = (factor[static_cast<std::size_t>(raw.point_side[static_cast<std::size_t>(j)])] - 1) * normal;
-      lamf(k, 2 * j) += d;
-      for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += d * G[j * kJointCount + q];
-      if (tangent) {
-        const double dt = transition_tangent(lamf(k, 2 * j + 1), normal, lamf(k, 2 * j), angle) - lamf(k, 2 * j + 1);
-        lamf(k, 2 * j + 1) += dt;
-        for (int q = 0; q < kJointCount; ++q) joint_torque_Nm(k, q) += dt * G[(np + j) * kJointCount + q];
-      }
-    }
+    move_load(factor, tangent ? angle : 0.0, raw.both_feet_torque_map.data() + static_cast<Eigen::Index>(m) * per_frame, raw.point_side, k,
+              lamf, joint_torque_Nm);
     ++frames;
   }
   Messages out;
