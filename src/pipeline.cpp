@@ -175,12 +175,12 @@ void append(Messages& to, Messages&& from) {
   to.insert(to.end(), std::make_move_iterator(from.begin()), std::make_move_iterator(from.end()));
 }
 
-/// What the sagittal stage makes of the markers: the frame, the processed window's landmarks and
-/// where that window lies in the trial.
 /// Whether the frontal split (EstimateOptions::frontal_split_weight) acts: where the solver fades
 /// its sagittal split of feet side by side (SolverOptions::min_split_distance_m).
 bool frontal_split_on(const EstimateOptions& o) { return o.frontal_split_weight > 0 && o.solver.min_split_distance_m > 0; }
 
+/// What the sagittal stage makes of the markers: the frame, the processed window's landmarks and
+/// where that window lies in the trial.
 struct SagittalStage {
   SagittalFrame frame;
   SagittalLandmarks landmarks;
@@ -911,7 +911,7 @@ Messages double_support_transition(double w, double angle, const std::array<std:
 }
 
 /// What the frontal split needs of the whole body (frontal_split): its COM's lateral place (m) and
-/// lateral inertial force (N, mediolateral_forces' total), each foot's lateral place (the heel-MT
+/// lateral inertial force (N; whole_body_lateral), each foot's lateral place (the heel-MT
 /// midpoint, m), per frame; the motion for the COM's height and the floor it stands on.
 struct FrontalBalance {
   Eigen::VectorXd com_lateral_m, lateral_total_N;
@@ -923,8 +923,9 @@ struct FrontalBalance {
 /// The whole body's frontal balance from the landmarks' sums (whole_body_lateral: the lateral
 /// model's centre of mass and whole-body lateral force), at the lateral force's cut-off
 /// (EstimateOptions::lateral_cutoff_hz: the body's sway is slow, the skin markers' noise is not),
-/// at most the kinematic one asked for (the noise rule's, made later, is not known yet; it lies
-/// below 3 Hz only on markers noisier than any development trial's). The torso's lateral lag is
+/// at most the kinematic cut-off asked for (EstimateOptions::kinematic_cutoff_hz: the noise rule's
+/// lowered one is made later, and where it falls under the lateral cut-off the balance keeps the
+/// lateral one; the lateral model takes the lower). The torso's lateral lag is
 /// not applied: the split acts on a landing, near its flight, where the lateral model does not
 /// lag either, and on standing, where the lateral force is about nil. FrontalBalance::motion and
 /// ground_level_m are the caller's to set once the motion and the floor are made.
@@ -1085,7 +1086,8 @@ FootResult foot_result(int side, const std::vector<bool>& contact, const Eigen::
   return f;
 }
 
-/// The post-filter (Sect. 2.6), the double-support transition and each foot's result.
+/// The post-filter (Sect. 2.6), the double-support transition, the frontal split of feet side by
+/// side (`frontal`: none, not made) and each foot's result.
 FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, double kinematic_cutoff_hz, int first_frame_number,
                      double ground_level_m, const FrontalBalance* frontal = nullptr) {
   FeetStage out;
