@@ -912,12 +912,10 @@ Messages double_support_transition(double w, double angle, const std::array<std:
 
 /// What the frontal split needs of the whole body (frontal_split): its COM's lateral place (m) and
 /// lateral inertial force (N; whole_body_lateral), each foot's lateral place (the heel-MT
-/// midpoint, m), per frame; the motion for the COM's height and the floor it stands on.
+/// midpoint, m), per frame.
 struct FrontalBalance {
   Eigen::VectorXd com_lateral_m, lateral_total_N;
   std::array<Eigen::VectorXd, 2> foot_lateral_m;
-  const ModelMotion* motion = nullptr;
-  double ground_level_m = 0.0;
 };
 
 /// The whole body's frontal balance from the landmarks' sums (whole_body_lateral: the lateral
@@ -927,29 +925,28 @@ struct FrontalBalance {
 /// lowered one is made later, and where it falls under the lateral cut-off the balance keeps the
 /// lateral one; the lateral model takes the lower). The torso's lateral lag is
 /// not applied: the split acts on a landing, near its flight, where the lateral model does not
-/// lag either, and on standing, where the lateral force is about nil. FrontalBalance::motion and
-/// ground_level_m are the caller's to set once the motion and the floor are made.
+/// lag either, and on standing, where the lateral force is about nil.
 FrontalBalance frontal_balance(const EstimateOptions& o, const SagittalStage& sag, const Model& model) {
   const UpperBodySegments upper = upper_body_segments(sag.upper_body_lab_m, anthropometric_table(o.anthropometry));
   const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, o.kinematic_cutoff_hz) : o.kinematic_cutoff_hz;
   WholeBodyLateral wb = whole_body_lateral(model, sag.com_sums_m, &upper, sag.lateral_axis, sag.landmarks.rate_hz, cutoff);
-  return FrontalBalance{std::move(wb.com_lateral_m), std::move(wb.total_N), sag.foot_lateral_m, nullptr, 0.0};
+  return FrontalBalance{std::move(wb.com_lateral_m), std::move(wb.total_N), sag.foot_lateral_m};
 }
 
 /// The frontal split (EstimateOptions::frontal_split_weight = w) on the post-filtered
 /// multipliers: where both feet carry load and their active points lie within `split_distance_m`
 /// along progression, the right foot's share of the two feet's vertical force becomes (1 - w f) x
-/// its share + w f x frontal_balance_right_share, f = 1 - the solver's sagittal weight there
-/// (ContactSolver::moment_direction_weight's smoothstep: 1 within half the distance, 0 beyond
-/// it). As in the double-support transition, each foot's normal multipliers are scaled (its COP
-/// stays), the sum is kept, the tangential ones follow by `angle` (transition_tangent) and the
-/// torques through the solve's maps.
-Messages frontal_split(double w, double split_distance_m, double angle, const FrontalBalance& fb, const RawSolve& raw, Eigen::MatrixXd& lamf,
-                       Eigen::MatrixXd& joint_torque_Nm) {
+/// its share + w f x frontal_balance_right_share, f = 1 - side_by_side_sagittal_weight (the
+/// solver's: 1 within half the distance, 0 beyond it), the COM's height from `motion` above
+/// `ground_level_m`. As in the double-support transition, each foot's normal multipliers are
+/// scaled (its COP stays), the sum is kept, the tangential ones follow by `angle`
+/// (transition_tangent) and the torques through the solve's maps.
+Messages frontal_split(double w, double split_distance_m, double angle, const FrontalBalance& fb, const ModelMotion& motion,
+                       double ground_level_m, const RawSolve& raw, Eigen::MatrixXd& lamf, Eigen::MatrixXd& joint_torque_Nm) {
   const int np = static_cast<int>(raw.point_side.size());
   const bool tangent = angle > 0 && raw.both_feet_tangent_map;
   const Eigen::Index per_frame = (tangent ? 2 : 1) * kJointCount * np;
-  const Model& model = *fb.motion->model;
+  const Model& model = *motion.model;
   long frames = 0;
   MotionFrame f;
   for (std::size_t m = 0; m < raw.both_feet_frames.size(); ++m) {
@@ -964,15 +961,14 @@ Messages frontal_split(double w, double split_distance_m, double angle, const Fr
       xmin = std::min(xmin, raw.point_x_m(k, j)), xmax = std::max(xmax, raw.point_x_m(k, j));
     }
     if (!(fy[0] > 1.0 && fy[1] > 1.0)) continue;
-    const double u = std::clamp(2.0 * (xmax - xmin) / split_distance_m - 1.0, 0.0, 1.0);
-    const double weight = w * (1 - u * u * (3 - 2 * u));
+    const double weight = w * (1 - side_by_side_sagittal_weight(xmax - xmin, split_distance_m));
     if (!(weight > 0)) continue;
-    fb.motion->frame(k, f);
+    motion.frame(k, f);
     double com_y = 0;
     for (int b = 0; b < kSegmentCount; ++b) com_y += model.bodies[static_cast<std::size_t>(b)].mass_kg * f.q[coord::com_x(b) + 1];
     com_y /= model.body_mass_kg;
     const double total = fy[0] + fy[1];
-    const double share = frontal_balance_right_share(fb.com_lateral_m[k], com_y - fb.ground_level_m, fb.lateral_total_N[k], total,
+    const double share = frontal_balance_right_share(fb.com_lateral_m[k], com_y - ground_level_m, fb.lateral_total_N[k], total,
                                                      fb.foot_lateral_m[0][k], fb.foot_lateral_m[1][k]);
     if (!std::isfinite(share)) continue;
     const double right = (1 - weight) * fy[0] + weight * share * total;
@@ -1087,9 +1083,10 @@ FootResult foot_result(int side, const std::vector<bool>& contact, const Eigen::
 }
 
 /// The post-filter (Sect. 2.6), the double-support transition, the frontal split of feet side by
-/// side (`frontal`: none, not made) and each foot's result.
-FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, double kinematic_cutoff_hz, int first_frame_number,
-                     double ground_level_m, const FrontalBalance* frontal = nullptr) {
+/// side (`frontal`: none when it is off) and each foot's result.
+FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, const ModelMotion& motion, double kinematic_cutoff_hz, int first_frame_number,
+                     double ground_level_m, const FrontalBalance* frontal) {
+  const double rate_hz = motion.rate_hz;
   FeetStage out;
   const Eigen::Index n = raw.lambda.rows();
   const int np = static_cast<int>(raw.point_side.size());
@@ -1117,9 +1114,9 @@ FeetStage feet_stage(const EstimateOptions& o, RawSolve raw, double rate_hz, dou
     append(out.messages,
            double_support_transition(o.double_support_sta_weight, o.double_support_angle, contact, *stance, rate_hz, raw, lamf,
                                      out.joint_torque_Nm));
-  if (frontal && frontal_split_on(o))
-    append(out.messages, frontal_split(o.frontal_split_weight, o.solver.min_split_distance_m, o.double_support_angle, *frontal, raw, lamf,
-                                       out.joint_torque_Nm));
+  if (frontal)
+    append(out.messages, frontal_split(o.frontal_split_weight, o.solver.min_split_distance_m, o.double_support_angle, *frontal, motion,
+                                       ground_level_m, raw, lamf, out.joint_torque_Nm));
   bool any = false;
   for (int side = 0; side < 2; ++side) {
     out.feet[side] = foot_result(side, contact[static_cast<std::size_t>(side)], lamf, raw);
@@ -1373,11 +1370,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   const std::vector<int> iterations = std::move(dyn.raw.iterations);
   const int cycled_frames = dyn.raw.cycled_frames, capped_frames = dyn.raw.capped_frames;
   const double ground_level_m = dyn.plan.calibration.contact.ground_level_m;
-  if (frontal) {
-    frontal->motion = &kin.motion;
-    frontal->ground_level_m = ground_level_m;
-  }
-  FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion.rate_hz, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m,
+  FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m,
                               frontal ? &*frontal : nullptr);
   frontal.reset();
   if (o.lateral_force()) {

@@ -1284,9 +1284,7 @@ TEST(Mediolateral, FeetSideBySideShareTheLoadByTheFrontalBalance) {
     if (frontal.time_s[i] > 0.2 && frontal.time_s[i] < 0.7)
       moved = std::max(moved, std::abs(frontal.joint_torque_Nm(i, 2) - sagittal.joint_torque_Nm(i, 2)));
   EXPECT_GT(moved, 1.0);
-  bool found = false;
-  for (const std::string& m : frontal.messages) found = found || m.find("feet side by side") != std::string::npos;
-  EXPECT_TRUE(found);
+  EXPECT_TRUE(said(frontal, "feet side by side"));
 }
 
 // The lateral force and the 3D moments are added to the sagittal results, which they leave as they

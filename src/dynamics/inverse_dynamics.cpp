@@ -322,8 +322,7 @@ double ContactSolver::moment_direction_weight(const FrameContacts& fc, unsigned 
     xmin = std::min(xmin, p.position.x()), xmax = std::max(xmax, p.position.x());
   }
   if (!(side_on[0] && side_on[1])) return 1.0;
-  const double u = std::clamp(2.0 * (xmax - xmin) / options_.min_split_distance_m - 1.0, 0.0, 1.0);
-  return u * u * (3.0 - 2.0 * u);  // smoothstep: 0 below half the distance, 1 above it
+  return side_by_side_sagittal_weight(xmax - xmin, options_.min_split_distance_m);
 }
 
 FrameSolution ContactSolver::solve_reduced(const Eigen::Ref<const Eigen::MatrixXd>& BpX, const Eigen::Ref<const Eigen::MatrixXd>& UtX,

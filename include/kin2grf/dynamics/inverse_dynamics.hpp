@@ -30,6 +30,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <array>
 #include <vector>
 
@@ -80,6 +81,16 @@ struct FrameSolution {
   bool capped = false;
 };
 
+/// Feet side by side (SolverOptions::min_split_distance_m): the weight the solve keeps of its
+/// sagittal split when the active points of both feet spread `spread_m` along progression, a
+/// smoothstep from 0 below half the distance to 1 at it. The frontal split of the pipeline
+/// (EstimateOptions::frontal_split_weight) acts by 1 minus it. split_distance_m <= 0: 1.
+inline double side_by_side_sagittal_weight(double spread_m, double split_distance_m) {
+  if (!(split_distance_m > 0)) return 1.0;
+  const double u = std::clamp(2.0 * spread_m / split_distance_m - 1.0, 0.0, 1.0);
+  return u * u * (3.0 - 2.0 * u);
+}
+
 /// Per-frame solver over (Model, TrialCalibration); owns its workspace (the Data) so that a
 /// trial's frames reuse the same buffers. From the calibration it takes the trial's speed gate
 /// and the belt velocity the gate is measured against.
@@ -102,7 +113,8 @@ class ContactSolver {
   FrameSolution solve_reduced(const Eigen::Ref<const Eigen::MatrixXd>& BpX, const Eigen::Ref<const Eigen::MatrixXd>& UtX,
                               const FrameContacts& contacts);
   /// Feet side by side (SolverOptions::min_split_distance_m): the weight, 1 down to 0, kept of the
-  /// 3-equation fit's weakest (moment) direction for this active set.
+  /// 3-equation fit's weakest (moment) direction for this active set (side_by_side_sagittal_weight
+  /// of its points' spread along progression).
   [[nodiscard]] double moment_direction_weight(const FrameContacts& contacts, unsigned active) const;
   FrameSolution solve_dense(const Eigen::MatrixXd& B, const FrameVector& qdd, const FrameContacts& contacts);
   const Model& model_;
