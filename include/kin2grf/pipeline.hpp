@@ -334,7 +334,7 @@ inline double frontal_balance_right_share(double com_lateral_m, double com_heigh
   if (!(vertical_total_N > 0) || !(std::abs(width) >= min_width_m)) return std::numeric_limits<double>::quiet_NaN();
   const double z_p = com_lateral_m - com_height_m * lateral_total_N / vertical_total_N;
   const double share = (left_lateral_m - z_p) / width;
-  return share < 0 ? 0.0 : share > 1 ? 1.0 : share;
+  return std::clamp(share, 0.0, 1.0);
 }
 
 /// A contact point's tangential multiplier after the double-support transition scaled its normal
