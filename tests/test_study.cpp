@@ -39,6 +39,33 @@ StudyTrialResult fake_trial(const char* name, const char* lab, double rrmse) {
 }
 }  // namespace
 
+// The criterion's vertical force: over each plate's stance, or over the loaded span (a foot loaded
+// before its plate's onset counted). Lab A's stances agree either way; lab B's "early" setting
+// loads its feet early (span 9 against stance 3), so the plate-stance criterion prefers it and the
+// loaded-span criterion does not.
+TEST(Study, TheCriterionTakesTheVerticalOverTheLoadedSpanWhenAsked) {
+  auto trial = [](const char* name, const char* lab, double vertical, double span) {
+    StudyTrialResult t = fake_trial(name, lab, 5);
+    SeriesMetrics v, sp;
+    v.rrmse_percent = vertical, sp.rrmse_percent = span;
+    t.stances[0].metrics.vertical = v;
+    t.stances[0].vertical_loaded_span = sp;
+    return t;
+  };
+  StudyResult s;
+  s.kind = "test";
+  s.rows = {{"early", 0, false, {}}, {"on time", 1, true, {}}};
+  s.per_trial = {{trial("a1", "A", 5, 5), trial("b1", "B", 3, 9)}, {trial("a1", "A", 5, 5), trial("b1", "B", 4, 4)}};
+  EXPECT_EQ(cross_validate(s).in_sample_choice, "early");
+  const CrossValidation span = cross_validate(s, CrossValidation::Vertical::LoadedSpan);
+  EXPECT_EQ(span.in_sample_choice, "on time");
+  EXPECT_NEAR(span.default_criterion, ((5 + 5 + 5) / 3.0 + (4 + 5 + 5) / 3.0) / 2, 1e-12);
+  EXPECT_NE(format_cross_validation(s, span).find("loaded span"), std::string::npos);
+  EXPECT_EQ(parse_criterion("loaded-span"), CrossValidation::Vertical::LoadedSpan);
+  EXPECT_EQ(parse_criterion("plate-stance"), CrossValidation::Vertical::PlateStance);
+  EXPECT_THROW((void)parse_criterion("span"), InputError);
+}
+
 // Leave-one-lab-out: lab A fits setting "low", labs B and C fit "high". In-sample picks "high"
 // (two labs of three); with B or C held out, the other two labs tie and the first setting is kept,
 // so B and C are scored at "low" and A at "high": the held-out figure shows what a lab unlike the

@@ -76,6 +76,55 @@ TEST(Validate, LagOfDelayedPlatesIsMeasured) {
   }
 }
 
+// The failure mode: the per-stance rRMSE starts at the plate's onset, so an estimate that loads
+// a foot before it lands is not charged for it (the issue-29 walks' landings, 27-47 ms early).
+// The loaded span counts those frames against the plate's own reading. The example walk with its
+// plates recorded 3 frames late: each landing's span reaches 3 frames further back than as
+// recorded, over frames the estimate loads and the plate reads below the threshold, and its error
+// exceeds the stance's. A squat with exact plates whose signals start and end 10 frames inside the
+// stance (feet loaded throughout, never landing): the span is the stance, the figures agree.
+TEST(Validate, TheLoadedSpanCountsAFootLoadedBeforeItsPlatesOnset) {
+  Trial t = make_example_walk();
+  const EstimateResult r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), {});
+  const auto v0 = validate(r, *t.plates);
+  ASSERT_EQ(v0.stances.size(), 2u);
+  std::map<std::string, Eigen::Index> early_as_recorded;
+  for (const auto& st : v0.stances) early_as_recorded[st.plate] = st.first - st.span_first;
+  for (auto& p : t.plates->plates) {
+    const Eigen::Index n = p.force_N.rows();
+    Eigen::MatrixX3d F = Eigen::MatrixX3d::Zero(n, 3), C = p.cop_m, M = Eigen::MatrixX3d::Zero(n, 3);
+    F.bottomRows(n - 3) = p.force_N.topRows(n - 3);
+    C.bottomRows(n - 3) = p.cop_m.topRows(n - 3);
+    M.bottomRows(n - 3) = p.moment_centre_Nm.topRows(n - 3);
+    p.force_N = F, p.cop_m = C, p.moment_centre_Nm = M;
+  }
+  const auto v = validate(r, *t.plates);
+  ASSERT_EQ(v.stances.size(), 2u);
+  for (const auto& st : v.stances) {
+    const auto& ev = r.feet[static_cast<std::size_t>(st.foot)].force_N;
+    EXPECT_EQ(st.first - st.span_first, early_as_recorded.at(st.plate) + 3) << "the landing's frames before the late plate's onset";
+    for (Eigen::Index i = st.span_first; i < st.first; ++i) {
+      EXPECT_GT(ev(i, 1), 20.0) << "frame " << i;
+      EXPECT_LT(v.plates[static_cast<std::size_t>(st.plate_index)].force_N(i, 1), 20.0) << "frame " << i;
+    }
+    EXPECT_TRUE(st.span_first == 0 || !(ev(st.span_first - 1, 1) > 20.0)) << "the span starts where the estimate's load does";
+    ASSERT_TRUE(st.vertical_loaded_span && st.metrics.vertical);
+    EXPECT_EQ(st.vertical_loaded_span->samples, st.metrics.vertical->samples + (st.first - st.span_first) + (st.span_last - st.last));
+    EXPECT_GT(st.vertical_loaded_span->rmse, st.metrics.vertical->rmse);
+  }
+  // Standing: the plates' signals start and end 10 frames inside the feet's stance.
+  const auto s = synthetic_with_exact_plates();
+  const auto vs = validate(s.estimate, s.plates);
+  ASSERT_FALSE(vs.stances.empty());
+  for (const auto& st : vs.stances) {
+    EXPECT_EQ(st.span_first, st.first);
+    EXPECT_EQ(st.span_last, st.last);
+    ASSERT_TRUE(st.vertical_loaded_span && st.metrics.vertical);
+    EXPECT_DOUBLE_EQ(st.vertical_loaded_span->rrmse_percent, st.metrics.vertical->rrmse_percent);
+  }
+  EXPECT_DOUBLE_EQ(mean_rrmse(vs.stances).vertical_loaded_span, mean_rrmse(vs.stances).vertical);
+}
+
 TEST(Validate, AssignmentFollowsTheCopNotThePlateName) {
   auto s = synthetic_with_exact_plates();
   // Swap the plates' signals: FP1 now carries the left foot's forces (and COP).

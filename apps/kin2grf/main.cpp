@@ -115,6 +115,12 @@ int main(int argc, char** argv) {
     study->add_option("--cross-validate", study_args.cross_validate,
                       "Also choose the setting leave-one-lab-out and print in-sample against held-out figures")
         ->check(CLI::IsMember({"lab"}));
+    study->add_option("--criterion", study_args.criterion,
+                      "The vertical force the leave-one-lab-out criterion takes: over each plate's stance (plate-stance, the "
+                      "default), or over the loaded span, which counts a foot loaded before its plate's onset or after its offset "
+                      "(loaded-span)")
+        ->check(CLI::IsMember({"plate-stance", "loaded-span"}))
+        ->capture_default_str();
     study->add_option("--plates", study_args.plates, "Measured forces for the TRIAL arguments (GRF .mot)");
     study->add_option("--json", study_args.out_json, "Study results as JSON");
     study->add_option("--report", study_args.report, "HTML report with the rRMSE-against-setting plots");

@@ -8,7 +8,8 @@
 //   forefoot rocker about the MT ground point to -phi_to at toe-off (60 %: 10 % double supports),
 //   speeding up so that the foot leaves the ground rotating. The swing carries the foot from its
 //   toe-off pose and velocity to rest at the next heel strike one stride ahead (minimum jerk plus
-//   a quintic term for the initial velocity), with a heel lift of `clearance_m`.
+//   a quintic term for the initial velocity), with a heel lift of `clearance_m`; with
+//   `heel_strike_descent_mps` it lands descending at that speed and stops at the heel strike.
 // - Knees from the two-link inverse kinematics of hip and ankle (knee forward); the torso leans
 //   forward by 0.05 rad over the hips.
 // - In 3D (issue 28): the feet's lines `step_width_m` apart; the hips and shoulders (0.1 m either
@@ -107,6 +108,10 @@ FootPose foot_pose(double cycles, double first_heel_x, const SyntheticWalkOption
   f.phi = off.phi + (on.phi - off.phi) * s + (off.phi - before.phi) * carry;
   f.heel_ground = off.heel_ground + (on.heel_ground - off.heel_ground) * s + (off.heel_ground - before.heel_ground) * carry;
   f.heel_ground.y() += o.clearance_m * std::pow(std::sin(M_PI * u), 2);
+  // A landing at speed: the quintic Hermite term of the final velocity (zero at both ends, zero
+  // velocity and acceleration at the start and acceleration at the end, slope 1 at the end),
+  // scaled to the swing's duration; it keeps the foot above its path (u^3 (3u - 4)(1 - u) <= 0).
+  f.heel_ground.y() -= o.heel_strike_descent_mps * (1 - kStanceEnd) * o.stride_time_s * (-4 * std::pow(u, 3) + 7 * std::pow(u, 4) - 3 * std::pow(u, 5));
   f.pivot_x = heel_x + stride * s;
   return f;
 }
@@ -115,8 +120,8 @@ FootPose foot_pose(double cycles, double first_heel_x, const SyntheticWalkOption
 
 SyntheticWalk make_synthetic_walk(const SyntheticWalkOptions& o) {
   if (!(o.speed_mps > 0.2 && o.speed_mps < 2.5 && o.stride_time_s > 0.6 && o.stride_time_s < 2.5 && o.duration_s >= 2 * o.stride_time_s &&
-        o.duration_s <= 600 && o.rate_hz >= 50 && o.rate_hz <= 2000))
-    throw InputError("synthetic walk: speed 0.2-2.5 m/s, stride time 0.6-2.5 s, at least two strides, 50-2000 Hz");
+        o.duration_s <= 600 && o.rate_hz >= 50 && o.rate_hz <= 2000 && o.heel_strike_descent_mps >= 0 && o.heel_strike_descent_mps <= 1))
+    throw InputError("synthetic walk: speed 0.2-2.5 m/s, stride time 0.6-2.5 s, at least two strides, 50-2000 Hz, heel-strike descent 0-1 m/s");
   SyntheticWalk w;
   w.trial = example_trial_frame("synthetic walk", o.duration_s, o.rate_hz, o.mass_kg);
   auto& m = w.trial.markers;

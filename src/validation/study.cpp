@@ -348,7 +348,13 @@ StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& tr
   return res;
 }
 
-CrossValidation cross_validate(const StudyResult& s) {
+CrossValidation::Vertical parse_criterion(const std::string& text) {
+  if (text == "plate-stance") return CrossValidation::Vertical::PlateStance;
+  if (text == "loaded-span") return CrossValidation::Vertical::LoadedSpan;
+  throw InputError("--criterion " + text + ": give plate-stance or loaded-span");
+}
+
+CrossValidation cross_validate(const StudyResult& s, CrossValidation::Vertical vertical) {
   if (s.per_trial.empty() || s.per_trial.front().empty()) throw InputError("cross-validation: the study has no trials");
   const auto& first = s.per_trial.front();
   std::vector<std::string> labs, activities;
@@ -373,7 +379,7 @@ CrossValidation cross_validate(const StudyResult& s) {
         }
       if (st.empty()) continue;
       const MeanMetrics m = mean_rrmse(st);
-      score += (m.vertical + m.anterior + m.cop) / 3.0, ++nlabs;
+      score += ((vertical == CrossValidation::Vertical::LoadedSpan ? m.vertical_loaded_span : m.vertical) + m.anterior + m.cop) / 3.0, ++nlabs;
     }
     return nlabs ? score / nlabs : std::numeric_limits<double>::quiet_NaN();
   };
@@ -394,6 +400,7 @@ CrossValidation cross_validate(const StudyResult& s) {
     return best;
   };
   CrossValidation cv;
+  cv.vertical = vertical;
   for (std::size_t r = 0; r < s.per_trial.size(); ++r)
     cv.criterion.emplace_back(s.rows[r].label, criterion(r, [](const StudyTrialResult&) { return true; }));
   const std::size_t all = choose([](const StudyTrialResult&) { return true; });
@@ -434,7 +441,9 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
   char b[256];
   os << "\nleave-one-lab-out (" << s.kind << "): chosen on all trials: " << cv.in_sample_choice << "\n";
   for (const auto& [lab, choice] : cv.lab_choice) os << "  without " << lab << ": " << choice << "\n";
-  os << "criterion on all trials (mean over labs of (vertical + anterior + COP) / 3, %):";
+  os << (cv.vertical == CrossValidation::Vertical::LoadedSpan
+             ? "criterion on all trials (mean over labs of (vertical over the loaded span + anterior + COP) / 3, %):"
+             : "criterion on all trials (mean over labs of (vertical + anterior + COP) / 3, %):");
   for (std::size_t r = 0; r < cv.criterion.size(); ++r) {  // one entry per row of the study, in its order
     const auto& [label, c] = cv.criterion[r];
     std::snprintf(b, sizeof b, " %s%s %.2f;", label.c_str(), r < s.rows.size() && s.rows[r].is_default ? " (default)" : "", c);
@@ -450,8 +459,8 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
     }
     os << "\n";
   }
-  std::snprintf(b, sizeof b, "%-14s %-10s %9s %9s %9s %10s %10s   %s\n", "activity", "", "vertical", "anterior", "COP", "total GRM",
-                "|onset| ms", "worst trial (vertical)");
+  std::snprintf(b, sizeof b, "%-14s %-10s %9s %9s %9s %10s %10s %9s   %s\n", "activity", "", "vertical", "anterior", "COP", "total GRM",
+                "|onset| ms", "span", "worst trial (vertical)");
   os << b;
   auto tot = [](double x) {
     char t[32];
@@ -459,12 +468,13 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
     return std::string(t);
   };
   for (const auto& c : cv.cells) {
-    std::snprintf(b, sizeof b, "%-14s %-10s %9.1f %9.1f %9.1f %10s %10s\n", c.activity.c_str(), "in-sample", c.in_sample.vertical,
-                  c.in_sample.anterior, c.in_sample.cop, tot(c.in_sample_total_grm).c_str(), tot(c.in_sample.onset_abs_ms).c_str());
+    std::snprintf(b, sizeof b, "%-14s %-10s %9.1f %9.1f %9.1f %10s %10s %9s\n", c.activity.c_str(), "in-sample", c.in_sample.vertical,
+                  c.in_sample.anterior, c.in_sample.cop, tot(c.in_sample_total_grm).c_str(), tot(c.in_sample.onset_abs_ms).c_str(),
+                  tot(c.in_sample.vertical_loaded_span).c_str());
     os << b;
-    std::snprintf(b, sizeof b, "%-14s %-10s %9.1f %9.1f %9.1f %10s %10s   %s %.1f\n", "", "held-out", c.held_out.vertical,
+    std::snprintf(b, sizeof b, "%-14s %-10s %9.1f %9.1f %9.1f %10s %10s %9s   %s %.1f\n", "", "held-out", c.held_out.vertical,
                   c.held_out.anterior, c.held_out.cop, tot(c.held_out_total_grm).c_str(), tot(c.held_out.onset_abs_ms).c_str(),
-                  c.worst_trial.c_str(), c.worst_vertical);
+                  tot(c.held_out.vertical_loaded_span).c_str(), c.worst_trial.c_str(), c.worst_vertical);
     os << b;
   }
   return os.str();
@@ -474,10 +484,13 @@ nlohmann::json cross_validation_json(const CrossValidation& cv) {
   auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
   auto metrics = [&](const MeanMetrics& m, double grm) {
     return nlohmann::json{{"stances", m.n},   {"vertical", num(m.vertical)}, {"anterior", num(m.anterior)},
-                          {"cop", num(m.cop)}, {"total_grm", num(grm)},      {"onset_abs_ms", num(m.onset_abs_ms)}};
+                          {"cop", num(m.cop)}, {"total_grm", num(grm)},      {"onset_abs_ms", num(m.onset_abs_ms)},
+                          {"vertical_loaded_span", num(m.vertical_loaded_span)}};
   };
   nlohmann::json j;
-  j["criterion"] = "mean over labs of the lab's mean per-stance (vertical + anterior + COP) / 3 rRMSE, all activities pooled";
+  j["criterion"] = cv.vertical == CrossValidation::Vertical::LoadedSpan
+                       ? "mean over labs of the lab's mean per-stance (vertical over the loaded span + anterior + COP) / 3 rRMSE, all activities pooled"
+                       : "mean over labs of the lab's mean per-stance (vertical + anterior + COP) / 3 rRMSE, all activities pooled";
   j["in_sample_choice"] = cv.in_sample_choice;
   for (const auto& [label, c] : cv.criterion) j["criterion_all_trials"][label] = num(c);
   j["criterion_held_out"] = num(cv.held_out_criterion);

@@ -354,6 +354,19 @@ void stance_timing(const EstimateResult& e, const MeasuredPlate& mp, const Candi
     if (const auto e_on = rising_crossing(ev, e.time_s, o.threshold_N, from, c.run.last)) s.onset_error_ms = 1000 * (*e_on - *m_on);
   if (m_off && !(ev[to] > o.threshold_N))
     if (const auto e_off = falling_crossing(ev, e.time_s, o.threshold_N, a, to)) s.offset_error_ms = 1000 * (*e_off - *m_off);
+  // The loaded span: the estimate's load on the foot next to its stance, while the plate it lands
+  // on (or leaves) reads below the threshold, counted against that reading (a NaN plate stops it).
+  // Only a landing's or a lift-off's: the estimate's load must begin (end) within the search, so
+  // that the foot was in the air before (after); a foot loaded throughout (a standing trial whose
+  // plate signal starts late) keeps its stance.
+  Eigen::Index first = a, last = c.run.last;
+  while (first > from && ev[first - 1] > o.threshold_N && pv[first - 1] < o.threshold_N) --first;
+  if (first < a && !(first > from && !(ev[first - 1] > o.threshold_N))) first = a;
+  while (last < to && ev[last + 1] > o.threshold_N && pv[last + 1] < o.threshold_N) ++last;
+  if (last > c.run.last && !(last < to && !(ev[last + 1] > o.threshold_N))) last = c.run.last;
+  s.span_first = first;
+  s.span_last = last;
+  s.vertical_loaded_span = compare_series(ev.segment(first, last - first + 1), pv.segment(first, last - first + 1));
   s.vertical_lag_ms = vertical_lag_ms(ev, pv, a, c.run.last, rate);
 }
 
@@ -790,10 +803,12 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
 MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   MeanMetrics mm;
   std::array<std::vector<double>, 5> vals;
-  std::vector<double> lateral_rmse, cop_lateral_rmse, onset_abs;
+  std::vector<double> lateral_rmse, cop_lateral_rmse, onset_abs, loaded_span;
   for (const auto& s : stances) {
     if (foot >= 0 && s.foot != foot) continue;
     if (s.onset_error_ms && std::isfinite(*s.onset_error_ms)) onset_abs.push_back(std::abs(*s.onset_error_ms));
+    if (s.vertical_loaded_span && std::isfinite(s.vertical_loaded_span->rrmse_percent))
+      loaded_span.push_back(s.vertical_loaded_span->rrmse_percent);
     const std::array<const std::optional<SeriesMetrics>*, 5> c = {&s.metrics.vertical, &s.metrics.anterior, &s.metrics.cop,
                                                                    &s.metrics.moment, &s.metrics.lateral};
     for (std::size_t k = 0; k < 5; ++k)
@@ -813,6 +828,7 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   };
   mm.cop_lateral_rmse_mm = mean_of(cop_lateral_rmse);
   mm.onset_abs_ms = mean_of(onset_abs);
+  mm.vertical_loaded_span = mean_of(loaded_span);
   mm.lateral_rmse_percent_bw = mean_of(lateral_rmse);
   std::array<double*, 5> mean = {&mm.vertical, &mm.anterior, &mm.cop, &mm.moment, &mm.lateral};
   std::array<double*, 5> sd = {&mm.vertical_sd, &mm.anterior_sd, &mm.cop_sd, &mm.moment_sd, &mm.lateral_sd};
@@ -913,6 +929,9 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     x["cop_rmse_percent_foot"] = s.metrics.cop ? num(100 * s.metrics.cop->rmse / s.foot_length_m) : nlohmann::json(nullptr);
     x["cop_reference_suspect"] = s.cop_reference_suspect;
     x["timing_ms"] = {{"onset", opt(s.onset_error_ms)}, {"offset", opt(s.offset_error_ms)}, {"vertical_lag", opt(s.vertical_lag_ms)}};
+    x["loaded_span"] = {{"frames", {e.first_frame_number + s.span_first, e.first_frame_number + s.span_last}},
+                        {"vertical_rrmse_percent", s.vertical_loaded_span ? num(s.vertical_loaded_span->rrmse_percent) : nlohmann::json(nullptr)},
+                        {"vertical_rmse_percent_bw", s.vertical_loaded_span ? num(100 * s.vertical_loaded_span->rmse / bw) : nlohmann::json(nullptr)}};
     if (s.moments_3d) x["joint_moments_3d"] = joint_moments_json(*s.moments_3d);
     j["per_foot"].push_back(x);
   }
@@ -934,7 +953,8 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
   for (int f = -1; f < 2; ++f) {
     const MeanMetrics m = mean_rrmse(v.stances, f);
     means[f < 0 ? "all" : side_name(f)] = {{"stances", m.n},         {"vertical", num(m.vertical)}, {"anterior", num(m.anterior)},
-                                            {"cop", num(m.cop)},      {"moment", num(m.moment)}};
+                                            {"cop", num(m.cop)},      {"moment", num(m.moment)},
+                                            {"vertical_loaded_span", num(m.vertical_loaded_span)}};
     if (std::isfinite(m.knee_adduction)) {
       auto& x = means[f < 0 ? "all" : side_name(f)];
       x["knee_sagittal_moment"] = num(m.knee_sagittal);
@@ -1060,6 +1080,15 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
   if (m.n > 0)
     os << table_label("per foot, mean (SD), n = " + std::to_string(m.n)) << table_msd(m.vertical, m.vertical_sd)
        << table_msd(m.anterior, m.anterior_sd) << table_msd(m.cop, m.cop_sd) << table_msd(m.moment, m.moment_sd) << "\n";
+  if (m.n > 0 && std::isfinite(m.vertical_loaded_span)) {
+    // The early and late loaded frames the stance columns do not see.
+    long early = 0, late = 0;
+    for (const auto& s : v.stances) early += static_cast<long>(s.first - s.span_first), late += static_cast<long>(s.span_last - s.last);
+    std::snprintf(buf, sizeof buf, "%.1f", m.vertical_loaded_span);
+    os << table_label("per foot, loaded span") << table_text(buf);
+    std::snprintf(buf, sizeof buf, "   vertical with the foot's load before its plate's onset (%ld frames) and after its offset (%ld)\n", early, late);
+    os << buf;
+  }
   if (std::isfinite(m.lateral_rmse_percent_bw)) format_lateral_rows(os, v, m);
   if (std::isfinite(m.knee_adduction)) format_joint_moment_rows(os, v, m, v.mass_kg);
   if (v.total)

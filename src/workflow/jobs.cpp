@@ -158,7 +158,7 @@ int study_job(const StudyJob& a, std::ostream& out, std::ostream& log) {
   out << format_study_table(res);
   auto j = study_json(res);
   if (!a.cross_validate.empty()) {
-    const auto cv = cross_validate(res);
+    const auto cv = cross_validate(res, parse_criterion(a.criterion));
     out << format_cross_validation(res, cv);
     j["cross_validation"] = cross_validation_json(cv);
   }

@@ -53,6 +53,10 @@ struct SyntheticWalkOptions {
   double clearance_m = 0.08;        ///< heel lift at mid-swing
   double heel_strike_angle_rad = 0.25;  ///< foot inclination at heel strike (toes up)
   double toe_off_angle_rad = 0.7;       ///< at toe-off (heel up)
+  /// The heel's descent at heel strike, m/s: 0 lands the swing foot at rest (the example's); a real
+  /// heel lands at 0.1-0.35 m/s and stops at the impact, which the kinematics' zero-lag filter
+  /// spreads over the frames before it (the touchdown rule's case, issue 29).
+  double heel_strike_descent_mps = 0.0;
   /// 3D gait (issue 28's synthetic walk; the defaults keep every marker in its side's vertical
   /// plane, the walk of the 2D tests):
   double step_width_m = 0.2;    ///< lateral distance between the feet's lines

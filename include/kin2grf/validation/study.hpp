@@ -89,6 +89,10 @@ struct StudyTrialResult {
 /// serves every activity, as kin2grf's defaults do). A tie keeps kin2grf's default setting (a
 /// default changes only when the figure improves), else the first (lowest) setting.
 struct CrossValidation {
+  /// The vertical rRMSE the criterion takes: over the plate's stance (the paper's; the default),
+  /// or over the loaded span (StanceValidation::vertical_loaded_span: a foot loaded before its
+  /// plate's onset or after its offset is counted against the plate's reading there).
+  enum class Vertical { PlateStance, LoadedSpan } vertical = Vertical::PlateStance;
   std::string in_sample_choice;                   ///< the setting chosen on every trial
   std::vector<std::pair<std::string, double>> criterion;  ///< per setting, on every trial
   std::vector<std::pair<std::string, std::string>> lab_choice;  ///< held lab -> setting chosen without it
@@ -123,7 +127,9 @@ StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& tr
 
 /// Leave-one-lab-out: for each lab, the setting with the lowest criterion on the other labs'
 /// trials, scored on that lab's. Needs trials from at least 2 labs (InputError otherwise).
-CrossValidation cross_validate(const StudyResult& s);
+CrossValidation cross_validate(const StudyResult& s, CrossValidation::Vertical vertical = CrossValidation::Vertical::PlateStance);
+/// `--criterion` as the user gives it: "plate-stance" or "loaded-span"; InputError otherwise.
+CrossValidation::Vertical parse_criterion(const std::string& text);
 std::string format_cross_validation(const StudyResult& s, const CrossValidation& cv);
 nlohmann::json cross_validation_json(const CrossValidation& cv);
 

@@ -188,6 +188,13 @@ struct StanceValidation {
   double foot_length_m = std::numeric_limits<double>::quiet_NaN();
   ComponentMetrics metrics;
   std::optional<double> onset_error_ms, offset_error_ms;  ///< estimate - plate; + = late
+  /// The loaded span: the stance's frames with the estimate's loaded frames next to them (its
+  /// vertical force above the stance threshold while the plate reads below it, at most 0.2 s on
+  /// each side), in the estimate's window, inclusive. The vertical rRMSE above compares the plate's
+  /// stance alone, which does not see a foot loaded before it lands or after it lifts; the foot is
+  /// in the air there, so the plate's own reading (about 0 N) is its load.
+  Eigen::Index span_first = 0, span_last = 0;
+  std::optional<SeriesMetrics> vertical_loaded_span;  ///< vertical force over the loaded span
   /// Time shift of the estimate's vertical force that best matches the plate over the stance
   /// (least RMSE over shifts of up to 60 ms, parabolic refinement between frames); + = the
   /// estimate lags, - = it leads.
@@ -256,6 +263,8 @@ void validate_total_3d(const EstimateResult& estimate, ValidationResult& v);
 struct MeanMetrics {
   int n = 0;
   double vertical = 0, anterior = 0, cop = 0, moment = 0, lateral = 0;
+  /// Mean vertical rRMSE over each stance's loaded span (StanceValidation::vertical_loaded_span).
+  double vertical_loaded_span = 0;
   double vertical_sd = 0, anterior_sd = 0, cop_sd = 0, moment_sd = 0, lateral_sd = 0;
   /// Mean mediolateral force RMSE, % body weight (NaN without --mediolateral): its rRMSE divides
   /// by a range of 10-15 % body weight, so a few newtons read large.

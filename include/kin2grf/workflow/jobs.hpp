@@ -32,6 +32,7 @@ struct ValidateJob {
 
 struct StudyJob {
   std::string kind, trial_list, out_json, report, cross_validate;
+  std::string criterion = "plate-stance";  ///< --criterion (parse_criterion)
   std::vector<std::string> trials;
   EstimateJob est;
   std::string plates;
