@@ -770,6 +770,7 @@ TEST(SharedEstimate, ALandingFootsLoadBeforeItsHeelHasStoppedIsDroppedNotMoved) 
   EstimateOptions off, on;
   off.keep_all_series = on.keep_all_series = true;
   off.double_support_sta_weight = on.double_support_sta_weight = 0.0;  // the drop alone (the handover would move the split too)
+  off.touchdown_stop_fraction = 0.0;
   on.touchdown_stop_fraction = 0.1;
   const MarkerSet& set = *recognise_marker_set(t.markers);
   const EstimateResult a = estimate(t, nullptr, set, off), b = estimate(t, nullptr, set, on);
@@ -825,6 +826,7 @@ TEST(Estimate, TheTouchdownRuleDropsTheLoadBeforeHeelStrikeAndLeavesTheHandoverA
   const MarkerSet& set = *recognise_marker_set(w.trial.markers);
   EstimateOptions off, on;
   off.keep_all_series = on.keep_all_series = true;
+  off.touchdown_stop_fraction = 0.0;
   on.touchdown_stop_fraction = 0.1;
   ASSERT_GT(off.double_support_sta_weight, 0.0);  // the default's handover
   const EstimateResult a = estimate(w.trial, nullptr, set, off), b = estimate(w.trial, nullptr, set, on);

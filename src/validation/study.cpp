@@ -513,8 +513,10 @@ nlohmann::json study_json(const StudyResult& s) {
     for (const auto& c : r.cells)
       row["activities"][c.activity] = {{"trials", c.trials},
                                        {"stances", c.per_foot.n},
+                                       {"onset_abs_ms", num(c.per_foot.onset_abs_ms)},
                                        {"rrmse_percent",
                                         {{"vertical", num(c.per_foot.vertical)},
+                                         {"vertical_loaded_span", num(c.per_foot.vertical_loaded_span)},
                                          {"anterior", num(c.per_foot.anterior)},
                                          {"cop", num(c.per_foot.cop)},
                                          {"moment", num(c.per_foot.moment)},

@@ -161,6 +161,10 @@ int study_job(const StudyJob& a, std::ostream& out, std::ostream& log) {
     const auto cv = cross_validate(res, parse_criterion(a.criterion));
     out << format_cross_validation(res, cv);
     j["cross_validation"] = cross_validation_json(cv);
+    // Both criteria in the JSON, whichever was asked for (VALIDATION.md reports them side by side).
+    for (const auto vertical : {CrossValidation::Vertical::PlateStance, CrossValidation::Vertical::LoadedSpan})
+      j["cross_validation_by_criterion"][vertical == CrossValidation::Vertical::LoadedSpan ? "loaded-span" : "plate-stance"] =
+          vertical == cv.vertical ? j["cross_validation"] : cross_validation_json(cross_validate(res, vertical));
   }
   if (!a.out_json.empty()) write_file_text(a.out_json, json_text(j));
   if (!a.report.empty()) write_file_text(a.report, study_report_html(res));
