@@ -131,29 +131,32 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   t << "<h2>Errors against the force plates</h2>\n<p>rRMSE and RMSE as in the paper's Eqs. 11-12, per plate stance "
        "(measured vertical force above the threshold) and in total where every loaded foot stands on a plate. "
        "COP compared where the plate carries at least 5 % of body weight; moment about the plate centre (total: GRM about "
-       "the midpoint of the plates in use). Timing: estimate minus plate, + = late. In brackets: a plate whose COP is "
+       "the midpoint of the plates in use). Timing: estimate minus plate, + = late. Loaded span: the stance with the frames "
+       "next to it where the estimate loads the foot while the plate reads under the threshold (a landing loaded before "
+       "it lands), against the plate's reading there. In brackets: a plate whose COP is "
        "not where the markers put the foot (validate's registration check), kept for the record, left out of the "
        "means.</p>\n";
   t << "<table><tr><th class=l>foot</th><th class=l>plate</th><th>frames</th><th>vertical rRMSE %</th><th>anterior rRMSE %</th>"
        "<th>COP rRMSE %</th><th>moment rRMSE %</th><th>vertical RMSE N</th><th>anterior RMSE N</th><th>COP RMSE mm</th>"
-       "<th>vertical r</th><th>onset ms</th><th>offset ms</th></tr>\n";
+       "<th>vertical r</th><th>onset ms</th><th>offset ms</th><th>vertical rRMSE % over the loaded span</th></tr>\n";
   for (const auto& s : j["per_foot"]) {
     t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>())
       << "</td><td>" << s["frames"][0] << "-" << s["frames"][1] << "</td><td>" << fmt(s["rrmse_percent"]["vertical"]) << "</td><td>"
       << fmt(s["rrmse_percent"]["anterior"]) << "</td><td>" << fmt_cop(s, s["rrmse_percent"]["cop"]) << "</td><td>"
       << fmt_cop(s, s["rrmse_percent"]["moment"]) << "</td><td>" << fmt(s["rmse"]["vertical_N"]) << "</td><td>"
       << fmt(s["rmse"]["anterior_N"]) << "</td><td>" << fmt_cop(s, s["rmse"]["cop_mm"]) << "</td><td>" << fmt(s["r"]["vertical"], "%.3f")
-      << "</td><td>" << fmt(s["timing_ms"]["onset"], "%.0f") << "</td><td>" << fmt(s["timing_ms"]["offset"], "%.0f") << "</td></tr>\n";
+      << "</td><td>" << fmt(s["timing_ms"]["onset"], "%.0f") << "</td><td>" << fmt(s["timing_ms"]["offset"], "%.0f") << "</td><td>"
+      << fmt(s.contains("loaded_span") ? s["loaded_span"]["vertical_rrmse_percent"] : nlohmann::json()) << "</td></tr>\n";
   }
   if (!j["total"].is_null()) {
     const auto& s = j["total"];
     t << "<tr><td class=l>total</td><td class=l>GRM</td><td>" << s["frames_compared"] << " frames</td><td>"
       << fmt(s["rrmse_percent"]["vertical"]) << "</td><td>" << fmt(s["rrmse_percent"]["anterior"]) << "</td><td>-</td><td>"
       << fmt(s["rrmse_percent"]["moment"]) << "</td><td>" << fmt(s["rmse"]["vertical_N"]) << "</td><td>"
-      << fmt(s["rmse"]["anterior_N"]) << "</td><td>-</td><td>" << fmt(s["r"]["vertical"], "%.3f") << "</td><td></td><td></td></tr>\n";
+      << fmt(s["rmse"]["anterior_N"]) << "</td><td>-</td><td>" << fmt(s["r"]["vertical"], "%.3f") << "</td><td></td><td></td><td></td></tr>\n";
   }
   t << "<tr><td class=l colspan=3>paper, Table 1 (24 gait trials)</td><td>4.1 (1.1)</td><td>11.2 (1.7)</td><td>-</td>"
-       "<td>5.3 (1.1)</td><td colspan=6></td></tr>\n</table>\n";
+       "<td>5.3 (1.1)</td><td colspan=7></td></tr>\n</table>\n";
   if (!v.excluded.empty() || !v.notes.empty()) {
     t << "<h3>Excluded and notes</h3><ul>\n";
     for (const auto& x : v.excluded) t << "<li>excluded: " << html_escape(x) << "</li>\n";
