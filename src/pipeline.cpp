@@ -771,8 +771,7 @@ Messages touchdown_stage(const EstimateOptions& o, const Model& model, const Con
   if (!(o.touchdown_stop_fraction > 0) || heights[0][0].size() != motion.frames()) return out;
   const Eigen::Index n = raw.lambda.rows();
   const auto contact = foot_contact_states(raw, n);
-  TouchdownStopRule rule;
-  rule.fraction = o.touchdown_stop_fraction;
+  const TouchdownStopRule rule = touchdown_stop_rule(o.touchdown_stop_fraction, median_stance_s(contact, motion.rate_hz));
   long landings = 0, frames = 0;
   for (int side = 0; side < 2; ++side) {
     auto& before = raw.before_touchdown[static_cast<std::size_t>(side)];

@@ -340,6 +340,36 @@ TEST(Contact, AFootInContactBeforeItsHeelHasStoppedHasNotLandedYet) {
   EXPECT_EQ(std::count(off.begin(), off.end(), true), 0);
 }
 
+// A slow walker (issue 29's held-out 0.36 m/s walk): the heel comes down at 0.08 m/s and the solve's
+// contact begins 250 ms before it stops. The rule's fixed window (150 ms) and least descent
+// (0.1 m/s) miss it; scaled to the walker's 1.8 s stance (touchdown_stop_rule: x 2.4) it holds the
+// load back to within a few frames of the stop. A normal walk's stance keeps the fixed values.
+TEST(Contact, ASlowWalkersLandingIsFoundOnItsOwnTimeScale) {
+  const Eigen::Index n = 600, impact = 300;
+  Heights h{Eigen::VectorXd(n), Eigen::VectorXd::Constant(n, 0.02)};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i - impact) / 200.0;
+    h.heel[i] = 0.05 + (t < 0 ? std::min(0.08 * -t, 0.06) : 0.0);
+  }
+  const auto contact = contact_from(n, impact - 50, impact + 300);
+  const auto fixed = frames_before_touchdown(contact, h.heel, h.mt, 200.0, touchdown_stop_rule(0.1, std::nullopt));
+  EXPECT_EQ(std::count(fixed.begin(), fixed.end(), true), 0);
+  const auto slow = frames_before_touchdown(contact, h.heel, h.mt, 200.0, touchdown_stop_rule(0.1, 1.8));
+  const auto flagged = std::count(slow.begin(), slow.end(), true);
+  EXPECT_GE(flagged, 44);  // the 50 frames before the stop, give or take the 15 Hz filter's spread
+  EXPECT_LE(flagged, 56);
+  for (Eigen::Index i = impact + 8; i < n; ++i) EXPECT_FALSE(slow[static_cast<std::size_t>(i)]) << i;
+  // A normal walk's stance, or none: the rule's own values.
+  const TouchdownStopRule base, normal = touchdown_stop_rule(0.1, 0.7), none = touchdown_stop_rule(0.1, std::nullopt),
+                                scaled = touchdown_stop_rule(0.1, 1.5);
+  EXPECT_EQ(normal.window_s, base.window_s);
+  EXPECT_EQ(normal.min_descent_mps, base.min_descent_mps);
+  EXPECT_EQ(none.window_s, base.window_s);
+  EXPECT_DOUBLE_EQ(scaled.window_s, 2 * base.window_s);
+  EXPECT_DOUBLE_EQ(scaled.min_descent_mps, 0.5 * base.min_descent_mps);
+  EXPECT_EQ(scaled.fraction, 0.1);
+}
+
 // A foot that did not come down (a standing foot, a stance at the window's first frame, a foot
 // set down slower than a landing) is never held back, however high its landmarks: with no
 // descent seen there is no evidence that it has not landed.

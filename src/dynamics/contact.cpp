@@ -242,6 +242,17 @@ std::vector<bool> frames_before_touchdown(const std::vector<bool>& contact, cons
   return out;
 }
 
+TouchdownStopRule touchdown_stop_rule(double fraction, std::optional<double> stance_s) {
+  TouchdownStopRule rule;
+  rule.fraction = fraction;
+  if (stance_s && *stance_s > kTouchdownNormalStanceS) {
+    const double scale = *stance_s / kTouchdownNormalStanceS;
+    rule.window_s *= scale;
+    rule.min_descent_mps /= scale;
+  }
+  return rule;
+}
+
 void BeltVelocitySamples::add(const FrameContacts& fc) {
   for (const auto& p : fc.points)
     if (p.gap_m < 0.01) v_mps.push_back(p.velocity.x());
