@@ -30,6 +30,20 @@ using namespace kin2grf;
 
 using kin2grf::test::synthetic_with_exact_plates;
 
+namespace {
+/// Every plate's samples recorded `samples` late (zeros first; the plates' clock as it was).
+void delay_plates(ForcePlateRecording& rec, Eigen::Index samples) {
+  for (auto& p : rec.plates) {
+    const Eigen::Index n = p.force_N.rows();
+    Eigen::MatrixX3d F = Eigen::MatrixX3d::Zero(n, 3), C = p.cop_m, M = Eigen::MatrixX3d::Zero(n, 3);
+    F.bottomRows(n - samples) = p.force_N.topRows(n - samples);
+    C.bottomRows(n - samples) = p.cop_m.topRows(n - samples);
+    M.bottomRows(n - samples) = p.moment_centre_Nm.topRows(n - samples);
+    p.force_N = F, p.cop_m = C, p.moment_centre_Nm = M;
+  }
+}
+}  // namespace
+
 TEST(Validate, ExactPlatesGiveNearZeroError) {
   const auto s = synthetic_with_exact_plates();
   const auto v = validate(s.estimate, s.plates);
@@ -60,14 +74,7 @@ TEST(Validate, LagOfDelayedPlatesIsMeasured) {
   ASSERT_TRUE(v0.stances[0].vertical_lag_ms.has_value());
   EXPECT_NEAR(*v0.stances[0].vertical_lag_ms, 0.0, 1.0);
   // Plates recorded 2 frames (20 ms) late: the estimate leads them, a lag of -20 ms.
-  for (auto& p : s.plates.plates) {
-    const Eigen::Index n = p.force_N.rows();
-    Eigen::MatrixX3d F = Eigen::MatrixX3d::Zero(n, 3), C = p.cop_m, M = Eigen::MatrixX3d::Zero(n, 3);
-    F.bottomRows(n - 2) = p.force_N.topRows(n - 2);
-    C.bottomRows(n - 2) = p.cop_m.topRows(n - 2);
-    M.bottomRows(n - 2) = p.moment_centre_Nm.topRows(n - 2);
-    p.force_N = F, p.cop_m = C, p.moment_centre_Nm = M;
-  }
+  delay_plates(s.plates, 2);
   const auto v = validate(s.estimate, s.plates);
   ASSERT_FALSE(v.stances.empty());
   for (const auto& st : v.stances) {
@@ -90,14 +97,7 @@ TEST(Validate, TheLoadedSpanCountsAFootLoadedBeforeItsPlatesOnset) {
   ASSERT_EQ(v0.stances.size(), 2u);
   std::map<std::string, Eigen::Index> early_as_recorded;
   for (const auto& st : v0.stances) early_as_recorded[st.plate] = st.first - st.span_first;
-  for (auto& p : t.plates->plates) {
-    const Eigen::Index n = p.force_N.rows();
-    Eigen::MatrixX3d F = Eigen::MatrixX3d::Zero(n, 3), C = p.cop_m, M = Eigen::MatrixX3d::Zero(n, 3);
-    F.bottomRows(n - 3) = p.force_N.topRows(n - 3);
-    C.bottomRows(n - 3) = p.cop_m.topRows(n - 3);
-    M.bottomRows(n - 3) = p.moment_centre_Nm.topRows(n - 3);
-    p.force_N = F, p.cop_m = C, p.moment_centre_Nm = M;
-  }
+  delay_plates(*t.plates, 3);
   const auto v = validate(r, *t.plates);
   ASSERT_EQ(v.stances.size(), 2u);
   for (const auto& st : v.stances) {
