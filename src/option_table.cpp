@@ -13,8 +13,8 @@ const std::vector<NumericOption>& numeric_options() {
        // measured where it acts: as recorded no development trial's cut-off is lowered
        {0.0, 2.5, 3.0, 3.5, 4.0, 5.0}, "%.1f cycles, 2 mm", 1.0, "off, 2 mm", 0.002},
       {"post-cutoff-floor", "post_cutoff_floor_ratio", [](O& o) -> double& { return o.post_cutoff_floor_ratio; }, 0.0, 10.0, std::nullopt,
-       "The per-stance post-filter cut-off is not taken below this multiple of the dynamics' kinematic cut-off (0 = no floor, the "
-       "default)",
+       "The per-stance post-filter cut-off is not taken below this multiple of the dynamics' kinematic cut-off (default 0.75: a "
+       "slow walker's stance; 0 = no floor)",
        {0.0, 0.5, 0.75, 1.0, 1.5, 2.0}, "%.2f x kinematic", 1.0, "none"},
       {"ground-shift", "ground_shift_m", [](O& o) -> double& { return o.contact.ground_shift_m; }, 1.0, -1.0, std::nullopt,
        "Shift the ground by this much, m (robustness study)",

@@ -51,10 +51,13 @@ struct EstimateOptions {
   /// multipliers come from kinematics filtered at that cut-off, and the post-filter is there for
   /// the solve's switching, not to remove what the kinematics kept; 4 cycles over a slow walker's
   /// 1.75 s stance is 2.3 Hz, which clipped a held-out slow walk's loading peak (784 N measured,
-  /// 719 estimated; at a fixed 12 Hz its error halved). Off by default: every development trial's
-  /// per-stance cut-off (5.0-16.7 Hz) lies above 0.75 x 6 Hz, so `kin2grf study post-cutoff-floor`
-  /// cannot tell 0, 0.5 and 0.75 apart (criterion 8.59 %) and 1.0 costs a little (8.62 %).
-  double post_cutoff_floor_ratio = 0.0;
+  /// 719 estimated; at a fixed 12 Hz its error halved). 0.75 since session 32 (off before): every
+  /// development trial's per-stance cut-off (5.0-16.7 Hz) lies above 0.75 x 6 Hz, so `kin2grf study
+  /// post-cutoff-floor` cannot tell 0, 0.5 and 0.75 apart (criterion 7.999 %) and 1.0 costs a little
+  /// (8.013 %): 0.75 is the highest floor that leaves them as they are, and a slow walker's stance
+  /// gets the physical reason's (a synthetic 0.36 m/s walk: the feet's sum 1.85 -> 1.43 % body
+  /// weight RMS off the kinematic total).
+  double post_cutoff_floor_ratio = 0.75;
   /// Lower the kinematic cut-off to what the markers' noise allows (noise_limited_cutoff; kin2grf)
   /// or keep it fixed (the paper).
   bool cutoff_from_noise = true;
