@@ -276,7 +276,7 @@ inline constexpr double kTouchdownNormalStanceS = 0.75;
 /// (their product, a descent of about 15 mm, kept). With the fixed window a walker slowed 2.5
 /// times lost the rule where the solve's contact began more than 150 ms before the heel stopped
 /// or the heel came down slower than 0.1 m/s (the development walks on a clock stretched 2.5 x,
-/// markers and plates alike: mean |onset| 67 ms without the rule, 62 with the fixed one, 38 scaled;
+/// markers and plates alike: mean |onset| 67 ms without the rule, 62 with the fixed one, 40 scaled;
 /// PiG_Motion3 -120 -> 0 ms). No stance (nullopt): the fixed values.
 TouchdownStopRule touchdown_stop_rule(double fraction, std::optional<double> stance_s);
 
