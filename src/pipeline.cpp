@@ -175,6 +175,12 @@ void append(Messages& to, Messages&& from) {
   to.insert(to.end(), std::make_move_iterator(from.begin()), std::make_move_iterator(from.end()));
 }
 
+/// The lateral force's and the frontal balance's cut-off: EstimateOptions::lateral_cutoff_hz, at
+/// most `kinematic_cutoff_hz` (0: the kinematic one).
+double lateral_cutoff(const EstimateOptions& o, double kinematic_cutoff_hz) {
+  return o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kinematic_cutoff_hz) : kinematic_cutoff_hz;
+}
+
 /// Whether the frontal split (EstimateOptions::frontal_split_weight) acts: where the solver fades
 /// its sagittal split of feet side by side (SolverOptions::min_split_distance_m).
 bool frontal_split_on(const EstimateOptions& o) { return o.frontal_split_weight > 0 && o.solver.min_split_distance_m > 0; }
@@ -841,6 +847,18 @@ void drop_touchdown_load(const std::vector<std::pair<Eigen::Index, int>>& droppe
   }
 }
 
+/// The layout of the solve's both-feet torque maps (RawSolve::both_feet_torque_map) for a move of
+/// load with force angle share `angle`: whether the tangential maps are there and used, and the
+/// doubles per frame.
+struct TorqueMapLayout {
+  bool tangent = false;
+  Eigen::Index per_frame = 0;
+};
+TorqueMapLayout torque_map_layout(const RawSolve& raw, double angle) {
+  const bool tangent = angle > 0 && raw.both_feet_tangent_map;
+  return {tangent, (tangent ? 2 : 1) * kJointCount * static_cast<Eigen::Index>(raw.point_side.size())};
+}
+
 /// Frame k's load moved between the feet (the double-support transition, the frontal split): each
 /// foot's normal multipliers scaled by its `factor` (its COP does not move), its tangential ones
 /// following by `angle` (transition_tangent; 0: as they are), and the joint torques with them
@@ -876,8 +894,7 @@ Messages double_support_transition(double w, double angle, const std::array<std:
   const int np = static_cast<int>(raw.point_side.size());
   // The maps' layout is the solve's (RawSolve::both_feet_tangent_map), which kept the tangential
   // ones when `angle` asked for them.
-  const bool tangent = angle > 0 && raw.both_feet_tangent_map;
-  const Eigen::Index per_frame = (tangent ? 2 : 1) * kJointCount * np;
+  const TorqueMapLayout map = torque_map_layout(raw, angle);
   const auto supports = walking_double_supports(contact, max_frames);
   for (const DoubleSupport& ds : supports) {
     const auto t = static_cast<std::size_t>(ds.trailing);
@@ -896,8 +913,8 @@ Messages double_support_transition(double w, double angle, const std::array<std:
       // Every frame of a double support has both feet active in the solve (the contact states
       // are the solve's), so it has its map; the test is a guard, not a case.
       if (it == raw.both_feet_frames.end() || *it != k) continue;
-      const double* G = raw.both_feet_torque_map.data() + (it - raw.both_feet_frames.begin()) * per_frame;
-      move_load(factor, tangent ? angle : 0.0, G, raw.point_side, k, lamf, joint_torque_Nm);
+      const double* G = raw.both_feet_torque_map.data() + (it - raw.both_feet_frames.begin()) * map.per_frame;
+      move_load(factor, map.tangent ? angle : 0.0, G, raw.point_side, k, lamf, joint_torque_Nm);
     }
   }
   Messages out;
@@ -927,8 +944,8 @@ struct FrontalBalance {
 /// lag either, and on standing, where the lateral force is about nil.
 FrontalBalance frontal_balance(const EstimateOptions& o, const SagittalStage& sag, const Model& model) {
   const UpperBodySegments upper = upper_body_segments(sag.upper_body_lab_m, anthropometric_table(o.anthropometry));
-  const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, o.kinematic_cutoff_hz) : o.kinematic_cutoff_hz;
-  WholeBodyLateral wb = whole_body_lateral(model, sag.com_sums_m, &upper, sag.lateral_axis, sag.landmarks.rate_hz, cutoff);
+  WholeBodyLateral wb =
+      whole_body_lateral(model, sag.com_sums_m, &upper, sag.lateral_axis, sag.landmarks.rate_hz, lateral_cutoff(o, o.kinematic_cutoff_hz));
   return FrontalBalance{std::move(wb.com_lateral_m), std::move(wb.total_N), sag.foot_lateral_m};
 }
 
@@ -943,8 +960,7 @@ FrontalBalance frontal_balance(const EstimateOptions& o, const SagittalStage& sa
 Messages frontal_split(double w, double split_distance_m, double angle, const FrontalBalance& fb, const ModelMotion& motion,
                        double ground_level_m, const RawSolve& raw, Eigen::MatrixXd& lamf, Eigen::MatrixXd& joint_torque_Nm) {
   const int np = static_cast<int>(raw.point_side.size());
-  const bool tangent = angle > 0 && raw.both_feet_tangent_map;
-  const Eigen::Index per_frame = (tangent ? 2 : 1) * kJointCount * np;
+  const TorqueMapLayout map = torque_map_layout(raw, angle);
   const Model& model = *motion.model;
   long frames = 0;
   MotionFrame f;
@@ -972,8 +988,8 @@ Messages frontal_split(double w, double split_distance_m, double angle, const Fr
     if (!std::isfinite(share)) continue;
     const double right = (1 - weight) * fy[0] + weight * share * total;
     const std::array<double, 2> factor{right / fy[0], (total - right) / fy[1]};
-    move_load(factor, tangent ? angle : 0.0, raw.both_feet_torque_map.data() + static_cast<Eigen::Index>(m) * per_frame, raw.point_side, k,
-              lamf, joint_torque_Nm);
+    move_load(factor, map.tangent ? angle : 0.0, raw.both_feet_torque_map.data() + static_cast<Eigen::Index>(m) * map.per_frame,
+              raw.point_side, k, lamf, joint_torque_Nm);
     ++frames;
   }
   Messages out;
@@ -1380,7 +1396,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
                               frontal ? &*frontal : nullptr);
   frontal.reset();
   if (o.lateral_force()) {
-    const double cutoff = o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kin.kinematic_cutoff_hz) : kin.kinematic_cutoff_hz;
+    const double cutoff = lateral_cutoff(o, kin.kinematic_cutoff_hz);
     const double lateral_lag_s = o.lateral_torso_lag && sag.trunk_measured ? dyn.torso_lag_added_s : 0.0;
     mediolateral_stage(kin.motion, sag, cutoff, kin.kinematic_cutoff_hz, o.lateral_own_leg_inertia, lateral_lag_s, dyn.plan.near_flight,
                        anthropometric_table(o.anthropometry),

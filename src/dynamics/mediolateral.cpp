@@ -31,8 +31,7 @@ UpperBodySegments upper_body_segments(const std::array<Eigen::MatrixX3d, kUpperB
 }
 
 std::vector<std::array<double, kLandmarkCount>> com_landmark_weights(const Model& model) {
-  double mass = 0;
-  for (const Body& b : model.bodies) mass += b.mass_kg;
+  const double mass = model.body_mass_kg;  // the segments' masses sum to it (build_model)
   std::vector<std::array<double, kLandmarkCount>> w(2, std::array<double, kLandmarkCount>{});
   for (int s = 0; s < kSegmentCount; ++s) {
     const Body& b = model.bodies[static_cast<std::size_t>(s)];
@@ -49,9 +48,7 @@ namespace {
 /// The HAT's share of the body mass less the upper body's parts of their own (their mass leaves
 /// the HAT's COM, which keeps the rest).
 double hat_share(const Model& model, const UpperBodySegments* upper) {
-  double mass = 0;
-  for (const Body& b : model.bodies) mass += b.mass_kg;
-  double share = model.bodies[kTorso].mass_kg / mass;
+  double share = model.bodies[kTorso].mass_kg / model.body_mass_kg;
   if (upper)
     for (const auto& part : upper->parts) share -= part.mass_fraction;
   return share;
@@ -154,8 +151,6 @@ WholeBodyLateral whole_body_lateral(const Model& model, const std::vector<Eigen:
   const Eigen::Index n = lateral_axis.rows();
   if (lab_sums.size() != 2 || lab_sums[0].rows() != n || lab_sums[1].rows() != n)
     throw InputError("whole body's lateral balance: the landmarks' sums do not match the lateral axes' frames");
-  double mass = 0;
-  for (const Body& b : model.bodies) mass += b.mass_kg;
   Eigen::MatrixXd com = lab_sums[0] + hat_share(model, upper) * lab_sums[1];
   if (upper)
     for (const auto& part : upper->parts) {
@@ -165,7 +160,7 @@ WholeBodyLateral whole_body_lateral(const Model& model, const std::vector<Eigen:
   if (cutoff_hz > 0) com = butterworth_filtfilt(std::move(com), rate_hz, cutoff_hz);
   WholeBodyLateral out;
   out.com_lateral_m = (com.array() * lateral_axis.array()).rowwise().sum().matrix();
-  out.total_N = mass * (second_difference(com, 1.0 / rate_hz).array() * lateral_axis.array()).rowwise().sum().matrix();
+  out.total_N = model.body_mass_kg * (second_difference(com, 1.0 / rate_hz).array() * lateral_axis.array()).rowwise().sum().matrix();
   return out;
 }
 
