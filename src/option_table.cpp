@@ -36,6 +36,10 @@ const std::vector<NumericOption>& numeric_options() {
        "A landing foot carries no load before its heel or MT head, seen at 15 Hz, has stopped descending: its descent fallen to "
        "this fraction of its recent peak (0 = off, the paper); the load the kinematics ask for before is dropped",
        {0.0, 0.1, 0.2, 0.3, 0.5}, "%.1f of the peak", 1.0, "off"},
+      {"still-foot", "still_foot_rad_per_s", [](O& o) -> double& { return o.contact.still_foot_rad_per_s; }, 0.0, 10.0, 0.0,
+       "The contact calibration's foot-flat reference from frames where the foot is also still, its angle turning slower than "
+       "this, rad/s (0 = every frame with the heel and MT near the floor, the paper)",
+       {0.0, 0.25, 0.5, 1.0, 2.0}, "%.2f rad/s", 1.0, "off"},
       {"split-distance", "min_split_distance_m", [](O& o) -> double& { return o.solver.min_split_distance_m; }, 0.0, 1.0, 0.0,
        "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)",
        {0.0, 0.05, 0.1, 0.15, 0.2}, "%.2f m", 1.0, "off"},

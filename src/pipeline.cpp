@@ -145,6 +145,8 @@ void check_options(const EstimateOptions& o) {
           "double-support force angle share", o.double_support_angle, "between 0 (none, the paper) and 1");
   require(finite(o.frontal_split_weight) && o.frontal_split_weight >= 0 && o.frontal_split_weight <= 1,
           "frontal split weight", o.frontal_split_weight, "between 0 (off, the paper) and 1");
+  require(finite(o.contact.still_foot_rad_per_s) && o.contact.still_foot_rad_per_s >= 0 && o.contact.still_foot_rad_per_s <= 10,
+          "still foot rate", o.contact.still_foot_rad_per_s, "between 0 (off, the paper) and 10 rad/s");
   require(finite(o.touchdown_stop_fraction) && o.touchdown_stop_fraction >= 0 && o.touchdown_stop_fraction <= 1,
           "touchdown stop fraction", o.touchdown_stop_fraction, "between 0 (off, the paper) and 1");
   require(o.grm_reference_m.allFinite(), "GRM reference (m)", o.grm_reference_m.x() + o.grm_reference_m.y(), "finite");
@@ -329,7 +331,7 @@ ModelStage model_stage(const EstimateOptions& o, const SagittalLandmarks& lm, do
   ModelStage out;
   const GroundLevel ground = o.ground_level_m ? GroundLevel{*o.ground_level_m, ""} : estimate_ground_level(lm);
   if (!ground.message.empty()) out.messages.push_back(ground.message);
-  out.soles = calibrate_contact(lm, ground.level_m);
+  out.soles = calibrate_contact(lm, ground.level_m, o.contact.still_foot_rad_per_s);
   if (!out.soles.message.empty()) out.messages.push_back(out.soles.message);
   for (int s = 0; s < 2; ++s)
     if (out.soles.flat_frames[static_cast<std::size_t>(s)] < 3)

@@ -91,6 +91,18 @@ MarkerTrajectories decimated(MarkerTrajectories m, int factor) {
   return m;
 }
 
+MarkerTrajectories cropped(MarkerTrajectories m, Eigen::Index first, Eigen::Index count) {
+  const Eigen::Index n = m.frames();
+  if (first < 0 || count < 1 || first + count > n)
+    throw InputError("frames " + std::to_string(m.first_frame + first) + "-" + std::to_string(m.first_frame + first + count - 1) +
+                     " are not within the recording's frames " + std::to_string(m.first_frame) + "-" +
+                     std::to_string(m.first_frame + n - 1));
+  for (auto& P : m.positions_m) P = Eigen::MatrixX3d(P.middleRows(first, count));
+  m.time_s = Eigen::VectorXd(m.time_s.segment(first, count));
+  m.first_frame += static_cast<int>(first);
+  return m;
+}
+
 int decimation_factor(double rate_hz, double target_hz) {
   if (!(rate_hz > 0) || !(target_hz > 0)) return 1;
   return std::max(1, static_cast<int>(std::lround(rate_hz / target_hz)));

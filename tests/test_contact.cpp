@@ -131,6 +131,57 @@ TEST(Contact, CalibrationPutsTheSolesOnTheFloorInFlatFrames) {
   EXPECT_EQ(one.feet[1].flat_angle_rad, one.feet[0].flat_angle_rad);
 }
 
+// The foot-flat reference is the angle the foot rests at, whatever share of the flat frames it is
+// still turning in (EstimateOptions' contact.still_foot_rad_per_s). A walk whose foot rests briefly
+// and rises slowly onto its toes within the 15 mm band (a trial cut to its stances has fewer
+// frames at rest): the flat frames' median is pulled into the heel rise, the still frames' is not.
+TEST(Contact, TheFootFlatReferenceIsTheAngleTheFootRestsAt) {
+  constexpr double rate = 1000.0, theta0 = -0.30, L = 0.16, marker = 0.02;
+  const Eigen::Vector2d heel_from_mt(-(L * std::cos(theta0) + 0.07), 0.0);  // heel and MT markers level at rest
+  auto walk = [&](double rest_s) {
+    // One cycle: rest; a heel rise about the MT at 1 rad/s (the heel 13 mm up after 60 ms); the
+    // lift, still turning; the swing (the angle back to theta0, out of the band); a flat descent.
+    const double rise = 0.08, lift = 0.1, swing = 0.2, descent = 0.1, cycle = rest_s + rise + lift + swing + descent;
+    const auto n = static_cast<Eigen::Index>(4 * cycle * rate);
+    SagittalLandmarks lm;
+    lm.rate_hz = rate;
+    lm.time_s = Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1) / rate);
+    for (auto& p : lm.p) p = Eigen::MatrixX2d::Zero(n, 2);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double t = std::fmod(lm.time_s[i], cycle);
+      double theta = theta0, h = 0.0;  // h: the MT marker's rise
+      if (t >= rest_s && t < rest_s + rise + lift) theta = theta0 - (t - rest_s);
+      if (t >= rest_s + rise && t < rest_s + rise + lift) h = 0.1 * (t - rest_s - rise) / lift;
+      if (t >= rest_s + rise + lift && t < rest_s + rise + lift + swing) {
+        const double u = (t - rest_s - rise - lift) / swing;
+        theta = theta0 - (rise + lift) * (1 - u), h = 0.1;
+      }
+      if (t >= cycle - descent) h = 0.1 * (cycle - t) / descent;
+      const Eigen::Vector2d M(1.0 * lm.time_s[i], marker + h);
+      const Eigen::Vector2d A = M - L * Eigen::Vector2d(std::cos(theta), std::sin(theta));
+      const Eigen::Vector2d E = M + rotation(theta - theta0) * heel_from_mt;
+      const Eigen::Vector2d T = M + rotation(theta - theta0) * Eigen::Vector2d(0.05, 0.0);
+      for (int side = 0; side < 2; ++side) {
+        lm.p[landmark(side, kMt)].row(i) = M.transpose();
+        lm.p[landmark(side, kAnkle)].row(i) = A.transpose();
+        lm.p[landmark(side, kHeel)].row(i) = E.transpose();
+        lm.p[landmark(side, kHallux)].row(i) = T.transpose();
+      }
+    }
+    return lm;
+  };
+  for (double rest_s : {0.04, 0.4}) {
+    const SagittalLandmarks lm = walk(rest_s);
+    const ContactCalibration still = calibrate_contact(lm, 0.0, 0.5), flat = calibrate_contact(lm, 0.0, 0.0);
+    for (int side = 0; side < 2; ++side) {
+      EXPECT_NEAR(still.feet[static_cast<std::size_t>(side)].flat_angle_rad, theta0, 3e-3) << "rest " << rest_s << " s";
+      EXPECT_GE(flat.flat_frames[static_cast<std::size_t>(side)], still.flat_frames[static_cast<std::size_t>(side)]);
+    }
+    if (rest_s < 0.1) EXPECT_LT(flat.feet[0].flat_angle_rad, theta0 - 8e-3) << "the flat frames alone: pulled into the heel rise";
+    else EXPECT_NEAR(flat.feet[0].flat_angle_rad, theta0, 3e-3) << "a long rest: both rules agree";
+  }
+}
+
 // The ground level: the lab floor (0) when the flat-stance landmarks stand 0-150 mm above it,
 // otherwise the lowest of them (a raised walkway, a floor below the origin), with a message.
 TEST(Contact, GroundLevelIsTheLabFloorUnlessTheFeetSayOtherwise) {

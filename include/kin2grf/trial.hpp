@@ -82,6 +82,11 @@ MarkerTrajectories decimated(MarkerTrajectories m, int factor);
 /// The whole factor that brings `rate_hz` nearest to `target_hz` (at least 1: never upsampled).
 int decimation_factor(double rate_hz, double target_hz);
 
+/// Frames [first, first + count) of the markers (0-based rows), each at its own time and file
+/// frame number: a trial cut short, as a user's frame range or a recording that stopped early
+/// gives it. InputError naming the range when it is empty or outside the recording.
+MarkerTrajectories cropped(MarkerTrajectories m, Eigen::Index first, Eigen::Index count);
+
 /// One force plate (or one per-foot channel set of a processed GRF file).
 struct ForcePlate {
   std::string name;               ///< e.g. "FP1" or "right" for GRF .mot columns

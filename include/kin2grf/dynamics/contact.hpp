@@ -179,6 +179,15 @@ struct ContactModelOptions {
   /// against 8.59 % off; `kin2grf study touchdown-fraction`) although it takes walking onsets
   /// from a worst trial's mean of 59 ms early to 44 (docs/METHOD-NOTES.md).
   double touchdown_fraction = 0.0;
+  /// The contact calibration's foot-flat frames are those where the foot is also still, its angle
+  /// turning slower than this (rad/s; 0 = every flat frame, the rule before session 33 and
+  /// --paper): a landing's foot slap and a heel rise turn it at 1-5 rad/s, a foot flat on the
+  /// floor at about 0. The flat frames alone (both landmarks within 15 mm of their floor) admit
+  /// the end of the foot slap and the start of the heel rise, whose share depends on how much of
+  /// the trial is stance; model 2's COP moves about 13 mm per 0.75 degrees of this reference in
+  /// mid-stance (the COP function's steep HO -> MO segment), so a trial cut to its plate stances
+  /// moved walking2's COP rRMSE from 6 to 13 % (docs/METHOD-NOTES.md).
+  double still_foot_rad_per_s = 0.5;
 };
 
 /// World positions of the sole points A, B, C of a foot in one frame (ModelMotion::frame).
@@ -294,15 +303,20 @@ std::vector<bool> flight_frames(const Model& model, const ModelMotion& motion, c
 
 namespace kin2grf {
 
+/// The contact calibration's still foot: its angle is differentiated at this cut-off (Hz, the
+/// dynamics' own).
+inline constexpr double kStillFootCutoffHz = 6.0;
+
 /// Contact calibration (Sect. 2.3: "A, B, C at ground level under heel, MT and hallux"):
 /// per foot, the foot-flat frames are those where both the heel and the MT landmark are within
-/// 15 mm of their 10th-percentile height; there, theta_foot,flat is the median foot angle and
+/// 15 mm of their 10th-percentile height and, with still_foot_rad_per_s > 0, the foot is still (its
+/// angle turning slower than that; all flat frames when fewer than 3 are still); there, theta_foot,flat is the median foot angle and
 /// A, B (foot frame) and C (toes frame) are the medians of the points at ground level straight
 /// below the heel, MT and hallux landmarks. A foot whose flat frames stand more than 30 mm
 /// higher than the other's never touches the floor: it takes the other foot's geometry. When
 /// both feet's heel landmarks stay more than 150 mm above the floor, neither foot stands on it:
 /// the soles go 40 mm below the heel landmarks (no stance is invented). Its `message` says which.
-ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_level_m);
+ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_level_m, double still_foot_rad_per_s = 0.0);
 
 /// The belt velocity of a treadmill trial (m/s), gathered frame by frame: the median horizontal
 /// velocity of the contact points within 10 mm of the floor; none when no point comes that close.
