@@ -698,6 +698,29 @@ TEST(CliExample, TheBundledRecordedWalkValidatesAsTheReadmeSays) {
   EXPECT_NE(v.out.find("left foot is partly off the plate"), std::string::npos) << v.out;
 }
 
+// --frames FIRST:LAST processes the file's own frames FIRST-LAST as if the trial were cut there:
+// the window says so, the settings record it, and a range the file does not hold is an error
+// naming the file and its frames.
+TEST(CliExample, FramesCutTheTrialToTheFilesOwnFrameNumbers) {
+  KIN2GRF_REQUIRE_CLI();
+  const std::string walk = (std::filesystem::path(KIN2GRF_SOURCE_DIR) / "data" / "example" / "walking2.c3d").string();
+  const auto dir = kin2grf::test::temp_dir("cli_frames");
+  const CliRun v = run("estimate " + walk + " --mass 64.9 --frames 600:900 --json " + (dir / "e.json").string());
+  ASSERT_EQ(v.status, 0) << v.out;
+  EXPECT_NE(v.out.find("processing frames 600-837 of 600-900"), std::string::npos) << v.out;
+  EXPECT_NE(kin2grf::read_file_text((dir / "e.json").string()).find("\"frames\": \"600:900\""), std::string::npos);
+  const CliRun open_end = run("estimate " + walk + " --mass 64.9 --frames 700:");
+  ASSERT_EQ(open_end.status, 0) << open_end.out;
+  EXPECT_NE(open_end.out.find("of 700-1249"), std::string::npos) << open_end.out;
+  for (const auto& [range, says] : std::vector<std::pair<std::string, std::string>>{
+           {"0:900", "not within the recording's frames 1-1249"}, {"900:600", "comes after its last"}, {"600", "give FIRST:LAST"}}) {
+    const CliRun bad = run("estimate " + walk + " --mass 64.9 --frames " + range);
+    EXPECT_EQ(bad.status, 2) << range << ": " << bad.out;
+    EXPECT_NE(bad.out.find(says), std::string::npos) << bad.out;
+    EXPECT_NE(bad.out.find("walking2.c3d"), std::string::npos) << bad.out;
+  }
+}
+
 // One GRF convention (issue 30, item 2): -o writes what --opensim's STEM_grf.mot holds (OpenSim's
 // frame, Y up, every frame of the trial) and its header names the frame; --lab-frame is asked for.
 TEST(CliExample, TheGrfMotIsInOpenSimsFrameLikeTheOpenSimSet) {

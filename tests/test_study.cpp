@@ -242,6 +242,47 @@ TEST(Study, MarkerRateStudyDecimatesTheMarkersAndKeepsThePlates) {
   }
 }
 
+// A trial cut short (cropped, --frames, the trial-cut study): each kept frame keeps its time and
+// its file frame number; a range outside the recording is refused, naming its frames. Cut to its
+// plates' loaded span and 0.2-1.0 s around it, the example walk keeps every plate stance, each
+// within a point of its vertical rRMSE as recorded (the ground, the foot-flat reference and the
+// speed are measured again from fewer frames), while the window really starts later.
+TEST(Study, TrialCutStudyCropsTheMarkersAroundThePlatesLoad) {
+  const Trial walk = make_example_walk();
+  const MarkerTrajectories part = cropped(walk.markers, 10, 50);
+  EXPECT_EQ(part.frames(), 50);
+  EXPECT_EQ(part.first_frame, walk.markers.first_frame + 10);
+  EXPECT_DOUBLE_EQ(part.time_s[0], walk.markers.time_s[10]);
+  EXPECT_TRUE(part.positions_m[0].row(49).isApprox(walk.markers.positions_m[0].row(59)));
+  EXPECT_THROW((void)cropped(walk.markers, -1, 10), InputError);
+  EXPECT_THROW((void)cropped(walk.markers, 0, 0), InputError);
+  try {
+    (void)cropped(walk.markers, walk.markers.frames() - 5, 10);
+    ADD_FAILURE() << "a range past the recording's end was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not within the recording's frames"), std::string::npos) << e.what();
+  }
+
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  StudyTrial t;
+  t.name = "walk", t.activity = "walking", t.lab = "lab", t.trial = &walk, t.plates = &*walk.plates, t.marker_set = &set;
+  const StudyResult s = run_study("trial-cut", {t});
+  ASSERT_EQ(s.rows.size(), 5u);  // as recorded, then +-1.0, 0.5, 0.3 and 0.2 s around the plates' load
+  ASSERT_TRUE(s.failures.empty()) << s.failures.front();
+  EXPECT_TRUE(s.rows[0].is_default);
+  const auto& recorded = s.per_trial[0][0].stances;
+  ASSERT_GT(recorded.size(), 0u);
+  for (std::size_t r = 1; r < s.rows.size(); ++r) {
+    const auto& cut = s.per_trial[r][0].stances;
+    ASSERT_EQ(cut.size(), recorded.size()) << s.rows[r].label;
+    for (std::size_t k = 0; k < cut.size(); ++k) {
+      ASSERT_TRUE(cut[k].metrics.vertical && recorded[k].metrics.vertical);
+      EXPECT_NEAR(cut[k].metrics.vertical->rrmse_percent, recorded[k].metrics.vertical->rrmse_percent, 1.0) << s.rows[r].label;
+    }
+  }
+  EXPECT_LT(s.per_trial[4][0].stances.front().first, recorded.front().first) << "the 0.2 s cut starts the window later";
+}
+
 // One parser reads a whole list (issue 31: 100,000 lines took 12 s, a line of 200,000 options
 // 20 s to refuse): a line's options never leak into the next, line endings may be LF, CRLF or a
 // lone CR, a byte-order mark is skipped, and an overlong line is refused at once.

@@ -27,6 +27,7 @@ struct Setting {
   bool without_trunk = false;   ///< the `trunk-ablation` study: the trial's trunk and arm markers unused
   double marker_rate_hz = 0.0;  ///< the `marker-rate` study: markers decimated to about this rate (0: as recorded)
   bool from_labels = false;     ///< the `marker-labels` study: the set made from the file's labels, not the trial's preset
+  double cut_margin_s = -1.0;   ///< the `trial-cut` study: markers cut to the plates' loaded span and this much around it (< 0: as recorded)
 };
 
 /// Marks the settings that leave the fields `get` reads at kin2grf's defaults (the added marker
@@ -183,6 +184,37 @@ std::vector<Setting> marker_labels_settings() {
   return s;
 }
 
+/// Robustness to a trial cut short (a user's frame range, a capture stopped early): every trial's
+/// markers as recorded and cut to its plates' loaded span (any plate's force above 20 N) with 1.0,
+/// 0.5, 0.3 and 0.2 s around it. Whatever the method measures from the trial itself (the ground,
+/// the foot-flat reference, the progression speed, the filters' edges) then has less of it; a
+/// trial whose plates are loaded throughout (a treadmill) keeps its frames.
+std::vector<Setting> trial_cut_settings() {
+  std::vector<Setting> s{{"as recorded", -1, [](EstimateOptions&) {}, 0.0, true}};
+  for (double m : {1.0, 0.5, 0.3, 0.2}) {
+    char b[48];
+    std::snprintf(b, sizeof b, "plates' span +-%.1f s", m);
+    Setting c{b, m, [](EstimateOptions&) {}};
+    c.cut_margin_s = m;
+    s.push_back(std::move(c));
+  }
+  return s;
+}
+
+/// The trial_cut_settings crop: the marker rows within `margin_s` of the plates' loaded span.
+MarkerTrajectories cut_to_plates(const MarkerTrajectories& m, const ForcePlateRecording& plates, double margin_s) {
+  double t0 = std::numeric_limits<double>::infinity(), t1 = -t0;
+  for (const ForcePlate& p : plates.plates)
+    for (Eigen::Index k = 0; k < plates.samples() && k < p.force_N.rows(); ++k)
+      if (p.force_N.row(k).norm() > 20.0) t0 = std::min(t0, plates.time_s[k]), t1 = std::max(t1, plates.time_s[k]);
+  Eigen::Index a = 0, b = m.frames() - 1;
+  if (std::isfinite(t0)) {
+    while (a < b && m.time_s[a] < t0 - margin_s) ++a;
+    while (b > a && m.time_s[b] > t1 + margin_s) --b;
+  }
+  return cropped(m, a, b - a + 1);
+}
+
 std::vector<Setting> torso_length_settings() {
   std::vector<Setting> s{{"fixed (the paper)", 0, [](EstimateOptions& o) { o.torso_length = TorsoLength::Fixed; }},
                          {"measured", 1, [](EstimateOptions& o) { o.torso_length = TorsoLength::Measured; }}};
@@ -216,6 +248,7 @@ const std::vector<StudyKind>& special_studies() {
       {"noise", noise_settings},
       {"marker-rate", marker_rate_settings},
       {"marker-labels", marker_labels_settings},
+      {"trial-cut", trial_cut_settings},
       {"torso-length", torso_length_settings},
       {"foot-model", foot_model_settings},
   };
@@ -290,12 +323,13 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
       ablated = parse_marker_set(*lm.mapping, t.name + " (its labels)");
     }
     const int factor = s.marker_rate_hz > 0 ? decimation_factor(d.trial->markers.rate_hz, s.marker_rate_hz) : 1;
-    const bool changed = s.marker_noise_m > 0 || factor > 1;
+    const bool changed = s.marker_noise_m > 0 || factor > 1 || s.cut_margin_s >= 0;
     for (int seed = 1; seed <= draws; ++seed) {
       // The trial as recorded, or a copy with the setting's noise or capture rate.
       Trial working;
       if (changed) {
         working = *d.trial;
+        if (s.cut_margin_s >= 0) working.markers = cut_to_plates(working.markers, *d.plates, s.cut_margin_s);
         if (factor > 1) working.markers = decimated(std::move(working.markers), factor);
         if (s.marker_noise_m > 0) add_marker_noise(working.markers, s.marker_noise_m, static_cast<unsigned>(seed));
       }

@@ -96,6 +96,9 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
   c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length, no torso or thigh lag, no vertical smoothing of the torso");
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
+  c->add_option("--frames", a.frames,
+                "Process only the file's frames FIRST:LAST (its own frame numbers, inclusive; FIRST: or :LAST leave an end "
+                "open), as the trial were cut there");
   for (const NumericOption& s : numeric_options()) {
     CLI::Option* opt = c->add_option(std::string("--") + s.flag, s.field(a.numeric), s.help)->capture_default_str();
     if (s.lo <= s.hi) opt->check(CLI::Range(s.lo, s.hi));
@@ -198,7 +201,8 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"anthropometry", o.anthropometry},
           {"ground_level_m", o.ground_level_m ? nlohmann::json(*o.ground_level_m) : nlohmann::json("auto")},
           {"grm_reference_m", {o.grm_reference_m.x(), o.grm_reference_m.y()}},
-          {"max_gap_frames", o.landmarks.max_gap_frames}};
+          {"max_gap_frames", o.landmarks.max_gap_frames},
+          {"frames", a.frames.empty() ? nlohmann::json("all") : nlohmann::json(a.frames)}};
   EstimateOptions used = o;
   for (const NumericOption& s : numeric_options()) j[s.json_key] = s.field(used);
   return j;
@@ -264,6 +268,33 @@ std::vector<std::string> input_files(const Settings& a) {
   return in;
 }
 
+void apply_frame_range(Trial& t, const std::string& range) {
+  if (range.empty()) return;
+  const auto colon = range.find(':');
+  const int first_file = t.markers.first_frame, last_file = t.markers.first_frame + static_cast<int>(t.markers.frames()) - 1;
+  auto number = [&](const std::string& text, int open) {
+    if (text.empty()) return open;
+    std::size_t used = 0;
+    int v = 0;
+    try {
+      v = std::stoi(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != text.size())
+      throw InputError(t.path + ": --frames " + range + ": give FIRST:LAST, the file's own frame numbers (" +
+                       std::to_string(first_file) + ":" + std::to_string(last_file) + " in this file)");
+    return v;
+  };
+  if (colon == std::string::npos) number("x", 0);  // the message above
+  const int a = number(range.substr(0, colon), first_file), b = number(range.substr(colon + 1), last_file);
+  if (a > b) throw InputError(t.path + ": --frames " + range + ": its first frame comes after its last");
+  if (a < first_file || b > last_file)
+    throw InputError(t.path + ": --frames " + range + ": frames " + std::to_string(a) + "-" + std::to_string(b) +
+                     " are not within the recording's frames " + std::to_string(first_file) + "-" + std::to_string(last_file));
+  t.markers = cropped(std::move(t.markers), a - first_file, b - a + 1);
+}
+
 TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load) {
   TrialAndStatic out;
   // Two files, two threads, when both are long enough to pay for a thread (about 5 ns a byte):
@@ -273,6 +304,7 @@ TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load)
   const bool both = !s.static_trial.empty() && std::min(bytes(s.trial), bytes(s.static_trial)) * 5e-9 >= kMinSecondsPerChunk;
   if (!both) {
     out.trial = load_trial(s.trial, load);
+    apply_frame_range(out.trial, s.frames);
     if (!s.static_trial.empty()) out.static_trial = load_trial(s.static_trial);
     return out;
   }
@@ -282,6 +314,7 @@ TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load)
       else out.static_trial = load_trial(s.static_trial);
     }
   });
+  apply_frame_range(out.trial, s.frames);
   return out;
 }
 

@@ -145,6 +145,7 @@ std::vector<StudyTrial> study_trials(const std::vector<TrialListEntry>& entries)
     x.load = [settings = in.settings, plates = in.plates] {
       auto held = std::make_shared<HeldTrial>();
       held->trial = load_trial(settings.trial, load_options("unloaded"));
+      apply_frame_range(held->trial, settings.frames);
       StudyTrialData d;
       d.trial = &held->trial;
       if (!settings.static_trial.empty()) {

@@ -41,6 +41,9 @@ struct Settings {
   bool post_cutoff_cycles_given = false;
   std::vector<double> grm_reference;
   int max_gap = 10;
+  /// --frames FIRST:LAST: the file's frames processed (its own frame numbers, inclusive; an end
+  /// left empty is open); empty: every frame.
+  std::string frames;
 };
 
 /// Registers TRIAL and every setting as options of `app` (the command line's and the trial
@@ -82,6 +85,11 @@ struct TrialAndStatic {
 /// Reads the trial (with `load`) and the static trial at the same time, one on each of two
 /// threads when thread_count() allows; an error is the trial's first, as when read in turn.
 TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load = {});
+
+/// --frames: the trial's markers cut to the file's frames FIRST:LAST (apply to the motion trial, not
+/// to the static; the plates are left whole, validate compares the estimate's frames); InputError
+/// naming the file, the range and the recording's frames when it is malformed or outside them.
+void apply_frame_range(Trial& t, const std::string& range);
 
 /// How `estimate` reads its trial: C3D plates without their samples (C3dReadOptions::
 /// plate_samples), since the estimate takes nothing of the plates but the lab's up axis.
