@@ -201,12 +201,20 @@ std::vector<Setting> trial_cut_settings() {
   return s;
 }
 
-/// The trial_cut_settings crop: the marker rows within `margin_s` of the plates' loaded span.
+/// The trial_cut_settings crop: the marker rows within `margin_s` of the plates' loaded span, each
+/// plate's load read on its axis of largest force (the vertical: a body weight against shear forces
+/// of a fifth of it; the axis is not the file's to say, a GRF .mot is Y up, a C3D mostly Z up, and
+/// a drifting shear channel must not count as load).
 MarkerTrajectories cut_to_plates(const MarkerTrajectories& m, const ForcePlateRecording& plates, double margin_s) {
   double t0 = std::numeric_limits<double>::infinity(), t1 = -t0;
-  for (const ForcePlate& p : plates.plates)
-    for (Eigen::Index k = 0; k < plates.samples() && k < p.force_N.rows(); ++k)
-      if (p.force_N.row(k).norm() > 20.0) t0 = std::min(t0, plates.time_s[k]), t1 = std::max(t1, plates.time_s[k]);
+  for (const ForcePlate& p : plates.plates) {
+    const Eigen::Index n = std::min(plates.samples(), p.force_N.rows());
+    if (n == 0) continue;
+    Eigen::Index up = 0;
+    p.force_N.topRows(n).cwiseAbs().colwise().maxCoeff().maxCoeff(&up);
+    for (Eigen::Index k = 0; k < n; ++k)
+      if (std::abs(p.force_N(k, up)) > 20.0) t0 = std::min(t0, plates.time_s[k]), t1 = std::max(t1, plates.time_s[k]);
+  }
   Eigen::Index a = 0, b = m.frames() - 1;
   if (std::isfinite(t0)) {
     while (a < b && m.time_s[a] < t0 - margin_s) ++a;
