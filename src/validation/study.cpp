@@ -156,6 +156,21 @@ std::vector<Setting> noise_settings() {
   return s;
 }
 
+/// A robustness condition's rows: the trial as recorded (the default row, labelled with
+/// `recorded_value`), then one row per value, labelled by `format` and given its condition by `mark`.
+template <class Mark>
+std::vector<Setting> condition_settings(double recorded_value, const std::vector<double>& values, const char* format, Mark mark) {
+  std::vector<Setting> s{{"as recorded", recorded_value, [](EstimateOptions&) {}, 0.0, true}};
+  for (double v : values) {
+    char b[48];
+    std::snprintf(b, sizeof b, format, v);
+    Setting c{b, v, [](EstimateOptions&) {}};
+    mark(c, v);
+    s.push_back(std::move(c));
+  }
+  return s;
+}
+
 /// Robustness to the capture rate: every trial's markers as recorded and decimated to about 100,
 /// 60 and 50 Hz (every k-th frame, k the whole factor nearest the rate; a trial already at or
 /// under a rate keeps its frames), the plates as recorded. Clinical systems capture at 50-120 Hz,
@@ -163,15 +178,7 @@ std::vector<Setting> noise_settings() {
 /// show here. `validate` averages the plates over each marker frame, so at a lower rate the
 /// plates' impact transient is smoothed in the reference too.
 std::vector<Setting> marker_rate_settings() {
-  std::vector<Setting> s{{"as recorded", 0, [](EstimateOptions&) {}, 0.0, true}};
-  for (double hz : {100.0, 60.0, 50.0}) {
-    char b[32];
-    std::snprintf(b, sizeof b, "about %.0f Hz", hz);
-    Setting c{b, hz, [](EstimateOptions&) {}};
-    c.marker_rate_hz = hz;
-    s.push_back(std::move(c));
-  }
-  return s;
+  return condition_settings(0.0, {100.0, 60.0, 50.0}, "about %.0f Hz", [](Setting& c, double hz) { c.marker_rate_hz = hz; });
 }
 
 /// Robustness to a marker set no preset knows: every trial with its preset (or mapping file) and
@@ -185,20 +192,12 @@ std::vector<Setting> marker_labels_settings() {
 }
 
 /// Robustness to a trial cut short (a user's frame range, a capture stopped early): every trial's
-/// markers as recorded and cut to its plates' loaded span (any plate's force above 20 N) with 1.0,
-/// 0.5, 0.3 and 0.2 s around it. Whatever the method measures from the trial itself (the ground,
+/// markers as recorded and cut to its plates' loaded span (any plate's vertical force above 20 N)
+/// with 1.0, 0.5, 0.3 and 0.2 s around it. Whatever the method measures from the trial itself (the ground,
 /// the foot-flat reference, the progression speed, the filters' edges) then has less of it; a
 /// trial whose plates are loaded throughout (a treadmill) keeps its frames.
 std::vector<Setting> trial_cut_settings() {
-  std::vector<Setting> s{{"as recorded", -1, [](EstimateOptions&) {}, 0.0, true}};
-  for (double m : {1.0, 0.5, 0.3, 0.2}) {
-    char b[48];
-    std::snprintf(b, sizeof b, "plates' span +-%.1f s", m);
-    Setting c{b, m, [](EstimateOptions&) {}};
-    c.cut_margin_s = m;
-    s.push_back(std::move(c));
-  }
-  return s;
+  return condition_settings(-1.0, {1.0, 0.5, 0.3, 0.2}, "plates' span +-%.1f s", [](Setting& c, double m) { c.cut_margin_s = m; });
 }
 
 /// The trial_cut_settings crop: the marker rows within `margin_s` of the plates' loaded span, each
