@@ -285,11 +285,12 @@ std::vector<Eigen::Index> flat_frames(const SagittalLandmarks& lm, int side) {
 /// Median, 0 for no samples (a foot with no flat frames keeps a neutral calibration).
 double median_or_zero(std::vector<double> v) { return v.empty() ? 0.0 : median(std::move(v)); }
 /// Of the flat frames, those where the foot is also still: its angle (ankle -> MT) turning slower
-/// than still_rad_per_s (0: every flat frame), at the dynamics' 6 Hz. The height band admits the end of the landing's
-/// foot slap and the start of the heel rise (15 mm over a 200 mm foot is 4 degrees), whose share of
-/// the flat frames, and with it their median angle, depends on how much of the trial is stance: a
-/// trial cut to its plate stances moved one foot's reference by 2 degrees and its COP rRMSE from 6 to
-/// 13 %. The foot at rest is the reference pose; fewer than 3 still frames keep the flat ones.
+/// than still_rad_per_s (0: every flat frame), at the dynamics' 6 Hz. The height band admits the
+/// end of the landing's foot slap and the start of the heel rise (15 mm over a 200 mm foot is 4
+/// degrees), whose share of the flat frames, and with it their median angle, depends on how much of
+/// the trial is stance: a trial cut to its plate stances moved one foot's reference by 2 degrees and
+/// its COP rRMSE from 6 to 13 %. The foot at rest is the reference pose; fewer than 3 still frames
+/// keep the flat ones.
 std::vector<Eigen::Index> still_frames(const SagittalLandmarks& lm, int side, const std::vector<Eigen::Index>& flat,
                                        double still_rad_per_s) {
   if (!(still_rad_per_s > 0)) return flat;

@@ -193,9 +193,9 @@ std::vector<Setting> marker_labels_settings() {
 
 /// Robustness to a trial cut short (a user's frame range, a capture stopped early): every trial's
 /// markers as recorded and cut to its plates' loaded span (any plate's vertical force above 20 N)
-/// with 1.0, 0.5, 0.3 and 0.2 s around it. Whatever the method measures from the trial itself (the ground,
-/// the foot-flat reference, the progression speed, the filters' edges) then has less of it; a
-/// trial whose plates are loaded throughout (a treadmill) keeps its frames.
+/// with 1.0, 0.5, 0.3 and 0.2 s around it. Whatever the method measures from the trial itself
+/// (the ground, the foot-flat reference, the progression speed, the filters' edges) then has less
+/// of it; a trial whose plates are loaded throughout (a treadmill) keeps its frames.
 std::vector<Setting> trial_cut_settings() {
   return condition_settings(-1.0, {1.0, 0.5, 0.3, 0.2}, "plates' span +-%.1f s", [](Setting& c, double m) { c.cut_margin_s = m; });
 }
@@ -332,7 +332,7 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
     const int factor = s.marker_rate_hz > 0 ? decimation_factor(d.trial->markers.rate_hz, s.marker_rate_hz) : 1;
     const bool changed = s.marker_noise_m > 0 || factor > 1 || s.cut_margin_s >= 0;
     for (int seed = 1; seed <= draws; ++seed) {
-      // The trial as recorded, or a copy with the setting's noise or capture rate.
+      // The trial as recorded, or a copy cut short or with the setting's noise or capture rate.
       Trial working;
       if (changed) {
         working = *d.trial;

@@ -98,7 +98,7 @@ void add_settings_options(CLI::App* c, Settings& a) {
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
   c->add_option("--frames", a.frames,
                 "Process only the file's frames FIRST:LAST (its own frame numbers, inclusive; FIRST: or :LAST leave an end "
-                "open), as the trial were cut there");
+                "open), as if the trial were cut there");
   for (const NumericOption& s : numeric_options()) {
     CLI::Option* opt = c->add_option(std::string("--") + s.flag, s.field(a.numeric), s.help)->capture_default_str();
     if (s.lo <= s.hi) opt->check(CLI::Range(s.lo, s.hi));
@@ -272,6 +272,10 @@ void apply_frame_range(Trial& t, const std::string& range) {
   if (range.empty()) return;
   const auto colon = range.find(':');
   const int first_file = t.markers.first_frame, last_file = t.markers.first_frame + static_cast<int>(t.markers.frames()) - 1;
+  const auto malformed = [&] {
+    return InputError(t.path + ": --frames " + range + ": give FIRST:LAST, the file's own frame numbers (" +
+                      std::to_string(first_file) + ":" + std::to_string(last_file) + " in this file)");
+  };
   auto number = [&](const std::string& text, int open) {
     if (text.empty()) return open;
     std::size_t used = 0;
@@ -281,12 +285,10 @@ void apply_frame_range(Trial& t, const std::string& range) {
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used != text.size())
-      throw InputError(t.path + ": --frames " + range + ": give FIRST:LAST, the file's own frame numbers (" +
-                       std::to_string(first_file) + ":" + std::to_string(last_file) + " in this file)");
+    if (used != text.size()) throw malformed();
     return v;
   };
-  if (colon == std::string::npos) number("x", 0);  // the message above
+  if (colon == std::string::npos) throw malformed();
   const int a = number(range.substr(0, colon), first_file), b = number(range.substr(colon + 1), last_file);
   if (a > b) throw InputError(t.path + ": --frames " + range + ": its first frame comes after its last");
   if (a < first_file || b > last_file)

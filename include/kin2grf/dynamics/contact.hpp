@@ -309,9 +309,9 @@ inline constexpr double kStillFootCutoffHz = 6.0;
 
 /// Contact calibration (Sect. 2.3: "A, B, C at ground level under heel, MT and hallux"):
 /// per foot, the foot-flat frames are those where both the heel and the MT landmark are within
-/// 15 mm of their 10th-percentile height and, with still_foot_rad_per_s > 0, the foot is still (its
-/// angle turning slower than that; all flat frames when fewer than 3 are still); there, theta_foot,flat is the median foot angle and
-/// A, B (foot frame) and C (toes frame) are the medians of the points at ground level straight
+/// 15 mm of their 10th-percentile height and, with still_foot_rad_per_s > 0, the foot is still
+/// (its angle turning slower than that; all flat frames when fewer than 3 are still); there,
+/// theta_foot,flat is the median foot angle and A, B (foot frame) and C (toes frame) are the medians of the points at ground level straight
 /// below the heel, MT and hallux landmarks. A foot whose flat frames stand more than 30 mm
 /// higher than the other's never touches the floor: it takes the other foot's geometry. When
 /// both feet's heel landmarks stay more than 150 mm above the floor, neither foot stands on it:
