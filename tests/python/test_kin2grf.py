@@ -110,6 +110,16 @@ def test_help_lists_every_setting():
             assert f"    {name}" in f.__doc__, (f.__name__, name)
 
 
+def test_frames_cut_the_trial_as_the_cli_does(example, tmp_path):
+    trial = example / "example_walk.c3d"
+    r = kin2grf.estimate(trial, frames="51:250")
+    assert_same_as_cli(r, cli_csv(trial, "--frames", "51:250", tmp=tmp_path))
+    assert r.summary["settings"]["frames"] == "51:250"
+    assert r.summary["frames"]["first"] >= 51 and r.summary["frames"]["last"] <= 250
+    with pytest.raises(kin2grf.InputError, match="not within the recording's frames"):
+        kin2grf.estimate(trial, frames="0:250")
+
+
 def test_validate_compares_the_example_plates(example):
     v = kin2grf.validate(example / "example_walk.c3d")
     assert v["mean_rrmse_percent"]["all"]["stances"] == 2
