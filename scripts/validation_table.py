@@ -188,9 +188,13 @@ if cv_kinds:
           "held-out vertical / anterior / COP, GRM | vertical over the loaded span in-sample / held-out | "
           "mean \\|onset\\| ms in-sample / held-out | worst held-out trial (vertical) | loaded-span criterion: chosen on all trials |")
     print("|---|---|---|---|---|---|---|---|---|")
-    def by_criterion(k, criterion):
+    cv_json = {}
+    for k in cv_kinds:
         with open(os.path.join(out, f"cv-{k}.json")) as f:
-            j = json.load(f)
+            cv_json[k] = json.load(f)
+
+    def by_criterion(k, criterion):
+        j = cv_json[k]
         return j.get("cross_validation_by_criterion", {}).get(criterion) or (j["cross_validation"] if criterion == "plate-stance" else None)
 
     for k in cv_kinds:

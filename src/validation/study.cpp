@@ -390,9 +390,17 @@ StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& tr
 }
 
 CrossValidation::Vertical parse_criterion(const std::string& text) {
-  if (text == "plate-stance") return CrossValidation::Vertical::PlateStance;
-  if (text == "loaded-span") return CrossValidation::Vertical::LoadedSpan;
+  for (const auto v : {CrossValidation::Vertical::PlateStance, CrossValidation::Vertical::LoadedSpan})
+    if (text == criterion_name(v)) return v;
   throw InputError("--criterion " + text + ": give plate-stance or loaded-span");
+}
+
+const char* criterion_name(CrossValidation::Vertical vertical) {
+  return vertical == CrossValidation::Vertical::LoadedSpan ? "loaded-span" : "plate-stance";
+}
+
+const char* criterion_terms(CrossValidation::Vertical vertical) {
+  return vertical == CrossValidation::Vertical::LoadedSpan ? "vertical over the loaded span + anterior + COP" : "vertical + anterior + COP";
 }
 
 CrossValidation cross_validate(const StudyResult& s, CrossValidation::Vertical vertical) {
@@ -482,9 +490,7 @@ std::string format_cross_validation(const StudyResult& s, const CrossValidation&
   char b[256];
   os << "\nleave-one-lab-out (" << s.kind << "): chosen on all trials: " << cv.in_sample_choice << "\n";
   for (const auto& [lab, choice] : cv.lab_choice) os << "  without " << lab << ": " << choice << "\n";
-  os << (cv.vertical == CrossValidation::Vertical::LoadedSpan
-             ? "criterion on all trials (mean over labs of (vertical over the loaded span + anterior + COP) / 3, %):"
-             : "criterion on all trials (mean over labs of (vertical + anterior + COP) / 3, %):");
+  os << "criterion on all trials (mean over labs of (" << criterion_terms(cv.vertical) << ") / 3, %):";
   for (std::size_t r = 0; r < cv.criterion.size(); ++r) {  // one entry per row of the study, in its order
     const auto& [label, c] = cv.criterion[r];
     std::snprintf(b, sizeof b, " %s%s %.2f;", label.c_str(), r < s.rows.size() && s.rows[r].is_default ? " (default)" : "", c);
@@ -529,9 +535,8 @@ nlohmann::json cross_validation_json(const CrossValidation& cv) {
                           {"vertical_loaded_span", num(m.vertical_loaded_span)}};
   };
   nlohmann::json j;
-  j["criterion"] = cv.vertical == CrossValidation::Vertical::LoadedSpan
-                       ? "mean over labs of the lab's mean per-stance (vertical over the loaded span + anterior + COP) / 3 rRMSE, all activities pooled"
-                       : "mean over labs of the lab's mean per-stance (vertical + anterior + COP) / 3 rRMSE, all activities pooled";
+  j["criterion"] = std::string("mean over labs of the lab's mean per-stance (") + criterion_terms(cv.vertical) +
+                   ") / 3 rRMSE, all activities pooled";
   j["in_sample_choice"] = cv.in_sample_choice;
   for (const auto& [label, c] : cv.criterion) j["criterion_all_trials"][label] = num(c);
   j["criterion_held_out"] = num(cv.held_out_criterion);

@@ -359,11 +359,14 @@ void stance_timing(const EstimateResult& e, const MeasuredPlate& mp, const Candi
   // Only a landing's or a lift-off's: the estimate's load must begin (end) within the search, so
   // that the foot was in the air before (after); a foot loaded throughout (a standing trial whose
   // plate signal starts late) keeps its stance.
+  const auto loaded = [&](Eigen::Index i) { return ev[i] > o.threshold_N; };
   Eigen::Index first = a, last = c.run.last;
-  while (first > from && ev[first - 1] > o.threshold_N && pv[first - 1] < o.threshold_N) --first;
-  if (first < a && !(first > from && !(ev[first - 1] > o.threshold_N))) first = a;
-  while (last < to && ev[last + 1] > o.threshold_N && pv[last + 1] < o.threshold_N) ++last;
-  if (last > c.run.last && !(last < to && !(ev[last + 1] > o.threshold_N))) last = c.run.last;
+  while (first > from && loaded(first - 1) && pv[first - 1] < o.threshold_N) --first;
+  const bool landed = first > from && !loaded(first - 1);  // the load began within the search
+  if (first < a && !landed) first = a;
+  while (last < to && loaded(last + 1) && pv[last + 1] < o.threshold_N) ++last;
+  const bool lifted = last < to && !loaded(last + 1);  // and ended within it
+  if (last > c.run.last && !lifted) last = c.run.last;
   s.span_first = first;
   s.span_last = last;
   s.vertical_loaded_span = compare_series(ev.segment(first, last - first + 1), pv.segment(first, last - first + 1));

@@ -163,7 +163,7 @@ int study_job(const StudyJob& a, std::ostream& out, std::ostream& log) {
     j["cross_validation"] = cross_validation_json(cv);
     // Both criteria in the JSON, whichever was asked for (VALIDATION.md reports them side by side).
     for (const auto vertical : {CrossValidation::Vertical::PlateStance, CrossValidation::Vertical::LoadedSpan})
-      j["cross_validation_by_criterion"][vertical == CrossValidation::Vertical::LoadedSpan ? "loaded-span" : "plate-stance"] =
+      j["cross_validation_by_criterion"][criterion_name(vertical)] =
           vertical == cv.vertical ? j["cross_validation"] : cross_validation_json(cross_validate(res, vertical));
   }
   if (!a.out_json.empty()) write_file_text(a.out_json, json_text(j));

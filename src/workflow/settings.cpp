@@ -306,16 +306,15 @@ TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load)
   const bool both = !s.static_trial.empty() && std::min(bytes(s.trial), bytes(s.static_trial)) * 5e-9 >= kMinSecondsPerChunk;
   if (!both) {
     out.trial = load_trial(s.trial, load);
-    apply_frame_range(out.trial, s.frames);
     if (!s.static_trial.empty()) out.static_trial = load_trial(s.static_trial);
-    return out;
+  } else {
+    for_chunks(2, 1, [&](std::size_t, std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        if (i == 0) out.trial = load_trial(s.trial, load);
+        else out.static_trial = load_trial(s.static_trial);
+      }
+    });
   }
-  for_chunks(2, 1, [&](std::size_t, std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      if (i == 0) out.trial = load_trial(s.trial, load);
-      else out.static_trial = load_trial(s.static_trial);
-    }
-  });
   apply_frame_range(out.trial, s.frames);
   return out;
 }

@@ -130,6 +130,11 @@ StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& tr
 CrossValidation cross_validate(const StudyResult& s, CrossValidation::Vertical vertical = CrossValidation::Vertical::PlateStance);
 /// `--criterion` as the user gives it: "plate-stance" or "loaded-span"; InputError otherwise.
 CrossValidation::Vertical parse_criterion(const std::string& text);
+/// The criterion's name as `--criterion` takes it (and the study JSON's cross_validation_by_criterion keys).
+const char* criterion_name(CrossValidation::Vertical vertical);
+/// The criterion's three terms as the tables say them: "vertical + anterior + COP", or with the
+/// vertical over the loaded span.
+const char* criterion_terms(CrossValidation::Vertical vertical);
 std::string format_cross_validation(const StudyResult& s, const CrossValidation& cv);
 nlohmann::json cross_validation_json(const CrossValidation& cv);
 
