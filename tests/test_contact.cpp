@@ -391,6 +391,36 @@ TEST(Contact, AFootInContactBeforeItsHeelHasStoppedHasNotLandedYet) {
   EXPECT_EQ(std::count(off.begin(), off.end(), true), 0);
 }
 
+// A heel that brakes before it lands (Plug-in Gait's flat-foot walker, session 34): it comes down at
+// 1.4 m/s, brakes within 40 ms to 0.15 m/s 10 mm above the floor and sinks on at that speed for
+// 70 ms before it stops. Slowed to under a tenth of its approach, it is still descending faster
+// than the slowest landing approach (0.1 m/s): it has not landed until it stops, and the contact
+// the solve begins 100 ms before that carries nothing until then.
+TEST(Contact, AHeelThatBrakesAndSinksOnHasNotLandedUntilItStops) {
+  const Eigen::Index n = 400, impact = 200;
+  Heights h{Eigen::VectorXd(n), Eigen::VectorXd::Constant(n, 0.02)};
+  const auto descent = [](double t) {  // m/s at time t (s) from the stop
+    if (t >= 0) return 0.0;
+    if (t >= -0.07) return 0.15;
+    if (t >= -0.11) return 0.15 + (1.4 - 0.15) * (-0.07 - t) / 0.04;
+    return 1.4;
+  };
+  h.heel[n - 1] = 0.05;
+  for (Eigen::Index i = n - 2; i >= 0; --i) {
+    const double t = static_cast<double>(i - impact) / 200.0;
+    h.heel[i] = std::min(h.heel[i + 1] + descent(t) / 200.0, 0.2);
+  }
+  TouchdownStopRule rule;
+  rule.fraction = 0.1;
+  const auto before = frames_before_touchdown(contact_from(n, impact - 20, impact + 120), h.heel, h.mt, 200.0, rule);
+  const auto flagged = std::count(before.begin(), before.end(), true);
+  // The whole sinking (14 frames) is held back, not only the approach before the brake.
+  for (Eigen::Index i = impact - 20; i < impact - 3; ++i) EXPECT_TRUE(before[static_cast<std::size_t>(i)]) << i;
+  EXPECT_GE(flagged, 17);
+  EXPECT_LE(flagged, 24);
+  for (Eigen::Index i = impact + 4; i < n; ++i) EXPECT_FALSE(before[static_cast<std::size_t>(i)]) << i;
+}
+
 // A slow walker (issue 29's held-out 0.36 m/s walk): the heel comes down at 0.08 m/s and the solve's
 // contact begins 250 ms before it stops. The rule's fixed window (150 ms) and least descent
 // (0.1 m/s) miss it; scaled to the walker's 1.8 s stance (touchdown_stop_rule: x 2.4) it holds the

@@ -226,7 +226,10 @@ std::vector<bool> frames_before_touchdown(const std::vector<bool>& contact, cons
     for (const Landmark& l : lm) {
       if (l.y[i] > l.floor + rule.height_band_m) continue;
       const double peak = l.descent.segment(std::max<Eigen::Index>(0, i - w), std::min(w, i) + 1).maxCoeff();
-      if (peak >= rule.min_descent_mps && l.descent[i] <= rule.fraction * peak) return true;
+      // Stopped: slowed to a fraction of the approach, and no longer sinking as fast as a landing
+      // approaches (a heel that brakes from 1.4 m/s to 0.11 m/s a few mm above its floor and sinks
+      // on at that speed for 70 ms has not yet landed).
+      if (peak >= rule.min_descent_mps && l.descent[i] <= std::min(rule.fraction * peak, rule.min_descent_mps)) return true;
     }
     return false;
   };

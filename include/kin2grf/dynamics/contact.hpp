@@ -253,7 +253,7 @@ struct TouchdownStopRule {
   double cutoff_hz = 15.0;
   double window_s = 0.15;        ///< the recent peak is the fastest descent within this before; the stop is looked for this long after activation
   double height_band_m = 0.02;   ///< and only where the landmark is this close to its own floor height (its 10th percentile)
-  double min_descent_mps = 0.1;  ///< a recent peak slower than this is no landing (a planted foot settling)
+  double min_descent_mps = 0.1;  ///< a recent peak slower than this is no landing (a planted foot settling); a landmark descending faster has not stopped
 };
 
 /// The frames, per foot, in which the solve has the foot in contact before it has landed
@@ -262,8 +262,11 @@ struct TouchdownStopRule {
 /// contact run that follows a frame without contact, scanned from its first frame for at most
 /// rule.window_s: the foot has landed at the first frame where its heel or its MT head lies within
 /// rule.height_band_m of its floor height and descends no faster than rule.fraction of its fastest
-/// descent over the window before (at least rule.min_descent_mps); the run's frames before that are
-/// returned. A run in which no landmark lands within the window (no descent: a foot set down
+/// descent over the window before (at least rule.min_descent_mps) and no faster than
+/// rule.min_descent_mps itself (a landmark still sinking as fast as the slowest landing approach
+/// has not stopped: Plug-in Gait's flat-foot walker's heel brakes from 1.4 to 0.11 m/s 5 mm above
+/// its floor and sinks on at 0.11-0.16 m/s for 70 ms before its plate loads; session 34); the
+/// run's frames before that are returned. A run in which no landmark lands within the window (no descent: a foot set down
 /// slowly, a trial's first stance) returns none, nor does one that begins on a frame of
 /// `near_flight` (flight_frames; empty: none): in flight the whole body's kinematics ask for no
 /// load until the impact, so a run's or a jump's contact does not begin early (the runs' onsets are
