@@ -34,7 +34,7 @@ const std::vector<NumericOption>& numeric_options() {
        {0.0, 0.5, 0.7, 0.8, 0.9, 1.0}, "%.1f of the peak", 1.0, "off"},
       {"touchdown-stop", "touchdown_stop_fraction", [](O& o) -> double& { return o.touchdown_stop_fraction; }, 0.0, 1.0, 0.0,
        "A landing foot carries no load before its heel or MT head, seen at 15 Hz, has stopped descending: its descent fallen to "
-       "this fraction of its recent peak (0 = off, the paper); the load the kinematics ask for before is dropped",
+       "this fraction of its recent peak and under 0.1 m/s (0 = off, the paper); the load the kinematics ask for before is dropped",
        {0.0, 0.1, 0.2, 0.3, 0.5}, "%.1f of the peak", 1.0, "off"},
       {"still-foot", "still_foot_rad_per_s", [](O& o) -> double& { return o.contact.still_foot_rad_per_s; }, 0.0, 10.0, 0.0,
        "The contact calibration's foot-flat reference from frames where the foot is also still, its angle turning slower than "
