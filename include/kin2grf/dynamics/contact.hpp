@@ -266,12 +266,12 @@ struct TouchdownStopRule {
 /// rule.min_descent_mps itself (a landmark still sinking as fast as the slowest landing approach
 /// has not stopped: Plug-in Gait's flat-foot walker's heel brakes from 1.4 to 0.11 m/s 5 mm above
 /// its floor and sinks on at 0.11-0.16 m/s for 70 ms before its plate loads; session 34); the
-/// run's frames before that are returned. A run in which no landmark lands within the window (no descent: a foot set down
-/// slowly, a trial's first stance) returns none, nor does one that begins on a frame of
-/// `near_flight` (flight_frames; empty: none): in flight the whole body's kinematics ask for no
-/// load until the impact, so a run's or a jump's contact does not begin early (the runs' onsets are
-/// 3-10 ms early), and a runner's heel and MT head go on sinking into the shoe and the heel pad for
-/// 20-30 ms after it. Why: a zero-lag 6 Hz filter spreads the impact's
+/// run's frames before that are returned. A run in which no landmark lands within the window (no
+/// descent: a foot set down slowly, a trial's first stance) returns none, nor does one that begins
+/// on a frame of `near_flight` (flight_frames; empty: none): in flight the whole body's kinematics
+/// ask for no load until the impact, so a run's or a jump's contact does not begin early (the runs'
+/// onsets are 3-10 ms early), and a runner's heel and MT head go on sinking into the shoe and the
+/// heel pad for 20-30 ms after it. Why: a zero-lag 6 Hz filter spreads the impact's
 /// deceleration over about +-40 ms, so the whole body's kinematics ask for a ground force before
 /// the foot arrives and the least squares hands it to the landing foot. On the development walks
 /// with raw plate signals the solve's contact began 13-48 ms before the plates' onsets (32 ms mean
