@@ -291,10 +291,11 @@ void apply_frame_range(Trial& t, const std::string& range) {
   if (colon == std::string::npos) throw malformed();
   const int a = number(range.substr(0, colon), first_file), b = number(range.substr(colon + 1), last_file);
   if (a > b) throw InputError(t.path + ": --frames " + range + ": its first frame comes after its last");
-  if (a < first_file || b > last_file)
-    throw InputError(t.path + ": --frames " + range + ": frames " + std::to_string(a) + "-" + std::to_string(b) +
-                     " are not within the recording's frames " + std::to_string(first_file) + "-" + std::to_string(last_file));
-  t.markers = cropped(std::move(t.markers), a - first_file, b - a + 1);
+  try {
+    t.markers = cropped(std::move(t.markers), a - first_file, b - a + 1);  // it refuses frames the recording does not hold
+  } catch (const InputError& e) {
+    throw InputError(t.path + ": --frames " + range + ": " + e.what());
+  }
 }
 
 TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load) {
