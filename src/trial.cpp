@@ -88,6 +88,10 @@ MarkerTrajectories decimated(MarkerTrajectories m, int factor) {
   }
   m.time_s = std::move(t);
   m.rate_hz /= factor;
+  // Frame numbers count the slower capture's frames, as a camera at rate_hz / factor would number
+  // them (row 0 keeps its time; the file's number of row i was first_frame + i * factor, which no
+  // one offset can give, so messages naming a frame would be off by i * (factor - 1)).
+  m.first_frame = (m.first_frame - 1) / factor + 1;
   return m;
 }
 

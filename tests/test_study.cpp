@@ -217,6 +217,12 @@ TEST(Study, MarkerRateStudyDecimatesTheMarkersAndKeepsThePlates) {
   EXPECT_DOUBLE_EQ(half.time_s[3], walk.markers.time_s[6]);
   EXPECT_TRUE(half.positions_m[0].row(3).isApprox(walk.markers.positions_m[0].row(6)));
   EXPECT_THROW((void)decimated(walk.markers, 0), InputError);
+  // Frame numbers count the slower capture's frames: a file starting at frame 101 at 100 Hz
+  // starts at frame 51 at 50 Hz (the same time, 1.0 s), so row 3 is frame 54, not 104.
+  MarkerTrajectories late = walk.markers;
+  late.first_frame = 101;
+  EXPECT_EQ(decimated(late, 2).first_frame, 51);
+  EXPECT_EQ(decimated(late, 4).first_frame, 26);
   EXPECT_EQ(decimation_factor(250.0, 60.0), 4);
   EXPECT_EQ(decimation_factor(100.0, 100.0), 1);
   EXPECT_EQ(decimation_factor(60.0, 100.0), 1) << "never upsampled";

@@ -76,6 +76,7 @@ void add_marker_noise(MarkerTrajectories& m, double sigma_m, unsigned seed);
 /// Every `factor`-th frame of the markers (frames 0, factor, 2 factor, ...), at rate_hz / factor,
 /// each kept frame at its own time: what a capture at a lower rate would have sampled of the same
 /// motion (a camera samples positions; it does not low-pass them first). The marker-rate study.
+/// Its frame numbers are the slower capture's: first_frame becomes (first_frame - 1) / factor + 1.
 /// factor 1 returns the markers as they are; factor < 1 is an InputError.
 MarkerTrajectories decimated(MarkerTrajectories m, int factor);
 
