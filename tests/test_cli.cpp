@@ -790,3 +790,38 @@ TEST(CliInput, WriteMappingNeverOverwritesTheRecording) {
   }
   EXPECT_EQ(std::filesystem::file_size(trc), before);
 }
+
+// estimate --c3d writes the trial with the estimated platforms, reported as written; an output
+// path that is the input is refused before any work, and the input is left as it was.
+TEST(CliExport, EstimateWritesTheC3dWithTheEstimatedPlatforms) {
+  KIN2GRF_REQUIRE_CLI();
+  const auto dir = kin2grf::test::temp_dir("cli_c3d_export");
+  const std::string c3d = (example_dir() / "example_walk.c3d").string(), out = (dir / "estimated.c3d").string();
+  const CliRun r = run("estimate " + c3d + " --c3d " + out, "2>&1");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("wrote " + out + " (C3D"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("foot strike and foot off events added"), std::string::npos) << r.out;
+  const kin2grf::Trial back = kin2grf::load_trial(out);
+  ASSERT_TRUE(back.plates.has_value());
+  EXPECT_EQ(back.plates->plates.size(), 2u);
+  EXPECT_FALSE(back.events.empty());
+  const std::string before = kin2grf::read_file_text(c3d);
+  const CliRun same = run("estimate " + c3d + " --c3d " + c3d, "2>&1");
+  EXPECT_NE(same.status, 0);
+  EXPECT_NE(same.out.find("is an input of this run"), std::string::npos) << same.out;
+  EXPECT_EQ(kin2grf::read_file_text(c3d), before);
+}
+
+// batch --c3d writes NAME.c3d beside each trial's other outputs; without --out-dir it is refused.
+TEST(CliExport, BatchWritesEachTrialsC3dIntoTheOutputFolder) {
+  KIN2GRF_REQUIRE_CLI();
+  const auto dir = kin2grf::test::temp_dir("cli_batch_c3d");
+  const auto list = dir / "list.txt";
+  kin2grf::write_file_text(list.string(), "walking|lab|walk|" + (example_dir() / "example_walk.c3d").string() + " --mass 70\n");
+  const CliRun r = run("batch " + list.string() + " --jobs 1 --c3d --out-dir " + (dir / "out").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  const kin2grf::Trial back = kin2grf::load_trial((dir / "out" / "walk.c3d").string());
+  ASSERT_TRUE(back.plates.has_value());
+  EXPECT_EQ(back.plates->plates.size(), 2u);
+  EXPECT_NE(run("batch " + list.string() + " --c3d").status, 0);
+}

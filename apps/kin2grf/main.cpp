@@ -152,7 +152,10 @@ int main(int argc, char** argv) {
     batch->add_option("-j,--jobs", batch_args.jobs, "Worker threads (default: every core)")->check(CLI::Range(0, 1024));
     batch->add_option("--csv", batch_args.out_csv, "Summary table, one line per trial (CSV)");
     batch->add_option("--json", batch_args.out_json, "Summary table as JSON, with each trial's messages");
-    batch->add_option("--out-dir", batch_args.out_dir, "Write NAME.csv, NAME_grf.mot and NAME.json per trial into this folder");
+    CLI::Option* out_dir =
+        batch->add_option("--out-dir", batch_args.out_dir, "Write NAME.csv, NAME_grf.mot and NAME.json per trial into this folder");
+    batch->add_flag("--c3d", batch_args.c3d, "With --out-dir: NAME.c3d per trial too (as estimate --c3d: the markers with the estimated GRF as force platforms)")
+        ->needs(out_dir);
   }
 
   std::string example_dir = "example";

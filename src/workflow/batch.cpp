@@ -17,6 +17,7 @@
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/output_file.hpp"
+#include "kin2grf/output/c3d_export.hpp"
 #include "kin2grf/output/opensim_export.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/output/results.hpp"
@@ -91,10 +92,12 @@ void parse_sync(const std::string& text, ValidationOptions& vo) {
   }
 }
 
-std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir) {
+std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir, bool c3d) {
   const auto base = (std::filesystem::path(out_dir) / file_stem(entry.name)).string();
   const auto opensim = opensim_export_paths(out_dir, file_stem(entry.name));
-  return {base + ".csv", opensim.grf_mot, base + ".json", opensim.markers_trc, opensim.external_loads_xml};
+  std::vector<std::string> out = {base + ".csv", opensim.grf_mot, base + ".json", opensim.markers_trc, opensim.external_loads_xml};
+  if (c3d) out.push_back(base + ".c3d");
+  return out;
 }
 
 BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& options) {
@@ -122,7 +125,7 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
     if (!options.out_dir.empty()) {
       // The trial's files are placed together, with the batch's, or not at all.
       OutputTransaction outputs;
-      const auto written = batch_trial_outputs(entry, options.out_dir);
+      const auto written = batch_trial_outputs(entry, options.out_dir, options.c3d);
       const std::string &csv = written[0], &json = written[2];
       write_results_csv(csv, r);
       auto settings = settings_json(entry.settings, estimate_options);
@@ -131,6 +134,8 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
       OpenSimExportOptions eo;
       eo.settings = settings.dump();
       write_opensim_export(options.out_dir, file_stem(entry.name), trial, r, eo);
+      if (options.c3d)
+        for (auto& m : write_c3d_export(written.back(), trial, r)) row.messages.push_back(std::move(m));
       write_file_text(json, json_text(v ? validation_json(entry.name, r, *v, settings) : results_summary(r, settings)));
       outputs.commit();
       row.outputs = written;

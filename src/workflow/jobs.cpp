@@ -15,6 +15,7 @@
 #include "kin2grf/io/marker_labels.hpp"
 #include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/summary.hpp"
+#include "kin2grf/output/c3d_export.hpp"
 #include "kin2grf/output/opensim_export.hpp"
 #include "kin2grf/output/report.hpp"
 #include "kin2grf/output/results.hpp"
@@ -73,12 +74,15 @@ void add_estimate_options(CLI::App* c, EstimateJob& a, bool outputs) {
                 "(Y up, X forward), ready for the ID tool");
   c->add_option("--opensim-bodies", a.opensim_bodies, "Bodies the right and left forces are applied to (default calcn_r calcn_l)")
       ->expected(2);
+  c->add_option("--c3d", a.out_c3d,
+                "Write the trial's markers with the estimated GRF as two force platforms (TYPE 2: 1 the right foot, 2 the left) "
+                "and its gait events, Z up, for Nexus, Visual3D, Mokka or ezc3d (docs/FORMATS.md)");
 }
 
 int estimate_job(const EstimateJob& a, std::ostream& out, std::ostream& log) {
   {
-    std::vector<std::string> files = {a.out_mot, a.out_csv, a.out_json, a.out_events, a.out_report},
-                             names = {"-o", "--csv", "--json", "--events", "--report"};
+    std::vector<std::string> files = {a.out_mot, a.out_csv, a.out_json, a.out_events, a.out_report, a.out_c3d},
+                             names = {"-o", "--csv", "--json", "--events", "--report", "--c3d"};
     if (!a.opensim_dir.empty()) {
       const auto f = opensim_export_paths(a.opensim_dir, std::filesystem::path(a.trial).stem().string());
       files.insert(files.end(), {f.grf_mot, f.markers_trc, f.external_loads_xml});
@@ -99,8 +103,9 @@ int estimate_job(const EstimateJob& a, std::ostream& out, std::ostream& log) {
   // the markers: a long trial's memory.
   options.keep_all_series = !a.out_report.empty();  // the report plots the GRM
   const Eigen::VectorXd trial_time_s = trial.markers.time_s;  // -o's rows: every frame of the trial
-  const auto r = a.opensim_dir.empty() ? estimate_trial(a, options, std::move(files.trial), files.static_trial)
-                                       : estimate_trial(a, options, trial, files.static_trial);
+  const bool keep_markers = !a.opensim_dir.empty() || !a.out_c3d.empty();  // the exports write them
+  const auto r = keep_markers ? estimate_trial(a, options, trial, files.static_trial)
+                              : estimate_trial(a, options, std::move(files.trial), files.static_trial);
   print_messages(r, log);
   const std::string settings_line = settings_json(a, options).dump();
   if (!a.out_mot.empty()) {
@@ -114,9 +119,13 @@ int estimate_job(const EstimateJob& a, std::ostream& out, std::ostream& log) {
     if (!a.out_report.empty()) write_file_text(a.out_report, estimate_report_html(a.trial, r, summary));
   }
   if (!a.out_events.empty()) write_file_text(a.out_events, gait_events_csv(r));
+  std::vector<std::string> c3d_messages;
+  if (!a.out_c3d.empty()) c3d_messages = write_c3d_export(a.out_c3d, trial, r);
+  for (const auto& m : c3d_messages) log << "kin2grf: " << m << "\n";
   out << format_results_text(r);
   for (const auto& [file, what] : {std::pair{a.out_mot, a.lab_frame ? "GRF, lab frame" : "GRF, OpenSim's frame"}, {a.out_csv, "per-frame CSV"}, {a.out_json, "JSON summary"},
-                                   {a.out_events, "gait events CSV"}, {a.out_report, "HTML report"}})
+                                   {a.out_events, "gait events CSV"}, {a.out_report, "HTML report"},
+                                   {a.out_c3d, "C3D: the markers with the estimated GRF as force platforms 1 (right) and 2 (left)"}})
     if (!file.empty()) out << "wrote " << file << " (" << what << ")\n";
   if (!a.opensim_dir.empty()) {
     OpenSimExportOptions eo;
@@ -126,7 +135,8 @@ int estimate_job(const EstimateJob& a, std::ostream& out, std::ostream& log) {
     out << "wrote " << f.grf_mot << ", " << f.markers_trc << " and " << f.external_loads_xml << " (OpenSim: Y up, X forward; "
         << (a.mediolateral ? "with the mediolateral force; no free moment)\n" : "sagittal model: no mediolateral force or free moment)\n");
   }
-  if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty() && a.out_events.empty() && a.out_report.empty() && a.opensim_dir.empty())
+  if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty() && a.out_events.empty() && a.out_report.empty() && a.opensim_dir.empty() &&
+      a.out_c3d.empty())
     out << "(-o GRF.mot, --csv FILE and --json FILE write the per-frame results and the full summary)\n";
   return 0;
 }
@@ -206,12 +216,12 @@ int batch_job(const BatchJob& a, std::ostream& out, std::ostream& log) {
     std::vector<std::string> files = {a.out_csv, a.out_json}, names = {"--csv", "--json"};
     if (!a.out_dir.empty())
       for (const auto& e : entries)
-        for (auto& f : batch_trial_outputs(e, a.out_dir)) files.push_back(std::move(f)), names.push_back("--out-dir");
+        for (auto& f : batch_trial_outputs(e, a.out_dir, a.c3d)) files.push_back(std::move(f)), names.push_back("--out-dir");
     check_outputs(files, list_input_files(entries), names);
   }
   BatchOptions o;
   o.jobs = a.jobs > 0 ? a.jobs : static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
-  o.out_dir = a.out_dir, o.progress = batch_progress(stderr);
+  o.out_dir = a.out_dir, o.c3d = a.c3d, o.progress = batch_progress(stderr);
   const auto start = std::chrono::steady_clock::now();
   allow_allocator_arenas(o.jobs);
   log << "kin2grf: batch of " << entries.size() << " trials on " << o.jobs << " threads\n";

@@ -39,6 +39,7 @@ struct BatchRow {
 struct BatchOptions {
   int jobs = 1;                  ///< worker threads (>= 1)
   std::string out_dir;           ///< when set: NAME.csv, NAME_grf.mot and NAME.json per trial
+  bool c3d = false;              ///< with out_dir: NAME.c3d too (output/c3d_export.hpp)
   ValidationOptions validation;
   /// Called after each trial with (trials done, trials in all, that trial's row), from the
   /// thread that ran it, one call at a time. The core prints nothing itself.
@@ -65,8 +66,9 @@ ValidationRun validate_trial(const Settings& settings, const std::string& plates
 void parse_sync(const std::string& text, ValidationOptions& validation);
 
 /// The files a trial of the batch writes into `out_dir`: NAME.csv, NAME_grf.mot (OpenSim's frame), NAME.json,
-/// NAME_markers.trc and NAME_external_loads.xml (the OpenSim set, as `estimate --opensim` writes it).
-std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir);
+/// NAME_markers.trc and NAME_external_loads.xml (the OpenSim set, as `estimate --opensim` writes it), and
+/// with `c3d` NAME.c3d (as `estimate --c3d` writes it).
+std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir, bool c3d = false);
 /// One trial: never throws for the trial's own faults (they are the row's error).
 BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& options = {});
 /// Every trial, rows in the list's order.

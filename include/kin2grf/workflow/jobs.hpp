@@ -20,7 +20,7 @@ namespace kin2grf {
 struct EstimateJob : Settings {
   std::string opensim_dir;
   std::vector<std::string> opensim_bodies;
-  std::string out_mot, out_csv, out_json, out_events, out_report;
+  std::string out_mot, out_csv, out_json, out_events, out_report, out_c3d;
   bool lab_frame = false;
 };
 
@@ -47,6 +47,7 @@ struct FitCopJob {
 struct BatchJob {
   std::string trial_list, out_csv, out_json, out_dir;
   int jobs = 0;  ///< 0: every core
+  bool c3d = false;  ///< --c3d: NAME.c3d per trial into out_dir too
 };
 
 /// Registers estimate's settings and, with `outputs`, its output options on `app`.

@@ -1,0 +1,57 @@
+// kin2grf outputs: the trial as a C3D with the estimated ground reactions as force platforms, for
+// the tools gait labs compute their kinetics with from C3D files (Vicon Nexus, Visual3D, Mokka,
+// ezc3d, BTK): they then run their own inverse dynamics on the estimate as on measured plates.
+//
+// What the file holds:
+//  - every marker of the trial as read (mm, the file's own frame numbers), a missing sample
+//    written with residual -1;
+//  - two force platforms of TYPE 2 (force and moment channels at the sensor origin, N and N mm),
+//    platform 1 the right foot's estimate, platform 2 the left foot's, sampled at the marker rate:
+//    zero outside contact and outside the processed window; the free moment is zero (not
+//    estimated). Each platform is a rectangle on the calibrated floor covering every place its
+//    foot's COP takes in the trial, kLoadedFootMarginM wider on every side (so the whole foot
+//    stands on it while it is loaded: a tool that assigns a platform to the foot over it finds
+//    that foot), with C3D's axes (x = c1 - c2, y = c1 - c4, z = x cross y pointing down) and its
+//    sensor origin at its surface centre (ORIGIN 0 0 0: no reader's sign convention for ORIGIN
+//    comes into play);
+//  - the file's own events, and where it has no "Foot Strike" or "Foot Off" event, the estimate's
+//    (gait_events), so that a tool can cut cycles;
+//  - the body mass the estimate used (PROCESSING:Bodymass) and the height where the file has one.
+// Not carried: the file's own analog channels (its measured plates, EMG), which would add
+// measured forces to the estimated ones in an inverse dynamics; the input file is not changed.
+//
+// Frame: the trial's lab frame when its up axis is +Z (C3D's convention, which ezc3d's platform
+// module assumes); otherwise every position, corner and force is rotated by the one rotation that
+// takes the trial's up direction to +Z (a TRC in OpenSim's Y-up frame: X stays, Y -> Z, Z -> -Y).
+//
+// Written with io/c3d.hpp's writer (Intel, float). Tested against ezc3d's reading rules for TYPE 2
+// platforms (its ForcePlatforms module: axes from the corners, the COP from the channels), not
+// against kin2grf's own reader.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "kin2grf/pipeline.hpp"
+#include "kin2grf/trial.hpp"
+
+namespace kin2grf {
+
+/// How far each virtual platform reaches beyond its foot's COPs, m: about half a foot's length,
+/// so that the foot around a COP at its heel or its toe is on the platform too.
+inline constexpr double kLoadedFootMarginM = 0.15;
+
+struct C3dExport {
+  Trial trial;                        ///< markers, platforms, events, mass: what write_c3d writes
+  int first_frame = 1;                ///< its first frame number: the trial's, where it fits 1-65535
+  std::vector<std::string> messages;  ///< what was done to the frame or the events, for the user
+};
+
+/// The trial with the estimate's ground reactions as two TYPE 2 platforms (right, left), in a
+/// Z-up lab frame. `trial` is the one the estimate was made from (its markers and events).
+C3dExport c3d_export(const Trial& trial, const EstimateResult& estimate);
+
+/// c3d_export written to `path` (Intel, float data, from its first_frame). Returns its messages.
+std::vector<std::string> write_c3d_export(const std::string& path, const Trial& trial, const EstimateResult& estimate);
+
+}  // namespace kin2grf

@@ -1,0 +1,145 @@
+#include "kin2grf/output/c3d_export.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "kin2grf/io/c3d.hpp"
+#include "kin2grf/io/force_plate.hpp"
+
+namespace kin2grf {
+
+namespace {
+
+bool is_gait_event(const std::string& label) {
+  std::string l;
+  for (char c : label) l += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return l == "foot strike" || l == "foot off";
+}
+
+/// The rotation that takes `up` to +Z (the identity when it is +Z already); an axis-aligned up
+/// gives a matrix of exact 0 and +-1.
+Eigen::Matrix3d up_to_z(const Eigen::Vector3d& up) {
+  const Eigen::Vector3d u = up.normalized();
+  if ((u - Eigen::Vector3d::UnitZ()).norm() < 1e-12) return Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(u, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (Eigen::Index k = 0; k < R.size(); ++k)
+    if (std::abs(R.data()[k] - std::round(R.data()[k])) < 1e-12) R.data()[k] = std::round(R.data()[k]);
+  return R;
+}
+
+}  // namespace
+
+C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
+  C3dExport out;
+  const MarkerTrajectories& m = trial.markers;
+  const Eigen::Index N = m.frames(), n = r.time_s.size();
+  const Eigen::Matrix3d R = up_to_z(r.frame.up);
+  if (!R.isIdentity()) {
+    char b[200];
+    std::snprintf(b, sizeof b, "C3D: the trial's up direction (%.3g, %.3g, %.3g) turned to +Z, C3D's convention (every position and force rotated alike)",
+                  r.frame.up.x(), r.frame.up.y(), r.frame.up.z());
+    out.messages.emplace_back(b);
+  }
+  out.trial.path = trial.path;
+  out.trial.format = "C3D";
+  out.trial.markers = R.isIdentity() ? m : rotated(m, R, Axis::Z);
+  out.trial.markers.up_axis = Axis::Z;
+  out.first_frame = m.first_frame >= 1 && m.first_frame <= 65535 ? m.first_frame : 1;
+  if (out.first_frame != m.first_frame)
+    out.messages.push_back("C3D: frame numbers start at 1 (the trial's first frame, " + std::to_string(m.first_frame) +
+                           ", does not fit the C3D header's 16 bits)");
+  out.trial.body_mass_kg = r.mass_kg;
+  out.trial.height_m = trial.height_m;
+
+  // The feet's ground reactions, lab frame, over the processed window; zero outside contact and
+  // outside the window, as the OpenSim export writes them.
+  const auto feet = as_lab_plates(r);
+  const double floor_m = r.ground_level_m();  // along up, which R takes to +Z
+  ForcePlateRecording rec;
+  rec.rate_hz = m.rate_hz;
+  rec.time_s = out.trial.markers.time_s;
+  rec.up_axis = Axis::Z;
+  std::array<Eigen::Vector4d, 2> box;  // x min, x max, y min, y max of each foot's COPs
+  std::array<bool, 2> loaded{false, false};
+  for (int side = 0; side < 2; ++side) {
+    ForcePlate p;
+    p.name = side ? "kin2grf left foot" : "kin2grf right foot";
+    p.type = 2;
+    p.has_geometry = true;
+    p.force_N = Eigen::MatrixX3d::Zero(N, 3);
+    p.cop_m = Eigen::MatrixX3d::Constant(N, 3, std::numeric_limits<double>::quiet_NaN());
+    p.free_moment_Nm = Eigen::MatrixX3d::Zero(N, 3);
+    p.moment_centre_Nm = Eigen::MatrixX3d::Constant(N, 3, std::numeric_limits<double>::quiet_NaN());
+    const ForcePlate& f = feet[static_cast<std::size_t>(side)];
+    const auto& contact = r.feet[static_cast<std::size_t>(side)].contact;
+    Eigen::Vector4d& b = box[static_cast<std::size_t>(side)];
+    b << std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+        -std::numeric_limits<double>::infinity();
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index k = r.first_index + i;
+      if (k < 0 || k >= N || !contact[static_cast<std::size_t>(i)] || !f.cop_m.row(i).allFinite()) continue;
+      const Eigen::Vector3d c = R * f.cop_m.row(i).transpose();
+      p.force_N.row(k) = (R * f.force_N.row(i).transpose()).transpose();
+      p.cop_m.row(k) = c.transpose();
+      b = Eigen::Vector4d(std::min(b[0], c.x()), std::max(b[1], c.x()), std::min(b[2], c.y()), std::max(b[3], c.y()));
+      loaded[static_cast<std::size_t>(side)] = true;
+    }
+    rec.plates.push_back(std::move(p));
+  }
+  for (int side = 0; side < 2; ++side) {
+    const auto s = static_cast<std::size_t>(side);
+    if (loaded[s]) continue;
+    // A foot never loaded: its platform (zero throughout) where the other foot's is, else about
+    // the lab's origin.
+    box[s] = loaded[1 - s] ? box[1 - s] : Eigen::Vector4d::Zero();
+    out.messages.push_back(std::string("C3D: the ") + side_name(side) + " foot is never loaded; its platform carries zero");
+  }
+  for (int side = 0; side < 2; ++side) {
+    ForcePlate& p = rec.plates[static_cast<std::size_t>(side)];
+    const Eigen::Vector4d& b = box[static_cast<std::size_t>(side)];
+    const double x0 = b[0] - kLoadedFootMarginM, x1 = b[1] + kLoadedFootMarginM, y0 = b[2] - kLoadedFootMarginM,
+                 y1 = b[3] + kLoadedFootMarginM;
+    // C3D's corner order with the platform's z pointing down: c1 - c2 along +x, c1 - c4 along -y.
+    p.corners_m = {Eigen::Vector3d(x1, y0, floor_m), Eigen::Vector3d(x0, y0, floor_m), Eigen::Vector3d(x0, y1, floor_m),
+                   Eigen::Vector3d(x1, y1, floor_m)};
+    Eigen::Matrix<double, 3, 4> C;
+    for (int c = 0; c < 4; ++c) C.col(c) = p.corners_m[static_cast<std::size_t>(c)];
+    p.lab_R_plate = plate_axes(C);
+    p.centre_m = C.rowwise().mean();
+    p.origin_m.setZero();
+  }
+  out.trial.plates = std::move(rec);
+
+  // Events on the C3D's clock: row i at (first_frame - 1 + i) / rate.
+  const double shift_s = N > 0 ? (out.first_frame - 1) / m.rate_hz - m.time_s[0] : 0.0;
+  bool has_gait_events = false;
+  for (const Event& e : trial.events) {
+    out.trial.events.push_back(Event{e.label, e.side, e.time_s + shift_s});
+    has_gait_events = has_gait_events || is_gait_event(e.label);
+  }
+  if (has_gait_events) {
+    out.messages.push_back("C3D: the file's own events kept (it has foot strikes or foot offs); the estimate's are in --events");
+  } else {
+    const auto events = gait_events({r.feet[0].contact, r.feet[1].contact}, r.time_s, r.motion.rate_hz);
+    for (const GaitEvent& e : events)
+      out.trial.events.push_back(Event{e.label, e.side == kLeft ? Side::Left : Side::Right, r.time_s[e.index] + shift_s});
+    out.messages.push_back("C3D: the estimate's " + std::to_string(events.size()) +
+                           " foot strike and foot off events added (the file has none)");
+  }
+  return out;
+}
+
+std::vector<std::string> write_c3d_export(const std::string& path, const Trial& trial, const EstimateResult& estimate) {
+  C3dExport e = c3d_export(trial, estimate);
+  C3dWriteOptions o;
+  o.first_frame = e.first_frame;
+  write_c3d(path, e.trial, o);
+  return std::move(e.messages);
+}
+
+}  // namespace kin2grf
