@@ -72,13 +72,29 @@ Param floats(const std::string& g, const std::string& n, std::vector<double> v, 
   p.type = 4;
   return p;
 }
+/// A parameter's dimension is one byte: 255 at most.
+constexpr std::size_t kMaxDimension = 255;
+
 Param strs(const std::string& g, const std::string& n, const std::vector<std::string>& s, bool array = true) {
   std::size_t len = 1;
   for (const auto& x : s) len = std::max(len, x.size());
+  if (len > kMaxDimension || (array && s.size() > kMaxDimension))
+    throw InputError("write_c3d: " + g + ":" + n + " would need a dimension over 255 (" + std::to_string(len) + " characters, " +
+                     std::to_string(s.size()) + " entries)");
   Param p{g, n, -1, {}, {}, s};
   p.dims = {static_cast<int>(len)};
   if (array) p.dims.push_back(static_cast<int>(s.size()));
   return p;
+}
+
+/// Strings of any count as C3D holds them: NAME with the first 255, NAME2 with the next, and so on
+/// (POINT:LABELS2, as Vicon, ezc3d and BTK write and read them).
+void push_strs_in_parts(std::vector<Param>& params, const std::string& g, const std::string& n, const std::vector<std::string>& s) {
+  for (std::size_t first = 0, part = 1; first < s.size() || part == 1; first += kMaxDimension, ++part) {
+    const auto last = std::min(s.size(), first + kMaxDimension);
+    params.push_back(strs(g, n + (part == 1 ? "" : std::to_string(part)),
+                          std::vector<std::string>(s.begin() + static_cast<std::ptrdiff_t>(first), s.begin() + static_cast<std::ptrdiff_t>(last))));
+  }
 }
 
 }  // namespace
@@ -138,8 +154,8 @@ std::vector<Param> c3d_parameters(const Trial& trial, const C3dWriteOptions& o, 
   std::vector<std::string> labels = m.names, descs = m.descriptions;
   descs.resize(labels.size());
   if (!labels.empty()) {
-    params.push_back(strs("POINT", "LABELS", labels));
-    params.push_back(strs("POINT", "DESCRIPTIONS", descs));
+    push_strs_in_parts(params, "POINT", "LABELS", labels);
+    push_strs_in_parts(params, "POINT", "DESCRIPTIONS", descs);
   }
   params.push_back(ints("ANALOG", "USED", {static_cast<double>(nchan)}));
   params.push_back(floats("ANALOG", "RATE", {m.rate_hz * spf}));
@@ -254,6 +270,9 @@ std::vector<std::uint8_t> write_c3d_bytes(const Trial& trial, const C3dWriteOpti
   if (nframes + o.first_frame > (1L << 30)) throw InputError("write_c3d: more than 2^30 frames");
   if (o.first_frame < 1 || o.first_frame > 65535) throw InputError("write_c3d: the first frame must be 1-65535");
   if (m.names.size() > 255 * 255) throw InputError("write_c3d: too many markers");
+  // EVENT:TIMES is 2 x events, each dimension a byte, and no second part is read by the tools.
+  if (trial.events.size() > kMaxDimension)
+    throw InputError("write_c3d: " + std::to_string(trial.events.size()) + " events; the EVENT group holds at most 255");
   const int spf = o.analog_samples_per_frame;
   const ForcePlateRecording* fpr = trial.plates ? &*trial.plates : nullptr;
   const int nplates = fpr ? static_cast<int>(fpr->plates.size()) : 0;

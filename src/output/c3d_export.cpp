@@ -131,6 +131,15 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
     out.messages.push_back("C3D: the estimate's " + std::to_string(events.size()) +
                            " foot strike and foot off events added (the file has none)");
   }
+  // C3D's EVENT group holds 255 events (its TIMES is 2 x events, each dimension a byte).
+  if (out.trial.events.size() > kMaxC3dEvents) {
+    std::stable_sort(out.trial.events.begin(), out.trial.events.end(), [](const Event& a, const Event& b) { return a.time_s < b.time_s; });
+    char b[200];
+    std::snprintf(b, sizeof b, "C3D: the first %zu of %zu events written (the EVENT group holds %zu; the estimate's are all in --events), up to %.3f s",
+                  kMaxC3dEvents, out.trial.events.size(), kMaxC3dEvents, out.trial.events[kMaxC3dEvents - 1].time_s);
+    out.messages.emplace_back(b);
+    out.trial.events.resize(kMaxC3dEvents);
+  }
   return out;
 }
 

@@ -15,7 +15,7 @@
 //    sensor origin at its surface centre (ORIGIN 0 0 0: no reader's sign convention for ORIGIN
 //    comes into play);
 //  - the file's own events, and where it has no "Foot Strike" or "Foot Off" event, the estimate's
-//    (gait_events), so that a tool can cut cycles;
+//    (gait_events), so that a tool can cut cycles; at most kMaxC3dEvents, the first in time;
 //  - the body mass the estimate used (PROCESSING:Bodymass) and the height where the file has one.
 // Not carried: the file's own analog channels (its measured plates, EMG), which would add
 // measured forces to the estimated ones in an inverse dynamics; the input file is not changed.
@@ -40,6 +40,9 @@ namespace kin2grf {
 /// How far each virtual platform reaches beyond its foot's COPs, m: about half a foot's length,
 /// so that the foot around a COP at its heel or its toe is on the platform too.
 inline constexpr double kLoadedFootMarginM = 0.15;
+/// C3D's EVENT group holds this many events (a parameter's dimension is a byte); a longer trial's
+/// first ones are written, and the messages say so.
+inline constexpr std::size_t kMaxC3dEvents = 255;
 
 struct C3dExport {
   Trial trial;                        ///< markers, platforms, events, mass: what write_c3d writes
