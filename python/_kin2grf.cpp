@@ -13,6 +13,7 @@
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/summary.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/output/c3d_export.hpp"
 #include "kin2grf/output/opensim_export.hpp"
 #include "kin2grf/output/results.hpp"
 #include "kin2grf/validation/validate.hpp"
@@ -48,7 +49,7 @@ py::dict estimate_dict(const kin2grf::Settings& s, const kin2grf::EstimateOption
 }
 
 py::dict estimate(const std::string& trial, const std::vector<std::string>& words, const std::string& opensim_dir,
-                  const std::string& mot_path, bool lab_frame) {
+                  const std::string& mot_path, bool lab_frame, const std::string& c3d_path) {
   const auto s = settings_from(trial, words);
   kin2grf::EstimateResult r;
   kin2grf::EstimateOptions o;
@@ -70,6 +71,10 @@ py::dict estimate(const std::string& trial, const std::vector<std::string>& word
       if (lab_frame) kin2grf::write_grf_mot(mot_path, r, settings);
       else kin2grf::write_opensim_grf_mot(mot_path, stem, files.trial.markers.time_s, r, settings);
       written.push_back(mot_path);
+    }
+    if (!c3d_path.empty()) {  // as `estimate --c3d`
+      kin2grf::write_c3d_export(c3d_path, files.trial, r);
+      written.push_back(c3d_path);
     }
   }
   py::dict d = estimate_dict(s, o, r);
@@ -137,7 +142,7 @@ PYBIND11_MODULE(_kin2grf, m) {
   // Bad input raises kin2grf.InputError (a ValueError) with the library's own message.
   py::register_exception<kin2grf::InputError>(m, "InputError", PyExc_ValueError);
   m.def("estimate", &estimate, py::arg("trial"), py::arg("words"), py::arg("opensim_dir") = std::string(),
-        py::arg("mot_path") = std::string(), py::arg("lab_frame") = false);
+        py::arg("mot_path") = std::string(), py::arg("lab_frame") = false, py::arg("c3d_path") = std::string());
   m.def("validate", &validate, py::arg("trial"), py::arg("words"), py::arg("plates"), py::arg("threshold_N"),
         py::arg("zero_offset"), py::arg("sync"));
   m.def("batch_lines", &batch_lines, py::arg("lines"), py::arg("jobs"), py::arg("out_dir"));

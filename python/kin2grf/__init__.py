@@ -114,6 +114,12 @@ class Estimate:
         processed window."""
         return _kin2grf.estimate(self._trial, self._words, "", os.fspath(path), bool(lab_frame))["written"][-1]
 
+    def write_c3d(self, path: str | os.PathLike) -> str:
+        """Write the trial's markers with the estimated GRF as two force platforms (TYPE 2: 1 the
+        right foot, 2 the left) and its gait events, Z up, as ``kin2grf estimate --c3d`` does, for
+        Nexus, Visual3D, Mokka or ezc3d. The estimate is made again from the same trial and settings."""
+        return _kin2grf.estimate(self._trial, self._words, "", "", False, os.fspath(path))["written"][-1]
+
     @property
     def table(self):
         return _table(self.columns, self.values)

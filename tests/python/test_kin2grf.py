@@ -79,6 +79,11 @@ def test_estimate_writes_the_opensim_set(example, tmp_path):
     mot = r.write_mot(tmp_path / "o.mot")
     assert Path(mot).read_text() == (tmp_path / "set" / "example_walk_grf.mot").read_text()
     assert "kin2grf_frame=lab" in Path(r.write_mot(tmp_path / "lab.mot", lab_frame=True)).read_text()
+    # and the C3D with the estimated platforms, byte for byte what `kin2grf estimate --c3d` writes.
+    c3d = r.write_c3d(tmp_path / "estimated.c3d")
+    cli = tmp_path / "cli.c3d"
+    subprocess.run([CLI, "estimate", str(example / "example_walk.c3d"), "--c3d", str(cli)], check=True, capture_output=True)
+    assert Path(c3d).read_bytes() == cli.read_bytes()
 
 
 def test_table_and_columns(example):
