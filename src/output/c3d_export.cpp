@@ -135,8 +135,8 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
   if (out.trial.events.size() > kMaxC3dEvents) {
     std::stable_sort(out.trial.events.begin(), out.trial.events.end(), [](const Event& a, const Event& b) { return a.time_s < b.time_s; });
     char b[200];
-    std::snprintf(b, sizeof b, "C3D: the first %zu of %zu events written (the EVENT group holds %zu; the estimate's are all in --events), up to %.3f s",
-                  kMaxC3dEvents, out.trial.events.size(), kMaxC3dEvents, out.trial.events[kMaxC3dEvents - 1].time_s);
+    std::snprintf(b, sizeof b, "C3D: the first %zu of %zu events written, up to %.3f s (the EVENT group holds %zu; --events writes every estimated one)",
+                  kMaxC3dEvents, out.trial.events.size(), out.trial.events[kMaxC3dEvents - 1].time_s, kMaxC3dEvents);
     out.messages.emplace_back(b);
     out.trial.events.resize(kMaxC3dEvents);
   }

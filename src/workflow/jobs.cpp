@@ -99,8 +99,8 @@ int estimate_job(const EstimateJob& a, std::ostream& out, std::ostream& log) {
   const Trial& trial = files.trial;
   auto options = to_options(a);
   options.progress = solve_progress(stderr);
-  // The outputs need neither what validation reads nor, unless the OpenSim export writes them,
-  // the markers: a long trial's memory.
+  // The outputs need neither what validation reads nor, unless the OpenSim or the C3D export writes
+  // them, the markers: a long trial's memory.
   options.keep_all_series = !a.out_report.empty();  // the report plots the GRM
   const Eigen::VectorXd trial_time_s = trial.markers.time_s;  // -o's rows: every frame of the trial
   const bool keep_markers = !a.opensim_dir.empty() || !a.out_c3d.empty();  // the exports write them
