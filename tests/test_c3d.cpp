@@ -554,6 +554,35 @@ TEST(CorruptCorpus, EachFileIsReadWithAWarningOrRefusedByName) {
 // A long capture (10 minutes at 2 kHz: 1.2 million frames) has more frames than the header's
 // 16-bit frame numbers hold: the writer stores them in TRIAL:ACTUAL_START/END_FIELD (two 16-bit
 // words each), as Vicon does, and every frame reads back, the numbers past 65535 too.
+// A parameter's dimension is a byte: 300 markers are written as POINT:LABELS (255) and
+// POINT:LABELS2 (45), as Vicon, ezc3d and BTK write them, and read back by name (they came back
+// as 44 names and *n placeholders before); more than 255 events, which the EVENT group cannot
+// hold, are refused rather than written wrapped.
+TEST(C3dRoundTrip, MoreThan255LabelsGoToLabels2AndMoreThan255EventsAreRefused) {
+  Trial t;
+  auto& m = t.markers;
+  m.rate_hz = 100, m.first_frame = 1, m.time_s = Eigen::VectorXd::LinSpaced(10, 0, 0.09);
+  for (int k = 0; k < 300; ++k) {
+    char name[16];
+    std::snprintf(name, sizeof name, "M%d", k);  // ("M" + std::to_string(k) trips GCC 12's -Wstringop-overflow at -O3)
+    m.names.emplace_back(name);
+    m.descriptions.emplace_back();
+    m.positions_m.push_back(Eigen::MatrixX3d::Constant(10, 3, 0.001 * k));
+  }
+  const auto bytes = write_c3d_bytes(t);
+  const C3dFile f = read_c3d_header(bytes, "many.c3d");
+  ASSERT_NE(f.find("POINT:LABELS2"), nullptr);
+  EXPECT_EQ(f.find("POINT:LABELS")->strings.size(), 255u);
+  EXPECT_EQ(f.find("POINT:LABELS2")->strings.size(), 45u);
+  const Trial back = read_c3d_bytes(bytes, "many.c3d");
+  EXPECT_EQ(back.markers.names, m.names);
+  EXPECT_NEAR(back.markers.positions_m[299](0, 0), 0.299, 1e-6);
+  for (int k = 0; k < 256; ++k) t.events.push_back(Event{"Foot Strike", Side::Right, 0.001 * k});
+  EXPECT_THROW((void)write_c3d_bytes(t), InputError);
+  t.events.pop_back();
+  EXPECT_EQ(read_c3d_bytes(write_c3d_bytes(t), "events.c3d").events.size(), 255u);
+}
+
 TEST(C3dRoundTrip, MoreThan65535FramesKeepEveryFrameAndTheirNumbers) {
   Trial t;
   t.path = "long.c3d";

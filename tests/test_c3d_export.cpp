@@ -310,38 +310,16 @@ TEST(C3dExport, ARecordedWalkKeepsItsFramesItsEventsAndNotItsMeasuredPlates) {
   EXPECT_LT(peak, 1.6 * e.estimate.mass_kg * 9.81);
 }
 
-// A long capture: more than 255 markers (POINT:LABELS2, as Vicon, ezc3d and BTK write them) and a
-// 4-minute walk's 400 gait events, more than C3D's EVENT group holds: the first 255 are written and
-// the messages say so; none is lost silently, no label is garbled.
-TEST(C3dExport, ManyMarkersGoToLabels2AndEventsBeyond255AreCutWithAMessage) {
-  Trial t;
-  auto& m = t.markers;
-  m.rate_hz = 100, m.first_frame = 1, m.time_s = Eigen::VectorXd::LinSpaced(10, 0, 0.09);
-  for (int k = 0; k < 300; ++k) {
-    char name[16];
-    std::snprintf(name, sizeof name, "M%d", k);  // ("M" + std::to_string(k) trips GCC 12's -Wstringop-overflow at -O3)
-    m.names.emplace_back(name);
-    m.descriptions.emplace_back();
-    m.positions_m.push_back(Eigen::MatrixX3d::Constant(10, 3, 0.001 * k));
-  }
-  const Decoded d = decode_intel_float_c3d(write_c3d_bytes(t));
-  ASSERT_EQ(d.at("POINT:LABELS").strings.size(), 255u);
-  ASSERT_EQ(d.at("POINT:LABELS2").strings.size(), 45u);
-  EXPECT_EQ(d.at("POINT:LABELS2").strings.back(), "M299");
-  EXPECT_NEAR(d.points[0](299, 0), 299.0, 1e-3);
-  const Trial back = read_c3d_bytes(write_c3d_bytes(t), "many.c3d");
-  EXPECT_EQ(back.markers.names, m.names);
-
-  for (int k = 0; k < 400; ++k) t.events.push_back(Event{"Foot Strike", Side::Right, 0.001 * k});
-  EXPECT_THROW((void)write_c3d_bytes(t), InputError) << "the writer never drops events itself";
-
+// A 4-minute walk's 400 gait events, more than C3D's EVENT group holds: the first 255 are
+// written and the messages say so (the writer itself refuses more: C3dRoundTrip's test).
+TEST(C3dExport, EventsBeyond255AreCutWithAMessage) {
   Exported e = export_walk(make_example_walk());
   for (int k = 0; k < 400; ++k) e.trial.events.push_back(Event{k % 2 ? "Foot Off" : "Foot Strike", Side::Left, 0.01 * k});
   const C3dExport c = c3d_export(e.trial, e.estimate);
   ASSERT_EQ(c.trial.events.size(), kMaxC3dEvents);
   EXPECT_NEAR(c.trial.events.back().time_s, 2.54, 1e-9);
   bool said = false;
-  for (const auto& s : c.messages) said = said || s.find("the first 255 of 400 events written") != std::string::npos;
+  for (const auto& m : c.messages) said = said || m.find("the first 255 of 400 events written") != std::string::npos;
   EXPECT_TRUE(said);
   EXPECT_NO_THROW((void)write_c3d_bytes(c.trial));
 }
