@@ -323,3 +323,19 @@ TEST(C3dExport, EventsBeyond255AreCutWithAMessage) {
   EXPECT_TRUE(said);
   EXPECT_NO_THROW((void)write_c3d_bytes(c.trial));
 }
+
+// A TRC whose frames count from 0: the C3D's count from 1 (a C3D header holds 1-65535), said in
+// the messages, and its events stay at their times (row 0 at 0 s either way).
+TEST(C3dExport, FramesCountedFromZeroAreWrittenFromOne) {
+  Trial walk = make_example_walk();
+  walk.markers.first_frame = 0;
+  const Exported e = export_walk(walk);
+  EXPECT_EQ(e.c3d.first_frame, 1);
+  EXPECT_EQ(e.file.number("TRIAL:ACTUAL_START_FIELD", 0), 1);
+  bool said = false;
+  for (const auto& m : e.c3d.messages) said = said || m.find("outside the 1-65535 a C3D header holds") != std::string::npos;
+  EXPECT_TRUE(said);
+  ASSERT_FALSE(e.c3d.trial.events.empty());
+  const auto events = gait_events({e.estimate.feet[0].contact, e.estimate.feet[1].contact}, e.estimate.time_s, e.estimate.motion.rate_hz);
+  EXPECT_NEAR(e.c3d.trial.events.front().time_s, e.estimate.time_s[events.front().index], 1e-12);
+}

@@ -52,7 +52,7 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
   out.first_frame = m.first_frame >= 1 && m.first_frame <= 65535 ? m.first_frame : 1;
   if (out.first_frame != m.first_frame)
     out.messages.push_back("C3D: frame numbers start at 1 (the trial's first frame, " + std::to_string(m.first_frame) +
-                           ", does not fit the C3D header's 16 bits)");
+                           ", is outside the 1-65535 a C3D header holds)");
   out.trial.body_mass_kg = r.mass_kg;
   out.trial.height_m = trial.height_m;
 
