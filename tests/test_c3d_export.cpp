@@ -6,6 +6,7 @@
 // corners' mean; Tz = M - F cross (-COP)). Not kin2grf's own reader.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -17,6 +18,7 @@
 #include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/output/c3d_export.hpp"
 #include "kin2grf/synth/example.hpp"
+#include "kin2grf/validation/validate.hpp"
 #include "test_support.hpp"
 
 using namespace kin2grf;
@@ -190,8 +192,16 @@ TEST(C3dExport, Ezc3dReadsEachFootsEstimateFromItsPlatform) {
   ASSERT_EQ(d.analog.rows(), e.trial.markers.frames()) << "one analog sample a frame";
   const auto feet = as_lab_plates(e.estimate);
   const Eigen::Index n = e.estimate.time_s.size();
+  const std::array<Ezc3dPlatform, 2> plates{ezc3d_platform(d, 0), ezc3d_platform(d, 1)};
+  std::array<Eigen::Vector2d, 2> half;  // each platform's half length (x) and half width (y), mm
   for (std::size_t side = 0; side < 2; ++side) {
-    const Ezc3dPlatform p = ezc3d_platform(d, side);
+    std::array<Eigen::Vector3d, 4> c;
+    for (std::size_t i = 0; i < 4; ++i)
+      for (std::size_t j = 0; j < 3; ++j) c[i](static_cast<Eigen::Index>(j)) = d.number("FORCE_PLATFORM:CORNERS", side * 12 + i * 3 + j);
+    half[side] = Eigen::Vector2d((c[0] - c[1]).norm() / 2, (c[0] - c[3]).norm() / 2);
+  }
+  for (std::size_t side = 0; side < 2; ++side) {
+    const Ezc3dPlatform& p = plates[side];
     EXPECT_NEAR(p.frame.col(2).dot(Eigen::Vector3d::UnitZ()), -1.0, 1e-9) << "the platform's z points down";
     int loaded = 0;
     for (Eigen::Index k = 0; k < d.analog.rows(); ++k) {
@@ -204,16 +214,18 @@ TEST(C3dExport, Ezc3dReadsEachFootsEstimateFromItsPlatform) {
       const Eigen::Vector3d cop_mm = 1000.0 * Eigen::Vector3d(feet[side].cop_m.row(i).transpose());
       ASSERT_LT((p.CoP[static_cast<std::size_t>(k)] - cop_mm).norm(), 0.1) << side_name(static_cast<int>(side)) << " frame " << k;
       EXPECT_LT(p.Tz[static_cast<std::size_t>(k)].norm(), 50.0) << "no free moment (N mm)";
-      // The COP, and the foot around it, on the platform.
-      for (int a = 0; a < 2; ++a) {
-        double lo = 1e300, hi = -1e300;
-        for (std::size_t c = 0; c < 4; ++c) {
-          lo = std::min(lo, d.number("FORCE_PLATFORM:CORNERS", side * 12 + c * 3 + static_cast<std::size_t>(a)));
-          hi = std::max(hi, d.number("FORCE_PLATFORM:CORNERS", side * 12 + c * 3 + static_cast<std::size_t>(a)));
-        }
-        EXPECT_GE(cop_mm(a) - lo, 1000 * kLoadedFootMarginM - 0.1);
-        EXPECT_GE(hi - cop_mm(a), 1000 * kLoadedFootMarginM - 0.1);
-      }
+      // The COP, and the foot around it, on its own platform: at least the margin inside its ends
+      // (along the progression, the platform's x) and its outer side; not on the other platform,
+      // which meets it on the line between the feet.
+      const Eigen::Vector3d q = p.frame.transpose() * (cop_mm - p.mean_corners);
+      EXPECT_LE(std::abs(q.x()), half[side].x() - 1000 * kLoadedFootMarginM + 0.1);
+      EXPECT_LE(std::abs(q.y()), half[side].y() + 0.1);
+      const double outer = side == 0 ? half[side].y() - q.y() : half[side].y() + q.y();  // y points to the walker's right
+      EXPECT_GE(outer, 1000 * kLoadedFootMarginM - 0.1) << side_name(static_cast<int>(side));
+      const Ezc3dPlatform& other = plates[1 - side];
+      const Eigen::Vector3d o = other.frame.transpose() * (cop_mm - other.mean_corners);
+      EXPECT_TRUE(std::abs(o.x()) > half[1 - side].x() || std::abs(o.y()) >= half[1 - side].y() - 1e-6)
+          << side_name(static_cast<int>(side)) << " COP on the other foot's platform, frame " << k;
     }
     EXPECT_GT(loaded, 50) << "the walk loads each foot";
   }
@@ -338,4 +350,35 @@ TEST(C3dExport, FramesCountedFromZeroAreWrittenFromOne) {
   ASSERT_FALSE(e.c3d.trial.events.empty());
   const auto events = gait_events({e.estimate.feet[0].contact, e.estimate.feet[1].contact}, e.estimate.time_s, e.estimate.motion.rate_hz);
   EXPECT_NEAR(e.c3d.trial.events.front().time_s, e.estimate.time_s[events.front().index], 1e-12);
+}
+
+// The whole chain, read back as a lab would use it: the export of a straight walk read by
+// kin2grf's reader and validated against its own platforms, with validate's check of which foot
+// stands on which plate (what an automatic assignment of platforms to feet does). Each platform
+// meets the other on the line between the feet, so no stance has the other foot on its platform,
+// and the estimate from the file's markers matches its platforms.
+TEST(C3dExport, EachFootAloneStandsOnItsPlatformAndTheFileValidatesAgainstItself) {
+  const Exported e = export_walk(make_example_walk());
+  bool said_overlap = false;
+  for (const auto& m : e.c3d.messages) said_overlap = said_overlap || m.find("overlap") != std::string::npos;
+  EXPECT_FALSE(said_overlap);
+  C3dWriteOptions o;
+  o.first_frame = e.c3d.first_frame;
+  const Trial back = read_c3d_bytes(write_c3d_bytes(e.c3d.trial, o), "exported.c3d");
+  ASSERT_TRUE(back.plates.has_value());
+  const EstimateResult again = estimate(back, nullptr, *find_marker_set("kin2grf-example"), [] {
+    EstimateOptions eo;
+    eo.keep_all_series = true;
+    return eo;
+  }());
+  const ValidationResult v = validate(again, *back.plates);
+  for (const auto& x : v.excluded) EXPECT_EQ(x.find("also stands on this plate"), std::string::npos) << x;
+  std::array<int, 2> kept{0, 0};
+  for (const auto& s : v.stances) {
+    ++kept[static_cast<std::size_t>(s.foot)];
+    ASSERT_TRUE(s.metrics.vertical.has_value());
+    EXPECT_LT(s.metrics.vertical->rrmse_percent, 0.5) << side_name(s.foot) << " on " << s.plate;
+  }
+  EXPECT_GE(kept[0], 1);
+  EXPECT_GE(kept[1], 1);
 }

@@ -60,12 +60,19 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
   // outside the window, as the OpenSim export writes them.
   const auto feet = as_lab_plates(r);
   const double floor_m = r.ground_level_m();  // along up, which R takes to +Z
+  // The platforms' axes on the floor: along the walker's progression and to its right; a turning
+  // walker's have no one direction, so the output frame's x and -y.
+  const bool straight = !r.frame.turning();
+  const Eigen::Vector3d u = straight ? Eigen::Vector3d(R * r.frame.forward) : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d w = straight ? Eigen::Vector3d(R * r.frame.lateral) : Eigen::Vector3d(-Eigen::Vector3d::UnitY());
   ForcePlateRecording rec;
   rec.rate_hz = m.rate_hz;
   rec.time_s = out.trial.markers.time_s;
   rec.up_axis = Axis::Z;
-  std::array<Eigen::Vector4d, 2> box;  // x min, x max, y min, y max of each foot's COPs
-  std::array<bool, 2> loaded{false, false};
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  std::array<Eigen::Vector4d, 2> box;  // along u min, max; along w min, max, of each foot's COPs
+  std::array<double, 2> mean_w{0.0, 0.0};
+  std::array<long, 2> loaded{0, 0};
   for (int side = 0; side < 2; ++side) {
     ForcePlate p;
     p.name = side ? "kin2grf left foot" : "kin2grf right foot";
@@ -75,38 +82,58 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
     p.cop_m = Eigen::MatrixX3d::Constant(N, 3, std::numeric_limits<double>::quiet_NaN());
     p.free_moment_Nm = Eigen::MatrixX3d::Zero(N, 3);
     p.moment_centre_Nm = Eigen::MatrixX3d::Constant(N, 3, std::numeric_limits<double>::quiet_NaN());
-    const ForcePlate& f = feet[static_cast<std::size_t>(side)];
-    const auto& contact = r.feet[static_cast<std::size_t>(side)].contact;
-    Eigen::Vector4d& b = box[static_cast<std::size_t>(side)];
-    b << std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-        -std::numeric_limits<double>::infinity();
+    const auto s = static_cast<std::size_t>(side);
+    const ForcePlate& f = feet[s];
+    const auto& contact = r.feet[s].contact;
+    box[s] << inf, -inf, inf, -inf;
     for (Eigen::Index i = 0; i < n; ++i) {
       const Eigen::Index k = r.first_index + i;
       if (k < 0 || k >= N || !contact[static_cast<std::size_t>(i)] || !f.cop_m.row(i).allFinite()) continue;
       const Eigen::Vector3d c = R * f.cop_m.row(i).transpose();
       p.force_N.row(k) = (R * f.force_N.row(i).transpose()).transpose();
       p.cop_m.row(k) = c.transpose();
-      b = Eigen::Vector4d(std::min(b[0], c.x()), std::max(b[1], c.x()), std::min(b[2], c.y()), std::max(b[3], c.y()));
-      loaded[static_cast<std::size_t>(side)] = true;
+      const double cu = c.dot(u), cw = c.dot(w);
+      box[s] = Eigen::Vector4d(std::min(box[s][0], cu), std::max(box[s][1], cu), std::min(box[s][2], cw), std::max(box[s][3], cw));
+      mean_w[s] += cw;
+      ++loaded[s];
     }
+    if (loaded[s] > 0) mean_w[s] /= static_cast<double>(loaded[s]);
     rec.plates.push_back(std::move(p));
   }
   for (int side = 0; side < 2; ++side) {
     const auto s = static_cast<std::size_t>(side);
-    if (loaded[s]) continue;
+    if (loaded[s] > 0) continue;
     // A foot never loaded: its platform (zero throughout) where the other foot's is, else about
     // the lab's origin.
-    box[s] = loaded[1 - s] ? box[1 - s] : Eigen::Vector4d::Zero();
+    box[s] = loaded[1 - s] > 0 ? box[1 - s] : Eigen::Vector4d::Zero();
     out.messages.push_back(std::string("C3D: the ") + side_name(side) + " foot is never loaded; its platform carries zero");
+  }
+  std::array<Eigen::Vector4d, 2> extent;
+  for (std::size_t s = 0; s < 2; ++s)
+    extent[s] = box[s] + Eigen::Vector4d(-kLoadedFootMarginM, kLoadedFootMarginM, -kLoadedFootMarginM, kLoadedFootMarginM);
+  // Where each foot's COPs keep to its own side of the line midway between the feet's mean paths
+  // (the right foot's to the right), the platforms meet on that line instead of overlapping: the
+  // other foot then never stands on a foot's platform, and a tool that assigns each platform to
+  // the one foot over it (Nexus's automatic contexts, validate's own check) can.
+  const double mid = 0.5 * (mean_w[0] + mean_w[1]);
+  const bool apart = straight && loaded[0] > 0 && loaded[1] > 0 && box[0][2] > mid && box[1][3] < mid;
+  if (apart) {
+    extent[0][2] = mid;
+    extent[1][3] = mid;
+  } else if (loaded[0] > 0 && loaded[1] > 0) {
+    out.messages.push_back(straight ? "C3D: the feet's COP paths cross (a foot steps over the line between them); the two platforms overlap: "
+                                      "assign platform 1 to the right foot and 2 to the left by hand"
+                                    : "C3D: a turning walker: the two platforms are the feet's paths' bounding rectangles in the lab and "
+                                      "overlap: assign platform 1 to the right foot and 2 to the left by hand");
   }
   for (int side = 0; side < 2; ++side) {
     ForcePlate& p = rec.plates[static_cast<std::size_t>(side)];
-    const Eigen::Vector4d& b = box[static_cast<std::size_t>(side)];
-    const double x0 = b[0] - kLoadedFootMarginM, x1 = b[1] + kLoadedFootMarginM, y0 = b[2] - kLoadedFootMarginM,
-                 y1 = b[3] + kLoadedFootMarginM;
-    // C3D's corner order with the platform's z pointing down: c1 - c2 along +x, c1 - c4 along -y.
-    p.corners_m = {Eigen::Vector3d(x1, y0, floor_m), Eigen::Vector3d(x0, y0, floor_m), Eigen::Vector3d(x0, y1, floor_m),
-                   Eigen::Vector3d(x1, y1, floor_m)};
+    const Eigen::Vector4d& e = extent[static_cast<std::size_t>(side)];
+    const Eigen::Vector3d z = floor_m * Eigen::Vector3d::UnitZ();
+    // C3D's corner order with the platform's z pointing down: c1 - c2 along u (forward), c1 - c4
+    // along w (to the right), u x w = -up.
+    p.corners_m = {Eigen::Vector3d(e[1] * u + e[3] * w + z), Eigen::Vector3d(e[0] * u + e[3] * w + z),
+                   Eigen::Vector3d(e[0] * u + e[2] * w + z), Eigen::Vector3d(e[1] * u + e[2] * w + z)};
     Eigen::Matrix<double, 3, 4> C;
     for (int c = 0; c < 4; ++c) C.col(c) = p.corners_m[static_cast<std::size_t>(c)];
     p.lab_R_plate = plate_axes(C);

@@ -8,12 +8,17 @@
 //  - two force platforms of TYPE 2 (force and moment channels at the sensor origin, N and N mm),
 //    platform 1 the right foot's estimate, platform 2 the left foot's, sampled at the marker rate:
 //    zero outside contact and outside the processed window; the free moment is zero (not
-//    estimated). Each platform is a rectangle on the calibrated floor covering every place its
-//    foot's COP takes in the trial, kLoadedFootMarginM wider on every side (so the whole foot
-//    stands on it while it is loaded: a tool that assigns a platform to the foot over it finds
-//    that foot), with C3D's axes (x = c1 - c2, y = c1 - c4, z = x cross y pointing down) and its
-//    sensor origin at its surface centre (ORIGIN 0 0 0: no reader's sign convention for ORIGIN
-//    comes into play);
+//    estimated). Each platform is a rectangle on the calibrated floor, its x along the walker's
+//    progression and its y to the walker's right, covering every place its foot's COP takes in
+//    the trial and kLoadedFootMarginM beyond them along the progression and on the foot's outer
+//    side (the whole foot stands on it while it is loaded). On the inner side the two platforms
+//    meet on the line midway between the feet's mean COP paths, so that the other foot never
+//    stands on a foot's platform and a tool that assigns each platform to the one foot over it
+//    can; where a foot's COPs cross that line (a runner's crossover) or the walker turns (the
+//    rectangles then in the lab's x and y), they overlap, and the messages say to assign them
+//    by hand. C3D's axes (x = c1 - c2, y = c1 - c4, z = x cross y pointing down) and the sensor
+//    origin at the surface centre (ORIGIN 0 0 0: no reader's sign convention for ORIGIN comes
+//    into play);
 //  - the file's own events, and where it has no "Foot Strike" or "Foot Off" event, the estimate's
 //    (gait_events), so that a tool can cut cycles; at most kMaxC3dEvents, the first in time;
 //  - the body mass the estimate used (PROCESSING:Bodymass) and the height where the file has one.
