@@ -60,19 +60,11 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
   // outside the window, as the OpenSim export writes them.
   const auto feet = as_lab_plates(r);
   const double floor_m = r.ground_level_m();  // along up, which R takes to +Z
-  // The platforms' axes on the floor: along the walker's progression and to its right; a turning
-  // walker's have no one direction, so the output frame's x and -y.
-  const bool straight = !r.frame.turning();
-  const Eigen::Vector3d u = straight ? Eigen::Vector3d(R * r.frame.forward) : Eigen::Vector3d::UnitX();
-  const Eigen::Vector3d w = straight ? Eigen::Vector3d(R * r.frame.lateral) : Eigen::Vector3d(-Eigen::Vector3d::UnitY());
   ForcePlateRecording rec;
   rec.rate_hz = m.rate_hz;
   rec.time_s = out.trial.markers.time_s;
   rec.up_axis = Axis::Z;
-  constexpr double inf = std::numeric_limits<double>::infinity();
-  std::array<Eigen::Vector4d, 2> box;  // along u min, max; along w min, max, of each foot's COPs
-  std::array<double, 2> mean_w{0.0, 0.0};
-  std::array<long, 2> loaded{0, 0};
+  std::array<std::vector<Eigen::Vector3d>, 2> cops;  // each foot's loaded COPs, output frame
   for (int side = 0; side < 2; ++side) {
     ForcePlate p;
     p.name = side ? "kin2grf left foot" : "kin2grf right foot";
@@ -85,20 +77,61 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
     const auto s = static_cast<std::size_t>(side);
     const ForcePlate& f = feet[s];
     const auto& contact = r.feet[s].contact;
-    box[s] << inf, -inf, inf, -inf;
     for (Eigen::Index i = 0; i < n; ++i) {
       const Eigen::Index k = r.first_index + i;
       if (k < 0 || k >= N || !contact[static_cast<std::size_t>(i)] || !f.cop_m.row(i).allFinite()) continue;
       const Eigen::Vector3d c = R * f.cop_m.row(i).transpose();
       p.force_N.row(k) = (R * f.force_N.row(i).transpose()).transpose();
       p.cop_m.row(k) = c.transpose();
+      cops[s].push_back(c);
+    }
+    rec.plates.push_back(std::move(p));
+  }
+  // The platforms' axes on the floor: along the feet's path and to the walker's right. The path is
+  // the progression turned by the slope of the feet's COPs across it (one slope for both feet,
+  // least squares about each foot's own mean: a walk at an angle to the pelvis's travel), where
+  // each foot's COPs span more than kPathSpanM along it; a turning walker's have no one
+  // direction, so the output frame's x and -y.
+  const bool straight = !r.frame.turning();
+  Eigen::Vector3d u = straight ? Eigen::Vector3d(R * r.frame.forward) : Eigen::Vector3d::UnitX();
+  Eigen::Vector3d w = straight ? Eigen::Vector3d(R * r.frame.lateral) : Eigen::Vector3d(-Eigen::Vector3d::UnitY());
+  if (straight) {
+    double suw = 0, suu = 0;
+    bool paths = true;
+    for (const auto& c : cops) {
+      if (c.empty()) {
+        paths = false;
+        continue;
+      }
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (const auto& p : c) mean += Eigen::Vector2d(p.dot(u), p.dot(w)) / static_cast<double>(c.size());
+      for (const auto& p : c) {
+        const double du = p.dot(u) - mean.x(), dw = p.dot(w) - mean.y();
+        suw += du * dw, suu += du * du;
+        lo = std::min(lo, p.dot(u)), hi = std::max(hi, p.dot(u));
+      }
+      paths = paths && hi - lo > kPathSpanM;
+    }
+    if (paths && suu > 0) {
+      const double b = suw / suu;
+      const Eigen::Vector3d u1 = (u + b * w).normalized(), w1 = (w - b * u).normalized();
+      u = u1, w = w1;
+    }
+  }
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  std::array<Eigen::Vector4d, 2> box;  // along u min, max; along w min, max, of each foot's COPs
+  std::array<double, 2> mean_w{0.0, 0.0};
+  std::array<long, 2> loaded{0, 0};
+  for (std::size_t s = 0; s < 2; ++s) {
+    box[s] << inf, -inf, inf, -inf;
+    for (const auto& c : cops[s]) {
       const double cu = c.dot(u), cw = c.dot(w);
       box[s] = Eigen::Vector4d(std::min(box[s][0], cu), std::max(box[s][1], cu), std::min(box[s][2], cw), std::max(box[s][3], cw));
       mean_w[s] += cw;
-      ++loaded[s];
     }
+    loaded[s] = static_cast<long>(cops[s].size());
     if (loaded[s] > 0) mean_w[s] /= static_cast<double>(loaded[s]);
-    rec.plates.push_back(std::move(p));
   }
   for (int side = 0; side < 2; ++side) {
     const auto s = static_cast<std::size_t>(side);

@@ -8,8 +8,10 @@
 //  - two force platforms of TYPE 2 (force and moment channels at the sensor origin, N and N mm),
 //    platform 1 the right foot's estimate, platform 2 the left foot's, sampled at the marker rate:
 //    zero outside contact and outside the processed window; the free moment is zero (not
-//    estimated). Each platform is a rectangle on the calibrated floor, its x along the walker's
-//    progression and its y to the walker's right, covering every place its foot's COP takes in
+//    estimated). Each platform is a rectangle on the calibrated floor, its x along the feet's path
+//    (the progression, turned by the slope of the feet's COPs across it where each foot's span
+//    more than kPathSpanM: a walk at an angle to the pelvis's travel) and its y to the walker's
+//    right, covering every place its foot's COP takes in
 //    the trial and kLoadedFootMarginM beyond them along the progression and on the foot's outer
 //    side (the whole foot stands on it while it is loaded). On the inner side the two platforms
 //    meet on the line midway between the feet's mean COP paths, so that the other foot never
@@ -45,6 +47,10 @@ namespace kin2grf {
 /// How far each virtual platform reaches beyond its foot's COPs, m: about half a foot's length,
 /// so that the foot around a COP at its heel or its toe is on the platform too.
 inline constexpr double kLoadedFootMarginM = 0.15;
+/// Each foot's COPs must span more than this along the progression (m) before the direction of
+/// their path is taken from them: more than one footprint (within one stance a COP moves about a
+/// foot's length, 0.25 m), so a path of two steps or more, not a landing in place.
+inline constexpr double kPathSpanM = 0.5;
 /// C3D's EVENT group holds this many events (a parameter's dimension is a byte); a longer trial's
 /// first ones are written, and the messages say so.
 inline constexpr std::size_t kMaxC3dEvents = 255;
