@@ -382,3 +382,45 @@ TEST(C3dExport, EachFootAloneStandsOnItsPlatformAndTheFileValidatesAgainstItself
   EXPECT_GE(kept[0], 1);
   EXPECT_GE(kept[1], 1);
 }
+
+// A walk whose feet's path runs at an angle to the pelvis's travel (walking5's, about 4 degrees):
+// the feet's markers sheared across the progression by 0.07 of their distance along it. The
+// platforms then run along the feet's path, so that each foot's COPs keep inside its own platform
+// and off the other's, which a pair of platforms along the pelvis's travel could not give.
+TEST(C3dExport, ThePlatformsFollowAFeetPathAtAnAngleToThePelvisTravel) {
+  Trial walk = make_example_walk();
+  auto& m = walk.markers;
+  for (std::size_t k = 0; k < m.names.size(); ++k) {
+    const std::string& name = m.names[k];
+    const std::string part = name.substr(1);
+    if (part != "AJC" && part != "HEE" && part != "MT1" && part != "HLX") continue;
+    m.positions_m[k].col(1) += 0.07 * m.positions_m[k].col(0);
+  }
+  const Exported e = export_walk(walk);
+  for (const auto& msg : e.c3d.messages) EXPECT_EQ(msg.find("overlap"), std::string::npos) << msg;
+  const auto feet = as_lab_plates(e.estimate);
+  const std::array<Ezc3dPlatform, 2> plates{ezc3d_platform(e.file, 0), ezc3d_platform(e.file, 1)};
+  std::array<Eigen::Vector2d, 2> half;
+  for (std::size_t side = 0; side < 2; ++side) {
+    std::array<Eigen::Vector3d, 4> c;
+    for (std::size_t i = 0; i < 4; ++i)
+      for (std::size_t j = 0; j < 3; ++j) c[i](static_cast<Eigen::Index>(j)) = e.file.number("FORCE_PLATFORM:CORNERS", side * 12 + i * 3 + j);
+    half[side] = Eigen::Vector2d((c[0] - c[1]).norm() / 2, (c[0] - c[3]).norm() / 2);
+    // The platform's x along the sheared path: 0.07 rad off the progression, not along it.
+    const Eigen::Vector3d x = plates[side].frame.col(0);
+    EXPECT_NEAR(std::abs(std::atan2(x.y(), x.x())), std::atan(0.07), 0.02) << side_name(static_cast<int>(side));
+  }
+  int checked = 0;
+  for (std::size_t side = 0; side < 2; ++side)
+    for (Eigen::Index i = 0; i < e.estimate.time_s.size(); ++i) {
+      if (!e.estimate.feet[side].contact[static_cast<std::size_t>(i)] || !feet[side].cop_m.row(i).allFinite()) continue;
+      const Eigen::Vector3d cop_mm = 1000.0 * Eigen::Vector3d(feet[side].cop_m.row(i).transpose());
+      const Eigen::Vector3d q = plates[side].frame.transpose() * (cop_mm - plates[side].mean_corners);
+      EXPECT_LE(std::abs(q.x()), half[side].x());
+      EXPECT_LE(std::abs(q.y()), half[side].y() + 1e-6);
+      const Eigen::Vector3d o = plates[1 - side].frame.transpose() * (cop_mm - plates[1 - side].mean_corners);
+      EXPECT_TRUE(std::abs(o.x()) > half[1 - side].x() || std::abs(o.y()) >= half[1 - side].y() - 1e-6);
+      ++checked;
+    }
+  EXPECT_GT(checked, 100);
+}
