@@ -20,7 +20,8 @@ rec=out/recorded-walk
 mkdir -p "$rec"
 echo "== A recorded walk (data/example/walking2.c3d; its source and licence: data/example/README.md)"
 $k estimate data/example/walking2.c3d --mass 64.9 -o "$rec/estimated_grf.mot" --csv "$rec/estimated.csv" \
-  --json "$rec/estimated.json" --events "$rec/gait_events.csv" --report "$rec/estimate.html" --opensim "$rec/opensim"
+  --json "$rec/estimated.json" --events "$rec/gait_events.csv" --report "$rec/estimate.html" --opensim "$rec/opensim" \
+  --c3d "$rec/estimated.c3d"
 $k validate data/example/walking2.c3d --mass 64.9 --json "$rec/validation.json" --report "$rec/validation.html"
 echo
 echo "Outputs in out/example/: the synthetic walk (example_walk.c3d, .trc, _grf.mot), a squat, and the walk's"
@@ -29,5 +30,6 @@ echo "  model's own totals shared between the feet by a fixed rule), so the demo
 echo "Outputs in out/recorded-walk/: the recorded walk's estimate (estimated_grf.mot in OpenSim's frame,"
 echo "  estimated.csv, estimated.json, gait_events.csv, estimate.html: its plots without plates), its"
 echo "  validation against the walk's own force plate above (validation.html, validation.json), and opensim/"
-echo "  (GRF .mot, markers .trc and ExternalLoads .xml for OpenSim's inverse dynamics)."
+echo "  (GRF .mot, markers .trc and ExternalLoads .xml for OpenSim's inverse dynamics), and estimated.c3d"
+echo "  (the markers with the estimate as force platforms 1 right and 2 left, for Nexus, Visual3D or ezc3d)."
 echo "docs/VALIDATION.md has the accuracy on 14 recorded trials from 8 labs."
