@@ -44,6 +44,12 @@ bool sole_point_planted(const EstimateResult& e, int f, int s, Eigen::Index i, c
 
 }  // namespace
 
+bool MeasuredPlate::covers(double x, double lateral, double margin_along_m) const {
+  const Eigen::Vector2d d = Eigen::Vector2d(x, lateral) - centre_m;
+  const Eigen::Vector2d across(-along.y(), along.x());
+  return std::abs(d.dot(along)) <= half_along_m + margin_along_m && std::abs(d.dot(across)) <= half_across_m;
+}
+
 namespace {
 /// A plate's surface height, and with geometry its centre and extent, in the sagittal frame
 /// (with turns, the frame of the middle of its loaded samples; without geometry, the median
@@ -74,6 +80,16 @@ void plate_place(const ForcePlate& p, const ForcePlateRecording& rec, const Sagi
     for (const auto& c : p.corners_m) {
       m.x_min = std::min(m.x_min, c.dot(fw) + off), m.x_max = std::max(m.x_max, c.dot(fw) + off);
       m.lateral_min = std::min(m.lateral_min, c.dot(lt)), m.lateral_max = std::max(m.lateral_max, c.dot(lt));
+    }
+    // The rectangle: its edges c1 - c2 and c1 - c4 in (x, lateral), the one nearer the progression
+    // taken as its length.
+    const auto flat = [&](const Eigen::Vector3d& v) { return Eigen::Vector2d(v.dot(fw), v.dot(lt)); };
+    Eigen::Vector2d e1 = flat(p.corners_m[0] - p.corners_m[1]), e2 = flat(p.corners_m[0] - p.corners_m[3]);
+    if (std::abs(e2.normalized().x()) > std::abs(e1.normalized().x())) std::swap(e1, e2);
+    if (e1.norm() > 0 && e2.norm() > 0) {
+      m.along = e1.normalized();
+      m.half_along_m = 0.5 * e1.norm();
+      m.half_across_m = 0.5 * e2.norm();
     }
   } else {
     std::vector<double> h;
@@ -199,16 +215,14 @@ int sole_frames(const EstimateResult& e, const MeasuredPlate& mp, const IndexRun
   int k = 0;
   for (Eigen::Index i = run.first; i <= run.last; ++i) {
     const double lat = e.foot_lateral_m[f][i];
-    const bool lat_in = lat >= mp.lateral_min && lat <= mp.lateral_max;
     bool hit = false;
     for (int s = 0; s < 3; ++s) {
       const double x = e.feet[static_cast<std::size_t>(f)].sole_m(i, 2 * s);
       const double y = e.feet[static_cast<std::size_t>(f)].sole_m(i, 2 * s + 1);
       if (y - ground > o.ground_contact_height_m) continue;
-      const double margin = outside ? o.edge_margin_m : 0.0;
-      const bool x_in = x >= mp.x_min - margin && x <= mp.x_max + margin;
+      const bool in = mp.covers(x, lat, outside ? o.edge_margin_m : 0.0);
       if (!outside && !sole_point_planted(e, f, s, i, o)) continue;
-      hit = hit || (outside ? !(x_in && lat_in) : (x_in && lat_in));
+      hit = hit || (outside ? !in : in);
     }
     k += hit;
   }

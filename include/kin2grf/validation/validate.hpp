@@ -70,6 +70,14 @@ struct MeasuredPlate {
   double surface_y_m = 0.0;        ///< plate surface height in the sagittal frame
   Eigen::Vector2d centre_m = Eigen::Vector2d::Zero();  ///< (x, lateral) of the surface centre
   double x_min = 0, x_max = 0, lateral_min = 0, lateral_max = 0;  ///< extent (with geometry)
+  /// The rectangle itself (with geometry), in the same (x, lateral) coordinates: the unit vector
+  /// of its edges nearer the progression, and its half length along them and half width across.
+  /// A plate at an angle to the progression covers less than its extent.
+  Eigen::Vector2d along = Eigen::Vector2d::UnitX();
+  double half_along_m = 0.0, half_across_m = 0.0;
+  /// Whether (x, lateral) lies on the plate: within `margin_along_m` of it along `along`, within
+  /// it across.
+  [[nodiscard]] bool covers(double x, double lateral, double margin_along_m = 0.0) const;
   /// The lab-frame force (N) and its moment about the lab origin (N m), free moment included: the
   /// wrench the plate-driven 3D joint moments take (validate_joint_moments_3d); NaN outside.
   Eigen::MatrixX3d force_lab_N, moment_origin_lab_Nm;
