@@ -640,3 +640,44 @@ TEST(Validate, TheMeansCarryTheMeanAbsoluteOnsetOverTheStancesThatHaveOne) {
   EXPECT_DOUBLE_EQ(mean_rrmse(s, 1).onset_abs_ms, 10.0);
   EXPECT_TRUE(std::isnan(mean_rrmse({s[2]}).onset_abs_ms));
 }
+
+// A foot is on a plate where it is over the plate's rectangle, not over the rectangle's extent
+// along the walker's axes: a 1.2 m plate at 30 degrees to the progression covers its own centre
+// and a point 0.55 m along its edge, but not a point of its extent off its corner (UWA's
+// Fast_Walking, a turning walker, had its FP1 stance set aside for a foot 3-5 cm behind the plate).
+TEST(Validate, APlateAtAnAngleCoversItsRectangleNotItsExtent) {
+  ForcePlateRecording rec;
+  rec.rate_hz = 100;
+  rec.time_s = Eigen::VectorXd::LinSpaced(3, 0.0, 0.02);
+  ForcePlate p;
+  p.name = "FP1";
+  p.type = 2;
+  p.has_geometry = true;
+  const double a = 30.0 * M_PI / 180.0;
+  const Eigen::Vector3d ex(std::cos(a), std::sin(a), 0), ey(-std::sin(a), std::cos(a), 0);
+  p.corners_m = {Eigen::Vector3d(0.6 * ex - 0.6 * ey), Eigen::Vector3d(-0.6 * ex - 0.6 * ey), Eigen::Vector3d(-0.6 * ex + 0.6 * ey),
+                 Eigen::Vector3d(0.6 * ex + 0.6 * ey)};
+  p.centre_m.setZero();
+  p.force_N = Eigen::MatrixX3d::Zero(3, 3);
+  p.cop_m = Eigen::MatrixX3d::Constant(3, 3, std::nan(""));
+  p.moment_centre_Nm = Eigen::MatrixX3d::Zero(3, 3);
+  p.free_moment_Nm = Eigen::MatrixX3d::Zero(3, 3);
+  rec.plates.push_back(p);
+  SagittalFrame fr;  // x forward = lab X, up = Z, lateral = forward x up = -Y
+  fr.lateral = fr.forward.cross(fr.up);
+  const auto plates = resample_plates(rec, fr, rec.time_s, 10.0);
+  ASSERT_EQ(plates.size(), 1u);
+  const MeasuredPlate& m = plates[0];
+  EXPECT_NEAR(m.half_along_m, 0.6, 1e-9);
+  EXPECT_NEAR(m.half_across_m, 0.6, 1e-9);
+  EXPECT_TRUE(m.covers(0.0, 0.0));
+  const Eigen::Vector3d edge = 0.55 * ex;  // in lab coordinates; (x, lateral) = (X, -Y)
+  EXPECT_TRUE(m.covers(edge.x(), -edge.y()));
+  // A point at the extent's far x, level with the centre: inside the extent along x (0.82 m),
+  // 0.79 m from the centre along x, outside the rectangle.
+  EXPECT_GT(m.x_max, 0.79);
+  EXPECT_FALSE(m.covers(0.79, 0.0));
+  // The margin stretches the rectangle along its length only.
+  EXPECT_TRUE(m.covers(0.62 * ex.x(), -0.62 * ex.y(), 0.05));
+  EXPECT_FALSE(m.covers(-0.62 * ey.x(), 0.62 * ey.y(), 0.05));
+}
