@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 
 #include "kin2grf/io/c3d.hpp"
 #include "kin2grf/io/force_plate.hpp"
@@ -30,6 +31,30 @@ Eigen::Matrix3d up_to_z(const Eigen::Vector3d& up) {
   for (Eigen::Index k = 0; k < R.size(); ++k)
     if (std::abs(R.data()[k] - std::round(R.data()[k])) < 1e-12) R.data()[k] = std::round(R.data()[k]);
   return R;
+}
+
+/// The platforms' axes on the floor, along the feet's path and to the walker's right: the
+/// progression `u` (and `w`, u x w pointing down) turned by the slope of the feet's COPs across it
+/// (one slope for both feet, least squares about each foot's own mean: a walk at an angle to the
+/// pelvis's travel), where each foot's COPs span more than kPathSpanM along it.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> path_axes(const Eigen::Vector3d& u, const Eigen::Vector3d& w,
+                                                      const std::array<std::vector<Eigen::Vector3d>, 2>& cops) {
+  double suw = 0, suu = 0;
+  for (const auto& c : cops) {
+    if (c.empty()) return {u, w};
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto& p : c) mean += Eigen::Vector2d(p.dot(u), p.dot(w)) / static_cast<double>(c.size());
+    for (const auto& p : c) {
+      const double du = p.dot(u) - mean.x(), dw = p.dot(w) - mean.y();
+      suw += du * dw, suu += du * du;
+      lo = std::min(lo, p.dot(u)), hi = std::max(hi, p.dot(u));
+    }
+    if (!(hi - lo > kPathSpanM)) return {u, w};
+  }
+  if (!(suu > 0)) return {u, w};
+  const double b = suw / suu;
+  return {(u + b * w).normalized(), (w - b * u).normalized()};
 }
 
 }  // namespace
@@ -87,38 +112,11 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
     }
     rec.plates.push_back(std::move(p));
   }
-  // The platforms' axes on the floor: along the feet's path and to the walker's right. The path is
-  // the progression turned by the slope of the feet's COPs across it (one slope for both feet,
-  // least squares about each foot's own mean: a walk at an angle to the pelvis's travel), where
-  // each foot's COPs span more than kPathSpanM along it; a turning walker's have no one
-  // direction, so the output frame's x and -y.
+  // The platforms' axes on the floor; a turning walker's path has no one direction, so the output
+  // frame's x and -y.
   const bool straight = !r.frame.turning();
-  Eigen::Vector3d u = straight ? Eigen::Vector3d(R * r.frame.forward) : Eigen::Vector3d::UnitX();
-  Eigen::Vector3d w = straight ? Eigen::Vector3d(R * r.frame.lateral) : Eigen::Vector3d(-Eigen::Vector3d::UnitY());
-  if (straight) {
-    double suw = 0, suu = 0;
-    bool paths = true;
-    for (const auto& c : cops) {
-      if (c.empty()) {
-        paths = false;
-        continue;
-      }
-      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-      for (const auto& p : c) mean += Eigen::Vector2d(p.dot(u), p.dot(w)) / static_cast<double>(c.size());
-      for (const auto& p : c) {
-        const double du = p.dot(u) - mean.x(), dw = p.dot(w) - mean.y();
-        suw += du * dw, suu += du * du;
-        lo = std::min(lo, p.dot(u)), hi = std::max(hi, p.dot(u));
-      }
-      paths = paths && hi - lo > kPathSpanM;
-    }
-    if (paths && suu > 0) {
-      const double b = suw / suu;
-      const Eigen::Vector3d u1 = (u + b * w).normalized(), w1 = (w - b * u).normalized();
-      u = u1, w = w1;
-    }
-  }
+  const auto [u, w] = straight ? path_axes(R * r.frame.forward, R * r.frame.lateral, cops)
+                               : std::pair<Eigen::Vector3d, Eigen::Vector3d>{Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitY()};
   constexpr double inf = std::numeric_limits<double>::infinity();
   std::array<Eigen::Vector4d, 2> box;  // along u min, max; along w min, max, of each foot's COPs
   std::array<double, 2> mean_w{0.0, 0.0};
