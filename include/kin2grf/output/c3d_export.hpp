@@ -3,8 +3,8 @@
 // ezc3d, BTK): they then run their own inverse dynamics on the estimate as on measured plates.
 //
 // What the file holds:
-//  - every marker of the trial as read (mm, the file's own frame numbers), a missing sample
-//    written with residual -1;
+//  - every marker of the trial as read (mm, the file's own frame numbers; the labels as kin2grf
+//    reads them, a Vicon subject prefix removed), a missing sample written with residual -1;
 //  - two force platforms of TYPE 2 (force and moment channels at the sensor origin, N and N mm),
 //    platform 1 the right foot's estimate, platform 2 the left foot's, sampled at the marker rate:
 //    zero outside contact and outside the processed window; the free moment is zero (not
