@@ -8,7 +8,6 @@
 
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <map>
 #include <string>
@@ -87,10 +86,8 @@ Decoded decode_intel_float_c3d(const std::vector<std::uint8_t>& b) {
           q.strings.push_back(s);
         }
       } else {
-        const std::size_t size = static_cast<std::size_t>(std::abs(q.type));
         for (std::size_t k = 0; k < count; ++k)
           q.numbers.push_back(q.type == 4 ? f32(r + k * 4) : q.type == 2 ? i16(r + k * 2) : i8(r + k));
-        (void)size;
       }
       pending.emplace_back(id, name, std::move(q));
     }
