@@ -1547,6 +1547,25 @@ LabFootFrame lab_foot_frame(const EstimateResult& r, int side, Eigen::Index i) {
   return out;
 }
 
+std::array<ForcePlate, 2> trial_foot_plates(const EstimateResult& r, Eigen::Index trial_frames, const Eigen::Matrix3d& R) {
+  const auto lab = as_lab_plates(r);
+  const Eigen::Index N = trial_frames, n = r.time_s.size();
+  std::array<ForcePlate, 2> out;
+  for (std::size_t s = 0; s < 2; ++s) {
+    ForcePlate& f = out[s];
+    f.force_N = Eigen::MatrixX3d::Zero(N, 3);
+    f.cop_m = Eigen::MatrixX3d::Constant(N, 3, std::numeric_limits<double>::quiet_NaN());
+    f.free_moment_Nm = Eigen::MatrixX3d::Zero(N, 3);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index k = r.first_index + i;
+      if (k < 0 || k >= N || !r.feet[s].contact[static_cast<std::size_t>(i)] || !lab[s].cop_m.row(i).allFinite()) continue;
+      f.force_N.row(k) = (R * lab[s].force_N.row(i).transpose()).transpose();
+      f.cop_m.row(k) = (R * lab[s].cop_m.row(i).transpose()).transpose();
+    }
+  }
+  return out;
+}
+
 std::array<ForcePlate, 2> as_lab_plates(const EstimateResult& r) {
   std::array<ForcePlate, 2> out;
   const Eigen::Index n = r.time_s.size();

@@ -384,5 +384,10 @@ std::array<FootWrench3D, 2> estimated_wrenches(const EstimateResult& r);
 /// The per-foot results as lab-frame force plates (force, COP, free moment), lab_foot_frame for
 /// every frame.
 std::array<ForcePlate, 2> as_lab_plates(const EstimateResult& r);
+/// The same over every frame of the trial (`trial_frames` rows, trial frame = r.first_index + the
+/// window's), each force and COP turned by R (an export's frame): zero force and a NaN COP outside
+/// the processed window and wherever the foot is not in contact; free moment zero. What the
+/// exports write (OpenSim's .mot, the C3D's platforms).
+std::array<ForcePlate, 2> trial_foot_plates(const EstimateResult& r, Eigen::Index trial_frames, const Eigen::Matrix3d& R);
 
 }  // namespace kin2grf

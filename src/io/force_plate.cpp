@@ -148,6 +148,15 @@ Eigen::Matrix3d plate_axes(const Eigen::Matrix<double, 3, 4>& c) {
   return R;
 }
 
+void set_plate_corners(ForcePlate& p, const std::array<Eigen::Vector3d, 4>& corners_m) {
+  Eigen::Matrix<double, 3, 4> C;
+  for (int c = 0; c < 4; ++c) C.col(c) = corners_m[static_cast<std::size_t>(c)];
+  p.has_geometry = true;
+  p.corners_m = corners_m;
+  p.lab_R_plate = plate_axes(C);
+  p.centre_m = C.rowwise().mean();
+}
+
 namespace {
 /// The plate's channels' scales to N and N m (and m for a type-1 plate's COP channels), from
 /// their units.

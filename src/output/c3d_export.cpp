@@ -3,7 +3,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -11,14 +10,14 @@
 
 #include "kin2grf/io/c3d.hpp"
 #include "kin2grf/io/force_plate.hpp"
+#include "kin2grf/io/text.hpp"
 
 namespace kin2grf {
 
 namespace {
 
 bool is_gait_event(const std::string& label) {
-  std::string l;
-  for (char c : label) l += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string l = to_lower(label);
   return l == "foot strike" || l == "foot off";
 }
 
@@ -62,7 +61,7 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> path_axes(const Eigen::Vector3d& u, 
 C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
   C3dExport out;
   const MarkerTrajectories& m = trial.markers;
-  const Eigen::Index N = m.frames(), n = r.time_s.size();
+  const Eigen::Index N = m.frames();
   const Eigen::Matrix3d R = up_to_z(r.frame.up);
   if (!R.isIdentity()) {
     char b[200];
@@ -81,9 +80,9 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
   out.trial.body_mass_kg = r.mass_kg;
   out.trial.height_m = trial.height_m;
 
-  // The feet's ground reactions, lab frame, over the processed window; zero outside contact and
-  // outside the window, as the OpenSim export writes them.
-  const auto feet = as_lab_plates(r);
+  // The feet's ground reactions over the whole trial, in the output frame; zero outside contact
+  // and outside the window, as the OpenSim export writes them.
+  auto feet = trial_foot_plates(r, N, R);
   const double floor_m = r.ground_level_m();  // along up, which R takes to +Z
   ForcePlateRecording rec;
   rec.rate_hz = m.rate_hz;
@@ -91,25 +90,13 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
   rec.up_axis = Axis::Z;
   std::array<std::vector<Eigen::Vector3d>, 2> cops;  // each foot's loaded COPs, output frame
   for (int side = 0; side < 2; ++side) {
-    ForcePlate p;
+    const auto s = static_cast<std::size_t>(side);
+    ForcePlate& p = feet[s];
     p.name = side ? "kin2grf left foot" : "kin2grf right foot";
     p.type = 2;
-    p.has_geometry = true;
-    p.force_N = Eigen::MatrixX3d::Zero(N, 3);
-    p.cop_m = Eigen::MatrixX3d::Constant(N, 3, std::numeric_limits<double>::quiet_NaN());
-    p.free_moment_Nm = Eigen::MatrixX3d::Zero(N, 3);
     p.moment_centre_Nm = Eigen::MatrixX3d::Constant(N, 3, std::numeric_limits<double>::quiet_NaN());
-    const auto s = static_cast<std::size_t>(side);
-    const ForcePlate& f = feet[s];
-    const auto& contact = r.feet[s].contact;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const Eigen::Index k = r.first_index + i;
-      if (k < 0 || k >= N || !contact[static_cast<std::size_t>(i)] || !f.cop_m.row(i).allFinite()) continue;
-      const Eigen::Vector3d c = R * f.cop_m.row(i).transpose();
-      p.force_N.row(k) = (R * f.force_N.row(i).transpose()).transpose();
-      p.cop_m.row(k) = c.transpose();
-      cops[s].push_back(c);
-    }
+    for (Eigen::Index k = 0; k < N; ++k)
+      if (p.cop_m.row(k).allFinite()) cops[s].emplace_back(p.cop_m.row(k).transpose());
     rec.plates.push_back(std::move(p));
   }
   // The platforms' axes on the floor; a turning walker's path has no one direction, so the output
@@ -120,7 +107,7 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   std::array<Eigen::Vector4d, 2> box;  // along u min, max; along w min, max, of each foot's COPs
   std::array<double, 2> mean_w{0.0, 0.0};
-  std::array<long, 2> loaded{0, 0};
+  const std::array<bool, 2> loaded{!cops[0].empty(), !cops[1].empty()};
   for (std::size_t s = 0; s < 2; ++s) {
     box[s] << inf, -inf, inf, -inf;
     for (const auto& c : cops[s]) {
@@ -128,15 +115,14 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
       box[s] = Eigen::Vector4d(std::min(box[s][0], cu), std::max(box[s][1], cu), std::min(box[s][2], cw), std::max(box[s][3], cw));
       mean_w[s] += cw;
     }
-    loaded[s] = static_cast<long>(cops[s].size());
-    if (loaded[s] > 0) mean_w[s] /= static_cast<double>(loaded[s]);
+    if (loaded[s]) mean_w[s] /= static_cast<double>(cops[s].size());
   }
   for (int side = 0; side < 2; ++side) {
     const auto s = static_cast<std::size_t>(side);
-    if (loaded[s] > 0) continue;
+    if (loaded[s]) continue;
     // A foot never loaded: its platform (zero throughout) where the other foot's is, else about
     // the lab's origin.
-    box[s] = loaded[1 - s] > 0 ? box[1 - s] : Eigen::Vector4d::Zero();
+    box[s] = loaded[1 - s] ? box[1 - s] : Eigen::Vector4d::Zero();
     out.messages.push_back(std::string("C3D: the ") + side_name(side) + " foot is never loaded; its platform carries zero");
   }
   std::array<Eigen::Vector4d, 2> extent;
@@ -147,11 +133,11 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
   // other foot then never stands on a foot's platform, and a tool that assigns each platform to
   // the one foot over it (Nexus's automatic contexts, validate's own check) can.
   const double mid = 0.5 * (mean_w[0] + mean_w[1]);
-  const bool apart = straight && loaded[0] > 0 && loaded[1] > 0 && box[0][2] > mid && box[1][3] < mid;
+  const bool apart = straight && loaded[0] && loaded[1] && box[0][2] > mid && box[1][3] < mid;
   if (apart) {
     extent[0][2] = mid;
     extent[1][3] = mid;
-  } else if (loaded[0] > 0 && loaded[1] > 0) {
+  } else if (loaded[0] && loaded[1]) {
     out.messages.push_back(straight ? "C3D: the feet's COP paths cross (a foot steps over the line between them); the two platforms overlap: "
                                       "assign platform 1 to the right foot and 2 to the left by hand"
                                     : "C3D: a turning walker: the two platforms are the feet's paths' bounding rectangles in the lab and "
@@ -163,12 +149,8 @@ C3dExport c3d_export(const Trial& trial, const EstimateResult& r) {
     const Eigen::Vector3d z = floor_m * Eigen::Vector3d::UnitZ();
     // C3D's corner order with the platform's z pointing down: c1 - c2 along u (forward), c1 - c4
     // along w (to the right), u x w = -up.
-    p.corners_m = {Eigen::Vector3d(e[1] * u + e[3] * w + z), Eigen::Vector3d(e[0] * u + e[3] * w + z),
-                   Eigen::Vector3d(e[0] * u + e[2] * w + z), Eigen::Vector3d(e[1] * u + e[2] * w + z)};
-    Eigen::Matrix<double, 3, 4> C;
-    for (int c = 0; c < 4; ++c) C.col(c) = p.corners_m[static_cast<std::size_t>(c)];
-    p.lab_R_plate = plate_axes(C);
-    p.centre_m = C.rowwise().mean();
+    set_plate_corners(p, {Eigen::Vector3d(e[1] * u + e[3] * w + z), Eigen::Vector3d(e[0] * u + e[3] * w + z),
+                          Eigen::Vector3d(e[0] * u + e[2] * w + z), Eigen::Vector3d(e[1] * u + e[2] * w + z)});
     p.origin_m.setZero();
   }
   out.trial.plates = std::move(rec);

@@ -57,25 +57,10 @@ OpenSimExportFiles opensim_export_paths(const std::string& dir, const std::strin
 }
 
 Table opensim_grf_table(const Eigen::VectorXd& trial_time_s, const EstimateResult& r, const std::string& settings) {
-  const Eigen::Matrix3d R = lab_to_opensim(r);
-  const Eigen::Index N = trial_time_s.size(), n = r.time_s.size();
-  const auto plates = as_lab_plates(r);
-
+  const Eigen::Index N = trial_time_s.size();
   // The GRF over the whole trial.
-  ForcePlate feet[2];
-  for (int side = 0; side < 2; ++side) {
-    ForcePlate& f = feet[side];
-    f.force_N = Eigen::MatrixX3d::Zero(N, 3);
-    f.cop_m = Eigen::MatrixX3d::Constant(N, 3, std::nan(""));
-    f.free_moment_Nm = Eigen::MatrixX3d::Zero(N, 3);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const Eigen::Index k = r.first_index + i;
-      if (k < 0 || k >= N || !r.feet[static_cast<std::size_t>(side)].contact[static_cast<std::size_t>(i)]) continue;
-      const auto& p = plates[static_cast<std::size_t>(side)];
-      if (!p.cop_m.row(i).allFinite()) continue;
-      f.force_N.row(k) = (R * p.force_N.row(i).transpose()).transpose();
-      f.cop_m.row(k) = (R * p.cop_m.row(i).transpose()).transpose();
-    }
+  auto feet = trial_foot_plates(r, N, lab_to_opensim(r));
+  for (auto& f : feet) {
     // A finite COP everywhere: the nearest contact COP held (OpenSim applies a zero force there).
     Eigen::Index last = -1;
     for (Eigen::Index k = 0; k < N; ++k) {

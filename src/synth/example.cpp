@@ -73,14 +73,9 @@ ForcePlateRecording example_plates(const EstimateResult& r, const Trial& t, int 
     ForcePlate p = feet[static_cast<std::size_t>(side)];
     p.name = side ? "FP2" : "FP1";
     p.type = 2;
-    p.has_geometry = true;
     const double y0 = side ? 0.0 : -0.5;  // right plate at -Y, left at +Y
-    p.corners_m = {Eigen::Vector3d(0.4, y0 + 0.5, 0), Eigen::Vector3d(-0.2, y0 + 0.5, 0), Eigen::Vector3d(-0.2, y0, 0),
-                   Eigen::Vector3d(0.4, y0, 0)};
-    Eigen::Matrix<double, 3, 4> C;
-    for (int c = 0; c < 4; ++c) C.col(c) = p.corners_m[static_cast<std::size_t>(c)];
-    p.lab_R_plate = plate_axes(C);
-    p.centre_m = C.rowwise().mean();
+    set_plate_corners(p, {Eigen::Vector3d(0.4, y0 + 0.5, 0), Eigen::Vector3d(-0.2, y0 + 0.5, 0), Eigen::Vector3d(-0.2, y0, 0),
+                          Eigen::Vector3d(0.4, y0, 0)});
     p.origin_m = Eigen::Vector3d(0, 0, -0.04);
     const Eigen::Index n = p.force_N.rows();
     for (Eigen::Index i = 0; i < n; ++i) {

@@ -262,14 +262,9 @@ Trial make_example_walk(const SyntheticWalkOptions& o) {
     ForcePlate p;
     p.name = k ? "FP2" : "FP1";
     p.type = 2;
-    p.has_geometry = true;
     const double x0 = (k ? left_heel : right_heel) - 0.18;
-    p.corners_m = {Eigen::Vector3d(x0 + 0.6, 0.25, 0), Eigen::Vector3d(x0, 0.25, 0), Eigen::Vector3d(x0, -0.25, 0),
-                   Eigen::Vector3d(x0 + 0.6, -0.25, 0)};
-    Eigen::Matrix<double, 3, 4> C;
-    for (int c = 0; c < 4; ++c) C.col(c) = p.corners_m[static_cast<std::size_t>(c)];
-    p.lab_R_plate = plate_axes(C);
-    p.centre_m = C.rowwise().mean();
+    set_plate_corners(p, {Eigen::Vector3d(x0 + 0.6, 0.25, 0), Eigen::Vector3d(x0, 0.25, 0), Eigen::Vector3d(x0, -0.25, 0),
+                          Eigen::Vector3d(x0 + 0.6, -0.25, 0)});
     p.origin_m = Eigen::Vector3d(0, 0, -0.04);
     p.force_N = Eigen::MatrixX3d::Zero(n, 3);
     p.cop_m = Eigen::MatrixX3d::Constant(n, 3, std::nan(""));

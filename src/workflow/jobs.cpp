@@ -119,9 +119,8 @@ int estimate_job(const EstimateJob& a, std::ostream& out, std::ostream& log) {
     if (!a.out_report.empty()) write_file_text(a.out_report, estimate_report_html(a.trial, r, summary));
   }
   if (!a.out_events.empty()) write_file_text(a.out_events, gait_events_csv(r));
-  std::vector<std::string> c3d_messages;
-  if (!a.out_c3d.empty()) c3d_messages = write_c3d_export(a.out_c3d, trial, r);
-  for (const auto& m : c3d_messages) log << "kin2grf: " << m << "\n";
+  if (!a.out_c3d.empty())
+    for (const auto& m : write_c3d_export(a.out_c3d, trial, r)) log << "kin2grf: " << m << "\n";
   out << format_results_text(r);
   for (const auto& [file, what] : {std::pair{a.out_mot, a.lab_frame ? "GRF, lab frame" : "GRF, OpenSim's frame"}, {a.out_csv, "per-frame CSV"}, {a.out_json, "JSON summary"},
                                    {a.out_events, "gait events CSV"}, {a.out_report, "HTML report"},

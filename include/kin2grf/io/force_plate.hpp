@@ -64,6 +64,9 @@ struct PlateProcessing {
 
 /// Plate frame (columns x, y, z in the lab) from the corners.
 Eigen::Matrix3d plate_axes(const Eigen::Matrix<double, 3, 4>& corners);
+/// A plate's corners (lab frame, C3D's order) and what follows from them: has_geometry, its axes
+/// (plate_axes) and its surface centre (the corners' mean).
+void set_plate_corners(ForcePlate& plate, const std::array<Eigen::Vector3d, 4>& corners_m);
 
 ForcePlateRecording compute_plates(const AnalogData& analog,
                                    const std::vector<PlateDescription>& plates,
