@@ -623,16 +623,58 @@ namespace {
 /// Turning walks: the body's heading is the direction its feet point (the 0.5 Hz zero-lag trend,
 /// below the step frequency, of the sum of both feet's horizontal heel -> MT directions: the
 /// feet's toe-out cancels between the sides, and unlike the pelvis's path it also holds while the
-/// subject stands or side-steps). When that heading turns by more than kTurnLimitRad over the
-/// trial and the pelvis travels kMinTravelM or more (not a treadmill, not on the spot), the frame
-/// follows it (SagittalFrame); otherwise the fixed frame stays.
+/// subject stands or side-steps). When that heading turns by more than kTurnLimitRad and the
+/// pelvis travels kMinTravelM or more (not a treadmill, not on the spot), the frame follows it
+/// (SagittalFrame); otherwise the fixed frame stays.
+/// Both are measured over the body's seen span alone (heading_span): the longest run of frames
+/// where the hip and both feet's heel and MT landmarks are defined, gaps of up to max_gap frames
+/// bridged, as the processed window bridges them. Outside it a foot's markers come and go as the
+/// subject leaves the capture volume: one foot's direction alone, held over hundreds of frames and
+/// spread by the 0.5 Hz trend, turned two straight overground runs (UWA's, a 0.37 s window) by
+/// 50 degrees within their one stance. Outside the span the heading holds its ends' value.
 constexpr double kTurnLimitRad = 30 * M_PI / 180;
 constexpr double kMinTravelM = 2.0;  ///< the slow pelvis path's length below which nothing turns
 
-void follow_heading(SagittalFrame& f, const Landmarks3D& lm, double rate_hz) {
-  const auto& hip = lm.p[kHip];
-  const Eigen::Index n = hip.rows();
-  if (n < 10 || rate_hz <= 0) return;
+/// [first, end) of the longest run of frames where the hip and the four foot landmarks (heel, MT)
+/// are defined, runs of up to `max_gap` undefined frames inside it bridged; {0, 0} when none.
+std::pair<Eigen::Index, Eigen::Index> heading_span(const Landmarks3D& lm, int max_gap) {
+  const Eigen::Index n = lm.p[kHip].rows();
+  const auto seen = [&](Eigen::Index i) {
+    if (!lm.p[kHip].row(i).allFinite()) return false;
+    for (int side = 0; side < 2; ++side)
+      for (int part : {kHeel, kMt})
+        if (lm.p[landmark(side, static_cast<LegLandmark>(part))].rows() != n ||
+            !lm.p[landmark(side, static_cast<LegLandmark>(part))].row(i).allFinite())
+          return false;
+    return true;
+  };
+  std::pair<Eigen::Index, Eigen::Index> best{0, 0};
+  Eigen::Index i = 0;
+  while (i < n) {
+    if (!seen(i)) { ++i; continue; }
+    Eigen::Index last = i, j = i + 1;  // the run's last seen frame; j scans on across short gaps
+    while (j < n && j - last <= max_gap + 1) {
+      if (seen(j)) last = j;
+      ++j;
+    }
+    if (last + 1 - i > best.second - best.first) best = {i, last + 1};
+    i = last + 1;
+  }
+  return best;
+}
+
+void follow_heading(SagittalFrame& f, const Landmarks3D& lm, double rate_hz, int max_gap) {
+  const auto& hip_all = lm.p[kHip];
+  const Eigen::Index n_all = hip_all.rows();
+  const auto [s0, s1] = heading_span(lm, max_gap);
+  if (n_all < 10 || rate_hz <= 0 || s1 - s0 < 10) return;
+  // The span's own landmarks; the heading is made over them and held beyond them.
+  const Eigen::MatrixX3d hip = hip_all.middleRows(s0, s1 - s0);
+  std::array<Eigen::MatrixX3d, 4> foot;
+  for (int side = 0; side < 2; ++side)
+    for (int k = 0; k < 2; ++k)
+      foot[static_cast<std::size_t>(2 * side + k)] = lm.p[landmark(side, k == 0 ? kHeel : kMt)].middleRows(s0, s1 - s0);
+  const Eigen::Index n = s1 - s0;
   // Horizontal basis e1, e2 (e1 x e2 = up): the two lab axes other than the up axis.
   Eigen::Index ua = 0;
   f.up.cwiseAbs().maxCoeff(&ua);
@@ -659,7 +701,7 @@ void follow_heading(SagittalFrame& f, const Landmarks3D& lm, double rate_hz) {
   const Eigen::MatrixXd feet = hold([&](Eigen::Index i, Eigen::RowVector2d& v) {
     v.setZero();
     for (int side = 0; side < 2; ++side) {
-      const Eigen::RowVector3d d = lm.p[landmark(side, kMt)].row(i) - lm.p[landmark(side, kHeel)].row(i);
+      const Eigen::RowVector3d d = foot[static_cast<std::size_t>(2 * side + 1)].row(i) - foot[static_cast<std::size_t>(2 * side)].row(i);
       const Eigen::RowVector2d dh(d.dot(e1.transpose()), d.dot(e2.transpose()));
       if (dh.allFinite()) v += dh;  // not normalised: a foot pitched steeply (swing) weighs little
     }
@@ -680,17 +722,20 @@ void follow_heading(SagittalFrame& f, const Landmarks3D& lm, double rate_hz) {
   double travel = 0;  // on a treadmill or on the spot the body does not travel: nothing to follow
   for (Eigen::Index i = 1; i < n; ++i) travel += (c.row(i) - c.row(i - 1)).norm();
   if (travel < kMinTravelM) return;
-  f.heading.resize(n, 3);
-  f.x_offset_m.resize(n);
+  f.heading.resize(n_all, 3);
+  f.x_offset_m.resize(n_all);
   double arc = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
     const double a = psi[static_cast<std::size_t>(i)];
     const Eigen::Vector3d hd = std::cos(a) * e1 + std::sin(a) * e2;
-    f.heading.row(i) = hd.transpose();
+    f.heading.row(s0 + i) = hd.transpose();
     const Eigen::Vector3d ci = c(i, 0) * e1 + c(i, 1) * e2;
     arc = i == 0 ? ci.dot(hd) : arc + (c.row(i) - c.row(i - 1)).dot(Eigen::RowVector2d(std::cos(a), std::sin(a)));
-    f.x_offset_m[i] = arc - ci.dot(hd);  // so that the path point's x is its arc length
+    f.x_offset_m[s0 + i] = arc - ci.dot(hd);  // so that the path point's x is its arc length
   }
+  // Beyond the span the frame holds still (a fixed frame there, continuous with the span's ends).
+  for (Eigen::Index i = 0; i < s0; ++i) f.heading.row(i) = f.heading.row(s0), f.x_offset_m[i] = f.x_offset_m[s0];
+  for (Eigen::Index i = s1; i < n_all; ++i) f.heading.row(i) = f.heading.row(s1 - 1), f.x_offset_m[i] = f.x_offset_m[s1 - 1];
   f.treadmill = false;
   const Eigen::Vector3d mean = f.heading.colwise().mean().transpose();
   f.forward = mean.norm() > 1e-6 ? Eigen::Vector3d(mean.normalized()) : Eigen::Vector3d(f.heading.row(0).transpose());
@@ -748,7 +793,7 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
   if (o.progression_sign) dir *= (*o.progression_sign > 0 ? 1.0 : -1.0) * (dir.sum() >= 0 ? 1.0 : -1.0);
   f.forward = dir;
   f.lateral = f.forward.cross(f.up);
-  if (!o.progression_axis) follow_heading(f, lm, m.rate_hz);
+  if (!o.progression_axis) follow_heading(f, lm, m.rate_hz, o.max_gap_frames);
   return f;
 }
 
