@@ -378,7 +378,7 @@ KinematicsStage kinematics_stage(const EstimateOptions& o, const std::shared_ptr
   out.position_cutoff_hz = out.kinematic_cutoff_hz;
   Eigen::MatrixXd x = model_coordinates(lm, o.torso_length);
   if (o.min_kinematic_cycles > 0 && out.kinematic_cutoff_hz < o.kinematic_cutoff_hz) out.unfiltered = x;
-  out.motion = motion_from_coordinates(model, std::move(x), lm.rate_hz, lm.time_s, out.kinematic_cutoff_hz);
+  out.motion = motion_from_coordinates(model, std::move(x), lm.rate_hz, lm.time_s, out.kinematic_cutoff_hz, 0.0, o.kinematic_edges);
   return out;
 }
 
@@ -1380,7 +1380,8 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
     Eigen::VectorXd time_s = std::move(kin.motion.time_s);
     kin.motion = ModelMotion();
     dyn = DynamicsPass();
-    kin.motion = motion_from_coordinates(mod.model, std::move(kin.unfiltered), rate_hz, std::move(time_s), *floor_hz, kin.position_cutoff_hz);
+    kin.motion = motion_from_coordinates(mod.model, std::move(kin.unfiltered), rate_hz, std::move(time_s), *floor_hz, kin.position_cutoff_hz,
+                                         o.kinematic_edges);
     kin.kinematic_cutoff_hz = *floor_hz;
     kin.messages.push_back(std::move(raised));
     seconds_kinematics += std::chrono::duration<double>(clock::now() - tk).count();

@@ -80,6 +80,34 @@ TEST(Estimate, BallisticFlightHasNoGroundReaction) {
   EXPECT_NEAR(r.feet[0].force_N(30, 1) + r.feet[1].force_N(30, 1), 70 * 9.81, 0.01 * 70 * 9.81);
 }
 
+// A capture that ends in flight (a run leaving a short capture volume, a jump): the synthetic
+// jump cut 0.25 s into its 0.49 s flight. The body falls freely there, so the kinematic total
+// sum m (a + g) is 0 N. The kinematics' filter extended past the window's end by the end's own
+// curvature (--kinematic-edges curvature, the default) keeps that; the odd reflection reads the
+// end's acceleration as zero, the body weight. The stance before the flight is the same either way.
+TEST(Estimate, ACaptureThatEndsInFlightEndsInFreeFall) {
+  SyntheticOptions so;
+  so.squat_depth = 0.0;
+  so.flight_height_m = 0.3;  // flight 1.253-1.747 s
+  Trial t = make_synthetic_trial(so);
+  t.markers = cropped(t.markers, 0, 150);  // to 1.49 s
+  const double bw = 70 * 9.81;
+  const auto with = [&](FilterEdge e) {
+    EstimateOptions eo;
+    eo.kinematic_edges = e;
+    return estimate(t, nullptr, *find_marker_set("kin2grf-example"), eo);
+  };
+  EXPECT_EQ(EstimateOptions{}.kinematic_edges, FilterEdge::Curvature);
+  const auto curved = with(FilterEdge::Curvature), odd = with(FilterEdge::OddReflection);
+  const Eigen::Index last = curved.time_s.size() - 1;
+  ASSERT_EQ(last, 149);
+  EXPECT_LT(std::abs(curved.kinematic_total(last, 1)), 0.05 * bw) << curved.kinematic_total(last, 1);
+  EXPECT_GT(odd.kinematic_total(last, 1), 0.5 * bw) << odd.kinematic_total(last, 1);
+  // Standing, well before the take-off: body weight either way.
+  EXPECT_NEAR(curved.feet[0].force_N(30, 1) + curved.feet[1].force_N(30, 1), bw, 0.01 * bw);
+  EXPECT_NEAR(odd.feet[0].force_N(30, 1) + odd.feet[1].force_N(30, 1), bw, 0.01 * bw);
+}
+
 TEST(Estimate, TrialWithNoStanceSaysSo) {
   Trial t = make_synthetic_trial({});
   for (auto& p : t.markers.positions_m) p.col(2).array() += 0.5;  // the whole body 50 cm up

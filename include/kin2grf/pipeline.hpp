@@ -74,6 +74,11 @@ struct EstimateOptions {
   /// held-out criterion 8.682 % against 3.5's 8.712 %); a trial the residual analysis leaves at
   /// kinematic_cutoff_hz (every development trial as recorded) is not changed by it.
   double min_kinematic_cycles = 3.0;
+  /// How the model coordinates' zero-lag filter extends them past the processed window's ends
+  /// (kinematics/filter.hpp): OddReflection reads each end's acceleration as zero; Curvature
+  /// keeps it (the end's own curvature over half a cut-off period). A window that ends mid-stance
+  /// or in flight (a run through a short capture volume) accelerates at 1-3 g there.
+  FilterEdge kinematic_edges = FilterEdge::Curvature;
   /// The torso's hip-shoulder length: measured per frame (kin2grf) or fixed (the paper).
   TorsoLength torso_length = TorsoLength::Measured;
   /// The upper body's fore-aft lag behind the pelvis, s (kin2grf): the HAT COM's fore-aft

@@ -1,6 +1,7 @@
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/parallel.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -66,9 +67,24 @@ void filtfilt_interleaved(const Biquad& q, std::vector<double>& e) {
 struct ZeroLagDesign {
   Biquad q;
   Eigen::Index pad;
+  /// FilterEdge::Curvature: the weights w of an end's curvature a = sum_k w_k y_k (per sample^2),
+  /// y_k the k-th sample in from the end, from the least-squares quadratic through the first
+  /// w.size() of them; empty: the odd reflection alone.
+  Eigen::VectorXd curvature_weights;
 };
 
-ZeroLagDesign design_zero_lag(Eigen::Index n, double rate_hz, double cutoff_hz) {
+/// Twice the quadratic coefficient of the least-squares quadratic through samples 0..m-1, as
+/// weights on the samples: the third row of (A^T A)^-1 A^T, A = [1 t t^2], times 2.
+Eigen::VectorXd curvature_weights(Eigen::Index m) {
+  Eigen::MatrixXd A(m, 3);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const double t = static_cast<double>(k);
+    A.row(k) << 1.0, t, t * t;
+  }
+  return 2.0 * (A.transpose() * A).ldlt().solve(A.transpose()).row(2).transpose();
+}
+
+ZeroLagDesign design_zero_lag(Eigen::Index n, double rate_hz, double cutoff_hz, FilterEdge edge) {
   const double C = zero_lag_correction();
   const double fc = cutoff_hz / C;
   if (!(fc > 0) || fc >= 0.5 * rate_hz) {
@@ -79,7 +95,13 @@ ZeroLagDesign design_zero_lag(Eigen::Index n, double rate_hz, double cutoff_hz) 
   // Compared as doubles before the cast: a rate of 1e300 Hz must not overflow Eigen::Index.
   const double want = std::ceil(3.0 * rate_hz / cutoff_hz);
   const Eigen::Index pad = want >= static_cast<double>(n - 1) || !(want >= 0) ? n - 1 : static_cast<Eigen::Index>(want);
-  return {design_lowpass(rate_hz, fc), pad};
+  ZeroLagDesign d{design_lowpass(rate_hz, fc), pad, Eigen::VectorXd()};
+  if (edge == FilterEdge::Curvature) {
+    const double span = std::round(kCurvatureSpanPeriods * rate_hz / cutoff_hz);
+    const Eigen::Index m = std::min<Eigen::Index>(n, std::max<Eigen::Index>(5, static_cast<Eigen::Index>(std::min(span, 1e9))));
+    if (m >= 3) d.curvature_weights = curvature_weights(m);  // fewer samples: no quadratic, the odd reflection
+  }
+  return d;
 }
 
 /// Filters columns [c0, c0 + L) of x into the same columns of y (n >= 2), `e` as workspace.
@@ -95,6 +117,17 @@ void filtfilt_columns(const ZeroLagDesign& d, const Eigen::Ref<const Eigen::Matr
     for (Eigen::Index i = 0; i < pad; ++i) at(i, l) = 2 * col[0] - col[pad - i];
     for (Eigen::Index i = 0; i < n; ++i) at(pad + i, l) = col[i];
     for (Eigen::Index i = 0; i < pad; ++i) at(pad + n + i, l) = 2 * col[n - 1] - col[n - 2 - i];
+    if (const Eigen::Index m = d.curvature_weights.size(); m > 0) {
+      // Each end's curvature (time runs inward from it: a second derivative does not see the
+      // direction), added as a_T s^2 at s samples beyond the end.
+      double a0 = 0, a1 = 0;
+      for (Eigen::Index k = 0; k < m; ++k) a0 += d.curvature_weights[k] * col[k], a1 += d.curvature_weights[k] * col[n - 1 - k];
+      for (Eigen::Index i = 0; i < pad; ++i) {
+        const auto s0 = static_cast<double>(pad - i), s1 = static_cast<double>(i + 1);
+        at(i, l) += a0 * s0 * s0;
+        at(pad + n + i, l) += a1 * s1 * s1;
+      }
+    }
   }
   filtfilt_interleaved<L>(d.q, e);
   for (int l = 0; l < L; ++l) {
@@ -114,20 +147,20 @@ void filtfilt_range(const ZeroLagDesign& d, const Eigen::Ref<const Eigen::Matrix
 
 }  // namespace
 
-Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, double cutoff_hz) {
+Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, double cutoff_hz, FilterEdge edge) {
   const Eigen::Index n = x.size();
   if (n < 2) return x;
-  const ZeroLagDesign d = design_zero_lag(n, rate_hz, cutoff_hz);
+  const ZeroLagDesign d = design_zero_lag(n, rate_hz, cutoff_hz, edge);
   Eigen::MatrixXd y(n, 1);
   std::vector<double> e;
   filtfilt_columns<1>(d, x, 0, y, e);
   return y.col(0);
 }
 
-Eigen::MatrixXd butterworth_filtfilt(Eigen::MatrixXd x, double rate_hz, double cutoff_hz) {
+Eigen::MatrixXd butterworth_filtfilt(Eigen::MatrixXd x, double rate_hz, double cutoff_hz, FilterEdge edge) {
   const Eigen::Index n = x.rows();
   if (n < 2 || x.cols() == 0) return x;
-  const ZeroLagDesign d = design_zero_lag(n, rate_hz, cutoff_hz);
+  const ZeroLagDesign d = design_zero_lag(n, rate_hz, cutoff_hz, edge);
   // In place: filtfilt_columns copies its columns into the workspace before it writes them back,
   // and no two chunks share a column, so a long trial's series is never held twice.
   // Columns are independent: on the machine's cores when long enough to pay for a thread (two
@@ -208,7 +241,7 @@ double residual_analysis_cutoff(const Eigen::MatrixXd& x, double rate_hz, double
     std::vector<double> e;
     for (int k = 0; k <= m; ++k) {
       const double f = k < m ? f_lo + (f_hi - f_lo) * k / (m - 1) : upper_hz;
-      filtfilt_range(design_zero_lag(n, rate_hz, f), head.middleCols(b, w), 0, w, y, e);
+      filtfilt_range(design_zero_lag(n, rate_hz, f, FilterEdge::OddReflection), head.middleCols(b, w), 0, w, y, e);
       for (Eigen::Index c = 0; c < w; ++c) residuals(k, c) = residual_rms(head.col(b + c), y.col(c));
     }
     for (Eigen::Index c = 0; c < w; ++c)

@@ -229,6 +229,13 @@ std::vector<Setting> torso_length_settings() {
   return s;
 }
 
+std::vector<Setting> kinematic_edges_settings() {
+  std::vector<Setting> s{{"odd reflection (the paper)", 0, [](EstimateOptions& o) { o.kinematic_edges = FilterEdge::OddReflection; }},
+                         {"curvature", 1, [](EstimateOptions& o) { o.kinematic_edges = FilterEdge::Curvature; }}};
+  mark_default(s, [](const EstimateOptions& o) { return o.kinematic_edges; });
+  return s;
+}
+
 std::vector<Setting> foot_model_settings() {
   std::vector<Setting> s{{"three-point (model 1)", 1, [](EstimateOptions& o) { o.contact.foot_model = FootModel::ThreePoint; }},
                          {"cop (model 2)", 2, [](EstimateOptions& o) { o.contact.foot_model = FootModel::Cop; }}};
@@ -257,6 +264,7 @@ const std::vector<StudyKind>& special_studies() {
       {"marker-labels", marker_labels_settings},
       {"trial-cut", trial_cut_settings},
       {"torso-length", torso_length_settings},
+      {"kinematic-edges", kinematic_edges_settings},
       {"foot-model", foot_model_settings},
   };
   return kinds;

@@ -83,6 +83,11 @@ void add_settings_options(CLI::App* c, Settings& a) {
   add_choice(c, "--torso-length", a.torso_length,
              "measured (the hip-shoulder distance of each frame, filtered) or fixed (its median, the paper's rigid HAT)",
              {"measured", "fixed"});
+  add_choice(c, "--kinematic-edges", a.kinematic_edges,
+             "How the kinematics' low-pass filter extends the coordinates past the processed window's ends: curvature (each end's own "
+             "acceleration kept, from a quadratic over half a cut-off period) or odd (a point-symmetric reflection, which reads the "
+             "ends' acceleration as zero; --paper)",
+             {"curvature", "odd"});
   add_choice(c, "--norm", a.norm, "Multiplier norm: paper (pseudo-inverse) or torque-scaled", {"paper", "torque-scaled"});
   c->add_option_function<std::string>(
        "--anthropometry", [&a](const std::string& v) { a.anthropometry = v, a.anthropometry_given = true; },
@@ -94,7 +99,7 @@ void add_settings_options(CLI::App* c, Settings& a) {
                 "COP function near flight phases (running): builtin (kin2grf's running fit), off, or a JSON file")
       ->capture_default_str();
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
-  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length, no torso or thigh lag, no vertical smoothing of the torso");
+  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length, no torso or thigh lag, no vertical smoothing of the torso, the kinematics filtered with the odd reflection at the window's ends");
   c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
   c->add_option("--frames", a.frames,
                 "Process only the file's frames FIRST:LAST (its own frame numbers, inclusive; FIRST: or :LAST leave an end "
@@ -162,6 +167,7 @@ EstimateOptions to_options(const Settings& a) {
   o.solver.norm = (a.paper || a.norm == "paper") ? MultiplierNorm::Paper : MultiplierNorm::TorqueScaled;
   o.contact.speed_gate.fixed_mps = a.paper ? 0.0 : a.speed_gate;
   o.torso_length = (a.paper || a.torso_length == "fixed") ? TorsoLength::Fixed : TorsoLength::Measured;
+  o.kinematic_edges = (a.paper || a.kinematic_edges == "odd") ? FilterEdge::OddReflection : FilterEdge::Curvature;
   o.landmarks.max_gap_frames = a.max_gap;
   o.landmarks.up_axis = parse_axis(a.up_axis);
   EstimateOptions given = a.numeric;
@@ -194,6 +200,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"lateral_lag", o.lateral_torso_lag ? "torso" : "none"},
           {"lateral_bilateral", o.lateral_least_squares ? "least-squares" : "split"},
           {"torso_length", torso_length_name(o.torso_length)},
+          {"kinematic_edges", filter_edge_name(o.kinematic_edges)},
           {"kinematic_cutoff_hz", o.kinematic_cutoff_hz},
           {"kinematic_cutoff_rule", o.cutoff_from_noise ? "noise" : "fixed"},
           {"post_cutoff_hz", o.post_cutoff_hz},

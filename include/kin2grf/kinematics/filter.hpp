@@ -7,7 +7,15 @@
 // making f_c the -3 dB frequency of the whole zero-lag filter.
 // Edges: the signal is extended at both ends by an odd (point-symmetric) reflection of
 // min(N - 1, 3 fs / f_c) samples and each pass starts from the steady state of its first sample,
-// so a trial's first and last frames carry no start-up transient.
+// so a trial's first and last frames carry no start-up transient. The odd reflection keeps the
+// end's position and velocity, and flips its acceleration: x_ext''(T + s) = -x''(T - s), so the
+// filtered acceleration at the end reads zero. FilterEdge::Curvature adds the end's own
+// curvature, x_ext(T + s) = 2 x(T) - x(T - s) + a_T s^2, a_T the second derivative of the
+// least-squares quadratic through the end's kCurvatureSpanPeriods of a cut-off period (at least
+// 5 samples): the extension of a parabola is the parabola, and the end keeps its acceleration.
+// Why: a short capture (a run through a small volume) ends mid-stance or in flight, where the
+// body accelerates at 1-3 g; read as zero there, the kinematic total left UWA's overground runs'
+// stance 1700 N above their plate as the foot lifted off.
 #pragma once
 
 #include <Eigen/Core>
@@ -21,13 +29,27 @@ double zero_lag_correction();
 /// below the Nyquist frequency, so every cut-off must be below 0.5 * rate * C (40.1 Hz at 100 Hz).
 inline double max_zero_lag_cutoff_hz(double rate_hz) { return 0.5 * rate_hz * zero_lag_correction(); }
 
+/// How a zero-lag filter extends a series past its ends (see above).
+enum class FilterEdge {
+  OddReflection,  ///< point-symmetric: position and velocity kept, the ends' acceleration read as zero
+  Curvature,      ///< the odd reflection plus the ends' own curvature (a_T s^2)
+};
+/// The share of a cut-off period the end's curvature is fitted over (FilterEdge::Curvature):
+/// half a period, the filter's own resolution (shorter spans fit the markers' noise, longer ones
+/// the next phase of the motion).
+inline constexpr double kCurvatureSpanPeriods = 0.5;
+/// The command line's word for each: "odd", "curvature".
+inline const char* filter_edge_name(FilterEdge e) { return e == FilterEdge::Curvature ? "curvature" : "odd"; }
+
 /// Zero-lag (forward-backward) 2nd-order Butterworth low-pass, -3 dB at cutoff_hz overall.
 /// Requires finite samples; cutoff must be below the Nyquist frequency.
-Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, double cutoff_hz);
+Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, double cutoff_hz,
+                                     FilterEdge edge = FilterEdge::OddReflection);
 
 /// Column-wise butterworth_filtfilt. Filters x in place: pass it with std::move where the
 /// unfiltered series is not needed again.
-Eigen::MatrixXd butterworth_filtfilt(Eigen::MatrixXd x, double rate_hz, double cutoff_hz);
+Eigen::MatrixXd butterworth_filtfilt(Eigen::MatrixXd x, double rate_hz, double cutoff_hz,
+                                     FilterEdge edge = FilterEdge::OddReflection);
 
 /// First derivative by central differences (one-sided at the ends), per column.
 Eigen::MatrixXd central_difference(const Eigen::MatrixXd& x, double dt_s);

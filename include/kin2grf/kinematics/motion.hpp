@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/model/model.hpp"
 
 namespace kin2grf {
@@ -125,19 +126,24 @@ enum class TorsoLength {
 /// without the torso length column for TorsoLength::Fixed; at least 8 frames.
 Eigen::MatrixXd model_coordinates(const SagittalLandmarks& lm, TorsoLength torso);
 
-/// compute_motion from model_coordinates' columns (unfiltered), their rate and times.
+/// compute_motion from model_coordinates' columns (unfiltered), their rate and times. `edges`: how
+/// the coordinates' filter extends them past the window's ends (kinematics/filter.hpp; the
+/// pipeline's EstimateOptions::kinematic_edges); the COP function's foot angles, positions,
+/// keep the odd reflection.
 ModelMotion motion_from_coordinates(std::shared_ptr<const Model> model, Eigen::MatrixXd x, double rate_hz, Eigen::VectorXd time_s,
-                                    double cutoff_hz, double cop_angle_cutoff_hz = 0.0);
+                                    double cutoff_hz, double cop_angle_cutoff_hz = 0.0, FilterEdge edges = FilterEdge::OddReflection);
 
 /// The whole kinematic step: independent coordinates, filter at cutoff_hz, differentiate,
 /// reconstruct. cop_angle_cutoff_hz > 0 (and not cutoff_hz): the COP function's foot angles
 /// are filtered at it instead (ModelMotion::cop_foot_angle_rad).
 ModelMotion compute_motion(std::shared_ptr<const Model> model, const SagittalLandmarks& lm, double cutoff_hz,
-                           TorsoLength torso = TorsoLength::Measured, double cop_angle_cutoff_hz = 0.0);
+                           TorsoLength torso = TorsoLength::Measured, double cop_angle_cutoff_hz = 0.0,
+                           FilterEdge edges = FilterEdge::OddReflection);
 /// The same with a copy of `model`.
 inline ModelMotion compute_motion(const Model& model, const SagittalLandmarks& lm, double cutoff_hz,
-                                  TorsoLength torso = TorsoLength::Measured, double cop_angle_cutoff_hz = 0.0) {
-  return compute_motion(std::make_shared<const Model>(model), lm, cutoff_hz, torso, cop_angle_cutoff_hz);
+                                  TorsoLength torso = TorsoLength::Measured, double cop_angle_cutoff_hz = 0.0,
+                                  FilterEdge edges = FilterEdge::OddReflection) {
+  return compute_motion(std::make_shared<const Model>(model), lm, cutoff_hz, torso, cop_angle_cutoff_hz, edges);
 }
 
 /// The upper body's fore-aft lag (kin2grf, not in the paper). The HAT is one rigid segment whose

@@ -14,6 +14,8 @@
 //                 pooled (robustness)
 //   split-distance  kin2grf's side-by-side feet distance, off .. 0.2 m (not in the paper)
 //   torso-length  the torso's hip-shoulder length fixed (the paper) or measured per frame
+//   kinematic-edges  the kinematics' filter past the window's ends: the odd reflection (the ends'
+//                 acceleration read as zero) or the ends' own curvature
 //   foot-model    model 1 (three points) against model 2 (moving COP) (paper: Fig. 6)
 #pragma once
 

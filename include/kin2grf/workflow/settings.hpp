@@ -30,6 +30,8 @@ struct Settings {
   std::string foot_model = "cop", norm = "torque-scaled", anthropometry = EstimateOptions{}.anthropometry, up_axis,
               cop_function, running_cop = "builtin", torso_length = "measured",
               kinematic_cutoff_rule = "noise";
+  /// --kinematic-edges: odd or curvature (EstimateOptions::kinematic_edges)
+  std::string kinematic_edges = filter_edge_name(EstimateOptions{}.kinematic_edges);
   double r = SolverOptions{}.r_N_per_m, kinematic_cutoff = EstimateOptions{}.kinematic_cutoff_hz,
          post_cutoff_cycles = EstimateOptions{}.post_cutoff_cycles, speed_gate = SpeedGateRule{}.fixed_mps;
   /// The numeric settings that are one option field each (option_table.hpp's rows: flag, range,
