@@ -32,4 +32,4 @@ echo "  estimated.csv, estimated.json, gait_events.csv, estimate.html: its plots
 echo "  validation against the walk's own force plate above (validation.html, validation.json), and opensim/"
 echo "  (GRF .mot, markers .trc and ExternalLoads .xml for OpenSim's inverse dynamics), and estimated.c3d"
 echo "  (the markers with the estimate as force platforms 1 right and 2 left, for Nexus, Visual3D or ezc3d)."
-echo "docs/VALIDATION.md has the accuracy on 14 recorded trials from 8 labs."
+echo "docs/VALIDATION.md has the accuracy on 16 recorded trials from 8 labs."
