@@ -348,6 +348,41 @@ TEST(Estimate, AFootSeenOutsideTheWindowDoesNotTurnTheFrame) {
     EXPECT_LT((a.feet[side].force_N - b.feet[side].force_N).cwiseAbs().maxCoeff(), 1e-6) << "side " << side;
 }
 
+// The same walk, its legs lost from frame 300 on while the pelvis and shoulders, still seen, turn
+// 90 degrees to the left and walk on 1.7 m (a walker turning away from the plates, the feet behind
+// the walkway's furniture). The progression is the pelvis's travel over the span where the body is
+// seen (frames 0-299): from its first to its last frame in the file, the turn tilted the frame 25
+// degrees, past the 10 degrees a heading is snapped to the lab axis within.
+TEST(Estimate, APelvisSeenTurningAfterTheFeetAreLostDoesNotTiltTheFrame) {
+  const Trial walk = make_example_walk();
+  const Eigen::Index cut = 300;
+  Trial leaving = walk;
+  for (std::size_t k = 0; k < leaving.markers.names.size(); ++k) {
+    const std::string& name = leaving.markers.names[k];
+    auto& P = leaving.markers.positions_m[k];
+    if (name == "RHJC" || name == "LHJC" || name == "RSHO" || name == "LSHO") {
+      for (Eigen::Index i = cut; i < P.rows(); ++i) {
+        const double ahead = P(i, 0) - P(cut, 0);  // walked on to the left: x held, y grows
+        P(i, 0) = P(cut, 0);
+        P(i, 1) += ahead;
+      }
+    } else {
+      P.bottomRows(P.rows() - cut).setConstant(std::numeric_limits<double>::quiet_NaN());
+    }
+  }
+  Trial cut_walk = walk;
+  cut_walk.markers = cropped(walk.markers, 0, cut);
+  cut_walk.plates.reset();
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  const auto a = estimate(cut_walk, nullptr, set, {});
+  const auto b = estimate(leaving, nullptr, set, {});
+  EXPECT_FALSE(b.frame.turning()) << b.frame.how;
+  EXPECT_NEAR(b.frame.forward.x(), 1.0, 1e-9) << b.frame.forward.transpose();
+  ASSERT_EQ(a.time_s.size(), b.time_s.size());
+  for (int side = 0; side < 2; ++side)
+    EXPECT_LT((a.feet[side].force_N - b.feet[side].force_N).cwiseAbs().maxCoeff(), 1e-6) << "side " << side;
+}
+
 // One sample of one marker 1 m, 10 m or 1e300 m off (issue 10: a 453 N or 12,036 N spike, or NaN
 // in the output): it is a gap, filled like any other, the forces are those of the clean trial,
 // and a message names the marker and frame.

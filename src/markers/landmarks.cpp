@@ -752,7 +752,12 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
   const Axis up = o.up_axis.value_or(m.up_axis);
   f.up = Eigen::Vector3d::Unit(static_cast<int>(up));
   auto horizontal = [&](Eigen::Vector3d v) { return Eigen::Vector3d(v - v.dot(f.up) * f.up); };
-  // Progression from the hip's horizontal travel between its first and last defined frames.
+  // Progression from the hip's horizontal travel between its first and last defined frames: the
+  // body travels (overground) or not (a treadmill, on the spot). Its direction is the travel over
+  // the span where the body is seen (heading_span), where the processed window lies, when the hip
+  // travels kMinSpanTravelM there: a walker who turns away after the feet are lost would otherwise
+  // tilt the window's frame by the turn (Estimate.APelvisSeenTurningAfterTheFeetAreLostDoesNotTiltTheFrame).
+  constexpr double kMinSpanTravelM = 0.3;
   const auto& hip = lm.p[kHip];
   Eigen::Index a = -1, b = -1;
   for (Eigen::Index i = 0; i < hip.rows(); ++i)
@@ -764,6 +769,14 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
     if (d.norm() > 0.5 && d.norm() / dur > 0.2) {
       dir = d.normalized();
       f.how = "pelvis travel " + std::to_string(d.norm()) + " m";
+      const auto [s0, s1] = heading_span(lm, o.max_gap_frames);
+      if (s1 - s0 >= 10 && hip.row(s0).allFinite() && hip.row(s1 - 1).allFinite()) {
+        const Eigen::Vector3d ds = horizontal((hip.row(s1 - 1) - hip.row(s0)).transpose());
+        if (ds.norm() >= kMinSpanTravelM) {
+          dir = ds.normalized();
+          f.how = "pelvis travel " + std::to_string(ds.norm()) + " m";
+        }
+      }
     }
   }
   if (dir.norm() == 0) {
