@@ -21,7 +21,7 @@ for row in "${TRIALS[@]}"; do
   # the kinematic cut-off), 3d-load: the split by load alone, 3d-lumped: the arms and head in the
   # torso, 3d-nolag: the torso's lateral share not delayed, 3d-split: a landing's bilateral stance
   # split as everywhere else, for the leave-one-lab-out choices.
-  for config in defaults paper 3d 3d-lc0 3d-lc2 3d-lc2.5 3d-lc3.5 3d-lc4 3d-lc5 3d-load 3d-lumped 3d-nolag 3d-split; do
+  for config in defaults paper 3d 3d-lc0 3d-lc2 3d-lc3 3d-lc3.5 3d-lc4 3d-lc5 3d-load 3d-lumped 3d-nolag 3d-split; do
     extra=""
     [ "$config" = paper ] && extra="--paper"
     [ "$config" = 3d ] && extra="--model 3d"
