@@ -668,13 +668,10 @@ void follow_heading(SagittalFrame& f, const Landmarks3D& lm, double rate_hz, int
   const Eigen::Index n_all = hip_all.rows();
   const auto [s0, s1] = heading_span(lm, max_gap);
   if (n_all < 10 || rate_hz <= 0 || s1 - s0 < 10) return;
-  // The span's own landmarks; the heading is made over them and held beyond them.
-  const Eigen::MatrixX3d hip = hip_all.middleRows(s0, s1 - s0);
-  std::array<Eigen::MatrixX3d, 4> foot;
-  for (int side = 0; side < 2; ++side)
-    for (int k = 0; k < 2; ++k)
-      foot[static_cast<std::size_t>(2 * side + k)] = lm.p[landmark(side, k == 0 ? kHeel : kMt)].middleRows(s0, s1 - s0);
+  // The span's own landmarks (views, not copies: a long trial's memory); the heading is made over
+  // them and held beyond them.
   const Eigen::Index n = s1 - s0;
+  const auto hip = hip_all.middleRows(s0, n);
   // Horizontal basis e1, e2 (e1 x e2 = up): the two lab axes other than the up axis.
   Eigen::Index ua = 0;
   f.up.cwiseAbs().maxCoeff(&ua);
@@ -701,7 +698,7 @@ void follow_heading(SagittalFrame& f, const Landmarks3D& lm, double rate_hz, int
   const Eigen::MatrixXd feet = hold([&](Eigen::Index i, Eigen::RowVector2d& v) {
     v.setZero();
     for (int side = 0; side < 2; ++side) {
-      const Eigen::RowVector3d d = foot[static_cast<std::size_t>(2 * side + 1)].row(i) - foot[static_cast<std::size_t>(2 * side)].row(i);
+      const Eigen::RowVector3d d = lm.p[landmark(side, kMt)].row(s0 + i) - lm.p[landmark(side, kHeel)].row(s0 + i);
       const Eigen::RowVector2d dh(d.dot(e1.transpose()), d.dot(e2.transpose()));
       if (dh.allFinite()) v += dh;  // not normalised: a foot pitched steeply (swing) weighs little
     }
