@@ -666,7 +666,9 @@ std::pair<Eigen::Index, Eigen::Index> heading_span(const Landmarks3D& lm, int ma
 void follow_heading(SagittalFrame& f, const Landmarks3D& lm, double rate_hz, int max_gap) {
   const auto& hip_all = lm.p[kHip];
   const Eigen::Index n_all = hip_all.rows();
-  const auto [s0, s1] = heading_span(lm, max_gap);
+  // Not a structured binding: the lambdas below read s0, which C++20 lets clang refuse.
+  const std::pair<Eigen::Index, Eigen::Index> span = heading_span(lm, max_gap);
+  const Eigen::Index s0 = span.first, s1 = span.second;
   if (n_all < 10 || rate_hz <= 0 || s1 - s0 < 10) return;
   // The span's own landmarks (views, not copies: a long trial's memory); the heading is made over
   // them and held beyond them.
