@@ -12,6 +12,11 @@ const std::vector<NumericOption>& numeric_options() {
        "stance (the COP function's foot angle keeps the lowered one); 0 = no floor",
        // measured where it acts: as recorded no development trial's cut-off is lowered
        {0.0, 2.5, 3.0, 3.5, 4.0, 5.0}, "%.1f cycles, 2 mm", 1.0, "off, 2 mm", 0.002},
+      {"kinematic-edge-span", "kinematic_edge_span_periods", [](O& o) -> double& { return o.kinematic_edge_span_periods; }, 0.05, 5.0,
+       std::nullopt,
+       "With --kinematic-edges curvature, the share of a kinematic cut-off period each window end's curvature is fitted over "
+       "(default 0.5: the filter's own resolution)",
+       {0.25, 0.5, 0.75, 1.0}, "%.2f periods"},
       {"post-cutoff-floor", "post_cutoff_floor_ratio", [](O& o) -> double& { return o.post_cutoff_floor_ratio; }, 0.0, 10.0, std::nullopt,
        "The per-stance post-filter cut-off is not taken below this multiple of the dynamics' kinematic cut-off (default 0.75: a "
        "slow walker's stance; 0 = no floor)",

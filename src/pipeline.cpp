@@ -112,6 +112,8 @@ void check_options(const EstimateOptions& o) {
           "post-filter floor (x the kinematic cut-off)", o.post_cutoff_floor_ratio, "between 0 (none) and 10");
   require(finite(o.min_kinematic_cycles) && o.min_kinematic_cycles >= 0 && o.min_kinematic_cycles <= 20, "kinematic cycles per stance",
           o.min_kinematic_cycles, "between 0 (no floor) and 20 (kin2grf: 3.0)");
+  require(finite(o.kinematic_edge_span_periods) && o.kinematic_edge_span_periods > 0 && o.kinematic_edge_span_periods <= 5,
+          "the kinematics' edge span (cut-off periods)", o.kinematic_edge_span_periods, "above 0 and at most 5 (kin2grf: 0.5)");
   require(finite(o.solver.r_N_per_m) && o.solver.r_N_per_m > 0, "activation parameter r (N/m)", o.solver.r_N_per_m,
           "a number above 0 (kin2grf: 1000, paper: 10000)");
   require(finite(o.contact.ground_shift_m) && std::abs(o.contact.ground_shift_m) <= 1.0, "ground shift (m)", o.contact.ground_shift_m,
@@ -378,7 +380,8 @@ KinematicsStage kinematics_stage(const EstimateOptions& o, const std::shared_ptr
   out.position_cutoff_hz = out.kinematic_cutoff_hz;
   Eigen::MatrixXd x = model_coordinates(lm, o.torso_length);
   if (o.min_kinematic_cycles > 0 && out.kinematic_cutoff_hz < o.kinematic_cutoff_hz) out.unfiltered = x;
-  out.motion = motion_from_coordinates(model, std::move(x), lm.rate_hz, lm.time_s, out.kinematic_cutoff_hz, 0.0, o.kinematic_edges);
+  out.motion = motion_from_coordinates(model, std::move(x), lm.rate_hz, lm.time_s, out.kinematic_cutoff_hz, 0.0, o.kinematic_edges,
+                                       o.kinematic_edge_span_periods);
   return out;
 }
 
@@ -1381,7 +1384,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
     kin.motion = ModelMotion();
     dyn = DynamicsPass();
     kin.motion = motion_from_coordinates(mod.model, std::move(kin.unfiltered), rate_hz, std::move(time_s), *floor_hz, kin.position_cutoff_hz,
-                                         o.kinematic_edges);
+                                         o.kinematic_edges, o.kinematic_edge_span_periods);
     kin.kinematic_cutoff_hz = *floor_hz;
     kin.messages.push_back(std::move(raised));
     seconds_kinematics += std::chrono::duration<double>(clock::now() - tk).count();

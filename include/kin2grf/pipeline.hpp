@@ -79,6 +79,11 @@ struct EstimateOptions {
   /// keeps it (the end's own curvature over half a cut-off period). A window that ends mid-stance
   /// or in flight (a run through a short capture volume) accelerates at 1-3 g there.
   FilterEdge kinematic_edges = FilterEdge::Curvature;
+  /// Curvature's span, in periods of the kinematic cut-off: the end's curvature is the least-squares
+  /// quadratic's over this much of the window's end (kinematics/filter.hpp, kCurvatureSpanPeriods).
+  /// Half a period, the filter's own resolution, set beforehand and chosen by every lab held out
+  /// (`kin2grf study kinematic-edge-span`, docs/METHOD-NOTES.md).
+  double kinematic_edge_span_periods = kCurvatureSpanPeriods;
   /// The torso's hip-shoulder length: measured per frame (kin2grf) or fixed (the paper).
   TorsoLength torso_length = TorsoLength::Measured;
   /// The upper body's fore-aft lag behind the pelvis, s (kin2grf): the HAT COM's fore-aft

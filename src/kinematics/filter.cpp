@@ -84,7 +84,7 @@ Eigen::VectorXd curvature_weights(Eigen::Index m) {
   return 2.0 * (A.transpose() * A).ldlt().solve(A.transpose()).row(2).transpose();
 }
 
-ZeroLagDesign design_zero_lag(Eigen::Index n, double rate_hz, double cutoff_hz, FilterEdge edge) {
+ZeroLagDesign design_zero_lag(Eigen::Index n, double rate_hz, double cutoff_hz, FilterEdge edge, double span_periods) {
   const double C = zero_lag_correction();
   const double fc = cutoff_hz / C;
   if (!(fc > 0) || fc >= 0.5 * rate_hz) {
@@ -97,7 +97,7 @@ ZeroLagDesign design_zero_lag(Eigen::Index n, double rate_hz, double cutoff_hz, 
   const Eigen::Index pad = want >= static_cast<double>(n - 1) || !(want >= 0) ? n - 1 : static_cast<Eigen::Index>(want);
   ZeroLagDesign d{design_lowpass(rate_hz, fc), pad, Eigen::VectorXd()};
   if (edge == FilterEdge::Curvature) {
-    const double span = std::round(kCurvatureSpanPeriods * rate_hz / cutoff_hz);
+    const double span = std::round(span_periods * rate_hz / cutoff_hz);
     const Eigen::Index m = std::min<Eigen::Index>(n, std::max<Eigen::Index>(5, static_cast<Eigen::Index>(std::min(span, 1e9))));
     if (m >= 3) d.curvature_weights = curvature_weights(m);  // fewer samples: no quadratic, the odd reflection
   }
@@ -147,20 +147,22 @@ void filtfilt_range(const ZeroLagDesign& d, const Eigen::Ref<const Eigen::Matrix
 
 }  // namespace
 
-Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, double cutoff_hz, FilterEdge edge) {
+Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, double cutoff_hz, FilterEdge edge,
+                                     double curvature_span_periods) {
   const Eigen::Index n = x.size();
   if (n < 2) return x;
-  const ZeroLagDesign d = design_zero_lag(n, rate_hz, cutoff_hz, edge);
+  const ZeroLagDesign d = design_zero_lag(n, rate_hz, cutoff_hz, edge, curvature_span_periods);
   Eigen::MatrixXd y(n, 1);
   std::vector<double> e;
   filtfilt_columns<1>(d, x, 0, y, e);
   return y.col(0);
 }
 
-Eigen::MatrixXd butterworth_filtfilt(Eigen::MatrixXd x, double rate_hz, double cutoff_hz, FilterEdge edge) {
+Eigen::MatrixXd butterworth_filtfilt(Eigen::MatrixXd x, double rate_hz, double cutoff_hz, FilterEdge edge,
+                                     double curvature_span_periods) {
   const Eigen::Index n = x.rows();
   if (n < 2 || x.cols() == 0) return x;
-  const ZeroLagDesign d = design_zero_lag(n, rate_hz, cutoff_hz, edge);
+  const ZeroLagDesign d = design_zero_lag(n, rate_hz, cutoff_hz, edge, curvature_span_periods);
   // In place: filtfilt_columns copies its columns into the workspace before it writes them back,
   // and no two chunks share a column, so a long trial's series is never held twice.
   // Columns are independent: on the machine's cores when long enough to pay for a thread (two
@@ -241,7 +243,7 @@ double residual_analysis_cutoff(const Eigen::MatrixXd& x, double rate_hz, double
     std::vector<double> e;
     for (int k = 0; k <= m; ++k) {
       const double f = k < m ? f_lo + (f_hi - f_lo) * k / (m - 1) : upper_hz;
-      filtfilt_range(design_zero_lag(n, rate_hz, f, FilterEdge::OddReflection), head.middleCols(b, w), 0, w, y, e);
+      filtfilt_range(design_zero_lag(n, rate_hz, f, FilterEdge::OddReflection, kCurvatureSpanPeriods), head.middleCols(b, w), 0, w, y, e);
       for (Eigen::Index c = 0; c < w; ++c) residuals(k, c) = residual_rms(head.col(b + c), y.col(c));
     }
     for (Eigen::Index c = 0; c < w; ++c)

@@ -226,7 +226,7 @@ Eigen::MatrixXd model_coordinates(const SagittalLandmarks& lm, TorsoLength torso
 }
 
 ModelMotion motion_from_coordinates(std::shared_ptr<const Model> model, Eigen::MatrixXd x, double rate_hz, Eigen::VectorXd time_s,
-                                    double cutoff_hz, double cop_angle_cutoff_hz, FilterEdge edges) {
+                                    double cutoff_hz, double cop_angle_cutoff_hz, FilterEdge edges, double edge_span_periods) {
   // The feet's absolute angles at the COP's own cut-off: the sum of the chain's columns (torso,
   // hip, knee, ankle), the foot's theta as frame() builds it, filtered (a linear filter, so the
   // sum of the filtered columns).
@@ -236,7 +236,7 @@ ModelMotion motion_from_coordinates(std::shared_ptr<const Model> model, Eigen::M
     for (int s = 0; s < 2; ++s) cop_angle.col(s) = x.col(2) + x.middleCols(3 + 4 * s, 3).rowwise().sum();
     cop_angle = butterworth_filtfilt(Eigen::MatrixXd(cop_angle), rate_hz, cop_angle_cutoff_hz);
   }
-  if (cutoff_hz > 0) x = butterworth_filtfilt(std::move(x), rate_hz, cutoff_hz, edges);
+  if (cutoff_hz > 0) x = butterworth_filtfilt(std::move(x), rate_hz, cutoff_hz, edges, edge_span_periods);
   // Empty derivatives: each frame takes x's central differences (ModelMotion::derivatives_at).
   ModelMotion m = reconstruct_motion(std::move(model), std::move(x), Eigen::MatrixXd(), Eigen::MatrixXd(), rate_hz, std::move(time_s));
   m.cop_foot_angle_rad = std::move(cop_angle);

@@ -35,22 +35,24 @@ enum class FilterEdge {
   OddReflection,  ///< point-symmetric: position and velocity kept, the ends' acceleration read as zero
   Curvature,      ///< the odd reflection plus the ends' own curvature (a_T s^2)
 };
-/// The share of a cut-off period the end's curvature is fitted over (FilterEdge::Curvature):
-/// half a period, the filter's own resolution (shorter spans fit the markers' noise, longer ones
-/// the next phase of the motion).
+/// The share of a cut-off period the end's curvature is fitted over (FilterEdge::Curvature), by
+/// default: half a period, the filter's own resolution (shorter spans fit the markers' noise, longer
+/// ones the next phase of the motion); chosen again leave-one-lab-out by the pipeline's
+/// EstimateOptions::kinematic_edge_span_periods (`kin2grf study kinematic-edge-span`).
 inline constexpr double kCurvatureSpanPeriods = 0.5;
 /// The command line's word for each: "odd", "curvature".
 inline const char* filter_edge_name(FilterEdge e) { return e == FilterEdge::Curvature ? "curvature" : "odd"; }
 
 /// Zero-lag (forward-backward) 2nd-order Butterworth low-pass, -3 dB at cutoff_hz overall.
 /// Requires finite samples; cutoff must be below the Nyquist frequency.
+/// `curvature_span_periods`: FilterEdge::Curvature's span, in periods of the cut-off (above 0).
 Eigen::VectorXd butterworth_filtfilt(const Eigen::VectorXd& x, double rate_hz, double cutoff_hz,
-                                     FilterEdge edge = FilterEdge::OddReflection);
+                                     FilterEdge edge = FilterEdge::OddReflection, double curvature_span_periods = kCurvatureSpanPeriods);
 
 /// Column-wise butterworth_filtfilt. Filters x in place: pass it with std::move where the
 /// unfiltered series is not needed again.
 Eigen::MatrixXd butterworth_filtfilt(Eigen::MatrixXd x, double rate_hz, double cutoff_hz,
-                                     FilterEdge edge = FilterEdge::OddReflection);
+                                     FilterEdge edge = FilterEdge::OddReflection, double curvature_span_periods = kCurvatureSpanPeriods);
 
 /// First derivative by central differences (one-sided at the ends), per column.
 Eigen::MatrixXd central_difference(const Eigen::MatrixXd& x, double dt_s);

@@ -128,10 +128,11 @@ Eigen::MatrixXd model_coordinates(const SagittalLandmarks& lm, TorsoLength torso
 
 /// compute_motion from model_coordinates' columns (unfiltered), their rate and times. `edges`: how
 /// the coordinates' filter extends them past the window's ends (kinematics/filter.hpp; the
-/// pipeline's EstimateOptions::kinematic_edges); the COP function's foot angles, positions,
-/// keep the odd reflection.
+/// pipeline's EstimateOptions::kinematic_edges, and its span in cut-off periods); the COP
+/// function's foot angles, positions, keep the odd reflection.
 ModelMotion motion_from_coordinates(std::shared_ptr<const Model> model, Eigen::MatrixXd x, double rate_hz, Eigen::VectorXd time_s,
-                                    double cutoff_hz, double cop_angle_cutoff_hz = 0.0, FilterEdge edges = FilterEdge::OddReflection);
+                                    double cutoff_hz, double cop_angle_cutoff_hz = 0.0, FilterEdge edges = FilterEdge::OddReflection,
+                                    double edge_span_periods = kCurvatureSpanPeriods);
 
 /// The whole kinematic step: independent coordinates, filter at cutoff_hz, differentiate,
 /// reconstruct. cop_angle_cutoff_hz > 0 (and not cutoff_hz): the COP function's foot angles
