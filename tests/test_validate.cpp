@@ -675,7 +675,9 @@ TEST(Validate, APlateAtAnAngleCoversItsRectangleNotItsExtent) {
   EXPECT_TRUE(m.covers(edge.x(), -edge.y()));
   // A point at the extent's far x, level with the centre: inside the extent along x (0.82 m),
   // 0.79 m from the centre along x, outside the rectangle.
-  EXPECT_GT(m.x_max, 0.79);
+  double extent_x = -1;  // the corners' largest x (the lab's X here)
+  for (const auto& c : p.corners_m) extent_x = std::max(extent_x, c.x());
+  EXPECT_GT(extent_x, 0.79);
   EXPECT_FALSE(m.covers(0.79, 0.0));
   // The margin stretches the rectangle along its length only.
   EXPECT_TRUE(m.covers(0.62 * ex.x(), -0.62 * ex.y(), 0.05));

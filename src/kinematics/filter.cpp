@@ -97,8 +97,9 @@ ZeroLagDesign design_zero_lag(Eigen::Index n, double rate_hz, double cutoff_hz, 
   const Eigen::Index pad = want >= static_cast<double>(n - 1) || !(want >= 0) ? n - 1 : static_cast<Eigen::Index>(want);
   ZeroLagDesign d{design_lowpass(rate_hz, fc), pad, Eigen::VectorXd()};
   if (edge == FilterEdge::Curvature) {
-    const double span = std::round(span_periods * rate_hz / cutoff_hz);
-    const Eigen::Index m = std::min<Eigen::Index>(n, std::max<Eigen::Index>(5, static_cast<Eigen::Index>(std::min(span, 1e9))));
+    // At least 5 samples, at most the series (compared as doubles: a huge rate must not overflow).
+    const double span = std::min(static_cast<double>(n), std::max(5.0, std::round(span_periods * rate_hz / cutoff_hz)));
+    const auto m = static_cast<Eigen::Index>(span);
     if (m >= 3) d.curvature_weights = curvature_weights(m);  // fewer samples: no quadratic, the odd reflection
   }
   return d;

@@ -663,11 +663,11 @@ std::pair<Eigen::Index, Eigen::Index> heading_span(const Landmarks3D& lm, int ma
   return best;
 }
 
-void follow_heading(SagittalFrame& f, const Landmarks3D& lm, double rate_hz, int max_gap) {
+/// `span`: heading_span's.
+void follow_heading(SagittalFrame& f, const Landmarks3D& lm, double rate_hz, const std::pair<Eigen::Index, Eigen::Index>& span) {
   const auto& hip_all = lm.p[kHip];
   const Eigen::Index n_all = hip_all.rows();
   // Not a structured binding: the lambdas below read s0, which C++20 lets clang refuse.
-  const std::pair<Eigen::Index, Eigen::Index> span = heading_span(lm, max_gap);
   const Eigen::Index s0 = span.first, s1 = span.second;
   if (n_all < 10 || rate_hz <= 0 || s1 - s0 < 10) return;
   // The span's own landmarks (views, not copies: a long trial's memory); the heading is made over
@@ -758,6 +758,7 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
   // tilt the window's frame by the turn (Estimate.APelvisSeenTurningAfterTheFeetAreLostDoesNotTiltTheFrame).
   constexpr double kMinSpanTravelM = 0.3;
   const auto& hip = lm.p[kHip];
+  const auto [s0, s1] = heading_span(lm, o.max_gap_frames);
   Eigen::Index a = -1, b = -1;
   for (Eigen::Index i = 0; i < hip.rows(); ++i)
     if (hip.row(i).allFinite()) { if (a < 0) a = i; b = i; }
@@ -768,7 +769,6 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
     if (d.norm() > 0.5 && d.norm() / dur > 0.2) {
       dir = d.normalized();
       f.how = "pelvis travel " + std::to_string(d.norm()) + " m";
-      const auto [s0, s1] = heading_span(lm, o.max_gap_frames);
       if (s1 - s0 >= 10 && hip.row(s0).allFinite() && hip.row(s1 - 1).allFinite()) {
         const Eigen::Vector3d ds = horizontal((hip.row(s1 - 1) - hip.row(s0)).transpose());
         if (ds.norm() >= kMinSpanTravelM) {
@@ -805,7 +805,7 @@ SagittalFrame detect_sagittal_frame(const Landmarks3D& lm, const MarkerTrajector
   if (o.progression_sign) dir *= (*o.progression_sign > 0 ? 1.0 : -1.0) * (dir.sum() >= 0 ? 1.0 : -1.0);
   f.forward = dir;
   f.lateral = f.forward.cross(f.up);
-  if (!o.progression_axis) follow_heading(f, lm, m.rate_hz, o.max_gap_frames);
+  if (!o.progression_axis) follow_heading(f, lm, m.rate_hz, {s0, s1});
   return f;
 }
 

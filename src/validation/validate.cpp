@@ -75,12 +75,6 @@ void plate_place(const ForcePlate& p, const ForcePlateRecording& rec, const Sagi
     const double off = fr.x_offset_at(g);
     m.surface_y_m = p.centre_m.dot(fr.up);
     m.centre_m = {p.centre_m.dot(fw) + off, p.centre_m.dot(lt)};
-    m.x_min = m.lateral_min = std::numeric_limits<double>::infinity();
-    m.x_max = m.lateral_max = -m.x_min;
-    for (const auto& c : p.corners_m) {
-      m.x_min = std::min(m.x_min, c.dot(fw) + off), m.x_max = std::max(m.x_max, c.dot(fw) + off);
-      m.lateral_min = std::min(m.lateral_min, c.dot(lt)), m.lateral_max = std::max(m.lateral_max, c.dot(lt));
-    }
     // The rectangle: its edges c1 - c2 and c1 - c4 in (x, lateral), the one nearer the progression
     // taken as its length.
     const auto flat = [&](const Eigen::Vector3d& v) { return Eigen::Vector2d(v.dot(fw), v.dot(lt)); };

@@ -69,7 +69,6 @@ struct MeasuredPlate {
   Eigen::VectorXd cop_lateral_m;
   double surface_y_m = 0.0;        ///< plate surface height in the sagittal frame
   Eigen::Vector2d centre_m = Eigen::Vector2d::Zero();  ///< (x, lateral) of the surface centre
-  double x_min = 0, x_max = 0, lateral_min = 0, lateral_max = 0;  ///< extent (with geometry)
   /// The rectangle itself (with geometry), in the same (x, lateral) coordinates: the unit vector
   /// of its edges nearer the progression, and its half length along them and half width across.
   /// A plate at an angle to the progression covers less than its extent.
