@@ -224,8 +224,19 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   // A trial the caller gave up is cleaned in place (`release` is `trial` then); otherwise the
   // cleaned copy is made only when there is an outlier.
   std::optional<MarkerTrajectories> cleaned;
-  if (release) remove_marker_outliers(release->markers, set.motion_markers(), cleaning);
-  else cleaned = without_marker_outliers(trial.markers, set.motion_markers(), cleaning);
+  const std::vector<std::string> motion_markers = set.motion_markers();
+  if (release) remove_marker_outliers(release->markers, motion_markers, cleaning);
+  else cleaned = without_marker_outliers(trial.markers, motion_markers, cleaning);
+  // Gaps beyond the landmarks' cubic fill, from the markers that move rigidly with the marker
+  // (the outliers just removed are gaps too); copied first only when there is one.
+  if (o.landmarks.rigid_fill) {
+    const int longer_than = o.landmarks.max_gap_frames;
+    if (release) fill_marker_gaps_rigidly(release->markers, motion_markers, longer_than, cleaning);
+    else if (has_long_marker_gap(cleaned ? *cleaned : trial.markers, motion_markers, longer_than)) {
+      if (!cleaned) cleaned = trial.markers;
+      fill_marker_gaps_rigidly(*cleaned, motion_markers, longer_than, cleaning);
+    }
+  }
   // The samples the landmarks are made of are released as they are used (the trial's, when the
   // caller gave it up).
   MarkerTrajectories* releasable = release ? &release->markers : nullptr;

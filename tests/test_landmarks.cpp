@@ -801,3 +801,67 @@ TEST(Landmarks, AKneePointFollowsTheBoneUnlessAClusterCarriesIt) {
     for (int side = 0; side < 2; ++side) EXPECT_FALSE(follows_the_bone(set->rules[landmark(side, kKnee)].kind)) << name;
   }
 }
+
+namespace {
+// A rigid foot-like body of four markers turning and travelling (0.6 rad of pitch, 0.3 rad of yaw,
+// 1 m forward over 2 s at 100 Hz), and one marker across a "joint" swinging 0.5 rad against it.
+MarkerTrajectories rigid_body_walk() {
+  MarkerTrajectories m;
+  const Eigen::Index n = 200;
+  m.rate_hz = 100.0;
+  m.time_s = Eigen::VectorXd::LinSpaced(n, 0.0, 1.99);
+  m.names = {"HEEL", "MT1", "MT5", "TOE", "SHANK"};
+  m.descriptions.assign(m.names.size(), "");
+  const std::vector<Eigen::Vector3d> body = {{0.0, 0.0, 0.03}, {0.18, 0.03, 0.02}, {0.16, -0.04, 0.02}, {0.24, 0.01, 0.01}};
+  m.positions_m.assign(m.names.size(), Eigen::MatrixX3d(n, 3));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = m.time_s[i];
+    const Eigen::Matrix3d R = (Eigen::AngleAxisd(0.3 * std::sin(2.0 * t), Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(0.6 * std::sin(3.0 * t), Eigen::Vector3d::UnitY()))
+                                  .toRotationMatrix();
+    const Eigen::Vector3d o(0.5 * t, 0.1, 0.05 + 0.04 * std::sin(5.0 * t));
+    for (std::size_t k = 0; k < body.size(); ++k) m.positions_m[k].row(i) = (R * body[k] + o).transpose();
+    const Eigen::Matrix3d swing = Eigen::AngleAxisd(0.5 * std::sin(4.0 * t), Eigen::Vector3d::UnitY()).toRotationMatrix();
+    m.positions_m[4].row(i) = (R * (Eigen::Vector3d(0.05, 0.0, 0.1) + swing * Eigen::Vector3d(0.0, 0.0, 0.3)) + o).transpose();
+  }
+  return m;
+}
+}  // namespace
+
+// A marker lost for 0.4 s inside the trial (a heel hidden by the other foot) is filled from the
+// three markers that move rigidly with it, exactly for a rigid body, and the message names them;
+// the marker swinging across the "joint" is not taken. The same gap at the trial's end (the
+// subject leaving the volume: no data after it) is not filled.
+TEST(Landmarks, ALongGapIsFilledFromTheMarkersThatMoveRigidlyWithIt) {
+  const MarkerTrajectories truth = rigid_body_walk();
+  MarkerTrajectories m = truth;
+  m.positions_m[0].middleRows(80, 40).setConstant(std::numeric_limits<double>::quiet_NaN());
+  m.positions_m[0].bottomRows(30).setConstant(std::numeric_limits<double>::quiet_NaN());
+  ASSERT_TRUE(has_long_marker_gap(m, {"HEEL"}, 10));
+  std::vector<std::string> messages;
+  EXPECT_EQ(fill_marker_gaps_rigidly(m, {"HEEL"}, 10, messages), 1U);
+  EXPECT_LT((m.positions_m[0].middleRows(80, 40) - truth.positions_m[0].middleRows(80, 40)).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_FALSE(m.positions_m[0].bottomRows(30).allFinite());  // the end's gap stays
+  ASSERT_EQ(messages.size(), 1U);
+  EXPECT_NE(messages[0].find("HEEL: filled a gap of 40 frames at frames 81-120"), std::string::npos) << messages[0];
+  for (const char* partner : {"MT1", "MT5", "TOE"}) EXPECT_NE(messages[0].find(partner), std::string::npos) << messages[0];
+  EXPECT_EQ(messages[0].find("SHANK"), std::string::npos) << messages[0];
+  // A gap no longer than the cubic fill's reach is left to it.
+  MarkerTrajectories shortgap = truth;
+  shortgap.positions_m[0].middleRows(80, 10).setConstant(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_FALSE(has_long_marker_gap(shortgap, {"HEEL"}, 10));
+}
+
+// With only two markers moving rigidly with it (the third lost with it), the gap is not guessed
+// from a marker across a joint: it is left, and the markers are unchanged.
+TEST(Landmarks, AGapWithoutThreeRigidPartnersIsLeft) {
+  MarkerTrajectories m = rigid_body_walk();
+  m.positions_m[0].middleRows(80, 40).setConstant(std::numeric_limits<double>::quiet_NaN());
+  m.positions_m[3].middleRows(70, 60).setConstant(std::numeric_limits<double>::quiet_NaN());
+  const MarkerTrajectories before = m;
+  std::vector<std::string> messages;
+  EXPECT_EQ(fill_marker_gaps_rigidly(m, {"HEEL"}, 10, messages), 0U);
+  EXPECT_TRUE(messages.empty());
+  EXPECT_FALSE(m.positions_m[0].middleRows(80, 40).allFinite());
+  EXPECT_TRUE(m.positions_m[3].middleRows(0, 70).isApprox(before.positions_m[3].middleRows(0, 70)));
+}

@@ -387,6 +387,47 @@ TEST(Estimate, APelvisSeenTurningAfterTheFeetAreLostDoesNotTiltTheFrame) {
   EXPECT_NEAR(b.frame.forward.x(), 1.0, 1e-9) << b.frame.forward.transpose();
 }
 
+// A heel marker lost for 0.3 s in the middle of the example walk (hidden by the other foot over a
+// plate): the gap, longer than the cubic fill's 10 frames, ended the processed window there and
+// half the walk's stances with it. The walk's right foot carries a technical marker on its dorsum
+// besides its ankle and MT markers, so three markers move rigidly with the heel: the gap is filled
+// from them, the whole walk is processed, and the forces are the intact walk's. With --rigid-fill
+// off, the window stops at the gap as before.
+TEST(Estimate, AHeelLostForATenthOfAStrideIsFilledFromItsFoot) {
+  Trial walk = make_example_walk();
+  MarkerTrajectories& m = walk.markers;
+  const auto at = [&](const char* name) -> Eigen::MatrixX3d& { return m.positions_m[static_cast<std::size_t>(m.find(name))]; };
+  const Eigen::MatrixX3d ajc = at("RAJC"), mt = at("RMT1");
+  Eigen::MatrixX3d dorsum(ajc.rows(), 3);
+  for (Eigen::Index i = 0; i < ajc.rows(); ++i) {
+    const Eigen::Vector3d along = (mt.row(i) - ajc.row(i)).transpose();
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitY().cross(along).normalized();  // in the foot's sagittal plane
+    dorsum.row(i) = (ajc.row(i).transpose() + 0.5 * along + 0.03 * up + Eigen::Vector3d(0, 0.02, 0)).transpose();
+  }
+  m.names.push_back("RFT1");
+  m.descriptions.push_back("");
+  m.positions_m.push_back(dorsum);
+  Trial gapped = walk;
+  const Eigen::Index first = m.frames() / 2, frames = 30;
+  ASSERT_EQ(m.rate_hz, 100.0);
+  gapped.markers.positions_m[static_cast<std::size_t>(m.find("RHEE"))].middleRows(first, frames).setConstant(
+      std::numeric_limits<double>::quiet_NaN());
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  const EstimateResult intact = estimate(walk, nullptr, set, {});
+  const EstimateResult filled = estimate(gapped, nullptr, set, {});
+  ASSERT_EQ(filled.time_s.size(), intact.time_s.size());
+  for (int side = 0; side < 2; ++side)
+    EXPECT_LT((filled.feet[side].force_N - intact.feet[side].force_N).cwiseAbs().maxCoeff(), 1e-6) << "side " << side;
+  const auto said = std::find_if(filled.messages.begin(), filled.messages.end(),
+                                 [](const std::string& x) { return x.find("RHEE: filled a gap of 30 frames") != std::string::npos; });
+  ASSERT_NE(said, filled.messages.end());
+  for (const char* partner : {"RAJC", "RMT1", "RFT1"}) EXPECT_NE(said->find(partner), std::string::npos) << *said;
+  EstimateOptions off;
+  off.landmarks.rigid_fill = false;
+  const EstimateResult cut = estimate(gapped, nullptr, set, off);
+  EXPECT_LE(cut.time_s.size(), first + 1);
+}
+
 // One sample of one marker 1 m, 10 m or 1e300 m off (issue 10: a 453 N or 12,036 N spike, or NaN
 // in the output): it is a gap, filled like any other, the forces are those of the clean trial,
 // and a message names the marker and frame.

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -468,6 +469,126 @@ std::size_t remove_marker_outliers(MarkerTrajectories& m, const std::vector<std:
     removed += where.size();
   }
   return removed;
+}
+
+namespace {
+/// A gap [first, end) of marker `marker`, seen at first - 1 and at end.
+struct InteriorGap {
+  std::size_t marker;
+  Eigen::Index first, end;
+};
+
+std::vector<InteriorGap> long_interior_gaps(const MarkerTrajectories& m, const std::vector<std::string>& only, int longer_than) {
+  std::vector<InteriorGap> out;
+  for (std::size_t k = 0; k < m.positions_m.size(); ++k) {
+    if (!checked(m, k, only)) continue;
+    const Eigen::MatrixX3d& P = m.positions_m[k];
+    const Eigen::Index n = P.rows();
+    Eigen::Index i = 0;
+    while (i < n && !P.row(i).allFinite()) ++i;  // the trial's start: not inside
+    while (i < n) {
+      if (P.row(i).allFinite()) {
+        ++i;
+        continue;
+      }
+      Eigen::Index j = i;
+      while (j < n && !P.row(j).allFinite()) ++j;
+      if (j < n && j - i > longer_than) out.push_back({k, i, j});
+      i = j;
+    }
+  }
+  return out;
+}
+
+/// SD (m) of the distance between two markers over the frames both are seen; infinity when
+/// those are fewer than kMinRigidFrames.
+double distance_sd(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
+  double s = 0, s2 = 0;
+  Eigen::Index count = 0;
+  for (Eigen::Index i = 0; i < a.rows(); ++i) {
+    if (!a.row(i).allFinite() || !b.row(i).allFinite()) continue;
+    const double d = (a.row(i) - b.row(i)).norm();
+    s += d, s2 += d * d, ++count;
+  }
+  if (count < kMinRigidFrames) return std::numeric_limits<double>::infinity();
+  const double mean = s / static_cast<double>(count);
+  return std::sqrt(std::max(s2 / static_cast<double>(count) - mean * mean, 0.0));
+}
+
+/// Each height of the triangle p0 p1 p2 (twice its area over each side) at least `span`.
+bool spans_triangle(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, double span) {
+  const double twice_area = (p1 - p0).cross(p2 - p0).norm();
+  const double longest = std::max({(p1 - p0).norm(), (p2 - p0).norm(), (p2 - p1).norm()});
+  return longest > 0 && twice_area / longest >= span;
+}
+
+/// One gap's fill (its frames, N x 3) from its partners, or nothing when they are not found.
+std::optional<Eigen::MatrixX3d> rigid_fill(const MarkerTrajectories& m, const InteriorGap& g, std::string& message) {
+  const Eigen::Index before = g.first - 1, len = g.end - before + 1;  // the gap and a seen frame at each end
+  const Eigen::MatrixX3d& T = m.positions_m[g.marker];
+  std::vector<std::pair<double, std::size_t>> candidates;
+  for (std::size_t k = 0; k < m.positions_m.size(); ++k) {
+    const Eigen::MatrixX3d& P = m.positions_m[k];
+    if (k == g.marker || P.rows() != T.rows()) continue;
+    bool seen = true;
+    for (Eigen::Index i = before; i <= g.end && seen; ++i) seen = P.row(i).allFinite();
+    if (!seen) continue;
+    const double sd = distance_sd(T, P);
+    if (sd <= kMaxRigidPartnerSdM) candidates.emplace_back(sd, k);
+  }
+  std::sort(candidates.begin(), candidates.end());
+  // The first three (by SD) that span a triangle at the frame before the gap.
+  const auto at = [&](std::size_t c) { return m.positions_m[candidates[c].second].row(before).transpose().eval(); };
+  std::array<std::size_t, 3> pick{};
+  bool found = false;
+  const std::size_t nc = candidates.size();
+  for (std::size_t a = 0; a < nc && !found; ++a)
+    for (std::size_t b = a + 1; b < nc && !found; ++b)
+      for (std::size_t c = b + 1; c < nc && !found; ++c)
+        if (spans_triangle(at(a), at(b), at(c), kMinRigidPartnerSpanM)) pick = {a, b, c}, found = true;
+  if (!found) return std::nullopt;
+  std::vector<Eigen::MatrixX3d> cluster;
+  for (const std::size_t c : pick) cluster.push_back(m.positions_m[candidates[c].second].middleRows(before, len));
+  std::vector<Eigen::Vector3d> from_before, from_after;
+  for (const auto& P : cluster) from_before.push_back(P.row(0).transpose()), from_after.push_back(P.row(len - 1).transpose());
+  const Eigen::Vector3d x_before = T.row(before).transpose(), x_after = T.row(g.end).transpose();
+  Eigen::MatrixX3d fill(len - 2, 3);
+  for (Eigen::Index i = 1; i + 1 < len; ++i) {
+    Eigen::Matrix3d R1, R2;
+    Eigen::Vector3d t1, t2;
+    if (!fit_cluster(cluster, i, from_before, R1, t1) || !fit_cluster(cluster, i, from_after, R2, t2)) return std::nullopt;
+    const double w = static_cast<double>(i) / static_cast<double>(len - 1);
+    fill.row(i - 1) = ((1.0 - w) * (R1 * x_before + t1) + w * (R2 * x_after + t2)).transpose();
+  }
+  char b[160];
+  std::snprintf(b, sizeof b, "%.1f-%.1f mm", 1000 * candidates[pick[0]].first, 1000 * candidates[pick[2]].first);
+  message = m.names[g.marker] + ": filled a gap of " + std::to_string(g.end - g.first) + " frames at frames " +
+            std::to_string(m.first_frame + g.first) + "-" + std::to_string(m.first_frame + g.end - 1) +
+            " from the markers that move rigidly with it (" + m.names[candidates[pick[0]].second] + ", " +
+            m.names[candidates[pick[1]].second] + ", " + m.names[candidates[pick[2]].second] + ": their distances to it vary by " + b +
+            " SD over the trial)";
+  return fill;
+}
+}  // namespace
+
+bool has_long_marker_gap(const MarkerTrajectories& m, const std::vector<std::string>& only, int longer_than_frames) {
+  return !long_interior_gaps(m, only, longer_than_frames).empty();
+}
+
+std::size_t fill_marker_gaps_rigidly(MarkerTrajectories& m, const std::vector<std::string>& only, int longer_than_frames,
+                                     std::vector<std::string>& messages) {
+  // Every fill is made from the markers as given, then written: a marker filled here is no
+  // partner for another's gap, and the order of the markers does not matter.
+  std::vector<std::pair<InteriorGap, Eigen::MatrixX3d>> fills;
+  for (const InteriorGap& g : long_interior_gaps(m, only, longer_than_frames)) {
+    std::string message;
+    std::optional<Eigen::MatrixX3d> fill = rigid_fill(m, g, message);
+    if (!fill) continue;
+    messages.push_back(std::move(message));
+    fills.emplace_back(g, std::move(*fill));
+  }
+  for (const auto& [g, fill] : fills) m.positions_m[g.marker].middleRows(g.first, fill.rows()) = fill;
+  return fills.size();
 }
 
 namespace {

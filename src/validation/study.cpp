@@ -28,6 +28,10 @@ struct Setting {
   double marker_rate_hz = 0.0;  ///< the `marker-rate` study: markers decimated to about this rate (0: as recorded)
   bool from_labels = false;     ///< the `marker-labels` study: the set made from the file's labels, not the trial's preset
   double cut_margin_s = -1.0;   ///< the `trial-cut` study: markers cut to the plates' loaded span and this much around it (< 0: as recorded)
+  /// The `marker-gaps` study: these landmarks' markers (LegLandmark) lost for gap_s at the middle
+  /// of every plate's loaded run (gap_s 0: as recorded).
+  LegLandmark gap_landmark = kHeel;
+  double gap_s = 0.0;
 };
 
 /// Marks the settings that leave the fields `get` reads at kin2grf's defaults (the added marker
@@ -222,6 +226,58 @@ MarkerTrajectories cut_to_plates(const MarkerTrajectories& m, const ForcePlateRe
   return cropped(m, a, b - a + 1);
 }
 
+/// Robustness to markers lost for a while (occluded by the other foot over a plate, a marker
+/// fallen off): the heel markers, then the MT markers, of both feet lost for 0.2 s at the middle
+/// of every plate's loaded run, with the rigid fill off (the gap ends the processed window, as
+/// before session 37) and on (LandmarkOptions::rigid_fill). A trial whose window is left with no
+/// plate stance fails that row.
+std::vector<Setting> marker_gaps_settings() {
+  std::vector<Setting> s{{"as recorded", 0, [](EstimateOptions&) {}, 0.0, true}};
+  for (const LegLandmark which : {kHeel, kMt})
+    for (const bool fill : {false, true}) {
+      Setting c{std::string(which == kHeel ? "heels" : "MT heads") + " lost 0.2 s, rigid fill " + (fill ? "on" : "off"),
+                static_cast<double>(s.size()), [fill](EstimateOptions& o) { o.landmarks.rigid_fill = fill; }};
+      c.gap_landmark = which, c.gap_s = 0.2;
+      s.push_back(std::move(c));
+    }
+  return s;
+}
+
+/// marker_gaps_settings' gaps: `names` lost (NaN) within gap_s / 2 of the middle of each run of
+/// each plate's load above 20 N (read as cut_to_plates reads it) that lasts a stance's
+/// kMinStanceS at least.
+constexpr double kMinStanceS = 0.1;
+void lose_markers_at_plate_stances(MarkerTrajectories& m, const ForcePlateRecording& plates, const std::vector<std::string>& names,
+                                   double gap_s) {
+  for (const ForcePlate& p : plates.plates) {
+    const Eigen::Index n = std::min(plates.samples(), p.force_N.rows());
+    if (n == 0) continue;
+    Eigen::Index up = 0;
+    p.force_N.topRows(n).cwiseAbs().colwise().maxCoeff().maxCoeff(&up);
+    for (Eigen::Index k = 0; k < n;) {
+      if (!(std::abs(p.force_N(k, up)) > 20.0)) {
+        ++k;
+        continue;
+      }
+      Eigen::Index j = k;
+      while (j < n && std::abs(p.force_N(j, up)) > 20.0) ++j;
+      const double mid = 0.5 * (plates.time_s[k] + plates.time_s[j - 1]);
+      if (plates.time_s[j - 1] - plates.time_s[k] < kMinStanceS) {  // a noisy channel's crossing, not a stance
+        k = j;
+        continue;
+      }
+      for (const std::string& name : names) {
+        const int idx = m.find(name);
+        if (idx < 0) continue;
+        auto& P = m.positions_m[static_cast<std::size_t>(idx)];
+        for (Eigen::Index i = 0; i < P.rows(); ++i)
+          if (std::abs(m.time_s[i] - mid) < 0.5 * gap_s) P.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
+      }
+      k = j;
+    }
+  }
+}
+
 std::vector<Setting> torso_length_settings() {
   std::vector<Setting> s{{"fixed (the paper)", 0, [](EstimateOptions& o) { o.torso_length = TorsoLength::Fixed; }},
                          {"measured", 1, [](EstimateOptions& o) { o.torso_length = TorsoLength::Measured; }}};
@@ -263,6 +319,7 @@ const std::vector<StudyKind>& special_studies() {
       {"marker-rate", marker_rate_settings},
       {"marker-labels", marker_labels_settings},
       {"trial-cut", trial_cut_settings},
+      {"marker-gaps", marker_gaps_settings},
       {"torso-length", torso_length_settings},
       {"kinematic-edges", kinematic_edges_settings},
       {"foot-model", foot_model_settings},
@@ -338,13 +395,20 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
       ablated = parse_marker_set(*lm.mapping, t.name + " (its labels)");
     }
     const int factor = s.marker_rate_hz > 0 ? decimation_factor(d.trial->markers.rate_hz, s.marker_rate_hz) : 1;
-    const bool changed = s.marker_noise_m > 0 || factor > 1 || s.cut_margin_s >= 0;
+    const bool changed = s.marker_noise_m > 0 || factor > 1 || s.cut_margin_s >= 0 || s.gap_s > 0;
     for (int seed = 1; seed <= draws; ++seed) {
       // The trial as recorded, or a copy cut short or with the setting's noise or capture rate.
       Trial working;
       if (changed) {
         working = *d.trial;
         if (s.cut_margin_s >= 0) working.markers = cut_to_plates(working.markers, *d.plates, s.cut_margin_s);
+        if (s.gap_s > 0) {
+          const MarkerSet& set = ablated ? *ablated : *d.marker_set;
+          std::vector<std::string> names;
+          for (int side = 0; side < 2; ++side)
+            for (const std::string& name : set.rules[static_cast<std::size_t>(landmark(side, s.gap_landmark))].markers) names.push_back(name);
+          lose_markers_at_plate_stances(working.markers, *d.plates, names, s.gap_s);
+        }
         if (factor > 1) working.markers = decimated(std::move(working.markers), factor);
         if (s.marker_noise_m > 0) add_marker_noise(working.markers, s.marker_noise_m, static_cast<unsigned>(seed));
       }

@@ -100,7 +100,11 @@ void add_settings_options(CLI::App* c, Settings& a) {
       ->capture_default_str();
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
   c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length, no torso or thigh lag, no vertical smoothing of the torso, the kinematics filtered with the odd reflection at the window's ends");
-  c->add_option("--max-gap", a.max_gap, "Longest marker gap filled, frames")->capture_default_str();
+  c->add_option("--max-gap", a.max_gap, "Longest landmark gap filled by cubic interpolation, frames")->capture_default_str();
+  add_choice(c, "--rigid-fill", a.rigid_fill,
+             "A marker's longer gap inside the trial: on (filled from three markers that move rigidly with it, where the "
+             "trial has them; the message names them) or off (it ends the processed window)",
+             {"on", "off"});
   c->add_option("--frames", a.frames,
                 "Process only the file's frames FIRST:LAST (its own frame numbers, inclusive; FIRST: or :LAST leave an end "
                 "open), as if the trial were cut there");
@@ -169,6 +173,7 @@ EstimateOptions to_options(const Settings& a) {
   o.torso_length = (a.paper || a.torso_length == "fixed") ? TorsoLength::Fixed : TorsoLength::Measured;
   o.kinematic_edges = (a.paper || a.kinematic_edges == "odd") ? FilterEdge::OddReflection : FilterEdge::Curvature;
   o.landmarks.max_gap_frames = a.max_gap;
+  o.landmarks.rigid_fill = a.rigid_fill == "on";
   o.landmarks.up_axis = parse_axis(a.up_axis);
   EstimateOptions given = a.numeric;
   for (const NumericOption& s : numeric_options()) s.field(o) = (a.paper && s.paper) ? *s.paper : s.field(given);
@@ -209,6 +214,7 @@ nlohmann::json settings_json(const Settings& a, const EstimateOptions& o) {
           {"ground_level_m", o.ground_level_m ? nlohmann::json(*o.ground_level_m) : nlohmann::json("auto")},
           {"grm_reference_m", {o.grm_reference_m.x(), o.grm_reference_m.y()}},
           {"max_gap_frames", o.landmarks.max_gap_frames},
+          {"rigid_fill", o.landmarks.rigid_fill ? "on" : "off"},
           {"frames", a.frames.empty() ? nlohmann::json("all") : nlohmann::json(a.frames)}};
   EstimateOptions used = o;
   for (const NumericOption& s : numeric_options()) j[s.json_key] = s.field(used);

@@ -143,6 +143,9 @@ std::optional<MarkerSet> choose_repeated_markers(const MarkerSet& set, const Mar
 
 struct LandmarkOptions {
   int max_gap_frames = 10;
+  /// Longer gaps inside a marker's trajectory filled from the markers that move rigidly with it
+  /// (fill_marker_gaps_rigidly); false: they end the processed window.
+  bool rigid_fill = true;
   std::optional<Axis> up_axis;      ///< default: the file's
   std::optional<int> progression_sign;  ///< +1/-1 along the detected axis; default: detected
   std::optional<Axis> progression_axis;
@@ -217,6 +220,33 @@ std::optional<MarkerTrajectories> without_marker_outliers(const MarkerTrajectori
 /// samples turned into gaps.
 std::size_t remove_marker_outliers(MarkerTrajectories& markers, const std::vector<std::string>& only,
                                    std::vector<std::string>& messages);
+
+/// A marker's gap longer than the landmarks' cubic fill reaches (LandmarkOptions::max_gap_frames),
+/// inside its trajectory (seen on the frames just before and just after it), filled from three
+/// markers that move rigidly with it: a skin or cluster marker occluded for a few tenths of a
+/// second (a heel marker hidden by the other foot at a plate, a pelvis marker by the arm) would
+/// otherwise end the processed window there, and half a trial's stances with it. The markers
+/// seen on every frame from the one before the gap to the one after it whose distance to the
+/// marker varies least over the trial (SD over the frames both are seen, at least
+/// kMinRigidFrames) and by at most kMaxRigidPartnerSdM (markers on one segment: skin moves
+/// against bone by a few mm; a marker across a joint moves by centimetres) are its partners, the
+/// first three by that SD that span a triangle (each of its heights at least
+/// kMinRigidPartnerSpanM, so that their rotation is defined). At each frame of the gap the
+/// partners' rigid motion from the frame before the gap (least squares, as a cluster's pose)
+/// carries the marker's position there, and likewise from the frame after; the two are blended
+/// linearly in time, so that the fill meets the data at both ends (Nexus's "rigid body fill"
+/// does the same from one side). A gap at the trial's start or end (no data on one side: the
+/// subject entering or leaving the volume) is not filled, nor a gap whose partners are not
+/// found; their message says so only by the processed window's. `only`: the markers to fill (a
+/// set's motion_markers()); partners may be any of the trial's markers. Each fill is named in
+/// `messages` with its partners. Returns the number of gaps filled.
+inline constexpr double kMaxRigidPartnerSdM = 0.008, kMinRigidPartnerSpanM = 0.02;
+inline constexpr Eigen::Index kMinRigidFrames = 20;
+std::size_t fill_marker_gaps_rigidly(MarkerTrajectories& markers, const std::vector<std::string>& only, int longer_than_frames,
+                                     std::vector<std::string>& messages);
+/// Whether fill_marker_gaps_rigidly has a gap to look at (one of `only`'s interior gaps is longer
+/// than `longer_than_frames`), so that a caller copies the markers only then.
+bool has_long_marker_gap(const MarkerTrajectories& markers, const std::vector<std::string>& only, int longer_than_frames);
 
 /// `release`: `motion` itself, when the caller has no further use for its samples: each
 /// marker's samples are released (left 0 x 3) after the last landmark that reads them, and those

@@ -32,6 +32,8 @@ struct Settings {
               kinematic_cutoff_rule = "noise";
   /// --kinematic-edges: odd or curvature (EstimateOptions::kinematic_edges)
   std::string kinematic_edges = filter_edge_name(EstimateOptions{}.kinematic_edges);
+  /// --rigid-fill: on or off (LandmarkOptions::rigid_fill)
+  std::string rigid_fill = "on";
   double r = SolverOptions{}.r_N_per_m, kinematic_cutoff = EstimateOptions{}.kinematic_cutoff_hz,
          post_cutoff_cycles = EstimateOptions{}.post_cutoff_cycles, speed_gate = SpeedGateRule{}.fixed_mps;
   /// The numeric settings that are one option field each (option_table.hpp's rows: flag, range,
