@@ -229,8 +229,8 @@ MarkerTrajectories cut_to_plates(const MarkerTrajectories& m, const ForcePlateRe
 /// Robustness to markers lost for a while (occluded by the other foot over a plate, a marker
 /// fallen off): the heel markers, then the MT markers, of both feet lost for 0.2 s at the middle
 /// of every plate's loaded run, with the rigid fill off (the gap ends the processed window, as
-/// before session 37) and on (LandmarkOptions::rigid_fill). A trial whose window is left with no
-/// plate stance fails that row.
+/// before session 37) and on (LandmarkOptions::rigid_fill). A trial whose window keeps no plate
+/// stance counts none in that row (the row's stance count says how many were kept).
 std::vector<Setting> marker_gaps_settings() {
   std::vector<Setting> s{{"as recorded", 0, [](EstimateOptions&) {}, 0.0, true}};
   for (const LegLandmark which : {kHeel, kMt})

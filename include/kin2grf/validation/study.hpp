@@ -12,6 +12,8 @@
 //                 against the fixed 1.5 m/s
 //   noise         0-3 mm of Gaussian noise on every marker coordinate, 8 seeded draws per level
 //                 pooled (robustness)
+//   marker-gaps   the heel or the MT markers lost for 0.2 s at every plate stance, the rigid fill
+//                 off and on (robustness to occlusions)
 //   split-distance  kin2grf's side-by-side feet distance, off .. 0.2 m (not in the paper)
 //   torso-length  the torso's hip-shoulder length fixed (the paper) or measured per frame
 //   kinematic-edges  the kinematics' filter past the window's ends: the odd reflection (the ends'
