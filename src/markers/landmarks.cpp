@@ -529,7 +529,8 @@ std::optional<Eigen::MatrixX3d> rigid_fill(const MarkerTrajectories& m, const In
   std::vector<std::pair<double, std::size_t>> candidates;
   for (std::size_t k = 0; k < m.positions_m.size(); ++k) {
     const Eigen::MatrixX3d& P = m.positions_m[k];
-    if (k == g.marker || P.rows() != T.rows()) continue;
+    // An unlabelled trajectory (Vicon's "*12") is not known to be one marker throughout.
+    if (k == g.marker || P.rows() != T.rows() || m.names[k].starts_with('*')) continue;
     bool seen = true;
     for (Eigen::Index i = before; i <= g.end && seen; ++i) seen = P.row(i).allFinite();
     if (!seen) continue;
@@ -537,15 +538,29 @@ std::optional<Eigen::MatrixX3d> rigid_fill(const MarkerTrajectories& m, const In
     if (sd <= kMaxRigidPartnerSdM) candidates.emplace_back(sd, k);
   }
   std::sort(candidates.begin(), candidates.end());
-  // The first three (by SD) that span a triangle at the frame before the gap.
+  // The first three (by SD) that move rigidly with each other too and span a triangle at the
+  // frame before the gap. A marker on a joint's axis (a knee marker) keeps its distance to both
+  // segments' markers: its partners must be one body, not two.
+  const std::size_t nc = std::min<std::size_t>(candidates.size(), kMaxRigidCandidates);
+  Eigen::MatrixXd pair_sd = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nc), static_cast<Eigen::Index>(nc));
+  for (std::size_t a = 0; a < nc; ++a)
+    for (std::size_t b = a + 1; b < nc; ++b)
+      pair_sd(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) =
+          distance_sd(m.positions_m[candidates[a].second], m.positions_m[candidates[b].second]);
+  const auto rigid = [&](std::size_t a, std::size_t b) { return pair_sd(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) <= kMaxRigidPartnerSdM; };
   const auto at = [&](std::size_t c) { return m.positions_m[candidates[c].second].row(before).transpose().eval(); };
   std::array<std::size_t, 3> pick{};
   bool found = false;
-  const std::size_t nc = candidates.size();
-  for (std::size_t a = 0; a < nc && !found; ++a)
-    for (std::size_t b = a + 1; b < nc && !found; ++b)
-      for (std::size_t c = b + 1; c < nc && !found; ++c)
-        if (spans_triangle(at(a), at(b), at(c), kMinRigidPartnerSpanM)) pick = {a, b, c}, found = true;
+  double least = std::numeric_limits<double>::infinity();  // the triple's largest SD of its six distances
+  for (std::size_t a = 0; a < nc; ++a)
+    for (std::size_t b = a + 1; b < nc; ++b)
+      for (std::size_t c = b + 1; c < nc; ++c) {
+        if (!(rigid(a, b) && rigid(a, c) && rigid(b, c)) || !spans_triangle(at(a), at(b), at(c), kMinRigidPartnerSpanM)) continue;
+        const double worst = std::max({candidates[c].first, pair_sd(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)),
+                                       pair_sd(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(c)),
+                                       pair_sd(static_cast<Eigen::Index>(b), static_cast<Eigen::Index>(c))});
+        if (worst < least) least = worst, pick = {a, b, c}, found = true;
+      }
   if (!found) return std::nullopt;
   std::vector<Eigen::MatrixX3d> cluster;
   for (const std::size_t c : pick) cluster.push_back(m.positions_m[candidates[c].second].middleRows(before, len));

@@ -230,8 +230,14 @@ std::size_t remove_marker_outliers(MarkerTrajectories& markers, const std::vecto
 /// marker varies least over the trial (SD over the frames both are seen, at least
 /// kMinRigidFrames) and by at most kMaxRigidPartnerSdM (markers on one segment: skin moves
 /// against bone by a few mm; a marker across a joint moves by centimetres) are its partners, the
-/// first three by that SD that span a triangle (each of its heights at least
-/// kMinRigidPartnerSpanM, so that their rotation is defined). At each frame of the gap the
+/// first three by that SD that also keep their distances to each other within it (one body: a
+/// marker on a joint's axis keeps its distance to both segments' markers) and span a triangle
+/// (each of its heights at least kMinRigidPartnerSpanM: a narrow triangle's rotation about its
+/// long side is its markers' few mm of noise and skin motion over its height, and a marker 8 cm
+/// off that side moves by as much times 8 cm over the height; at 2 cm subject01's medial toe
+/// marker, filled from the lateral border's heel, midfoot and toe, was 96 mm off). Among such
+/// triples, the one whose largest SD of its six distances is least: the most rigid body.
+/// Unlabelled trajectories (Vicon's "*12") are no partners: they are not known to be one marker. At each frame of the gap the
 /// partners' rigid motion from the frame before the gap (least squares, as a cluster's pose)
 /// carries the marker's position there, and likewise from the frame after; the two are blended
 /// linearly in time, so that the fill meets the data at both ends (Nexus's "rigid body fill"
@@ -240,8 +246,10 @@ std::size_t remove_marker_outliers(MarkerTrajectories& markers, const std::vecto
 /// found; their message says so only by the processed window's. `only`: the markers to fill (a
 /// set's motion_markers()); partners may be any of the trial's markers. Each fill is named in
 /// `messages` with its partners. Returns the number of gaps filled.
-inline constexpr double kMaxRigidPartnerSdM = 0.008, kMinRigidPartnerSpanM = 0.02;
+inline constexpr double kMaxRigidPartnerSdM = 0.008, kMinRigidPartnerSpanM = 0.03;
 inline constexpr Eigen::Index kMinRigidFrames = 20;
+/// The candidates (by that SD) a partner triple is sought among.
+inline constexpr std::size_t kMaxRigidCandidates = 12;
 std::size_t fill_marker_gaps_rigidly(MarkerTrajectories& markers, const std::vector<std::string>& only, int longer_than_frames,
                                      std::vector<std::string>& messages);
 /// Whether fill_marker_gaps_rigidly has a gap to look at (one of `only`'s interior gaps is longer
