@@ -538,9 +538,10 @@ std::optional<Eigen::MatrixX3d> rigid_fill(const MarkerTrajectories& m, const In
     if (sd <= kMaxRigidPartnerSdM) candidates.emplace_back(sd, k);
   }
   std::sort(candidates.begin(), candidates.end());
-  // The first three (by SD) that move rigidly with each other too and span a triangle at the
-  // frame before the gap. A marker on a joint's axis (a knee marker) keeps its distance to both
-  // segments' markers: its partners must be one body, not two.
+  // Of the candidates nearest rigid with it, the triple that moves rigidly with each other too and
+  // spans a triangle at the frame before the gap, the most rigid such (least largest SD of its six
+  // distances). A marker on a joint's axis (a knee marker) keeps its distance to both segments'
+  // markers: its partners must be one body, not two.
   const std::size_t nc = std::min<std::size_t>(candidates.size(), kMaxRigidCandidates);
   Eigen::MatrixXd pair_sd = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nc), static_cast<Eigen::Index>(nc));
   for (std::size_t a = 0; a < nc; ++a)
