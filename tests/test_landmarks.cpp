@@ -865,3 +865,23 @@ TEST(Landmarks, AGapWithoutThreeRigidPartnersIsLeft) {
   EXPECT_FALSE(m.positions_m[0].middleRows(80, 40).allFinite());
   EXPECT_TRUE(m.positions_m[3].middleRows(0, 70).isApprox(before.positions_m[3].middleRows(0, 70)));
 }
+
+// Several gaps in one call (a long trial's occlusions, the markers' distances measured once for
+// all of them) are filled as each would be alone, whichever marker they belong to.
+TEST(Landmarks, ManyGapsAreFilledAsEachAlone) {
+  const MarkerTrajectories truth = rigid_body_walk();
+  MarkerTrajectories all = truth;
+  const std::vector<std::pair<std::size_t, Eigen::Index>> gaps{{0, 30}, {0, 90}, {1, 60}, {3, 140}};
+  for (const auto& [k, first] : gaps) all.positions_m[k].middleRows(first, 15).setConstant(std::numeric_limits<double>::quiet_NaN());
+  const MarkerTrajectories given = all;
+  std::vector<std::string> messages;
+  ASSERT_EQ(fill_marker_gaps_rigidly(all, {}, 10, messages), gaps.size());
+  for (const auto& [k, first] : gaps) {
+    MarkerTrajectories one = given;
+    std::vector<std::string> none;
+    // The other gaps left as they are, this one alone asked for: the same partners, the same fill.
+    fill_marker_gaps_rigidly(one, {truth.names[k]}, 10, none);
+    EXPECT_TRUE(one.positions_m[k].middleRows(first, 15).isApprox(all.positions_m[k].middleRows(first, 15), 1e-12)) << truth.names[k];
+    EXPECT_LT((all.positions_m[k].middleRows(first, 15) - truth.positions_m[k].middleRows(first, 15)).cwiseAbs().maxCoeff(), 1e-9);
+  }
+}

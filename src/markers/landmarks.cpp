@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 #include <optional>
 #include <set>
 #include <stdexcept>
@@ -522,8 +523,26 @@ bool spans_triangle(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const 
   return longest > 0 && twice_area / longest >= span;
 }
 
+/// distance_sd of markers i and j of `m`, each pair computed once per call of
+/// fill_marker_gaps_rigidly (a long trial's many gaps of one marker ask for the same pairs; the
+/// markers do not change until every fill is made).
+class DistanceSds {
+ public:
+  explicit DistanceSds(const MarkerTrajectories& m) : m_(m) {}
+  double operator()(std::size_t i, std::size_t j) {
+    const auto key = std::minmax(i, j);
+    const auto [it, added] = sd_.try_emplace(key, 0.0);
+    if (added) it->second = distance_sd(m_.positions_m[key.first], m_.positions_m[key.second]);
+    return it->second;
+  }
+
+ private:
+  const MarkerTrajectories& m_;
+  std::map<std::pair<std::size_t, std::size_t>, double> sd_;
+};
+
 /// One gap's fill (its frames, N x 3) from its partners, or nothing when they are not found.
-std::optional<Eigen::MatrixX3d> rigid_fill(const MarkerTrajectories& m, const InteriorGap& g, std::string& message) {
+std::optional<Eigen::MatrixX3d> rigid_fill(const MarkerTrajectories& m, const InteriorGap& g, DistanceSds& sds, std::string& message) {
   const Eigen::Index before = g.first - 1, len = g.end - before + 1;  // the gap and a seen frame at each end
   const Eigen::MatrixX3d& T = m.positions_m[g.marker];
   std::vector<std::pair<double, std::size_t>> candidates;
@@ -534,7 +553,7 @@ std::optional<Eigen::MatrixX3d> rigid_fill(const MarkerTrajectories& m, const In
     bool seen = true;
     for (Eigen::Index i = before; i <= g.end && seen; ++i) seen = P.row(i).allFinite();
     if (!seen) continue;
-    const double sd = distance_sd(T, P);
+    const double sd = sds(g.marker, k);
     if (sd <= kMaxRigidPartnerSdM) candidates.emplace_back(sd, k);
   }
   std::sort(candidates.begin(), candidates.end());
@@ -546,8 +565,7 @@ std::optional<Eigen::MatrixX3d> rigid_fill(const MarkerTrajectories& m, const In
   Eigen::MatrixXd pair_sd = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nc), static_cast<Eigen::Index>(nc));
   for (std::size_t a = 0; a < nc; ++a)
     for (std::size_t b = a + 1; b < nc; ++b)
-      pair_sd(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) =
-          distance_sd(m.positions_m[candidates[a].second], m.positions_m[candidates[b].second]);
+      pair_sd(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = sds(candidates[a].second, candidates[b].second);
   const auto rigid = [&](std::size_t a, std::size_t b) { return pair_sd(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) <= kMaxRigidPartnerSdM; };
   const auto at = [&](std::size_t c) { return m.positions_m[candidates[c].second].row(before).transpose().eval(); };
   std::array<std::size_t, 3> pick{};
@@ -596,9 +614,10 @@ std::size_t fill_marker_gaps_rigidly(MarkerTrajectories& m, const std::vector<st
   // Every fill is made from the markers as given, then written: a marker filled here is no
   // partner for another's gap, and the order of the markers does not matter.
   std::vector<std::pair<InteriorGap, Eigen::MatrixX3d>> fills;
+  DistanceSds sds(m);
   for (const InteriorGap& g : long_interior_gaps(m, only, longer_than_frames)) {
     std::string message;
-    std::optional<Eigen::MatrixX3d> fill = rigid_fill(m, g, message);
+    std::optional<Eigen::MatrixX3d> fill = rigid_fill(m, g, sds, message);
     if (!fill) continue;
     messages.push_back(std::move(message));
     fills.emplace_back(g, std::move(*fill));
