@@ -29,9 +29,11 @@
 //   {"virtual_hallux": 0.30}                  hallux fallback: a toes segment of that fraction of
 //       the ankle-MT length, straight along the foot in swing, held at the MT head's foot-flat
 //       height while the heel rises (the toes stay on the ground at push-off).
-// Gaps of up to max_gap_frames are filled by cubic (Catmull-Rom) interpolation between the
-// neighbouring valid samples; longer gaps end the processed window (the longest run of frames
-// where every landmark is defined), with a message naming the marker and frames.
+// A marker's longer gap inside the trial is first filled from three markers that move rigidly
+// with it (fill_marker_gaps_rigidly, below). Gaps of up to max_gap_frames are filled by cubic
+// (Catmull-Rom) interpolation between the neighbouring valid samples; longer gaps left end the
+// processed window (the longest run of frames where every landmark is defined), with a message
+// naming the marker and frames.
 #pragma once
 
 #include <Eigen/Dense>
@@ -225,30 +227,29 @@ std::size_t remove_marker_outliers(MarkerTrajectories& markers, const std::vecto
 /// inside its trajectory (seen on the frames just before and just after it), filled from three
 /// markers that move rigidly with it: a skin or cluster marker occluded for a few tenths of a
 /// second (a heel marker hidden by the other foot at a plate, a pelvis marker by the arm) would
-/// otherwise end the processed window there, and half a trial's stances with it. The markers
-/// seen on every frame from the one before the gap to the one after it whose distance to the
-/// marker varies least over the trial (SD over the frames both are seen, at least
-/// kMinRigidFrames) and by at most kMaxRigidPartnerSdM (markers on one segment: skin moves
-/// against bone by a few mm; a marker across a joint moves by centimetres) are its partners, the
-/// first three by that SD that also keep their distances to each other within it (one body: a
-/// marker on a joint's axis keeps its distance to both segments' markers) and span a triangle
-/// (each of its heights at least kMinRigidPartnerSpanM: a narrow triangle's rotation about its
-/// long side is its markers' few mm of noise and skin motion over its height, and a marker 8 cm
-/// off that side moves by as much times 8 cm over the height; at 2 cm subject01's medial toe
-/// marker, filled from the lateral border's heel, midfoot and toe, was 96 mm off). Among such
-/// triples, the one whose largest SD of its six distances is least: the most rigid body.
-/// Unlabelled trajectories (Vicon's "*12") are no partners: they are not known to be one marker. At each frame of the gap the
-/// partners' rigid motion from the frame before the gap (least squares, as a cluster's pose)
-/// carries the marker's position there, and likewise from the frame after; the two are blended
-/// linearly in time, so that the fill meets the data at both ends (Nexus's "rigid body fill"
-/// does the same from one side). A gap at the trial's start or end (no data on one side: the
-/// subject entering or leaving the volume) is not filled, nor a gap whose partners are not
-/// found; their message says so only by the processed window's. `only`: the markers to fill (a
-/// set's motion_markers()); partners may be any of the trial's markers. Each fill is named in
-/// `messages` with its partners. Returns the number of gaps filled.
+/// otherwise end the processed window there, and half a trial's stances with it.
+/// Candidates: the labelled markers seen on every frame from the one before the gap to the one
+/// after it whose distance to the marker varies by at most kMaxRigidPartnerSdM (SD over the
+/// frames both are seen, at least kMinRigidFrames; markers on one segment move against each other
+/// by the skin's few mm, across a joint by centimetres), the kMaxRigidCandidates least varying.
+/// Unlabelled trajectories (Vicon's "*12") are none: they are not known to be one marker.
+/// Partners: of the candidate triples that keep their distances to each other within the same SD
+/// (one body: a marker on a joint's axis keeps its distance to both segments' markers) and span a
+/// triangle at the frame before the gap whose every height is at least kMinRigidPartnerSpanM (a
+/// narrow triangle's rotation about its long side is its markers' few mm of noise and skin motion
+/// over its height, and a marker 8 cm off that side moves by as much times 8 cm over the height:
+/// at 2 cm subject01's medial toe marker, filled from the lateral border's heel, midfoot and toe,
+/// was 96 mm off), the one whose largest SD of its six distances is least: the most rigid body.
+/// Fill: at each frame of the gap, the partners' rigid motion from the frame before the gap
+/// (least squares, as a cluster's pose) carries the marker's position there, and likewise from
+/// the frame after; the two are blended linearly in time, so that the fill meets the data at both
+/// ends. A gap at the trial's start or end (no data on one side: the subject entering or leaving
+/// the volume) is not filled, nor a gap whose partners are not found: the processed window then
+/// ends there, and its message names the frames. `only`: the markers to fill (a set's
+/// motion_markers()). Each fill is named in `messages` with its partners. Returns the number of
+/// gaps filled.
 inline constexpr double kMaxRigidPartnerSdM = 0.008, kMinRigidPartnerSpanM = 0.03;
 inline constexpr Eigen::Index kMinRigidFrames = 20;
-/// The candidates (by that SD) a partner triple is sought among.
 inline constexpr std::size_t kMaxRigidCandidates = 12;
 std::size_t fill_marker_gaps_rigidly(MarkerTrajectories& markers, const std::vector<std::string>& only, int longer_than_frames,
                                      std::vector<std::string>& messages);
