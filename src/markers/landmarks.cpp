@@ -562,25 +562,19 @@ std::optional<Eigen::MatrixX3d> rigid_fill(const MarkerTrajectories& m, const In
   // distances). A marker on a joint's axis (a knee marker) keeps its distance to both segments'
   // markers: its partners must be one body, not two.
   const std::size_t nc = std::min<std::size_t>(candidates.size(), kMaxRigidCandidates);
-  Eigen::MatrixXd pair_sd = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nc), static_cast<Eigen::Index>(nc));
-  for (std::size_t a = 0; a < nc; ++a)
-    for (std::size_t b = a + 1; b < nc; ++b)
-      pair_sd(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = sds(candidates[a].second, candidates[b].second);
-  const auto rigid = [&](std::size_t a, std::size_t b) { return pair_sd(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) <= kMaxRigidPartnerSdM; };
+  const auto pair_sd = [&](std::size_t a, std::size_t b) { return sds(candidates[a].second, candidates[b].second); };
   const auto at = [&](std::size_t c) { return m.positions_m[candidates[c].second].row(before).transpose().eval(); };
   std::array<std::size_t, 3> pick{};
-  bool found = false;
   double least = std::numeric_limits<double>::infinity();  // the triple's largest SD of its six distances
   for (std::size_t a = 0; a < nc; ++a)
     for (std::size_t b = a + 1; b < nc; ++b)
       for (std::size_t c = b + 1; c < nc; ++c) {
-        if (!(rigid(a, b) && rigid(a, c) && rigid(b, c)) || !spans_triangle(at(a), at(b), at(c), kMinRigidPartnerSpanM)) continue;
-        const double worst = std::max({candidates[c].first, pair_sd(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)),
-                                       pair_sd(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(c)),
-                                       pair_sd(static_cast<Eigen::Index>(b), static_cast<Eigen::Index>(c))});
-        if (worst < least) least = worst, pick = {a, b, c}, found = true;
+        // candidates[c] is the least rigid with the marker of the three (sorted by that SD).
+        const double worst = std::max({candidates[c].first, pair_sd(a, b), pair_sd(a, c), pair_sd(b, c)});
+        if (worst <= kMaxRigidPartnerSdM && worst < least && spans_triangle(at(a), at(b), at(c), kMinRigidPartnerSpanM))
+          least = worst, pick = {a, b, c};
       }
-  if (!found) return std::nullopt;
+  if (!std::isfinite(least)) return std::nullopt;
   std::vector<Eigen::MatrixX3d> cluster;
   for (const std::size_t c : pick) cluster.push_back(m.positions_m[candidates[c].second].middleRows(before, len));
   std::vector<Eigen::Vector3d> from_before, from_after;

@@ -13,6 +13,7 @@
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/marker_labels.hpp"
 #include "kin2grf/io/marker_presets.hpp"
+#include "kin2grf/numeric.hpp"
 #include "kin2grf/option_table.hpp"
 
 namespace kin2grf {
@@ -204,20 +205,28 @@ std::vector<Setting> trial_cut_settings() {
   return condition_settings(-1.0, {1.0, 0.5, 0.3, 0.2}, "plates' span +-%.1f s", [](Setting& c, double m) { c.cut_margin_s = m; });
 }
 
-/// The trial_cut_settings crop: the marker rows within `margin_s` of the plates' loaded span, each
-/// plate's load read on its axis of largest force (the vertical: a body weight against shear forces
-/// of a fifth of it; the axis is not the file's to say, a GRF .mot is Y up, a C3D mostly Z up, and
-/// a drifting shear channel must not count as load).
-MarkerTrajectories cut_to_plates(const MarkerTrajectories& m, const ForcePlateRecording& plates, double margin_s) {
-  double t0 = std::numeric_limits<double>::infinity(), t1 = -t0;
+/// Each plate's runs of load (first and last sample's times, s), its load read on its axis of
+/// largest force (the vertical: a body weight against shear forces of a fifth of it; the axis is
+/// not the file's to say, a GRF .mot is Y up, a C3D mostly Z up, and a drifting shear channel must
+/// not count as load) above 20 N. The plate studies' reading of where the plates are loaded.
+std::vector<std::pair<double, double>> plate_loaded_runs_s(const ForcePlateRecording& plates) {
+  std::vector<std::pair<double, double>> out;
   for (const ForcePlate& p : plates.plates) {
     const Eigen::Index n = std::min(plates.samples(), p.force_N.rows());
     if (n == 0) continue;
     Eigen::Index up = 0;
     p.force_N.topRows(n).cwiseAbs().colwise().maxCoeff().maxCoeff(&up);
-    for (Eigen::Index k = 0; k < n; ++k)
-      if (std::abs(p.force_N(k, up)) > 20.0) t0 = std::min(t0, plates.time_s[k]), t1 = std::max(t1, plates.time_s[k]);
+    for (const IndexRun& r : runs_where(n, [&](Eigen::Index k) { return std::abs(p.force_N(k, up)) > 20.0; }))
+      out.emplace_back(plates.time_s[r.first], plates.time_s[r.last]);
   }
+  return out;
+}
+
+/// The trial_cut_settings crop: the marker rows within `margin_s` of the plates' loaded span
+/// (plate_loaded_runs_s).
+MarkerTrajectories cut_to_plates(const MarkerTrajectories& m, const ForcePlateRecording& plates, double margin_s) {
+  double t0 = std::numeric_limits<double>::infinity(), t1 = -t0;
+  for (const auto& [first, last] : plate_loaded_runs_s(plates)) t0 = std::min(t0, first), t1 = std::max(t1, last);
   Eigen::Index a = 0, b = m.frames() - 1;
   if (std::isfinite(t0)) {
     while (a < b && m.time_s[a] < t0 - margin_s) ++a;
@@ -243,37 +252,21 @@ std::vector<Setting> marker_gaps_settings() {
   return s;
 }
 
-/// marker_gaps_settings' gaps: `names` lost (NaN) within gap_s / 2 of the middle of each run of
-/// each plate's load above 20 N (read as cut_to_plates reads it) that lasts a stance's
-/// kMinStanceS at least.
+/// marker_gaps_settings' gaps: `names` lost (NaN) within gap_s / 2 of the middle of each of the
+/// plates' loaded runs (plate_loaded_runs_s) that lasts a stance's kMinStanceS at least (shorter:
+/// a noisy channel's crossings, not a stance).
 constexpr double kMinStanceS = 0.1;
 void lose_markers_at_plate_stances(MarkerTrajectories& m, const ForcePlateRecording& plates, const std::vector<std::string>& names,
                                    double gap_s) {
-  for (const ForcePlate& p : plates.plates) {
-    const Eigen::Index n = std::min(plates.samples(), p.force_N.rows());
-    if (n == 0) continue;
-    Eigen::Index up = 0;
-    p.force_N.topRows(n).cwiseAbs().colwise().maxCoeff().maxCoeff(&up);
-    for (Eigen::Index k = 0; k < n;) {
-      if (!(std::abs(p.force_N(k, up)) > 20.0)) {
-        ++k;
-        continue;
-      }
-      Eigen::Index j = k;
-      while (j < n && std::abs(p.force_N(j, up)) > 20.0) ++j;
-      const double mid = 0.5 * (plates.time_s[k] + plates.time_s[j - 1]);
-      if (plates.time_s[j - 1] - plates.time_s[k] < kMinStanceS) {  // a noisy channel's crossing, not a stance
-        k = j;
-        continue;
-      }
-      for (const std::string& name : names) {
-        const int idx = m.find(name);
-        if (idx < 0) continue;
-        auto& P = m.positions_m[static_cast<std::size_t>(idx)];
-        for (Eigen::Index i = 0; i < P.rows(); ++i)
-          if (std::abs(m.time_s[i] - mid) < 0.5 * gap_s) P.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
-      }
-      k = j;
+  for (const auto& [first, last] : plate_loaded_runs_s(plates)) {
+    if (last - first < kMinStanceS) continue;
+    const double mid = 0.5 * (first + last);
+    for (const std::string& name : names) {
+      const int idx = m.find(name);
+      if (idx < 0) continue;
+      auto& P = m.positions_m[static_cast<std::size_t>(idx)];
+      for (Eigen::Index i = 0; i < P.rows(); ++i)
+        if (std::abs(m.time_s[i] - mid) < 0.5 * gap_s) P.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
     }
   }
 }
