@@ -15,39 +15,44 @@ namespace {
 /// The vocabulary: spellings (lower case, separators removed) of each landmark in the marker sets
 /// gait labs use: Plug-in Gait and Helen Hayes (RKNE, RANK, RHEE, RTOE, RMED), ISB and CAST
 /// (LE/ME or FLE/FME, LM/MM or FAL/TAM, FCC or CA, FM1/FM5, IAS/IPS), OpenSim's and OpenCap's
-/// (R.Knee.Lat, r_mknee, r_5meta, r_calc), Visual3D's (RLKN, RMKN) and spelt-out ones.
+/// (R.Knee.Lat, r_mknee, r_5meta, r_calc), Visual3D's (RLKN, RMKN) and spelt-out ones; and those of
+/// the sets sports and treadmill labs use: Qualisys's and OptiTrack Motive's animation sets
+/// (WaistLFront, LKneeOut, LAnkleOut, LHeelBack, LForefootIn/Out, LToeIn/Out, LToeTip,
+/// LShoulderTop), Vicon's production set (LFWT, LBWT), the conventional gait model 2.4's
+/// forefoot (LFMH, LSMH, LVMH), the Oxford foot model's (LD1M, LD5M, LHLX), Motek's Human Body
+/// Model for GRAIL and CAREN treadmills (LLEK, LLM, LMT5, LLEE, LLW) and the RRIS40 set (RFMT1).
 struct Word {
   const char* key;
   std::vector<const char*> spellings;
 };
 const std::vector<Word>& vocabulary() {
   static const std::vector<Word> v = {
-      {"asis", {"asi", "asis", "ias", "antsupiliacspine", "anteriorsuperioriliacspine"}},
-      {"psis", {"psi", "psis", "ips", "postsupiliacspine", "posteriorsuperioriliacspine"}},
+      {"asis", {"asi", "asis", "ias", "antsupiliacspine", "anteriorsuperioriliacspine", "waistfront", "fwt"}},
+      {"psis", {"psi", "psis", "ips", "postsupiliacspine", "posteriorsuperioriliacspine", "waistback", "bwt"}},
       {"sacrum", {"sacr", "sacrum", "sac", "sacral", "vsacral"}},
       {"hjc", {"hjc", "hipjc", "hipjointcentre", "hipjointcenter", "hipcentre", "hipcenter"}},
       {"kjc", {"kjc", "kneejc", "kneejointcentre", "kneejointcenter", "kneecentre", "kneecenter"}},
       {"ajc", {"ajc", "anklejc", "anklejointcentre", "anklejointcenter", "anklecentre", "anklecenter"}},
       {"knee_lateral", {"kne", "knee", "kneelat", "kneelateral", "latknee", "lateralknee", "lkn", "le", "fle", "lfe", "lfc", "lep",
-                        "lepi", "latepi", "latepicondyle", "lateralepicondyle", "lfepi", "femlatepi"}},
+                        "lepi", "latepi", "latepicondyle", "lateralepicondyle", "lfepi", "femlatepi", "kneeout", "lek"}},
       {"knee_medial", {"knm", "kneemed", "kneemedial", "medknee", "medialknee", "mknee", "mkn", "me", "fme", "mfe", "mfc", "mep", "mepi",
-                       "medepi", "medepicondyle", "medialepicondyle", "mfepi", "femmedepi"}},
+                       "medepi", "medepicondyle", "medialepicondyle", "mfepi", "femmedepi", "kneein", "mek"}},
       {"ankle_lateral", {"ank", "ankle", "anklelat", "anklelateral", "latankle", "lateralankle", "lm", "lma", "lmal", "lmall", "latmal",
-                         "latmalleolus", "lateralmalleolus", "fal"}},
+                         "latmalleolus", "lateralmalleolus", "fal", "ankleout"}},
       {"ankle_medial", {"ankm", "ankmed", "anklemed", "anklemedial", "medankle", "medialankle", "mankle", "mm", "mma", "mmal", "mmall",
-                        "medmal", "medmalleolus", "medialmalleolus", "tam", "med"}},
-      {"heel", {"hee", "heel", "hel", "cal", "calc", "calcaneus", "fcc", "ca", "heelbottom", "heelback", "heelpost"}},
-      {"mt1", {"mt1", "mth1", "mh1", "fm1", "met1", "meta1", "1mt", "1meta", "1stmet", "mt1head", "toemed", "toemedial"}},
-      {"mt2", {"mt2", "mth2", "mh2", "fm2", "met2", "meta2", "2mt", "2meta", "2ndmet"}},
-      {"mt5", {"mt5", "mth5", "mh5", "fm5", "met5", "meta5", "5mt", "5meta", "5thmet", "mt5head", "toelat", "toelateral"}},
+                        "medmal", "medmalleolus", "medialmalleolus", "tam", "med", "anklein"}},
+      {"heel", {"hee", "heel", "hel", "cal", "calc", "calcaneus", "fcc", "ca", "heelbottom", "heelback", "heelpost", "phe"}},
+      {"mt1", {"mt1", "mth1", "mh1", "fm1", "met1", "meta1", "1mt", "1meta", "1stmet", "mt1head", "toemed", "toemedial", "fmt1", "fmh", "d1m", "1st", "forefootin", "forefoot1", "toein"}},
+      {"mt2", {"mt2", "mth2", "mh2", "fm2", "met2", "meta2", "2mt", "2meta", "2ndmet", "fmt2", "smh", "2nd", "forefoot2"}},
+      {"mt5", {"mt5", "mth5", "mh5", "fm5", "met5", "meta5", "5mt", "5meta", "5thmet", "mt5head", "toelat", "toelateral", "fmt5", "vmh", "d5m", "5th", "forefootout", "forefoot5", "toeout"}},
       {"toe", {"toe"}},
       {"hallux", {"hlx", "hallux", "hal", "toetip", "tiptoe", "bigtoe"}},
-      {"shoulder", {"sho", "shoulder", "acr", "acromion", "acromium", "ac", "sae"}},
+      {"shoulder", {"sho", "shoulder", "acr", "acromion", "acromium", "ac", "sae", "shouldertop"}},
       {"c7", {"c7", "cv7"}},
       {"clav", {"clav", "ij", "clavicle", "jugularnotch", "manubrium"}},
-      {"elbow", {"elb", "elbow", "elbowlat", "el", "lel", "lhe"}},
-      {"wrist", {"wra", "wrb", "wrist", "wri", "rs", "us", "rsp", "usp", "wristlat", "wristmed"}},
-      {"head", {"fhd", "bhd", "head", "hea", "headfront", "headback", "headtop", "tophead"}},
+      {"elbow", {"elb", "elbow", "elbowlat", "el", "lel", "hle", "elbowout", "lee"}},
+      {"wrist", {"wra", "wrb", "wrist", "wri", "rs", "us", "rsp", "usp", "wristlat", "wristmed", "wristout", "wristin", "lw", "mw"}},
+      {"head", {"fhd", "bhd", "head", "hea", "headfront", "headback", "headtop", "tophead", "headside"}},
   };
   return v;
 }
@@ -130,6 +135,9 @@ MarkerLabel read_marker_label(const std::string& label) {
     if (word.size() > p.size() + 1 && word.compare(0, p.size(), p) == 0)
       if (const std::string k = lookup(word.substr(p.size())); !k.empty() && !midline(k)) return {s, k};
   }
+  // The side inside the word: Qualisys's and OptiTrack's pelvis markers ("WaistLFront", "WaistRBack").
+  if (word.size() > 6 && word.compare(0, 5, "waist") == 0 && (word[5] == 'l' || word[5] == 'r'))
+    if (const std::string k = lookup("waist" + word.substr(6)); !k.empty()) return {word[5], k};
   // A known word with no side ("Heel" is not "Hee" on the left), then "ASISR", "KneeL": a side
   // letter last, on a word of three letters or more.
   if (const std::string k = lookup(word); !k.empty()) return {0, k};
