@@ -23,6 +23,8 @@
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/summary.hpp"
 #include "kin2grf/io/marker_presets.hpp"
+#include "kin2grf/workflow/batch.hpp"
+#include "kin2grf/workflow/settings.hpp"
 #include "test_support.hpp"
 
 using namespace kin2grf;
@@ -394,6 +396,69 @@ TEST(C3dQuirks, ForcePlatformGroupWithoutAnalogDataGivesNoPlatesAndANote) {
   EXPECT_EQ(back.markers.names.size(), 3u);
   ASSERT_FALSE(back.warnings.empty());
   EXPECT_NE(back.warnings.back().find("FORCE_PLATFORM:USED = 2"), std::string::npos) << back.warnings.back();
+}
+
+// A plate of a type kin2grf cannot compute (here TYPE 6, Kistler's 12 channels with a 12 x 12
+// calibration matrix) is left out with a warning that names the file, the plate and its type; the
+// markers and the lab's other plates are read as they are. Before, the whole file was refused, so
+// `estimate`, which needs no plate, could not run on it.
+TEST(C3dQuirks, APlateOfAnUnsupportedTypeIsLeftOutByNameAndTheOthersAreRead) {
+  Trial t = small_trial();
+  ForcePlate second = t.plates->plates[0];
+  second.name = "FP2";
+  for (auto& c : second.corners_m) c.x() += 0.6;
+  second.centre_m.x() += 0.6;
+  second.force_N *= 0.5;
+  t.plates->plates.push_back(second);
+  C3dWriteOptions o;
+  o.analog_samples_per_frame = 4;
+  auto bytes = write_c3d_bytes(t, o);
+  const Trial as_written = read_c3d_bytes(bytes, "lab.c3d");
+  ASSERT_TRUE(as_written.plates);
+  ASSERT_EQ(as_written.plates->plates.size(), 2u);
+  // FORCE_PLATFORM:TYPE: name, offset (2), type (1), ndims (1), dim (1), then one int16 a plate.
+  const std::string key = "TYPE";
+  std::size_t at = std::string::npos;
+  for (std::size_t i = 1; i + key.size() + 8 < bytes.size(); ++i)
+    if (bytes[i - 1] == 4 && std::equal(key.begin(), key.end(), bytes.begin() + static_cast<long>(i) + 1)) at = i;
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t first = at + 1 + key.size() + 2 + 1 + 1 + 1;
+  ASSERT_EQ(bytes[first], 2);
+  bytes[first] = 6;
+  ASSERT_EQ(read_c3d_header(bytes, "lab.c3d").find("FORCE_PLATFORM:TYPE")->numbers.at(0), 6.0);
+  const Trial back = read_c3d_bytes(bytes, "lab.c3d");
+  ASSERT_TRUE(back.plates);
+  ASSERT_EQ(back.plates->plates.size(), 1u);
+  EXPECT_EQ(back.plates->plates[0].name, "FP2");
+  EXPECT_TRUE(back.plates->plates[0].force_N.isApprox(as_written.plates->plates[1].force_N));
+  EXPECT_EQ(back.markers.names, as_written.markers.names);
+  bool said = false;
+  for (const auto& w : back.warnings)
+    said = said || (w.find("lab.c3d: FP1: FORCE_PLATFORM:TYPE[1] = 6 is not supported") != std::string::npos &&
+                    w.find("left out") != std::string::npos);
+  EXPECT_TRUE(said) << (back.warnings.empty() ? "no warning" : back.warnings.back());
+  // A file whose only plate is left out: `validate` says why it has none to validate against.
+  auto one = write_c3d_bytes(small_trial(), o);
+  for (std::size_t i = 1; i + key.size() + 8 < one.size(); ++i)
+    if (one[i - 1] == 4 && std::equal(key.begin(), key.end(), one.begin() + static_cast<long>(i) + 1)) at = i;
+  const std::size_t ndims = at + 1 + key.size() + 2 + 1;  // one plate: a scalar, no dimension
+  ASSERT_EQ(one[ndims + 1 + one[ndims]], 2);
+  one[ndims + 1 + one[ndims]] = 6;
+  const std::string path = (test::temp_dir("plate-type") / "type6.c3d").string();
+  {
+    std::ofstream f(path, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(one.data()), static_cast<std::streamsize>(one.size()));
+  }
+  Settings st;
+  st.trial = path;
+  try {
+    (void)validate_trial(st, "", ValidationOptions{}, "none");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("type6.c3d: no force plates to validate against"), std::string::npos) << what;
+    EXPECT_NE(what.find("TYPE[1] = 6 is not supported"), std::string::npos) << what;
+  }
 }
 
 // `estimate` reads the plates without their samples (C3dReadOptions::plate_samples = false):

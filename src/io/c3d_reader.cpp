@@ -576,11 +576,7 @@ PlateDescription plate_description(const C3dFile& f, int p, int nchannels, doubl
   d.name = "FP" + std::to_string(p + 1);
   if (static_cast<int>(types->numbers.size()) <= p)
     throw InputError(path + ": FORCE_PLATFORM:TYPE has no entry for plate " + std::to_string(p + 1));
-  d.type = count_value(types->numbers[p]);
-  if (d.type < 1 || d.type > 4) {
-    throw InputError(path + ": FORCE_PLATFORM:TYPE[" + std::to_string(p + 1) + "] = " +
-                     std::to_string(d.type) + " is not supported (types 1-4 are)");
-  }
+  d.type = count_value(types->numbers[p]);  // 1-4: the caller leaves the others out
   if (corners->numbers.size() < static_cast<std::size_t>(12 * (p + 1)))
     throw InputError(path + ": FORCE_PLATFORM:CORNERS has no entry for plate " + std::to_string(p + 1));
   for (int c = 0; c < 4; ++c)
@@ -646,7 +642,21 @@ void read_c3d_plates(const C3dFile& f, const C3dLayout& l, const AnalogData& ana
       throw InputError(path + ": FORCE_PLATFORM:USED = " + std::to_string(nplates) +
                        " but TYPE, CORNERS, ORIGIN or CHANNEL is missing");
     }
-    for (int p = 0; p < nplates; ++p) descs_fp.push_back(plate_description(f, p, nchannels, to_m, options, path));
+    for (int p = 0; p < nplates; ++p) {
+      // A plate of a type kin2grf cannot compute (5-7 with their calibration matrices, the
+      // treadmills' 11 and 12, AMTI's stairs 21) is left out with its name, as a plate whose
+      // calibration is broken is: the markers, and the other plates, are still good, and
+      // `estimate` does not need the plates at all.
+      if (static_cast<int>(types->numbers.size()) > p) {
+        const int type = count_value(types->numbers[p]);
+        if (type < 1 || type > 4) {
+          t.warnings.push_back(path + ": FP" + std::to_string(p + 1) + ": FORCE_PLATFORM:TYPE[" + std::to_string(p + 1) + "] = " +
+                               std::to_string(type) + " is not supported (types 1-4 are); this plate is left out");
+          continue;
+        }
+      }
+      descs_fp.push_back(plate_description(f, p, nchannels, to_m, options, path));
+    }
     PlateProcessing proc;
     proc.cop_threshold_N = options.cop_threshold_N;
     proc.zero_offset = options.zero_offset;

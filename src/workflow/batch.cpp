@@ -58,8 +58,13 @@ ValidationRun validate_trial(const Settings& s, const std::string& plates_file, 
   std::optional<Trial> measured;
   if (!plates_file.empty()) measured = load_trial(plates_file, load_options(zero_offset));
   const Trial& source = measured ? *measured : trial;
-  if (!source.plates || source.plates->plates.empty())
-    throw InputError(source.path + ": no force plates to validate against" + (measured ? "" : "; give a plates file"));
+  if (!source.plates || source.plates->plates.empty()) {
+    // Why the file's plates were not read (an unsupported type, a broken calibration), if it says.
+    std::string why;
+    for (const auto& w : source.warnings)
+      if (w.find("FORCE_PLATFORM") != std::string::npos || w.find("left out") != std::string::npos) why += "; " + w;
+    throw InputError(source.path + ": no force plates to validate against" + why + (measured ? "" : "; give a plates file"));
+  }
   EstimateOptions options = to_options(s);
   options.progress = std::move(progress);
   ValidationRun run;
