@@ -42,6 +42,30 @@ TEST(Trc, RoundTripKeepsValuesAndGaps) {
       }
 }
 
+// A gap some exporters write as zeros: a marker at exactly (0, 0, 0) is read as missing, with a
+// warning that counts them, as C3D points at the origin are; a single zero coordinate is a place.
+TEST(Trc, AMarkerAtExactlyTheOriginIsAGap) {
+  MarkerTrajectories m;
+  m.rate_hz = 100;
+  m.first_frame = 1;
+  m.time_s = Eigen::VectorXd::LinSpaced(6, 0, 0.05);
+  m.names = {"RHEE", "RTOE"};
+  m.descriptions = {"", ""};
+  m.up_axis = Axis::Y;
+  for (int k = 0; k < 2; ++k) m.positions_m.push_back(Eigen::MatrixX3d::Constant(6, 3, 0.3 + k));
+  m.positions_m[0].row(2).setZero();
+  m.positions_m[0].row(3).setZero();
+  m.positions_m[1].row(4) << 0.0, 0.05, 0.0;  // on two axes' zero: a place, kept
+  std::vector<std::string> warnings;
+  const auto r = parse_trc(format_trc(m, "zeros.trc"), "zeros.trc", &warnings);
+  EXPECT_TRUE(r.positions_m[0].row(2).array().isNaN().all());
+  EXPECT_TRUE(r.positions_m[0].row(3).array().isNaN().all());
+  EXPECT_TRUE(r.positions_m[0].row(1).allFinite());
+  EXPECT_NEAR(r.positions_m[1](4, 1), 0.05, 1e-9);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("2 marker samples at exactly (0, 0, 0) are read as missing"), std::string::npos) << warnings[0];
+}
+
 TEST(Trc, MalformedFilesNameTheLineAndField) {
   const std::string head =
       "PathFileType\t4\t(X/Y/Z)\tx.trc\nDataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\n";

@@ -237,6 +237,14 @@ MarkerTrajectories parse_trc(std::string_view text, const std::string& path, std
     warnings->push_back("NumFrames says " + fmt(th.frames_declared) + " but " + std::to_string(n) + " data rows were read");
   if (short_rows && warnings)
     warnings->push_back(std::to_string(short_rows) + " rows end early; their trailing markers are treated as missing");
+  // A marker at exactly (0, 0, 0) is a gap some exporters write as zeros (as C3D files' points at
+  // the origin): no marker sits exactly on the lab's origin to the last digit in all three axes.
+  long at_origin = 0;
+  for (auto& P : m.positions_m)
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (P(i, 0) == 0.0 && P(i, 1) == 0.0 && P(i, 2) == 0.0) P.row(i).setConstant(kNaN), ++at_origin;
+  if (at_origin && warnings)
+    warnings->push_back(std::to_string(at_origin) + " marker samples at exactly (0, 0, 0) are read as missing (an exporter's gap)");
   m.first_frame = frames.front();
   m.names = th.names;
   m.descriptions.assign(th.names.size(), "");
