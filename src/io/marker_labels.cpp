@@ -49,7 +49,7 @@ const std::vector<Word>& vocabulary() {
       {"hallux", {"hlx", "hallux", "hal", "toetip", "tiptoe", "bigtoe"}},
       {"shoulder", {"sho", "shoulder", "acr", "acromion", "acromium", "ac", "sae", "shouldertop"}},
       {"c7", {"c7", "cv7"}},
-      {"clav", {"clav", "ij", "clavicle", "jugularnotch", "manubrium"}},
+      {"clav", {"clav", "ij", "sjn", "clavicle", "jugularnotch", "manubrium"}},
       {"elbow", {"elb", "elbow", "elbowlat", "el", "lel", "hle", "elbowout", "lee"}},
       {"wrist", {"wra", "wrb", "wrist", "wri", "rs", "us", "rsp", "usp", "wristlat", "wristmed", "wristout", "wristin", "lw", "mw"}},
       {"head", {"fhd", "bhd", "head", "hea", "headfront", "headback", "headtop", "tophead", "headside"}},
