@@ -20,7 +20,8 @@ namespace {
 /// (WaistLFront, LKneeOut, LAnkleOut, LHeelBack, LForefootIn/Out, LToeIn/Out, LToeTip,
 /// LShoulderTop), Vicon's production set (LFWT, LBWT), the conventional gait model 2.4's
 /// forefoot (LFMH, LSMH, LVMH), the Oxford foot model's (LD1M, LD5M, LHLX), Motek's Human Body
-/// Model for GRAIL and CAREN treadmills (LLEK, LLM, LMT5, LLEE, LLW) and the RRIS40 set (RFMT1).
+/// Model for GRAIL and CAREN treadmills (LLEK, LLM, LMT5, LLEE, LLW), the RRIS40 set (RFMT1) and
+/// IOR-gait's forefoot (RFM, RSM, RVM: the 1st, 2nd and 5th metatarsal heads, Leardini et al. 2007).
 struct Word {
   const char* key;
   std::vector<const char*> spellings;
@@ -42,9 +43,9 @@ const std::vector<Word>& vocabulary() {
       {"ankle_medial", {"ankm", "ankmed", "anklemed", "anklemedial", "medankle", "medialankle", "mankle", "mm", "mma", "mmal", "mmall",
                         "medmal", "medmalleolus", "medialmalleolus", "tam", "med", "anklein"}},
       {"heel", {"hee", "heel", "hel", "cal", "calc", "calcaneus", "fcc", "ca", "heelbottom", "heelback", "heelpost", "phe"}},
-      {"mt1", {"mt1", "mth1", "mh1", "fm1", "met1", "meta1", "1mt", "1meta", "1stmet", "mt1head", "toemed", "toemedial", "fmt1", "fmh", "d1m", "1st", "forefootin", "forefoot1", "toein"}},
-      {"mt2", {"mt2", "mth2", "mh2", "fm2", "met2", "meta2", "2mt", "2meta", "2ndmet", "fmt2", "smh", "2nd", "forefoot2"}},
-      {"mt5", {"mt5", "mth5", "mh5", "fm5", "met5", "meta5", "5mt", "5meta", "5thmet", "mt5head", "toelat", "toelateral", "fmt5", "vmh", "d5m", "5th", "forefootout", "forefoot5", "toeout"}},
+      {"mt1", {"mt1", "mth1", "mh1", "fm1", "met1", "meta1", "1mt", "1meta", "1stmet", "mt1head", "toemed", "toemedial", "fm", "fmt1", "fmh", "d1m", "1st", "forefootin", "forefoot1", "toein"}},
+      {"mt2", {"mt2", "mth2", "mh2", "fm2", "met2", "meta2", "2mt", "2meta", "2ndmet", "sm", "fmt2", "smh", "2nd", "forefoot2"}},
+      {"mt5", {"mt5", "mth5", "mh5", "fm5", "met5", "meta5", "5mt", "5meta", "5thmet", "mt5head", "toelat", "toelateral", "vm", "fmt5", "vmh", "d5m", "5th", "forefootout", "forefoot5", "toeout"}},
       {"toe", {"toe"}},
       {"hallux", {"hlx", "hallux", "hal", "toetip", "tiptoe", "bigtoe"}},
       {"shoulder", {"sho", "shoulder", "acr", "acromion", "acromium", "ac", "sae", "shouldertop"}},
