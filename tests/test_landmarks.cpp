@@ -644,6 +644,8 @@ TEST(MarkerLabels, MapsTheSetsOfSportsAndTreadmillLabs) {
       for (const auto& [k, v] : rule.items()) EXPECT_EQ(L[landmark][k], v) << set.name << " " << landmark << "." << k;
     }
     EXPECT_NO_THROW((void)parse_marker_set(*lm.mapping, "labels")) << set.name;
+    const bool waist = set.name == "qualisys-animation" || set.name == "optitrack-baseline-toes";
+    EXPECT_EQ(lm.rules[0].find("(waist markers taken as the ASIS and PSIS)") != std::string::npos, waist) << set.name << ": " << lm.rules[0];
   }
   // That lab's lateral heel (RLHE) is not taken for an elbow (the 3D model's arm segments).
   MarkerTrajectories own;

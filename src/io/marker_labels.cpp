@@ -239,6 +239,14 @@ LabelMapping map_marker_labels(const MarkerTrajectories& m, const MarkerTrajecto
       pelvis = {{"rasis", rasis}, {"lasis", lasis}, {"sacrum", sacrum}};
       pelvis_said = rasis + ", " + lasis + ", " + sacrum;
     }
+    // An animation set's waist markers sit near the ASIS and PSIS, not on them: the hip centre is
+    // then as good as their placement, which the user should know.
+    const auto waist = [](const std::string& l) {
+      const std::string w = lower_alnum(l);
+      return w.find("waist") != std::string::npos || w.find("fwt") != std::string::npos || w.find("bwt") != std::string::npos;
+    };
+    if (!pelvis_said.empty() && (waist(rasis) || waist(lasis) || waist(rpsis) || waist(lpsis)))
+      pelvis_said += " (waist markers taken as the ASIS and PSIS)";
   }
   const std::string rhjc = f.one('r', "hjc", notes), lhjc = f.one('l', "hjc", notes);
   if (!rhjc.empty() && !lhjc.empty()) rule("hip", {{"mean", {rhjc, lhjc}}}, "mean of the hip joint centres " + rhjc + ", " + lhjc);
