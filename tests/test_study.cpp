@@ -428,3 +428,37 @@ TEST(Study, MarkerLabelsStudyRunsTheMappingFromTheLabelsBesideThePreset) {
   for (std::size_t k = 0; k < preset.size(); ++k)
     EXPECT_DOUBLE_EQ(labels[k].metrics.vertical->rrmse_percent, preset[k].metrics.vertical->rrmse_percent) << "stance " << k;
 }
+
+// The toe-ablation study replaces each hallux made of a marker by the presets' virtual toes: on
+// the example walk, whose toes are markers, the COP moves (model 2's place is an arc fraction of
+// heel -> MT -> toe) and the forces' stances stay; a set whose toes are virtual already is the same
+// in both rows.
+TEST(Study, ToeAblationStudyReplacesToeMarkersByVirtualToes) {
+  const Trial walk = make_example_walk();
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  ASSERT_EQ(set.rules[static_cast<std::size_t>(landmark(0, kHallux))].kind, RuleKind::Marker);
+  MarkerSet virtual_toes = set;
+  for (int side = 0; side < 2; ++side) {
+    LandmarkRule& r = virtual_toes.rules[static_cast<std::size_t>(landmark(side, kHallux))];
+    r = LandmarkRule{};
+    r.kind = RuleKind::VirtualHallux;
+    r.value = kVirtualToeShare;
+  }
+  for (const MarkerSet* s : std::array<const MarkerSet*, 2>{&set, &virtual_toes}) {
+    StudyTrial t;
+    t.name = "walk", t.activity = "walking", t.lab = "lab", t.trial = &walk, t.plates = &*walk.plates, t.marker_set = s;
+    const StudyResult r = run_study("toe-ablation", {t});
+    ASSERT_EQ(r.rows.size(), 2u);
+    ASSERT_TRUE(r.failures.empty());
+    EXPECT_TRUE(r.rows[0].is_default);
+    const auto& recorded = r.per_trial[0][0].stances;
+    const auto& ablated = r.per_trial[1][0].stances;
+    ASSERT_GT(recorded.size(), 0u);
+    ASSERT_EQ(ablated.size(), recorded.size());
+    double cop_change = 0;
+    for (std::size_t k = 0; k < recorded.size(); ++k)
+      cop_change += std::abs(ablated[k].metrics.cop->rmse - recorded[k].metrics.cop->rmse);
+    if (s == &set) EXPECT_GT(cop_change, 1e-4) << "the toes' markers replaced: the COP moves";
+    else EXPECT_EQ(cop_change, 0.0) << "virtual toes already: nothing to replace";
+  }
+}

@@ -33,6 +33,9 @@ struct Setting {
   /// of every plate's loaded run (gap_s 0: as recorded).
   LegLandmark gap_landmark = kHeel;
   double gap_s = 0.0;
+  /// The `toe-ablation` study: each hallux made of a marker replaced by virtual toes of this share
+  /// of the ankle-MT length (0: as recorded).
+  double virtual_toes = 0.0;
 };
 
 /// Marks the settings that leave the fields `get` reads at kin2grf's defaults (the added marker
@@ -235,6 +238,17 @@ MarkerTrajectories cut_to_plates(const MarkerTrajectories& m, const ForcePlateRe
   return cropped(m, a, b - a + 1);
 }
 
+/// What the COP owes to a toe marker (a lab whose set has none): every trial as recorded, and with
+/// each hallux landmark made of a marker replaced by the presets' virtual toes (kVirtualToeShare of
+/// the ankle-MT length). Trials whose sets have virtual toes already are the same in both rows.
+std::vector<Setting> toe_ablation_settings() {
+  std::vector<Setting> s{{"as recorded", 0, [](EstimateOptions&) {}, 0.0, true}};
+  Setting c{"toe markers removed", 1, [](EstimateOptions&) {}};
+  c.virtual_toes = kVirtualToeShare;
+  s.push_back(std::move(c));
+  return s;
+}
+
 /// Robustness to markers lost for a while (occluded by the other foot over a plate, a marker
 /// fallen off): the heel markers, then the MT markers, of both feet lost for 0.2 s at the middle
 /// of every plate's loaded run, with the rigid fill off (the gap ends the processed window, as
@@ -313,6 +327,7 @@ const std::vector<StudyKind>& special_studies() {
       {"marker-labels", marker_labels_settings},
       {"trial-cut", trial_cut_settings},
       {"marker-gaps", marker_gaps_settings},
+      {"toe-ablation", toe_ablation_settings},
       {"torso-length", torso_length_settings},
       {"kinematic-edges", kinematic_edges_settings},
       {"foot-model", foot_model_settings},
@@ -386,6 +401,17 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
         throw InputError(t.name + ": its labels give no mapping: " + missing);
       }
       ablated = parse_marker_set(*lm.mapping, t.name + " (its labels)");
+    }
+    if (s.virtual_toes > 0) {
+      MarkerSet toeless = ablated ? *ablated : *d.marker_set;
+      for (int side = 0; side < 2; ++side) {
+        LandmarkRule& r = toeless.rules[static_cast<std::size_t>(landmark(side, kHallux))];
+        if (r.kind == RuleKind::VirtualHallux) continue;
+        r = LandmarkRule{};
+        r.kind = RuleKind::VirtualHallux;
+        r.value = s.virtual_toes;
+      }
+      ablated = std::move(toeless);
     }
     const int factor = s.marker_rate_hz > 0 ? decimation_factor(d.trial->markers.rate_hz, s.marker_rate_hz) : 1;
     const bool changed = s.marker_noise_m > 0 || factor > 1 || s.cut_margin_s >= 0 || s.gap_s > 0;

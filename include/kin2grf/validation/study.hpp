@@ -14,6 +14,7 @@
 //                 pooled (robustness)
 //   marker-gaps   the heel or the MT markers lost for 0.2 s at every plate stance, the rigid fill
 //                 off and on (robustness to occlusions)
+//   toe-ablation  each toe marker replaced by virtual toes (a lab whose set has none)
 //   split-distance  kin2grf's side-by-side feet distance, off .. 0.2 m (not in the paper)
 //   torso-length  the torso's hip-shoulder length fixed (the paper) or measured per frame
 //   kinematic-edges  the kinematics' filter past the window's ends: the odd reflection (the ends'
