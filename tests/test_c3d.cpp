@@ -416,13 +416,17 @@ TEST(C3dQuirks, APlateOfAnUnsupportedTypeIsLeftOutByNameAndTheOthersAreRead) {
   const Trial as_written = read_c3d_bytes(bytes, "lab.c3d");
   ASSERT_TRUE(as_written.plates);
   ASSERT_EQ(as_written.plates->plates.size(), 2u);
-  // FORCE_PLATFORM:TYPE: name, offset (2), type (1), ndims (1), dim (1), then one int16 a plate.
-  const std::string key = "TYPE";
-  std::size_t at = std::string::npos;
-  for (std::size_t i = 1; i + key.size() + 8 < bytes.size(); ++i)
-    if (bytes[i - 1] == 4 && std::equal(key.begin(), key.end(), bytes.begin() + static_cast<long>(i) + 1)) at = i;
-  ASSERT_NE(at, std::string::npos);
-  const std::size_t first = at + 1 + key.size() + 2 + 1 + 1 + 1;
+  // FORCE_PLATFORM:TYPE's first plate's byte: the name, offset (2), type (1), ndims (1), the
+  // dimensions (none for one plate), then one int16 a plate.
+  const auto first_type = [](const std::vector<std::uint8_t>& b) {
+    const std::string key = "TYPE";
+    std::size_t at = 0;
+    for (std::size_t i = 1; i + key.size() + 8 < b.size(); ++i)
+      if (b[i - 1] == 4 && std::equal(key.begin(), key.end(), b.begin() + static_cast<long>(i) + 1)) at = i;
+    const std::size_t ndims = at + 1 + key.size() + 2 + 1;
+    return ndims + 1 + b[ndims];
+  };
+  const std::size_t first = first_type(bytes);
   ASSERT_EQ(bytes[first], 2);
   bytes[first] = 6;
   ASSERT_EQ(read_c3d_header(bytes, "lab.c3d").find("FORCE_PLATFORM:TYPE")->numbers.at(0), 6.0);
@@ -439,11 +443,8 @@ TEST(C3dQuirks, APlateOfAnUnsupportedTypeIsLeftOutByNameAndTheOthersAreRead) {
   EXPECT_TRUE(said) << (back.warnings.empty() ? "no warning" : back.warnings.back());
   // A file whose only plate is left out: `validate` says why it has none to validate against.
   auto one = write_c3d_bytes(small_trial(), o);
-  for (std::size_t i = 1; i + key.size() + 8 < one.size(); ++i)
-    if (one[i - 1] == 4 && std::equal(key.begin(), key.end(), one.begin() + static_cast<long>(i) + 1)) at = i;
-  const std::size_t ndims = at + 1 + key.size() + 2 + 1;  // one plate: a scalar, no dimension
-  ASSERT_EQ(one[ndims + 1 + one[ndims]], 2);
-  one[ndims + 1 + one[ndims]] = 6;
+  ASSERT_EQ(one[first_type(one)], 2);
+  one[first_type(one)] = 6;
   const std::string path = (test::temp_dir("plate-type") / "type6.c3d").string();
   {
     std::ofstream f(path, std::ios::binary);

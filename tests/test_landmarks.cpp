@@ -627,17 +627,19 @@ TEST(MarkerLabels, MapsTheSetsOfSportsAndTreadmillLabs) {
       {"a-lab's-own", labels({"@ASIS", "@PSIS", "@IC", "@GT", "@LFC", "@MFC", "@LMA", "@MMA", "@PHE", "@DHE", "@LHE", "@1ST", "@2ND", "@5TH", "@TOE"}, {}),
        {{"heel_r", {{"marker", "RPHE"}}}, {"mt_r", {{"mean", {"R1ST", "R2ND", "R5TH"}}}}, {"shoulder", {{"pelvis_up", 0.5}}}}},
   };
-  for (const Set& set : sets) {
+  const auto trajectories = [](const std::vector<std::string>& names) {  // every label holding data
     MarkerTrajectories m;
-    const Eigen::Index n = 20;
-    m.time_s = Eigen::VectorXd::LinSpaced(n, 0.0, 0.19);
+    m.time_s = Eigen::VectorXd::LinSpaced(20, 0.0, 0.19);
     m.rate_hz = 100;
-    for (const auto& l : set.labels) {
+    for (const auto& l : names) {
       m.names.push_back(l);
       m.descriptions.emplace_back();
-      m.positions_m.push_back(Eigen::MatrixX3d::Constant(n, 3, 0.01 * static_cast<double>(m.names.size())));
+      m.positions_m.push_back(Eigen::MatrixX3d::Constant(20, 3, 0.01 * static_cast<double>(m.names.size())));
     }
-    const LabelMapping lm = map_marker_labels(m);
+    return m;
+  };
+  for (const Set& set : sets) {
+    const LabelMapping lm = map_marker_labels(trajectories(set.labels));
     ASSERT_TRUE(lm.mapping) << set.name << ": " << (lm.missing.empty() ? "" : lm.missing[0]);
     const auto& L = (*lm.mapping)["landmarks"];
     for (const auto& [landmark, rule] : set.expect) {
@@ -648,15 +650,7 @@ TEST(MarkerLabels, MapsTheSetsOfSportsAndTreadmillLabs) {
     EXPECT_EQ(lm.rules[0].find("(waist markers taken as the ASIS and PSIS)") != std::string::npos, waist) << set.name << ": " << lm.rules[0];
   }
   // That lab's lateral heel (RLHE) is not taken for an elbow (the 3D model's arm segments).
-  MarkerTrajectories own;
-  own.time_s = Eigen::VectorXd::LinSpaced(20, 0.0, 0.19);
-  own.rate_hz = 100;
-  for (const auto& l : sets.back().labels) {
-    own.names.push_back(l);
-    own.descriptions.emplace_back();
-    own.positions_m.push_back(Eigen::MatrixX3d::Constant(20, 3, 0.01 * static_cast<double>(own.names.size())));
-  }
-  const LabelMapping lm = map_marker_labels(own);
+  const LabelMapping lm = map_marker_labels(trajectories(sets.back().labels));
   ASSERT_TRUE(lm.mapping);
   EXPECT_FALSE(lm.mapping->contains("upper_body")) << lm.mapping->dump();
 }
