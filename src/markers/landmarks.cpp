@@ -1090,28 +1090,35 @@ void place_virtual_toes(const Eigen::MatrixX2d& A, const Eigen::MatrixX2d& M, Ei
 /// stands implausibly near the MT head (a toe segment under kMinToeShare of the ankle-MT length;
 /// the development trials' toe markers give 0.25-0.86, a held-out overground run's marker mapped
 /// as the toe about 0.08), which cannot carry the COP's roll to the toe tip.
+/// Toes grown from a 5th-metatarsal marker start behind the 2nd head: they are
+/// kLateralMtToeExtraShare longer.
 void check_toes(SagittalLandmarks& s, const MarkerSet& set, int side, std::vector<std::string>& messages) {
   const LandmarkRule& r = set.rules[static_cast<std::size_t>(landmark(side, kHallux))];
   const auto& A = s.p[landmark(side, kAnkle)];
   const auto& M = s.p[landmark(side, kMt)];
   auto& T = s.p[landmark(side, kHallux)];
+  const bool lateral_mt = set.rules[static_cast<std::size_t>(landmark(side, kMt))].lateral_surface;
+  const double extra = lateral_mt ? kLateralMtToeExtraShare : 0.0;
+  const std::string from_mt5 = lateral_mt ? " (from a 5th-metatarsal marker, which lies behind the 2nd head: " +
+                                                std::to_string(extra).substr(0, 4) + " longer)"
+                                          : "";
   if (r.kind == RuleKind::VirtualHallux) {
-    place_virtual_toes(A, M, T, r.value);
-    messages.push_back(std::string("hallux_") + side_letter(side) + ": no hallux marker; virtual toes of " + std::to_string(r.value) +
-                       " x ankle-MT length");
+    place_virtual_toes(A, M, T, r.value + extra);
+    messages.push_back(std::string("hallux_") + side_letter(side) + ": no hallux marker; virtual toes of " +
+                       std::to_string(r.value + extra).substr(0, 4) + " x ankle-MT length" + from_mt5);
     return;
   }
   std::vector<double> toe, foot;
   for (Eigen::Index i = 0; i < M.rows(); ++i) toe.push_back((T.row(i) - M.row(i)).norm()), foot.push_back((M.row(i) - A.row(i)).norm());
   const double toe_m = median(toe), foot_m = median(foot);
   if (toe_m < kMinToeShare * foot_m) {
-    place_virtual_toes(A, M, T, kVirtualToeShare);
+    place_virtual_toes(A, M, T, kVirtualToeShare + extra);
     char b[300];
     std::snprintf(b, sizeof b,
                   "hallux_%s: the toe marker stands a median %.0f mm ahead of the MT head, under %.2f x the ankle-MT length "
                   "(%.0f mm): too near for a toe; virtual toes of %.2f x ankle-MT length instead",
-                  side_letter(side), 1000 * toe_m, kMinToeShare, 1000 * foot_m, kVirtualToeShare);
-    messages.emplace_back(b);
+                  side_letter(side), 1000 * toe_m, kMinToeShare, 1000 * foot_m, kVirtualToeShare + extra);
+    messages.emplace_back(std::string(b) + from_mt5);
   }
 }
 

@@ -92,6 +92,12 @@ inline constexpr double kTrunkSwayGainRunning = 0.05;
 /// tip about a third of that ahead of the MT head); a toe marker nearer the MT head than half
 /// of it is not on the toe and is replaced by them, with a message.
 inline constexpr double kVirtualToeShare = 0.3, kMinToeShare = 0.15;
+/// Virtual toes grown from a 5th-metatarsal marker ("surface": "lateral") are longer by this
+/// share of the ankle-MT length: the 5th metatarsal head lies behind the 2nd's, the metatarsal
+/// break running about 60-70 degrees to the foot's long axis (Isman and Inman 1969) across the
+/// 55-65 mm from the 2nd head to the 5th, about 30 mm, 0.2 of an adult's 140-150 mm ankle-MT5
+/// length. Anatomy, not fitted; measured in study toe-ablation (docs/METHOD-NOTES.md).
+inline constexpr double kLateralMtToeExtraShare = 0.2;
 /// A 5th-metatarsal head marker's distance (lateral skin, marker centre) to the foot's midline
 /// (the 2nd metatarsal head) as a fraction of the heel-MT5 length: about 45 mm on an adult's
 /// 180 mm (the MT1-MT5 heads' breadth is about 0.4 of the foot's length, the 2nd head a quarter
