@@ -28,7 +28,8 @@
 //       line moves its forefoot end medially by kLateralMtToMidline of the heel-MT length.
 //   {"virtual_hallux": 0.30}                  hallux fallback: a toes segment of that fraction of
 //       the ankle-MT length, straight along the foot in swing, held at the MT head's foot-flat
-//       height while the heel rises (the toes stay on the ground at push-off).
+//       height while the heel rises (the toes stay on the ground at push-off); from a
+//       5th-metatarsal marker kLateralMtToeExtraShare longer (its head lies behind the 2nd's).
 // A marker's longer gap inside the trial is first filled from three markers that move rigidly
 // with it (fill_marker_gaps_rigidly, below). Gaps of up to max_gap_frames are filled by cubic
 // (Catmull-Rom) interpolation between the neighbouring valid samples; longer gaps left end the
