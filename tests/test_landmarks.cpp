@@ -585,7 +585,8 @@ TEST(MarkerLabels, ReadsTheSpellingsOfTheFieldsMarkerSets) {
       {"RToeIn", 'r', "mt1"},          {"LToeOut", 'l', "mt5"},         {"LForefootOut", 'l', "mt5"},
       {"RFMH", 'r', "mt1"},            {"RVMH", 'r', "mt5"},            {"LD1M", 'l', "mt1"},
       {"RFMT5", 'r', "mt5"},           {"LLEK", 'l', "knee_lateral"},   {"RShoulderTop", 'r', "shoulder"},
-      {"RHLE", 'r', "elbow"},            {"SJN", 0, "clav"},
+      {"RHLE", 'r', "elbow"},            {"SJN", 0, "clav"},             {"R_MTP5", 'r', "mt5"},
+      {"L_Lat_Mall", 'l', "ankle_lateral"}, {"RMTP1", 'r', "mt1"},
       {"RLHE", 0, ""},  // a lateral heel in one lab, a humerus's lateral epicondyle in another: left out
       {"LP1M", 0, ""},  // the Oxford foot model's proximal 1st metatarsal: not the MT head
   };
