@@ -228,14 +228,11 @@ SagittalStage sagittal_stage(const Trial& trial, Trial* release, const Trial* st
   if (release) remove_marker_outliers(release->markers, motion_markers, cleaning);
   else cleaned = without_marker_outliers(trial.markers, motion_markers, cleaning);
   // Gaps beyond the landmarks' cubic fill, from the markers that move rigidly with the marker
-  // (the outliers just removed are gaps too); copied first only when there is one.
+  // (the outliers just removed are gaps too); the markers copied first only when there is a fill.
   if (o.landmarks.rigid_fill) {
-    const int longer_than = o.landmarks.max_gap_frames;
-    if (release) fill_marker_gaps_rigidly(release->markers, motion_markers, longer_than, cleaning);
-    else if (has_long_marker_gap(cleaned ? *cleaned : trial.markers, motion_markers, longer_than)) {
-      if (!cleaned) cleaned = trial.markers;
-      fill_marker_gaps_rigidly(*cleaned, motion_markers, longer_than, cleaning);
-    }
+    const MarkerTrajectories& source = release ? release->markers : cleaned ? *cleaned : trial.markers;
+    const std::vector<RigidGapFill> fills = rigid_gap_fills(source, motion_markers, o.landmarks.max_gap_frames, cleaning);
+    if (!fills.empty()) write_gap_fills(release ? release->markers : cleaned ? *cleaned : cleaned.emplace(trial.markers), fills);
   }
   // The samples the landmarks are made of are released as they are used (the trial's, when the
   // caller gave it up).

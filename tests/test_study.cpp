@@ -409,20 +409,31 @@ TEST(Batch, TheCsvKeepsFullPrecision) {
   EXPECT_GT(cells[12].size(), 6u) << "more than 4 significant figures";
 }
 
+namespace {
+/// A two-row robustness study (as recorded, then the condition) on the example walk with `set`:
+/// its rows' stances, checked to be the same stances.
+std::array<std::vector<StanceValidation>, 2> two_row_study(const char* kind, const Trial& walk, const MarkerSet& set) {
+  StudyTrial t;
+  t.name = "walk", t.activity = "walking", t.lab = "lab", t.trial = &walk, t.plates = &*walk.plates, t.marker_set = &set;
+  const StudyResult r = run_study(kind, {t});
+  EXPECT_EQ(r.rows.size(), 2u);
+  EXPECT_TRUE(r.failures.empty());
+  EXPECT_TRUE(!r.rows.empty() && r.rows[0].is_default);
+  if (r.per_trial.size() != 2) return {};
+  const auto& first = r.per_trial[0][0].stances;
+  const auto& second = r.per_trial[1][0].stances;
+  EXPECT_GT(first.size(), 0u);
+  EXPECT_EQ(second.size(), first.size());
+  return {first, second};
+}
+}  // namespace
+
 // The marker-labels study runs every trial with its preset and with the mapping made from its own
 // labels: on the example walk, whose labels give the preset's very landmarks, the two rows agree
 // stance for stance.
 TEST(Study, MarkerLabelsStudyRunsTheMappingFromTheLabelsBesideThePreset) {
   const Trial walk = make_example_walk();
-  const MarkerSet& set = *find_marker_set("kin2grf-example");
-  StudyTrial t;
-  t.name = "walk", t.activity = "walking", t.lab = "lab", t.trial = &walk, t.plates = &*walk.plates, t.marker_set = &set;
-  const StudyResult s = run_study("marker-labels", {t});
-  ASSERT_EQ(s.rows.size(), 2u);
-  ASSERT_TRUE(s.failures.empty());
-  EXPECT_TRUE(s.rows[0].is_default);
-  const auto& preset = s.per_trial[0][0].stances;
-  const auto& labels = s.per_trial[1][0].stances;
+  const auto [preset, labels] = two_row_study("marker-labels", walk, *find_marker_set("kin2grf-example"));
   ASSERT_GT(preset.size(), 0u);
   ASSERT_EQ(labels.size(), preset.size());
   for (std::size_t k = 0; k < preset.size(); ++k)
@@ -445,14 +456,7 @@ TEST(Study, ToeAblationStudyReplacesToeMarkersByVirtualToes) {
     r.value = kVirtualToeShare;
   }
   for (const MarkerSet* s : std::array<const MarkerSet*, 2>{&set, &virtual_toes}) {
-    StudyTrial t;
-    t.name = "walk", t.activity = "walking", t.lab = "lab", t.trial = &walk, t.plates = &*walk.plates, t.marker_set = s;
-    const StudyResult r = run_study("toe-ablation", {t});
-    ASSERT_EQ(r.rows.size(), 2u);
-    ASSERT_TRUE(r.failures.empty());
-    EXPECT_TRUE(r.rows[0].is_default);
-    const auto& recorded = r.per_trial[0][0].stances;
-    const auto& ablated = r.per_trial[1][0].stances;
+    const auto [recorded, ablated] = two_row_study("toe-ablation", walk, *s);
     ASSERT_GT(recorded.size(), 0u);
     ASSERT_EQ(ablated.size(), recorded.size());
     double cop_change = 0;

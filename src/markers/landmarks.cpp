@@ -603,20 +603,30 @@ bool has_long_marker_gap(const MarkerTrajectories& m, const std::vector<std::str
   return !long_interior_gaps(m, only, longer_than_frames).empty();
 }
 
-std::size_t fill_marker_gaps_rigidly(MarkerTrajectories& m, const std::vector<std::string>& only, int longer_than_frames,
-                                     std::vector<std::string>& messages) {
+std::vector<RigidGapFill> rigid_gap_fills(const MarkerTrajectories& m, const std::vector<std::string>& only, int longer_than_frames,
+                                          std::vector<std::string>& messages) {
   // Every fill is made from the markers as given, then written: a marker filled here is no
   // partner for another's gap, and the order of the markers does not matter.
-  std::vector<std::pair<InteriorGap, Eigen::MatrixX3d>> fills;
+  std::vector<RigidGapFill> fills;
   DistanceSds sds(m);
   for (const InteriorGap& g : long_interior_gaps(m, only, longer_than_frames)) {
     std::string message;
     std::optional<Eigen::MatrixX3d> fill = rigid_fill(m, g, sds, message);
     if (!fill) continue;
     messages.push_back(std::move(message));
-    fills.emplace_back(g, std::move(*fill));
+    fills.push_back({g.marker, g.first, std::move(*fill)});
   }
-  for (const auto& [g, fill] : fills) m.positions_m[g.marker].middleRows(g.first, fill.rows()) = fill;
+  return fills;
+}
+
+void write_gap_fills(MarkerTrajectories& m, const std::vector<RigidGapFill>& fills) {
+  for (const RigidGapFill& f : fills) m.positions_m[f.marker].middleRows(f.first, f.positions_m.rows()) = f.positions_m;
+}
+
+std::size_t fill_marker_gaps_rigidly(MarkerTrajectories& m, const std::vector<std::string>& only, int longer_than_frames,
+                                     std::vector<std::string>& messages) {
+  const std::vector<RigidGapFill> fills = rigid_gap_fills(m, only, longer_than_frames, messages);
+  write_gap_fills(m, fills);
   return fills.size();
 }
 

@@ -260,8 +260,19 @@ inline constexpr Eigen::Index kMinRigidFrames = 20;
 inline constexpr std::size_t kMaxRigidCandidates = 12;
 std::size_t fill_marker_gaps_rigidly(MarkerTrajectories& markers, const std::vector<std::string>& only, int longer_than_frames,
                                      std::vector<std::string>& messages);
+/// fill_marker_gaps_rigidly in its two steps, for a caller that copies the markers only when
+/// there is a fill to write: the fills made from `markers` as given (each named in `messages`),
+/// then written.
+struct RigidGapFill {
+  std::size_t marker = 0;
+  Eigen::Index first = 0;         ///< the gap's first frame
+  Eigen::MatrixX3d positions_m;   ///< the gap's frames
+};
+std::vector<RigidGapFill> rigid_gap_fills(const MarkerTrajectories& markers, const std::vector<std::string>& only,
+                                          int longer_than_frames, std::vector<std::string>& messages);
+void write_gap_fills(MarkerTrajectories& markers, const std::vector<RigidGapFill>& fills);
 /// Whether fill_marker_gaps_rigidly has a gap to look at (one of `only`'s interior gaps is longer
-/// than `longer_than_frames`), so that a caller copies the markers only then.
+/// than `longer_than_frames`).
 bool has_long_marker_gap(const MarkerTrajectories& markers, const std::vector<std::string>& only, int longer_than_frames);
 
 /// `release`: `motion` itself, when the caller has no further use for its samples: each
