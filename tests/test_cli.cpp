@@ -719,6 +719,18 @@ TEST(CliExample, FramesCutTheTrialToTheFilesOwnFrameNumbers) {
     EXPECT_NE(bad.out.find(says), std::string::npos) << bad.out;
     EXPECT_NE(bad.out.find("walking2.c3d"), std::string::npos) << bad.out;
   }
+  // Frames the subject is not seen in (walking2's markers hold samples in frames 207-1230): the
+  // error says so, not that no marker set matches the labels or that the walker does not travel.
+  for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+           {"--frames 1:100", "no marker holds a sample in frames 1-100 (the markers hold samples in frames 207-1230)"},
+           {"--frames 300:400 --markers fullbody-2009",
+            "landmark shoulder is undefined in every one of the trial's frames 300-400: its markers C7, CLAV never all hold a sample there"},
+           {"--frames 100:300 --markers labels", "Left out for holding samples in too few of the trial's 201 frames"},
+           {"--frames 100:300 --markers labels", "RASI (0 of 201 frames)"}}) {
+    const CliRun bad = run("estimate " + walk + " --mass 64.9 " + args);
+    EXPECT_EQ(bad.status, 2) << args << ": " << bad.out;
+    EXPECT_NE(bad.out.find(says), std::string::npos) << args << ": " << bad.out;
+  }
 }
 
 // One GRF convention (issue 30, item 2): -o writes what --opensim's STEM_grf.mot holds (OpenSim's

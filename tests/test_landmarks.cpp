@@ -780,6 +780,10 @@ TEST(MarkerLabels, AMissingLandmarkIsNamedWithTheFileAndTheSpellingsLookedFor) {
   ASSERT_EQ(lm.missing.size(), 2u);
   EXPECT_EQ(lm.missing[0].rfind("knee_r: no joint centre (kjc", 0), 0u) << lm.missing[0];
   EXPECT_EQ(lm.missing[1].rfind("shoulder: no acromion markers", 0), 0u) << lm.missing[1];
+  // The acromion's label is in the file but empty: named with its count, so that the error does
+  // not read as if the label were absent.
+  const std::string racr = "RACR (0 of " + std::to_string(isb.markers.frames()) + " frames)";
+  EXPECT_NE(std::find(lm.too_few.begin(), lm.too_few.end(), racr), lm.too_few.end());
   // The draft to complete by hand: what was found, and a placeholder naming what was not.
   EXPECT_EQ(lm.draft["landmarks"]["ankle_r"]["marker"], "R_AJC");
   EXPECT_EQ(lm.draft["landmarks"]["knee_r"]["marker"].get<std::string>().rfind("FILL IN: knee_r: no joint centre", 0), 0u);
@@ -794,6 +798,8 @@ TEST(MarkerLabels, AMissingLandmarkIsNamedWithTheFileAndTheSpellingsLookedFor) {
     EXPECT_NE(what.find("isb.c3d"), std::string::npos) << what;
     EXPECT_NE(what.find("knee_r: no joint centre"), std::string::npos) << what;
     EXPECT_NE(what.find("ankle_r = R_AJC"), std::string::npos) << what;
+    EXPECT_NE(what.find("Left out for holding samples in too few"), std::string::npos) << what;
+    EXPECT_NE(what.find(racr), std::string::npos) << what;
   }
 }
 

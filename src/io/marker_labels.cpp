@@ -152,6 +152,8 @@ namespace {
 /// The labels found for each (side, landmark word), with the frames each holds data in.
 struct Found {
   std::map<std::pair<char, std::string>, std::vector<std::pair<std::string, long>>> by_place;
+  /// Labels that read as a landmark but were left out for holding too few samples, with their count.
+  std::vector<std::string> too_few;
 
   /// The label for a place: the one holding data in the most frames; `notes` says when there were several.
   [[nodiscard]] std::string one(char side, const std::string& key, std::vector<std::string>& notes) const {
@@ -206,7 +208,10 @@ Found find_labels(const MarkerTrajectories& m) {
   for (std::size_t i = 0; i < m.names.size(); ++i) {
     const MarkerLabel l = read_marker_label(m.names[i]);
     if (l.landmark.empty()) continue;
-    if (held[i] == 0 || 5 * held[i] < most) continue;
+    if (held[i] == 0 || 5 * held[i] < most) {
+      f.too_few.push_back(m.names[i] + " (" + std::to_string(held[i]) + " of " + std::to_string(m.frames()) + " frames)");
+      continue;
+    }
     f.by_place[{l.side, l.landmark}].emplace_back(m.names[i], held[i]);
   }
   return f;
@@ -217,6 +222,7 @@ Found find_labels(const MarkerTrajectories& m) {
 LabelMapping map_marker_labels(const MarkerTrajectories& m, const MarkerTrajectories* static_markers) {
   LabelMapping out;
   const Found f = find_labels(m);
+  out.too_few = f.too_few;
   const std::optional<Found> fs = static_markers ? std::optional<Found>(find_labels(*static_markers)) : std::nullopt;
   nlohmann::json lm = nlohmann::json::object();
   auto& notes = out.notes;

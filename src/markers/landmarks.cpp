@@ -772,6 +772,20 @@ Landmarks3D compute_landmarks(const MarkerSet& set, const MarkerTrajectories& m,
     } else if (r.kind == RuleKind::Static) {
       P = static_landmark(set, r, id, m, st, path);
     }
+    // A landmark with no sample in any frame (its markers empty in the trial or in the frames cut
+    // from it) is named here; the steps after would fail on it with less to say (a walker who
+    // does not travel, no run of defined frames).
+    if (r.kind != RuleKind::VirtualHallux && n > 0 && !(P.array().isFinite().rowwise().all()).any()) {
+      std::vector<std::string> names = r.markers;
+      names.insert(names.end(), r.cluster.begin(), r.cluster.end());
+      for (const auto& [role, name] : r.pelvis) names.push_back(name);
+      std::string list;
+      for (const auto& name : names) list += (list.empty() ? "" : ", ") + name;
+      throw InputError(path + ": landmark " + kNames[id] + " is undefined in every one of the trial's frames " + std::to_string(m.first_frame) +
+                       "-" + std::to_string(m.first_frame + n - 1) +
+                       (list.empty() ? std::string() : ": its markers " + list + " never all hold a sample there") +
+                       " (`kin2grf info` lists each marker's missing frames; --frames cuts the trial)");
+    }
     out.p[static_cast<std::size_t>(id)] = std::move(P);  // virtual_hallux stays NaN: built in the sagittal step
     release_after(id);
   }

@@ -232,8 +232,15 @@ const MarkerSet& resolve_marker_set(const Settings& a, const Trial& trial, Marke
       std::string found, lacking;
       for (const auto& r : lm.rules) found += "\n  " + r;
       for (const auto& r : lm.missing) lacking += "\n  " + r;
+      std::string empty;
+      constexpr std::size_t kListed = 12;
+      for (std::size_t i = 0; i < std::min(lm.too_few.size(), kListed); ++i) empty += (i ? ", " : "") + lm.too_few[i];
+      if (lm.too_few.size() > kListed) empty += " and " + std::to_string(lm.too_few.size() - kListed) + " more";
       throw InputError(a.trial + ": " + because + presets_tried + "; from the file's labels no mapping could be made. Missing:" + lacking +
                        (found.empty() ? std::string() : "\nFound:" + found) +
+                       (empty.empty() ? std::string()
+                                      : "\nLeft out for holding samples in too few of the trial's " + std::to_string(trial.markers.frames()) +
+                                            " frames (under a fifth of the best-held marker's): " + empty) +
                        "\nGive a mapping file (--markers FILE.json, docs/MARKERSETS.md) with a rule for each landmark: shoulder, hip, knee_r, "
                        "ankle_r, heel_r, mt_r, hallux_r and the same _l; `kin2grf info " + a.trial +
                        " --write-mapping FILE.json` writes what the labels give, to complete");
@@ -304,11 +311,26 @@ void apply_frame_range(Trial& t, const std::string& range) {
   if (colon == std::string::npos) throw malformed();
   const int a = number(range.substr(0, colon), first_file), b = number(range.substr(colon + 1), last_file);
   if (a > b) throw InputError(t.path + ": --frames " + range + ": its first frame comes after its last");
+  // The file's frames where some marker holds a sample: a cut outside them is named as such, not
+  // left to fail later as a marker set no label matches (every label is empty there) or a walker
+  // who does not travel.
+  Eigen::Index seen_first = -1, seen_last = -1;
+  for (Eigen::Index k = 0; k < t.markers.frames(); ++k)
+    for (const auto& P : t.markers.positions_m)
+      if (P.row(k).allFinite()) {
+        if (seen_first < 0) seen_first = k;
+        seen_last = k;
+        break;
+      }
   try {
     t.markers = cropped(std::move(t.markers), a - first_file, b - a + 1);  // it refuses frames the recording does not hold
   } catch (const InputError& e) {
     throw InputError(t.path + ": --frames " + range + ": " + e.what());
   }
+  if (seen_first >= 0 && (first_file + seen_last < a || first_file + seen_first > b))
+    throw InputError(t.path + ": --frames " + range + ": no marker holds a sample in frames " + std::to_string(a) + "-" + std::to_string(b) +
+                     " (the markers hold samples in frames " + std::to_string(first_file + seen_first) + "-" +
+                     std::to_string(first_file + seen_last) + ")");
 }
 
 TrialAndStatic load_trial_and_static(const Settings& s, const LoadOptions& load) {

@@ -52,6 +52,10 @@ struct LabelMapping {
   std::vector<std::string> rules;         ///< one line a landmark: what it was made from
   std::vector<std::string> notes;         ///< choices between labels, fallbacks taken
   std::vector<std::string> missing;       ///< a landmark that no label gives, with the spellings looked for
+  /// Labels that read as a landmark but hold a sample in no frame, or in under a fifth of the
+  /// best-held marker's frames (an empty label, a ghost), each with its count: "RASI (0 of 201
+  /// frames)". What the trial's frames lack, where `missing` would only name the spellings.
+  std::vector<std::string> too_few;
 };
 /// `static_markers`: the static trial's, whose lateral and medial joint markers a cluster then
 /// carries (a set that takes its epicondyles and malleoli off for the motion trials).
