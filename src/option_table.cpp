@@ -48,6 +48,11 @@ const std::vector<NumericOption>& numeric_options() {
       {"split-distance", "min_split_distance_m", [](O& o) -> double& { return o.solver.min_split_distance_m; }, 0.0, 1.0, 0.0,
        "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)",
        {0.0, 0.05, 0.1, 0.15, 0.2}, "%.2f m", 1.0, "off"},
+      // The lever in leg lengths; 0 keeps the fixed 0.9 m (the default until it is chosen held out).
+      {"torque-length", "torque_length_legs", [](O& o) -> double& { return o.torque_length_legs; }, 0.0, 10.0, std::nullopt,
+       "The multiplier norm's joint torques are divided by this multiple of the subject's leg length (thigh + shank), so that "
+       "they weigh against the contact forces as for a subject of any size; 0 = a fixed 0.9 m",
+       {0.0, 0.5, 0.75, 1.0, 1.06, 1.25, 1.5, 2.0}, "%.2f x leg", 1.0, "fixed 0.9 m"},
       {"torso-lag", "torso_lag_s", [](O& o) -> double& { return o.torso_lag_s; }, 0.0, 0.2, 0.0,
        "The upper body's fore-aft lag behind the pelvis, s: the HAT's fore-aft inertial force is delayed by this time, less what "
        "the trunk markers already lag the hip by (0 = none, the paper)",

@@ -133,6 +133,8 @@ void check_options(const EstimateOptions& o) {
           "speed gate at standstill (m/s)", o.contact.speed_gate.standstill_mps, "between 0 and 20");
   require(finite(o.solver.min_split_distance_m) && o.solver.min_split_distance_m >= 0 && o.solver.min_split_distance_m <= 1,
           "split distance (m)", o.solver.min_split_distance_m, "between 0 (none) and 1");
+  require(finite(o.torque_length_legs) && o.torque_length_legs >= 0 && o.torque_length_legs <= 10, "torque length (leg lengths)",
+          o.torque_length_legs, "between 0 (the fixed lever) and 10");
   require(finite(o.torso_lag_s) && o.torso_lag_s >= 0 && o.torso_lag_s <= 0.2, "torso lag (s)", o.torso_lag_s,
           "between 0 (none, the paper) and 0.2");
   require(finite(o.thigh_lag_s) && o.thigh_lag_s >= 0 && o.thigh_lag_s <= 0.2, "thigh lag (s)", o.thigh_lag_s,
@@ -183,6 +185,14 @@ void append(Messages& to, Messages&& from) {
 /// most `kinematic_cutoff_hz` (0: the kinematic one).
 double lateral_cutoff(const EstimateOptions& o, double kinematic_cutoff_hz) {
   return o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kinematic_cutoff_hz) : kinematic_cutoff_hz;
+}
+
+/// The solver's options for this subject: the torque-scaled norm's lever from its leg length
+/// (EstimateOptions::torque_length_legs) when asked.
+SolverOptions solver_options_for(const EstimateOptions& o, const Model& model) {
+  SolverOptions s = o.solver;
+  if (o.torque_length_legs > 0) s.torque_length_m = o.torque_length_legs * leg_length_m(model);
+  return s;
 }
 
 /// Whether the frontal split (EstimateOptions::frontal_split_weight) acts: where the solver fades
@@ -684,7 +694,7 @@ RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCa
   std::vector<std::pair<std::vector<Eigen::Index>, std::vector<double>>> chunk_maps(
       keep_torque_map ? static_cast<std::size_t>(std::max(1, thread_count())) : 0);
   for_chunks(static_cast<std::size_t>(n), min_chunk_for(10e-6), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
-    ContactSolver solver(model, calibration, o.solver);
+    ContactSolver solver(model, calibration, solver_options_for(o, model));
     MotionFrame f;
     FrameContacts fc;
     const auto step = std::max<std::size_t>(1, (end - begin) / 100);
@@ -805,7 +815,7 @@ Messages touchdown_stage(const EstimateOptions& o, const Model& model, const Con
   }
   if (frames == 0) return out;
   const int np = static_cast<int>(raw.point_side.size());
-  ContactSolver solver(model, plan.calibration, o.solver);
+  ContactSolver solver(model, plan.calibration, solver_options_for(o, model));
   MotionFrame f;
   FrameContacts fc;
   for (Eigen::Index i = 0; i < n; ++i) {

@@ -75,6 +75,52 @@ void add_marker_noise(MarkerTrajectories& m, double sigma_m, unsigned seed) {
     for (Eigen::Index i = 0; i < P.size(); ++i) P.data()[i] += noise(rng);
 }
 
+namespace {
+void check_length_scale(double L) {
+  if (!(L > 0) || !std::isfinite(L)) throw InputError("length scale " + std::to_string(L) + ": it must be a positive number");
+}
+}  // namespace
+
+MarkerTrajectories dynamically_scaled(MarkerTrajectories m, double L) {
+  check_length_scale(L);
+  const double time_scale = std::sqrt(L);
+  for (auto& P : m.positions_m) P *= L;
+  m.time_s *= time_scale;
+  m.rate_hz /= time_scale;
+  return m;
+}
+
+ForcePlateRecording dynamically_scaled(ForcePlateRecording r, double L) {
+  check_length_scale(L);
+  const double time_scale = std::sqrt(L), force = L * L * L, moment = force * L;
+  r.time_s *= time_scale;
+  r.rate_hz /= time_scale;
+  r.cop_threshold_N *= force;
+  for (ForcePlate& p : r.plates) {
+    for (auto& c : p.corners_m) c *= L;
+    p.centre_m *= L;
+    p.origin_m *= L;
+    p.force_N *= force;
+    p.moment_centre_Nm *= moment;
+    p.cop_m *= L;
+    p.free_moment_Nm *= moment;
+  }
+  return r;
+}
+
+Trial dynamically_scaled(Trial t, double L) {
+  t.markers = dynamically_scaled(std::move(t.markers), L);
+  if (t.plates) t.plates = dynamically_scaled(std::move(*t.plates), L);
+  for (Event& e : t.events) e.time_s *= std::sqrt(L);
+  if (t.body_mass_kg) *t.body_mass_kg *= L * L * L;
+  if (t.height_m) *t.height_m *= L;
+  for (auto* w : {&t.knee_width_m, &t.ankle_width_m})
+    for (auto& x : *w)
+      if (x) *x *= L;
+  if (t.marker_diameter_m) *t.marker_diameter_m *= L;
+  return t;
+}
+
 MarkerTrajectories decimated(MarkerTrajectories m, int factor) {
   if (factor < 1) throw InputError("decimation factor " + std::to_string(factor) + ": it must be 1 or more");
   if (factor == 1) return m;

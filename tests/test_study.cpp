@@ -466,3 +466,42 @@ TEST(Study, ToeAblationStudyReplacesToeMarkersByVirtualToes) {
     else EXPECT_EQ(cop_change, 0.0) << "virtual toes already: nothing to replace";
   }
 }
+
+// The subject-scale study makes each trial's subject dynamically similar at 0.6, 0.8 and 1.2 of
+// its size (dynamically_scaled: lengths x L, times x sqrt(L), forces x L^3, moments x L^4) and
+// scales the validation's own thresholds alike: on the example walk every row keeps its stances,
+// each scaled stance's vertical error in newtons is about L^3 times the recorded one's, and its
+// rRMSE stays within a tenth of it (what is left is owed to the settings in absolute units).
+TEST(Study, SubjectScaleStudyScalesTheSubjectItsPlatesAndTheValidation) {
+  const Trial walk = make_example_walk();
+  const Trial small = dynamically_scaled(walk, 0.6);
+  ASSERT_TRUE(small.plates && walk.plates);
+  const auto& p = walk.plates->plates[0];
+  const auto& q = small.plates->plates[0];
+  EXPECT_NEAR(q.force_N.cwiseAbs().maxCoeff(), 0.216 * p.force_N.cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_NEAR(q.centre_m.x(), 0.6 * p.centre_m.x(), 1e-12);
+  EXPECT_NEAR(small.markers.time_s[10], std::sqrt(0.6) * walk.markers.time_s[10], 1e-12);
+  EXPECT_NEAR(small.plates->rate_hz, walk.plates->rate_hz / std::sqrt(0.6), 1e-9);
+  EXPECT_THROW((void)dynamically_scaled(walk, 0.0), InputError);
+
+  StudyTrial t;
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  t.name = "walk", t.activity = "walking", t.lab = "lab", t.trial = &walk, t.plates = &*walk.plates, t.marker_set = &set;
+  const StudyResult r = run_study("subject-scale", {t});
+  ASSERT_EQ(r.rows.size(), 4u);
+  EXPECT_TRUE(r.failures.empty());
+  EXPECT_TRUE(r.rows[0].is_default);
+  const auto& recorded = r.per_trial[0][0].stances;
+  ASSERT_GT(recorded.size(), 0u);
+  for (std::size_t k = 1; k < r.rows.size(); ++k) {
+    const double L = r.rows[k].value;
+    const auto& scaled = r.per_trial[k][0].stances;
+    ASSERT_EQ(scaled.size(), recorded.size()) << r.rows[k].label;
+    for (std::size_t s = 0; s < scaled.size(); ++s) {
+      const double a = recorded[s].metrics.vertical->rrmse_percent, b = scaled[s].metrics.vertical->rrmse_percent;
+      EXPECT_NEAR(b, a, 0.1 * a + 0.5) << r.rows[k].label << " stance " << s;
+      EXPECT_NEAR(scaled[s].metrics.vertical->rmse / (L * L * L), recorded[s].metrics.vertical->rmse, 0.25 * recorded[s].metrics.vertical->rmse + 2.0)
+          << r.rows[k].label << " stance " << s;
+    }
+  }
+}

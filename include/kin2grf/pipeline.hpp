@@ -86,6 +86,17 @@ struct EstimateOptions {
   double kinematic_edge_span_periods = kCurvatureSpanPeriods;
   /// The torso's hip-shoulder length: measured per frame (kin2grf) or fixed (the paper).
   TorsoLength torso_length = TorsoLength::Measured;
+  /// The torque-scaled multiplier norm's lever (SolverOptions::torque_length_m) as this multiple
+  /// of the subject's leg length (thigh + shank, the mean of the two sides), so that the joint
+  /// torques weigh against the contact forces in the least squares of Eq. 7 as they would for a
+  /// subject of any size: a torque is a force times a lever, a child's torques are smaller than
+  /// an adult's by one length more than its forces, and the leg is the lever of the ground
+  /// reaction about the hip. 0: the fixed SolverOptions::torque_length_m (0.9 m, kin2grf's lever
+  /// until session 39). 1.06 is that lever for the development subjects' mean leg of 0.85 m
+  /// (0.76-0.90 m over the 16 trials), not fitted: the same weighting for an average adult, scaled
+  /// for a child or a tall subject (`kin2grf study subject-scale`; `kin2grf study torque-length`
+  /// for the ratio, docs/METHOD-NOTES.md).
+  double torque_length_legs = 1.06;
   /// The upper body's fore-aft lag behind the pelvis, s (kin2grf): the HAT COM's fore-aft
   /// acceleration is delayed (lag_torso_fore_aft) by this time less what the trunk
   /// markers already lag the hip by (measured_torso_lag_s), never below 0. 0: none (the paper).

@@ -80,6 +80,13 @@ void add_marker_noise(MarkerTrajectories& m, double sigma_m, unsigned seed);
 /// factor 1 returns the markers as they are; factor < 1 is an InputError.
 MarkerTrajectories decimated(MarkerTrajectories m, int factor);
 
+/// A dynamically similar subject (Froude similarity, Alexander and Jayes 1983: the same gait at
+/// the same speed / sqrt(g L)): every length times `length_scale` L, every time times sqrt(L), so
+/// velocities scale by sqrt(L) and accelerations not at all, as gravity does not. The markers keep
+/// their samples at rate_hz / sqrt(L). A subject 0.6 times as tall walking at the same Froude
+/// number: a child's gait, faster in cadence. The subject-scale study; InputError for L <= 0.
+MarkerTrajectories dynamically_scaled(MarkerTrajectories m, double length_scale);
+
 /// The whole factor that brings `rate_hz` nearest to `target_hz` (at least 1: never upsampled).
 int decimation_factor(double rate_hz, double target_hz);
 
@@ -125,6 +132,10 @@ struct Event {
   double time_s = 0.0;
 };
 
+/// The plates of a dynamically similar subject (see the markers' dynamically_scaled): its mass
+/// scales by L^3, so forces by L^3, moments by L^4, places by L, times by sqrt(L).
+ForcePlateRecording dynamically_scaled(ForcePlateRecording r, double length_scale);
+
 /// A loaded trial: what `kin2grf info` describes.
 struct Trial {
   std::string path;
@@ -143,5 +154,9 @@ struct Trial {
   std::vector<std::string> model_outputs;  ///< C3D points that are model outputs, not markers
   std::vector<std::string> warnings;
 };
+
+/// The whole trial of a dynamically similar subject: markers, plates, events, the body mass
+/// (L^3), height and joint widths.
+Trial dynamically_scaled(Trial t, double length_scale);
 
 }  // namespace kin2grf

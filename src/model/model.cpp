@@ -30,6 +30,11 @@ Eigen::VectorXd Model::gravity_force() const {
   return f;
 }
 
+double leg_length_m(const Model& model) {
+  const auto& b = model.bodies;
+  return 0.5 * (b[kThighR].length_m + b[kShankR].length_m + b[kThighL].length_m + b[kShankL].length_m);
+}
+
 Model build_model(const BodyGeometry& g, double mass, const AnthropometricTable& t) {
   if (!(mass > 0) || mass > 500) throw InputError("body mass " + std::to_string(mass) + " kg is not plausible");
   Model m;

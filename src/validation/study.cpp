@@ -36,6 +36,9 @@ struct Setting {
   /// The `toe-ablation` study: each hallux made of a marker replaced by virtual toes of this share
   /// of the ankle-MT length (0: as recorded).
   double virtual_toes = 0.0;
+  /// The `subject-scale` study: the trial's subject made dynamically similar at this length scale
+  /// (dynamically_scaled in trial.hpp; 1: as recorded).
+  double body_scale = 1.0;
 };
 
 /// Marks the settings that leave the fields `get` reads at kin2grf's defaults (the added marker
@@ -249,6 +252,32 @@ std::vector<Setting> toe_ablation_settings() {
   return s;
 }
 
+/// Robustness to the subject's size: every trial as recorded and its subject made dynamically
+/// similar at 0.6, 0.8 and 1.2 times its size (Froude similarity: lengths times L, times times
+/// sqrt(L), the mass and so the plates' forces times L^3; dynamically_scaled in trial.hpp), the
+/// validation's own lengths, forces and speeds scaled alike. The true ground reactions in body
+/// weights are the same gait's, so a method all of whose rules scale with the subject scores the
+/// same in every row; what changes is owed to a rule in metres, newtons, m/s or hertz that does
+/// not (0.6: a child of about 1.05 m, faster in cadence by 1.29; 1.2: a tall adult). The markers'
+/// own noise scales with them here, where a real child's markers would be as noisy as an adult's.
+std::vector<Setting> subject_scale_settings() {
+  return condition_settings(1.0, {0.6, 0.8, 1.2}, "subject x %.1f", [](Setting& c, double L) { c.body_scale = L; });
+}
+
+/// The validation's lengths, forces and speeds for a subject dynamically scaled by L (the
+/// subject-scale study), so that only the estimate's own rules can change the figures.
+ValidationOptions scaled_validation(double L) {
+  ValidationOptions v;
+  const double force = L * L * L;
+  v.threshold_N *= force;
+  v.max_assign_distance_m *= L;
+  v.max_cop_beyond_foot_m *= L;
+  v.ground_contact_height_m *= L;
+  v.edge_margin_m *= L;
+  v.still_speed_mps *= std::sqrt(L);
+  return v;
+}
+
 /// Robustness to markers lost for a while (occluded by the other foot over a plate, a marker
 /// fallen off): the heel markers, then the MT markers, of both feet lost for 0.2 s at the middle
 /// of every plate's loaded run, with the rigid fill off (the gap ends the processed window, as
@@ -328,6 +357,7 @@ const std::vector<StudyKind>& special_studies() {
       {"trial-cut", trial_cut_settings},
       {"marker-gaps", marker_gaps_settings},
       {"toe-ablation", toe_ablation_settings},
+      {"subject-scale", subject_scale_settings},
       {"torso-length", torso_length_settings},
       {"kinematic-edges", kinematic_edges_settings},
       {"foot-model", foot_model_settings},
@@ -414,12 +444,28 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
       ablated = std::move(toeless);
     }
     const int factor = s.marker_rate_hz > 0 ? decimation_factor(d.trial->markers.rate_hz, s.marker_rate_hz) : 1;
-    const bool changed = s.marker_noise_m > 0 || factor > 1 || s.cut_margin_s >= 0 || s.gap_s > 0;
+    const bool scaled = s.body_scale != 1.0;
+    const bool changed = s.marker_noise_m > 0 || factor > 1 || s.cut_margin_s >= 0 || s.gap_s > 0 || scaled;
+    // A dynamically similar subject: its static trial, plates, mass and floor scaled with it.
+    std::optional<Trial> scaled_static;
+    std::optional<ForcePlateRecording> scaled_plates;
+    ValidationOptions vo;
+    if (scaled) {
+      const double L = s.body_scale;
+      if (d.static_trial) scaled_static = dynamically_scaled(*d.static_trial, L);
+      scaled_plates = dynamically_scaled(*d.plates, L);
+      if (o.mass_kg) *o.mass_kg *= L * L * L;
+      if (o.ground_level_m) *o.ground_level_m *= L;
+      o.allow_unusual_mass = true;  // a 47.5 kg subject at 0.6 weighs 10 kg
+      vo = scaled_validation(L);
+    }
+    const Trial* static_trial = scaled_static ? &*scaled_static : d.static_trial;
+    const ForcePlateRecording& plates = scaled_plates ? *scaled_plates : *d.plates;
     for (int seed = 1; seed <= draws; ++seed) {
       // The trial as recorded, or a copy cut short or with the setting's noise or capture rate.
       Trial working;
       if (changed) {
-        working = *d.trial;
+        working = scaled ? dynamically_scaled(*d.trial, s.body_scale) : *d.trial;
         if (s.cut_margin_s >= 0) working.markers = cut_to_plates(working.markers, *d.plates, s.cut_margin_s);
         if (s.gap_s > 0) {
           const MarkerSet& set = ablated ? *ablated : *d.marker_set;
@@ -431,8 +477,8 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
         if (factor > 1) working.markers = decimated(std::move(working.markers), factor);
         if (s.marker_noise_m > 0) add_marker_noise(working.markers, s.marker_noise_m, static_cast<unsigned>(seed));
       }
-      const EstimateResult e = estimate(changed ? working : *d.trial, d.static_trial, ablated ? *ablated : *d.marker_set, o);
-      const ValidationResult v = validate(e, *d.plates);
+      const EstimateResult e = estimate(changed ? working : *d.trial, static_trial, ablated ? *ablated : *d.marker_set, o);
+      const ValidationResult v = validate(e, plates, vo);
       tr.stances.insert(tr.stances.end(), v.stances.begin(), v.stances.end());
       if (v.total && v.total->metrics.moment) grm_sum += v.total->metrics.moment->rrmse_percent, ++grm_n;
     }

@@ -114,6 +114,10 @@ struct BodyGeometry {
   std::array<Eigen::Vector2d, 2> heel_local{Eigen::Vector2d(-0.06, -0.04), Eigen::Vector2d(-0.06, -0.04)};
 };
 
+/// The subject's leg length (m): thigh plus shank, the mean of the two sides (hip centre to
+/// ankle centre along the segments).
+double leg_length_m(const Model& model);
+
 /// Masses and inertias from the table; geometry as given. Built once per trial and const
 /// afterwards: what else the trial fixes (the floor, the soles, the belt) is its TrialCalibration
 /// (dynamics/contact.hpp).
