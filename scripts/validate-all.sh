@@ -41,7 +41,7 @@ done
 # Every setting chosen from data, chosen again leave-one-lab-out (in-sample beside held-out).
 for kind in speed-gate-ratio r split-distance torso-length torso-lag post-cutoff-cycles double-support-sta min-kinematic-cycles \
   touchdown-fraction touchdown-stop post-cutoff-floor speed-gate-floor speed-gate-standstill running-sway-gain thigh-lag \
-  torso-vertical-cutoff double-support-angle still-foot kinematic-edges kinematic-edge-span; do
+  torso-vertical-cutoff double-support-angle still-foot kinematic-edges kinematic-edge-span torque-length; do
   $BIN study "$kind" --trial-list "$OUT/trials.txt" --cross-validate lab --json "$OUT/cv-$kind.json" >"$OUT/cv-$kind.txt" 2>/dev/null
   echo "cross-validated $kind"
 done
