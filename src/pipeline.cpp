@@ -133,6 +133,8 @@ void check_options(const EstimateOptions& o) {
           "speed gate at standstill (m/s)", o.contact.speed_gate.standstill_mps, "between 0 and 20");
   require(finite(o.solver.min_split_distance_m) && o.solver.min_split_distance_m >= 0 && o.solver.min_split_distance_m <= 1,
           "split distance (m)", o.solver.min_split_distance_m, "between 0 (none) and 1");
+  require(finite(o.lag_reference_leg_m) && o.lag_reference_leg_m >= 0 && o.lag_reference_leg_m <= 3, "lags' reference leg (m)",
+          o.lag_reference_leg_m, "between 0 (the lags as given) and 3");
   require(finite(o.torque_length_legs) && o.torque_length_legs >= 0 && o.torque_length_legs <= 10, "torque length (leg lengths)",
           o.torque_length_legs, "between 0 (the fixed lever) and 10");
   require(finite(o.torso_lag_s) && o.torso_lag_s >= 0 && o.torso_lag_s <= 0.2, "torso lag (s)", o.torso_lag_s,
@@ -750,14 +752,22 @@ DynamicsPass dynamics_pass(const EstimateOptions& o, const Model& model, const C
   using clock = std::chrono::steady_clock;
   const auto ta = clock::now();
   DynamicsPass pass;
-  Messages lag = lag_torso_stage(o, motion, pass.torso_lag_added_s);
+  // The lags as this subject's (EstimateOptions::lag_reference_leg_m): a subject's soft tissue
+  // follows its gait's own time scale, sqrt(leg length) at a given Froude number.
+  EstimateOptions lags = o;
+  if (o.lag_reference_leg_m > 0) {
+    const double f = std::sqrt(leg_length_m(model) / o.lag_reference_leg_m);
+    lags.torso_lag_s *= f;
+    lags.thigh_lag_s *= f;
+  }
+  Messages lag = lag_torso_stage(lags, motion, pass.torso_lag_added_s);
   pass.plan = contact_stage(o, model, soles, treadmill, hip_speed_mps, motion);
   // The contact plan reads no fore-aft acceleration, so the thighs' lag may follow it and take its
   // flight phases. Its flight test reads the vertical, the chain's; the torso's vertical smoothing,
   // only in a trial where that test finds no flight, then replaces the HAT's for the solve.
   const auto& flight = pass.plan.near_flight;
   const bool has_flight = std::find(flight.begin(), flight.end(), true) != flight.end();
-  append(lag, lag_thigh_stage(o, motion, knee_on_bone, has_flight));
+  append(lag, lag_thigh_stage(lags, motion, knee_on_bone, has_flight));
   append(lag, smooth_torso_vertical_stage(o, motion, kinematic_cutoff_hz, has_flight));
   pass.plan.messages.insert(pass.plan.messages.begin(), std::make_move_iterator(lag.begin()), std::make_move_iterator(lag.end()));
   const auto tb = clock::now();
