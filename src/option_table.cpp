@@ -48,7 +48,8 @@ const std::vector<NumericOption>& numeric_options() {
       {"split-distance", "min_split_distance_m", [](O& o) -> double& { return o.solver.min_split_distance_m; }, 0.0, 1.0, 0.0,
        "Feet closer than this along progression share the load by the minimum norm, m (0 = off, the paper)",
        {0.0, 0.05, 0.1, 0.15, 0.2}, "%.2f m", 1.0, "off"},
-      // The lever in leg lengths; 0 keeps the fixed 0.9 m (the default until it is chosen held out).
+      // The lever in leg lengths: 1.06 is the fixed 0.9 m of sessions before 39 for the development
+      // subjects' mean leg (0.85 m), not chosen from the grid (VALIDATION.md); 0 keeps the fixed 0.9 m.
       {"torque-length", "torque_length_legs", [](O& o) -> double& { return o.torque_length_legs; }, 0.0, 10.0, std::nullopt,
        "The multiplier norm's joint torques are divided by this multiple of the subject's leg length (thigh + shank), so that "
        "they weigh against the contact forces as for a subject of any size; 0 = a fixed 0.9 m",

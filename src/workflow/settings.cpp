@@ -327,7 +327,9 @@ void apply_frame_range(Trial& t, const std::string& range) {
   } catch (const InputError& e) {
     throw InputError(t.path + ": --frames " + range + ": " + e.what());
   }
-  if (seen_first >= 0 && (first_file + seen_last < a || first_file + seen_first > b))
+  const bool seen = std::any_of(t.markers.positions_m.begin(), t.markers.positions_m.end(),
+                                [](const Eigen::MatrixX3d& P) { return P.array().isFinite().rowwise().all().any(); });
+  if (seen_first >= 0 && !seen)
     throw InputError(t.path + ": --frames " + range + ": no marker holds a sample in frames " + std::to_string(a) + "-" + std::to_string(b) +
                      " (the markers hold samples in frames " + std::to_string(first_file + seen_first) + "-" +
                      std::to_string(first_file + seen_last) + ")");
