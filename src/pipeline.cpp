@@ -133,8 +133,8 @@ void check_options(const EstimateOptions& o) {
           "speed gate at standstill (m/s)", o.contact.speed_gate.standstill_mps, "between 0 and 20");
   require(finite(o.solver.min_split_distance_m) && o.solver.min_split_distance_m >= 0 && o.solver.min_split_distance_m <= 1,
           "split distance (m)", o.solver.min_split_distance_m, "between 0 (none) and 1");
-  require(finite(o.lag_reference_leg_m) && o.lag_reference_leg_m >= 0 && o.lag_reference_leg_m <= 3, "lags' reference leg (m)",
-          o.lag_reference_leg_m, "between 0 (the lags as given) and 3");
+  require(finite(o.time_scale_leg_m) && o.time_scale_leg_m >= 0 && o.time_scale_leg_m <= 3, "time scale's leg (m)",
+          o.time_scale_leg_m, "between 0 (the settings as given) and 3");
   require(finite(o.torque_length_legs) && o.torque_length_legs >= 0 && o.torque_length_legs <= 10, "torque length (leg lengths)",
           o.torque_length_legs, "between 0 (the fixed lever) and 10");
   require(finite(o.torso_lag_s) && o.torso_lag_s >= 0 && o.torso_lag_s <= 0.2, "torso lag (s)", o.torso_lag_s,
@@ -194,6 +194,30 @@ double lateral_cutoff(const EstimateOptions& o, double kinematic_cutoff_hz) {
 SolverOptions solver_options_for(const EstimateOptions& o, const Model& model) {
   SolverOptions s = o.solver;
   if (o.torque_length_legs > 0) s.torque_length_m = o.torque_length_legs * leg_length_m(model);
+  return s;
+}
+
+/// The settings in seconds and hertz as this subject's (EstimateOptions::time_scale_leg_m): scaled
+/// by sqrt(leg / the reference leg), its gait's time scale at the same Froude number; said in
+/// `messages`. The options as given when it is 0.
+EstimateOptions subject_time_scaled(const EstimateOptions& o, const Model& model, double rate_hz, Messages& messages) {
+  if (!(o.time_scale_leg_m > 0)) return o;
+  const double leg = leg_length_m(model), f = std::sqrt(leg / o.time_scale_leg_m);
+  EstimateOptions s = o;
+  // A raised cut-off stays below what a zero-lag filter at this marker rate takes.
+  const double limit = 0.95 * max_zero_lag_cutoff_hz(rate_hz);
+  s.kinematic_cutoff_hz = std::min(s.kinematic_cutoff_hz / f, std::max(limit, o.kinematic_cutoff_hz));
+  s.post_cutoff_hz = std::min(s.post_cutoff_hz / f, std::max(limit, o.post_cutoff_hz));
+  s.torso_vertical_cutoff_hz /= f;
+  s.lateral_cutoff_hz /= f;
+  s.torso_lag_s *= f;
+  s.thigh_lag_s *= f;
+  char b[260];
+  std::snprintf(b, sizeof b,
+                "time scale: the leg (thigh + shank) is %.3f m against the settings' %.3f m, so their cut-offs are divided and their lags "
+                "multiplied by %.3f (kinematic cut-off %.2f Hz, lags %.0f ms)",
+                leg, o.time_scale_leg_m, f, s.kinematic_cutoff_hz, 1000 * s.torso_lag_s);
+  messages.emplace_back(b);
   return s;
 }
 
@@ -752,22 +776,14 @@ DynamicsPass dynamics_pass(const EstimateOptions& o, const Model& model, const C
   using clock = std::chrono::steady_clock;
   const auto ta = clock::now();
   DynamicsPass pass;
-  // The lags as this subject's (EstimateOptions::lag_reference_leg_m): a subject's soft tissue
-  // follows its gait's own time scale, sqrt(leg length) at a given Froude number.
-  EstimateOptions lags = o;
-  if (o.lag_reference_leg_m > 0) {
-    const double f = std::sqrt(leg_length_m(model) / o.lag_reference_leg_m);
-    lags.torso_lag_s *= f;
-    lags.thigh_lag_s *= f;
-  }
-  Messages lag = lag_torso_stage(lags, motion, pass.torso_lag_added_s);
+  Messages lag = lag_torso_stage(o, motion, pass.torso_lag_added_s);
   pass.plan = contact_stage(o, model, soles, treadmill, hip_speed_mps, motion);
   // The contact plan reads no fore-aft acceleration, so the thighs' lag may follow it and take its
   // flight phases. Its flight test reads the vertical, the chain's; the torso's vertical smoothing,
   // only in a trial where that test finds no flight, then replaces the HAT's for the solve.
   const auto& flight = pass.plan.near_flight;
   const bool has_flight = std::find(flight.begin(), flight.end(), true) != flight.end();
-  append(lag, lag_thigh_stage(lags, motion, knee_on_bone, has_flight));
+  append(lag, lag_thigh_stage(o, motion, knee_on_bone, has_flight));
   append(lag, smooth_torso_vertical_stage(o, motion, kinematic_cutoff_hz, has_flight));
   pass.plan.messages.insert(pass.plan.messages.begin(), std::make_move_iterator(lag.begin()), std::make_move_iterator(lag.end()));
   const auto tb = clock::now();
@@ -1361,13 +1377,16 @@ EstimateResult assemble_result(const std::string& marker_set, double mass_kg, Sa
 /// once the landmarks are made. The stages in order, each taking what it reads and returning
 /// what it makes; the result is assembled at the end.
 EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* static_trial, const MarkerSet& set,
-                             const EstimateOptions& o) {
+                             const EstimateOptions& given) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
-  check_options(o);
-  const double mass_kg = resolve_mass(trial, o);
-  SagittalStage sag = sagittal_stage(trial, release, static_trial, set, o);
-  ModelStage mod = model_stage(o, sag.landmarks, mass_kg);
+  check_options(given);
+  const double mass_kg = resolve_mass(trial, given);
+  SagittalStage sag = sagittal_stage(trial, release, static_trial, set, given);
+  ModelStage mod = model_stage(given, sag.landmarks, mass_kg);
+  // From here the settings in seconds and hertz are this subject's (the sagittal stage and the
+  // model read none of them).
+  const EstimateOptions o = subject_time_scaled(given, *mod.model, sag.landmarks.rate_hz, mod.messages);
   // The frontal split's whole-body balance (its COM's lateral place and lateral inertial force),
   // made once the model's masses are known; the landmarks' sums and (the sagittal model) the
   // lateral axes go then, before the kinematics (a long trial's peak memory is there).

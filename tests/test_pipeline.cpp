@@ -1641,15 +1641,12 @@ TEST(LateralCop, LateralMarkersMoveTheCopLineAndTheJointCentresMediallyOnly) {
 }
 
 namespace {
-/// The options in absolute units (Hz, m/s, m, N/m) for a subject dynamically scaled by L
-/// (dynamically_scaled in trial.hpp): times by sqrt(L), lengths by L, r (force per gap) by L^2.
-/// Not the norm's lever nor the lags: the estimate scales them with the subject's leg.
+/// The options in absolute units (m/s, m, N/m) for a subject dynamically scaled by L
+/// (dynamically_scaled in trial.hpp): speeds by sqrt(L), lengths by L, r (force per gap) by L^2.
+/// Not the norm's lever nor the settings in seconds and hertz: the estimate scales them with the
+/// subject's leg (the latter with EstimateOptions::time_scale_leg_m).
 EstimateOptions dynamically_scaled_options(EstimateOptions o, double L) {
   const double t = std::sqrt(L);
-  o.kinematic_cutoff_hz /= t;
-  o.post_cutoff_hz /= t;
-  o.torso_vertical_cutoff_hz /= t;
-  o.lateral_cutoff_hz /= t;
   o.contact.speed_gate.floor_mps *= t;
   o.contact.speed_gate.standstill_mps *= t;
   o.contact.still_foot_rad_per_s /= t;
@@ -1664,8 +1661,8 @@ EstimateOptions dynamically_scaled_options(EstimateOptions o, double L) {
 // same ground reactions in body weights, with every setting in absolute units scaled alike: the
 // multiplier norm's lever is the subject's leg length (EstimateOptions::torque_length_legs), so
 // its joint torques, one length smaller than an adult's relative to its forces, weigh against the
-// contact forces as an adult's do, and (when asked) the torso's and thighs' lags follow its gait's
-// time scale (EstimateOptions::lag_reference_leg_m). With the fixed 0.9 m lever a child's torques weigh too
+// contact forces as an adult's do, and (when asked) its settings in seconds and hertz follow its
+// gait's time scale (EstimateOptions::time_scale_leg_m). With the fixed 0.9 m lever a child's torques weigh too
 // little and the double supports' fore-aft split moves; with an adult's lags its fore-aft forces
 // are delayed too long.
 TEST(Estimate, ADynamicallySimilarSmallerSubjectSharesItsDoubleSupportsAsTheLargerOne) {
@@ -1691,12 +1688,16 @@ TEST(Estimate, ADynamicallySimilarSmallerSubjectSharesItsDoubleSupportsAsTheLarg
     EXPECT_GT(both, 20);
     return std::sqrt(sum / (2.0 * std::max(both, 1)));
   };
-  EstimateOptions legs, fixed_lever, fixed_lags;
-  legs.lag_reference_leg_m = fixed_lever.lag_reference_leg_m = 0.85;  // off by default: it ties on the adults
+  EstimateOptions legs, fixed_lever, adults_times;
+  legs.time_scale_leg_m = fixed_lever.time_scale_leg_m = 0.85;  // off by default: mixed on the adults
   fixed_lever.torque_length_legs = 0.0;
-  // 0.4 % body weight RMS with the leg's lever and lags (the rest at the trailing foot's last
-  // frames, its release), 3.7 % with the fixed 0.9 m lever, 1.2 % with the adults' 30 ms lags.
+  // 0.4 % body weight RMS with the leg's lever and time scale (the rest at the trailing foot's
+  // last frames, its release), 3.7 % with the fixed 0.9 m lever, 1.2 % with the adults' cut-offs
+  // and lags.
   EXPECT_LT(fore_aft_rms(legs), 0.006);
   EXPECT_GT(fore_aft_rms(fixed_lever), 0.025);
-  EXPECT_GT(fore_aft_rms(fixed_lags), 0.008);
+  EXPECT_GT(fore_aft_rms(adults_times), 0.008);
+  // The time scale says what it did.
+  const EstimateResult small_scaled = estimate(small, nullptr, set, dynamically_scaled_options(legs, L));
+  EXPECT_TRUE(said(small_scaled, "time scale: the leg (thigh + shank) is"));
 }

@@ -111,15 +111,18 @@ struct EstimateOptions {
   /// session 30, when each foot's force angle kept through the double support moved every lab's
   /// held-out choice to 30 ms).
   double thigh_lag_s = 0.03;
-  /// The leg length (thigh + shank, m) torso_lag_s and thigh_lag_s are for: a subject's lags are
-  /// them times sqrt(its leg / this), the time scale of its gait at the same Froude number (a child
-  /// 0.6 times an adult's size walks the same gait at sqrt(0.6) of its times; Alexander and Jayes
-  /// 1983). 0.85 m would be the development subjects' mean leg (0.76-0.90 m), at which the lags
-  /// were chosen. 0 (the default): the lags as given, whatever the subject's size. Measured, not
-  /// the default: on the development adults it ties (criterion 8.381 against 8.380 %), on their
-  /// subjects made 0.6 of their size it takes walking anterior 8.05 -> 7.40 % (`kin2grf study
-  /// subject-scale`, docs/METHOD-NOTES.md); a pediatric lab may set it.
-  double lag_reference_leg_m = 0.0;
+  /// The leg length (thigh + shank, m) the settings in seconds and hertz are for: the kinematic,
+  /// torso-vertical, lateral and fixed post-filter cut-offs and the torso's and thighs' lags. A
+  /// subject's are scaled by sqrt(its leg / this), the time scale of its gait at the same Froude
+  /// number (a child 0.6 times an adult's size walks the same gait at sqrt(0.6) of its times;
+  /// Alexander and Jayes 1983): cut-offs divided by it, lags multiplied. 0.85 m is the development
+  /// subjects' mean leg (0.76-0.90 m), at which those settings were chosen. 0 (the default): as
+  /// given, whatever the subject's size. Measured, not the default: on the development adults the
+  /// criterion goes 8.380 -> 8.369 % but mixed (walking vertical better, running's and the GRM
+  /// worse by hundredths); on their subjects made 0.6 of their size it takes walking 5.71 / 8.05 %
+  /// vertical / anterior to 5.4 / 7.4 % and running 5.79 / 11.28 % to 4.6 / 9.9 % (`kin2grf study
+  /// subject-scale`, docs/METHOD-NOTES.md): a pediatric lab sets it.
+  double time_scale_leg_m = 0.0;
   /// The upper body's vertical smoothing, Hz (kin2grf): the HAT COM's vertical acceleration is
   /// low-passed at this cut-off (smooth_torso_vertical), since the pelvis markers carry the heel
   /// strike's jolt that the upper body's mass does not pass on. A trial with flight phases (a
