@@ -683,3 +683,42 @@ TEST(Validate, APlateAtAnAngleCoversItsRectangleNotItsExtent) {
   EXPECT_TRUE(m.covers(0.62 * ex.x(), -0.62 * ex.y(), 0.05));
   EXPECT_FALSE(m.covers(-0.62 * ey.x(), 0.62 * ey.y(), 0.05));
 }
+
+// A trial that starts and ends on the plates (a squat, a standing start: the paper's unilateral
+// squat jump begins standing still on the plate) has its stances cut by the processed window's
+// ends. They are compared as cut stances: listed with their figures and the vertical RMSE in % body
+// weight, with no onset or offset at the window's edge, and kept out of the means and the totals;
+// a stance cut by the plate recording's own ends is still excluded. Before, none was compared.
+TEST(Validate, StancesCutByTheWindowAreComparedApartFromTheMeans) {
+  auto s = synthetic_with_exact_plates();
+  const auto whole = example_plates(s.estimate, s.trial, 0);  // loaded from the first frame to the last
+  const ValidationResult v = validate(s.estimate, whole);
+  EXPECT_TRUE(v.stances.empty());
+  ASSERT_EQ(v.cut_stances.size(), 2u);
+  for (const StanceValidation& c : v.cut_stances) {
+    ASSERT_TRUE(c.metrics.vertical.has_value());
+    EXPECT_LT(c.metrics.vertical->rmse, 0.01 * c.body_weight_N);  // the plates are the estimate's own forces
+    EXPECT_FALSE(c.onset_error_ms.has_value());
+    EXPECT_FALSE(c.offset_error_ms.has_value());
+    EXPECT_EQ(c.first, 0);
+  }
+  EXPECT_EQ(mean_rrmse(v.stances).n, 0);
+  EXPECT_FALSE(v.total.has_value());
+  const std::string table = format_validation_table("squat", v);
+  EXPECT_NE(table.find("right foot on FP1, cut"), std::string::npos) << table;
+  EXPECT_NE(table.find("vertical RMSE"), std::string::npos) << table;
+  EXPECT_EQ(table.find("no stance on a plate could be compared"), std::string::npos) << table;
+  const nlohmann::json j = validation_json("squat", s.estimate, v, nlohmann::json::object());
+  EXPECT_EQ(j["cut_stances"].size(), 2u);
+  EXPECT_EQ(j["per_foot"].size(), 0u);
+  // The same plates recorded from the trial's third frame on: the stances are cut by the
+  // recording, whose plate signal before them is unknown, not by the window.
+  auto late = whole;
+  for (auto& p : late.plates)
+    for (Eigen::Index k = 0; k < 2; ++k) p.force_N.row(k).setConstant(std::nan("")), p.moment_centre_Nm.row(k).setConstant(std::nan(""));
+  const ValidationResult w = validate(s.estimate, late);
+  EXPECT_TRUE(w.stances.empty());
+  EXPECT_TRUE(w.cut_stances.empty());
+  EXPECT_NE(std::find_if(w.excluded.begin(), w.excluded.end(), [](const std::string& x) { return x.find("cut by the plate recording") != std::string::npos; }),
+            w.excluded.end());
+}

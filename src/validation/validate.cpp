@@ -180,6 +180,7 @@ struct Candidate {
   int foot;
   double distance;
   bool kept;
+  bool cut = false;  ///< cut by the processed window's ends: ValidationResult::cut_stances, no total
 };
 
 /// How far x lies outside the span between a and b (0 inside): a COP beyond a foot's heel-toe span.
@@ -236,9 +237,9 @@ std::vector<Candidate> assign_stances(const EstimateResult& e, ValidationResult&
     for (const IndexRun& run : runs_above(mp.force_N.col(1), o.threshold_N)) {
       const std::string where = "plate " + mp.name + " " + frames_text(e, run.first, run.last);
       if (run.last - run.first < 2) continue;  // a blip, not a stance
-      if (run.first == 0 || run.last == n - 1 || !std::isfinite(mp.force_N(run.first - 1, 1)) ||
-          !std::isfinite(mp.force_N(run.last + 1, 1))) {
-        v.excluded.push_back(where + ": stance cut by the processed window's ends or the plate recording's");
+      const bool cut = run.first == 0 || run.last == n - 1;
+      if ((run.first > 0 && !std::isfinite(mp.force_N(run.first - 1, 1))) || (run.last < n - 1 && !std::isfinite(mp.force_N(run.last + 1, 1)))) {
+        v.excluded.push_back(where + ": stance cut by the plate recording's ends");
         continue;
       }
       const std::array<double, 2> dist{cop_to_foot_m(e, mp, run, 0), cop_to_foot_m(e, mp, run, 1)};
@@ -269,15 +270,22 @@ std::vector<Candidate> assign_stances(const EstimateResult& e, ValidationResult&
         v.notes.push_back("plates without geometry (GRF .mot): a foot partly off a plate or two feet on one plate cannot be checked");
         noted_geometry = true;
       }
-      cands.push_back({pi, run, foot, dist[static_cast<std::size_t>(foot)], kept});
+      if (kept && cut)
+        v.notes.push_back(where + ": stance cut by the processed window's ends; compared as a cut stance, out of the means and the "
+                                  "totals");
+      cands.push_back({pi, run, foot, dist[static_cast<std::size_t>(foot)], kept, cut});
     }
   }
-  // A foot on two plates at once.
+  // A foot on two plates at once (a cut stance there is set aside alone: it leaves a complete one be).
   for (std::size_t a = 0; a < cands.size(); ++a)
     for (std::size_t b = a + 1; b < cands.size(); ++b) {
       Candidate &ca = cands[a], &cb = cands[b];
       if (ca.foot != cb.foot || ca.plate == cb.plate) continue;
       if (ca.run.last < cb.run.first || cb.run.last < ca.run.first) continue;
+      if (ca.cut != cb.cut) {
+        (ca.cut ? ca : cb).kept = false;
+        continue;
+      }
       if (ca.kept || cb.kept)
         v.excluded.push_back(std::string("the ") + side_name(ca.foot) + " foot stands on plates " + v.plates[static_cast<std::size_t>(ca.plate)].name +
                              " and " + v.plates[static_cast<std::size_t>(cb.plate)].name + " at once (" +
@@ -443,6 +451,12 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
   }
   s.metrics.moment = compare_series(me, mm);
   stance_timing(e, mp, c, o, s);
+  if (c.cut) {
+    // The plate's onset (offset) lies outside the window: the crossing found at its edge is none.
+    if (c.run.first == 0) s.onset_error_ms.reset();
+    if (c.run.last == n - 1) s.offset_error_ms.reset();
+    return s;
+  }
   for (Eigen::Index i = 0; i < len; ++i) {
     auto& mf = v.measured_force_N[static_cast<std::size_t>(c.foot)];
     if (!std::isfinite(mf(a + i, 1))) mf.row(a + i).setZero();
@@ -489,14 +503,14 @@ std::pair<std::vector<Eigen::Index>, std::vector<unsigned>> total_frames(const E
       if (!sole_point_planted(e, side, 0, i, o) && !sole_point_planted(e, side, 1, i, o) && !sole_point_planted(e, side, 2, i, o))
         continue;
       bool on_plate = false;
-      for (const Candidate& c : cands) on_plate = on_plate || (c.kept && c.foot == side && i >= c.run.first && i <= c.run.last);
+      for (const Candidate& c : cands) on_plate = on_plate || (c.kept && !c.cut && c.foot == side && i >= c.run.first && i <= c.run.last);
       if (!on_plate) off_plate[static_cast<std::size_t>(i)] = true;
     }
     for (int pi = 0; pi < np && pi < 32; ++pi) {
       if (!(mk & (1u << pi))) continue;
       bool covered = false;
       for (const Candidate& c : cands)
-        covered = covered || (c.kept && c.plate == pi && i >= c.run.first && i <= c.run.last);
+        covered = covered || (c.kept && !c.cut && c.plate == pi && i >= c.run.first && i <= c.run.last);
       if (!covered) ok[static_cast<std::size_t>(i)] = false;
     }
   }
@@ -681,8 +695,9 @@ ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateR
                       "): check that markers and plates share one clock");
   const std::vector<Candidate> cands = assign_stances(e, v, o);
   for (const Candidate& c : cands)
-    if (c.kept) v.stances.push_back(compare_stance(e, v, c, o));
-  std::sort(v.stances.begin(), v.stances.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    if (c.kept) (c.cut ? v.cut_stances : v.stances).push_back(compare_stance(e, v, c, o));
+  for (auto* list : {&v.stances, &v.cut_stances})
+    std::sort(list->begin(), list->end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   compare_totals(e, v, cands, o);
   if (e.legs_3d) validate_joint_moments_3d(e, v);
   validate_total_3d(e, v);
@@ -927,8 +942,7 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
   j["kin2grf_version"] = KIN2GRF_VERSION;
   j["mass_kg"] = v.mass_kg;
   j["settings"] = settings;
-  j["per_foot"] = nlohmann::json::array();
-  for (const auto& s : v.stances) {
+  const auto stance_json = [&](const StanceValidation& s) {
     nlohmann::json x = component_json(s.metrics, bw);
     x["foot"] = side_name(s.foot);
     x["plate"] = s.plate;
@@ -944,8 +958,12 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
                         {"vertical_rrmse_percent", s.vertical_loaded_span ? num(s.vertical_loaded_span->rrmse_percent) : nlohmann::json(nullptr)},
                         {"vertical_rmse_percent_bw", s.vertical_loaded_span ? num(100 * s.vertical_loaded_span->rmse / bw) : nlohmann::json(nullptr)}};
     if (s.moments_3d) x["joint_moments_3d"] = joint_moments_json(*s.moments_3d);
-    j["per_foot"].push_back(x);
-  }
+    return x;
+  };
+  j["per_foot"] = nlohmann::json::array();
+  for (const auto& s : v.stances) j["per_foot"].push_back(stance_json(s));
+  j["cut_stances"] = nlohmann::json::array();
+  for (const auto& s : v.cut_stances) j["cut_stances"].push_back(stance_json(s));
   if (v.total) {
     nlohmann::json x = component_json(v.total->metrics, bw);
     x["frames_compared"] = v.total->frames.size();
@@ -1086,7 +1104,18 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
                   static_cast<long>(v.first_frame_number + s.last));
     os << buf;
   }
-  if (v.stances.empty()) os << "  (no stance on a plate could be compared)\n";
+  for (const auto& s : v.cut_stances) {
+    os << table_label(std::string(side_name(s.foot)) + " foot on " + s.plate + ", cut") << table_cell(s.metrics.vertical)
+       << table_cell(s.metrics.anterior) << table_cell(s.metrics.cop, s.cop_reference_suspect)
+       << table_cell(s.metrics.moment, s.cop_reference_suspect);
+    std::snprintf(buf, sizeof buf, "   %ld-%ld, vertical RMSE %.1f %%BW\n", static_cast<long>(v.first_frame_number + s.first),
+                  static_cast<long>(v.first_frame_number + s.last),
+                  s.metrics.vertical ? 100 * s.metrics.vertical->rmse / s.body_weight_N : std::nan(""));
+    os << buf;
+  }
+  if (!v.cut_stances.empty())
+    os << "  (cut: a stance cut by the processed window's ends, compared over its frames in the window and out of the means)\n";
+  if (v.stances.empty() && v.cut_stances.empty()) os << "  (no stance on a plate could be compared)\n";
   const MeanMetrics m = mean_rrmse(v.stances);
   if (m.n > 0)
     os << table_label("per foot, mean (SD), n = " + std::to_string(m.n)) << table_msd(m.vertical, m.vertical_sd)
