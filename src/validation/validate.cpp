@@ -271,8 +271,8 @@ std::vector<Candidate> assign_stances(const EstimateResult& e, ValidationResult&
         noted_geometry = true;
       }
       if (kept && cut)
-        v.notes.push_back(where + ": stance cut by the processed window's ends; compared as a cut stance, out of the means and the "
-                                  "totals");
+        v.notes.push_back(where + ": stance cut by the processed window's ends; compared as a cut stance, out of the means (and of "
+                                  "the totals, unless no stance is complete)");
       cands.push_back({pi, run, foot, dist[static_cast<std::size_t>(foot)], kept, cut});
     }
   }
@@ -484,6 +484,10 @@ std::pair<std::vector<Eigen::Index>, std::vector<unsigned>> total_frames(const E
   const Eigen::Index n = e.time_s.size();
   const double bw = e.mass_kg * e.model().gravity_mps2;
   const int np = static_cast<int>(v.plates.size());
+  // A cut stance counts for the total only in a trial with no complete one (standing, a squat):
+  // elsewhere the totals are the complete stances' alone.
+  const bool no_complete = std::none_of(cands.begin(), cands.end(), [](const Candidate& c) { return c.kept && !c.cut; });
+  const auto counts = [&](const Candidate& c) { return c.kept && (!c.cut || no_complete); };
   // Total: every loaded plate in a kept stance, and the plates carrying the whole body.
   std::vector<unsigned> mask(static_cast<std::size_t>(n), 0u);
   std::vector<bool> ok(static_cast<std::size_t>(n), true);
@@ -503,14 +507,14 @@ std::pair<std::vector<Eigen::Index>, std::vector<unsigned>> total_frames(const E
       if (!sole_point_planted(e, side, 0, i, o) && !sole_point_planted(e, side, 1, i, o) && !sole_point_planted(e, side, 2, i, o))
         continue;
       bool on_plate = false;
-      for (const Candidate& c : cands) on_plate = on_plate || (c.kept && !c.cut && c.foot == side && i >= c.run.first && i <= c.run.last);
+      for (const Candidate& c : cands) on_plate = on_plate || (counts(c) && c.foot == side && i >= c.run.first && i <= c.run.last);
       if (!on_plate) off_plate[static_cast<std::size_t>(i)] = true;
     }
     for (int pi = 0; pi < np && pi < 32; ++pi) {
       if (!(mk & (1u << pi))) continue;
       bool covered = false;
       for (const Candidate& c : cands)
-        covered = covered || (c.kept && !c.cut && c.plate == pi && i >= c.run.first && i <= c.run.last);
+        covered = covered || (counts(c) && c.plate == pi && i >= c.run.first && i <= c.run.last);
       if (!covered) ok[static_cast<std::size_t>(i)] = false;
     }
   }

@@ -235,9 +235,10 @@ struct ValidationResult {
   std::vector<StanceValidation> stances;
   /// Plate stances cut by the processed window's ends (a trial that starts or ends on a plate: a
   /// standing start, a squat, the paper's unilateral squat jump from standing), compared as the
-  /// others over their frames in the window, and kept out of every mean, the totals, the per-foot
-  /// measured series and the 3D moments: a part of a stance has part of its range (Eq. 12 divides
-  /// by it) and the filters see one side of it at the window's edge. No onset (offset) where the
+  /// others over their frames in the window, and kept out of every mean, the per-foot measured
+  /// series, the 3D moments and the totals (unless the trial has no complete stance, whose total is
+  /// then compared over them): a part of a stance has part of its range (Eq. 12 divides by it) and
+  /// the filters see one side of it at the window's edge. No onset (offset) where the
   /// stance begins (ends) at the window's edge. Their vertical RMSE in % body weight is the figure
   /// to read on a quiet stance, whose range is a few newtons.
   std::vector<StanceValidation> cut_stances;
