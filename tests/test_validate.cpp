@@ -704,6 +704,7 @@ TEST(Validate, StancesCutByTheWindowAreComparedApartFromTheMeans) {
     EXPECT_EQ(c.first, 0);
   }
   EXPECT_EQ(mean_rrmse(v.stances).n, 0);
+  EXPECT_TRUE(std::isfinite(v.measured_force_N[0](0, 1)));  // plotted in the report
   // No stance is complete: the total is compared over the cut ones (the plates carry the model's
   // own totals here).
   ASSERT_TRUE(v.total.has_value());

@@ -196,8 +196,9 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   for (int f = 0; f < 2; ++f) {
     const std::string foot = side_name(f);
     std::vector<std::pair<double, double>> shaded;
-    for (const auto& s : v.stances)
-      if (s.foot == f) shaded.emplace_back(e.time_s[s.first], e.time_s[s.last]);
+    for (const auto* list : {&v.stances, &v.cut_stances})
+      for (const auto& s : *list)
+        if (s.foot == f) shaded.emplace_back(e.time_s[s.first], e.time_s[s.last]);
     const auto& fe = e.feet[static_cast<std::size_t>(f)];
     const auto& mf = v.measured_force_N[static_cast<std::size_t>(f)];
     auto fig = [&](const std::string& what, const std::string& unit, const Eigen::VectorXd& est, const Eigen::VectorXd& meas) {

@@ -455,7 +455,6 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
     // The plate's onset (offset) lies outside the window: the crossing found at its edge is none.
     if (c.run.first == 0) s.onset_error_ms.reset();
     if (c.run.last == n - 1) s.offset_error_ms.reset();
-    return s;
   }
   for (Eigen::Index i = 0; i < len; ++i) {
     auto& mf = v.measured_force_N[static_cast<std::size_t>(c.foot)];

@@ -235,9 +235,9 @@ struct ValidationResult {
   std::vector<StanceValidation> stances;
   /// Plate stances cut by the processed window's ends (a trial that starts or ends on a plate: a
   /// standing start, a squat, the paper's unilateral squat jump from standing), compared as the
-  /// others over their frames in the window, and kept out of every mean, the per-foot measured
-  /// series, the 3D moments and the totals (unless the trial has no complete stance, whose total is
-  /// then compared over them): a part of a stance has part of its range (Eq. 12 divides by it) and
+  /// others over their frames in the window (their plates in the per-foot measured series, the
+  /// report's plots), and kept out of every mean, the 3D moments and the totals (unless the trial
+  /// has no complete stance, whose total is then compared over them): a part of a stance has part of its range (Eq. 12 divides by it) and
   /// the filters see one side of it at the window's edge. No onset (offset) where the
   /// stance begins (ends) at the window's edge. Their vertical RMSE in % body weight is the figure
   /// to read on a quiet stance, whose range is a few newtons.
@@ -245,7 +245,8 @@ struct ValidationResult {
   std::optional<TotalValidation> total;
   std::vector<std::string> excluded;  ///< one reason per excluded stance or window
   std::vector<std::string> notes;
-  /// Per-frame measured per-foot series (sum of the foot's kept stances; NaN elsewhere).
+  /// Per-frame measured per-foot series (sum of the foot's kept stances, the cut ones included;
+  /// NaN elsewhere): the report's plots.
   std::array<Eigen::MatrixX2d, 2> measured_force_N;
   std::array<Eigen::VectorXd, 2> measured_cop_x_m;
   /// Likewise the lateral force (N) and the COP's lateral place (m, where the COP is compared),
