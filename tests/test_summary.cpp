@@ -62,4 +62,12 @@ TEST(Summary, InfoSaysWhichMarkerSetEstimateWouldTake) {
     if (n == "R_KJC") n = "R_XYZ";
   const std::string missing = format_summary(trial_summary(t));
   EXPECT_NE(missing.find("missing knee_r: no joint centre"), std::string::npos) << missing;
+  // A label in the file but empty is named as such, not only as a landmark no label gives.
+  const int ankle = t.markers.find("R_AJC");
+  ASSERT_GE(ankle, 0);
+  t.markers.positions_m[static_cast<std::size_t>(ankle)].setConstant(std::nan(""));
+  const nlohmann::json empty = trial_summary(t);
+  ASSERT_EQ(empty["marker_set"]["too_few_samples"].size(), 1u) << empty["marker_set"].dump();
+  EXPECT_EQ(empty["marker_set"]["too_few_samples"][0].get<std::string>().rfind("R_AJC (0 of ", 0), 0u);
+  EXPECT_NE(format_summary(empty).find("left out, samples in too few frames: R_AJC (0 of"), std::string::npos);
 }

@@ -78,7 +78,7 @@ nlohmann::json trial_summary(const Trial& t, double thr) {
       set = {{"preset", p->name}};
     } else {
       const LabelMapping lm = map_marker_labels(m);
-      set = {{"preset", nullptr}, {"labels", lm.rules}, {"notes", lm.notes}, {"missing", lm.missing}};
+      set = {{"preset", nullptr}, {"labels", lm.rules}, {"notes", lm.notes}, {"missing", lm.missing}, {"too_few_samples", lm.too_few}};
     }
     s["marker_set"] = set;
   } else {
@@ -176,6 +176,8 @@ std::string format_summary(const nlohmann::json& s) {
       for (const auto& x : set["missing"]) os << "    missing " << x.get<std::string>() << "\n";
       for (const auto& x : set["labels"]) os << "    " << x.get<std::string>() << "\n";
       for (const auto& x : set["notes"]) os << "    (" << x.get<std::string>() << ")\n";
+      if (set.contains("too_few_samples"))
+        for (const auto& x : set["too_few_samples"]) os << "    left out, samples in too few frames: " << x.get<std::string>() << "\n";
     }
   }
   os << "  force plates: " << s["force_plates"].size() << "\n";
