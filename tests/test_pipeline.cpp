@@ -1662,9 +1662,9 @@ EstimateOptions dynamically_scaled_options(EstimateOptions o, double L) {
 // multiplier norm's lever is the subject's leg length (EstimateOptions::torque_length_legs), so
 // its joint torques, one length smaller than an adult's relative to its forces, weigh against the
 // contact forces as an adult's do, and (when asked) its settings in seconds and hertz follow its
-// gait's time scale (EstimateOptions::time_scale_leg_m). With the fixed 0.9 m lever a child's torques weigh too
-// little and the double supports' fore-aft split moves; with an adult's lags its fore-aft forces
-// are delayed too long.
+// gait's time scale (EstimateOptions::time_scale_leg_m). With the fixed 0.9 m lever a child's
+// torques weigh too little and the double supports' fore-aft split moves; with an adult's cut-offs
+// and lags its fore-aft forces are smoothed and delayed too much.
 TEST(Estimate, ADynamicallySimilarSmallerSubjectSharesItsDoubleSupportsAsTheLargerOne) {
   const MarkerSet& set = *find_marker_set("kin2grf-example");
   const SyntheticWalk walk = make_synthetic_walk({});
