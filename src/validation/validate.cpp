@@ -1111,10 +1111,16 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
     os << table_label(std::string(side_name(s.foot)) + " foot on " + s.plate + ", cut") << table_cell(s.metrics.vertical)
        << table_cell(s.metrics.anterior) << table_cell(s.metrics.cop, s.cop_reference_suspect)
        << table_cell(s.metrics.moment, s.cop_reference_suspect);
-    std::snprintf(buf, sizeof buf, "   %ld-%ld, vertical RMSE %.1f %%BW\n", static_cast<long>(v.first_frame_number + s.first),
+    std::snprintf(buf, sizeof buf, "   %ld-%ld, vertical RMSE %.1f %%BW", static_cast<long>(v.first_frame_number + s.first),
                   static_cast<long>(v.first_frame_number + s.last),
                   s.metrics.vertical ? 100 * s.metrics.vertical->rmse / s.body_weight_N : std::nan(""));
     os << buf;
+    // A quiet stance's COP barely moves: its error in mm, not over its range.
+    if (s.metrics.cop) {
+      std::snprintf(buf, sizeof buf, ", COP RMSE %.0f mm", 1000 * s.metrics.cop->rmse);
+      os << buf;
+    }
+    os << "\n";
   }
   if (!v.cut_stances.empty())
     os << "  (cut: a stance cut by the processed window's ends, compared over its frames in the window and out of the means)\n";
