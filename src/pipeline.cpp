@@ -385,7 +385,9 @@ ModelStage model_stage(const EstimateOptions& o, const SagittalLandmarks& lm, do
                              std::to_string(out.soles.flat_frames[static_cast<std::size_t>(s)]) +
                              " foot-flat frames for the contact calibration");
   out.soles.ground_level_m += o.contact.ground_shift_m;
-  out.model = std::make_shared<const Model>(build_model(measure_geometry(lm), mass_kg, anthropometric_table(o.anthropometry)));
+  const BodyGeometry geometry = measure_geometry(lm);
+  append(out.messages, segment_proportion_notes(geometry));
+  out.model = std::make_shared<const Model>(build_model(geometry, mass_kg, anthropometric_table(o.anthropometry)));
   return out;
 }
 

@@ -12,6 +12,7 @@
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/model/anthropometry.hpp"
+#include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
 #include "test_support.hpp"
@@ -53,4 +54,23 @@ TEST(Model, AnthropometricTablesCoverTheWholeBody) {
   EXPECT_NEAR(thigh.mass_kg, 80.0 * de_leva_table().thigh.mass_fraction, 1e-12);
   EXPECT_NEAR(thigh.inertia_kgm2, thigh.mass_kg * std::pow(de_leva_table().thigh.gyration_fraction * g.thigh[kLeft], 2), 1e-12);
   EXPECT_THROW((void)build_model(g, -1.0, de_leva_table()), InputError);
+}
+
+// A knee or ankle landmark off its joint shows in the segments' proportions (a shank 0.9-1.1 of
+// its thigh, the sides within 15 % of each other): a shank of 0.71 of its thigh is named, as UWA's
+// functional ankle centres from a walk give (0.67-0.72, where its runs give 0.91-0.94), and so are
+// sides 29 % apart; the synthetic walk as made says nothing.
+TEST(Model, AShankOutOfProportionWithItsThighIsNamed) {
+  BodyGeometry g;
+  EXPECT_TRUE(segment_proportion_notes(g).empty());
+  const EstimateResult walk = estimate(make_example_walk(), nullptr, *find_marker_set("kin2grf-example"), {});
+  for (const auto& m : walk.messages) EXPECT_EQ(m.find("seems misplaced"), std::string::npos) << m;
+  g.shank[0] = 0.30;  // against 0.42 m thighs: 0.71
+  const std::vector<std::string> notes = segment_proportion_notes(g);
+  ASSERT_EQ(notes.size(), 2u);
+  EXPECT_EQ(notes[0].rfind("shank_r is 0.300 m against its thigh's 0.420 m (0.71 of it", 0), 0u) << notes[0];
+  EXPECT_EQ(notes[1].rfind("the right shank is 0.300 m and the left 0.420 m (29 % apart)", 0), 0u) << notes[1];
+  g.shank = {0.40, 0.40};
+  g.thigh = {0.42, 0.30};  // a left thigh short: 1.33 out, and the sides apart
+  EXPECT_EQ(segment_proportion_notes(g).size(), 2u);
 }

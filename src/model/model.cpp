@@ -2,6 +2,11 @@
 
 #include "kin2grf/error.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
 namespace kin2grf {
 
 const char* joint_name(int j) {
@@ -33,6 +38,32 @@ Eigen::VectorXd Model::gravity_force() const {
 double leg_length_m(const Model& model) {
   const auto& b = model.bodies;
   return 0.5 * (b[kThighR].length_m + b[kShankR].length_m + b[kThighL].length_m + b[kShankL].length_m);
+}
+
+std::vector<std::string> segment_proportion_notes(const BodyGeometry& g) {
+  std::vector<std::string> out;
+  char b[400];
+  for (int side = 0; side < 2; ++side) {
+    const auto k = static_cast<std::size_t>(side);
+    const double ratio = g.shank[k] / g.thigh[k];
+    if (ratio < kMinShankPerThigh || ratio > kMaxShankPerThigh) {
+      std::snprintf(b, sizeof b,
+                    "%s is %.3f m against its thigh's %.3f m (%.2f of it; a shank is 0.9-1.1 of its thigh): the %s knee or "
+                    "ankle landmark seems misplaced (a functional joint centre from a small range of motion, a marker off "
+                    "its landmark): the shank's centre of mass, the foot's length and the ankle torque move with it",
+                    segment_name(segment(side, kShank)), g.shank[k], g.thigh[k], ratio, side_name(side));
+      out.emplace_back(b);
+    }
+  }
+  for (const auto& [name, lengths] : {std::pair{"thigh", g.thigh}, std::pair{"shank", g.shank}}) {
+    const double apart = std::abs(lengths[0] - lengths[1]) / std::max(lengths[0], lengths[1]);
+    if (apart > kMaxSidesApart) {
+      std::snprintf(b, sizeof b, "the right %s is %.3f m and the left %.3f m (%.0f %% apart): a landmark of one side seems misplaced",
+                    name, lengths[0], lengths[1], 100 * apart);
+      out.emplace_back(b);
+    }
+  }
+  return out;
 }
 
 Model build_model(const BodyGeometry& g, double mass, const AnthropometricTable& t) {

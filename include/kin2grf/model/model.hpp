@@ -21,6 +21,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <string>
+#include <vector>
 
 #include "kin2grf/model/anthropometry.hpp"
 
@@ -117,6 +118,15 @@ struct BodyGeometry {
 /// The subject's leg length (m): thigh plus shank, the mean of the two sides (hip centre to
 /// ankle centre along the segments).
 double leg_length_m(const Model& model);
+
+/// A shank is 0.9-1.1 times its thigh, joint centre to joint centre (Winter's 0.246 and 0.245 of
+/// the height; de Leva's 0.434 and 0.422 m, men), and a side's segment is within a few per cent of
+/// the other side's. Outside these bounds a knee or ankle landmark is misplaced (a functional
+/// joint centre from a walk's small range of motion, a marker off its landmark, a label swapped).
+inline constexpr double kMinShankPerThigh = 0.75, kMaxShankPerThigh = 1.33, kMaxSidesApart = 0.15;
+/// What the geometry's proportions say (segment_proportions' bounds above), a line each; none
+/// when they are a leg's.
+std::vector<std::string> segment_proportion_notes(const BodyGeometry& geometry);
 
 /// Masses and inertias from the table; geometry as given. Built once per trial and const
 /// afterwards: what else the trial fixes (the floor, the soles, the belt) is its TrialCalibration
