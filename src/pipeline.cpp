@@ -189,21 +189,16 @@ double lateral_cutoff(const EstimateOptions& o, double kinematic_cutoff_hz) {
   return o.lateral_cutoff_hz > 0 ? std::min(o.lateral_cutoff_hz, kinematic_cutoff_hz) : kinematic_cutoff_hz;
 }
 
-/// The solver's options for this subject: the torque-scaled norm's lever from its leg length
-/// (EstimateOptions::torque_length_legs) when asked.
-SolverOptions solver_options_for(const EstimateOptions& o, const Model& model) {
-  SolverOptions s = o.solver;
-  if (o.torque_length_legs > 0) s.torque_length_m = o.torque_length_legs * leg_length_m(model);
-  return s;
-}
-
-/// The settings in seconds and hertz as this subject's (EstimateOptions::time_scale_leg_m): scaled
-/// by sqrt(leg / the reference leg), its gait's time scale at the same Froude number; said in
-/// `messages`. The options as given when it is 0.
-EstimateOptions subject_time_scaled(const EstimateOptions& o, const Model& model, double rate_hz, Messages& messages) {
-  if (!(o.time_scale_leg_m > 0)) return o;
-  const double leg = leg_length_m(model), f = std::sqrt(leg / o.time_scale_leg_m);
+/// The options as this subject's, from its leg length: the torque-scaled norm's lever
+/// (EstimateOptions::torque_length_legs) and, when asked (EstimateOptions::time_scale_leg_m), the
+/// settings in seconds and hertz scaled by sqrt(leg / the reference leg), its gait's time scale at
+/// the same Froude number, said in `messages`. Everything after the model reads these.
+EstimateOptions options_for_subject(const EstimateOptions& o, const Model& model, double rate_hz, Messages& messages) {
   EstimateOptions s = o;
+  const double leg = leg_length_m(model);
+  if (o.torque_length_legs > 0) s.solver.torque_length_m = o.torque_length_legs * leg;
+  if (!(o.time_scale_leg_m > 0)) return s;
+  const double f = std::sqrt(leg / o.time_scale_leg_m);
   // A raised cut-off stays below what a zero-lag filter at this marker rate takes.
   const double limit = 0.95 * max_zero_lag_cutoff_hz(rate_hz);
   s.kinematic_cutoff_hz = std::min(s.kinematic_cutoff_hz / f, std::max(limit, o.kinematic_cutoff_hz));
@@ -722,7 +717,7 @@ RawSolve solve_stage(const EstimateOptions& o, const Model& model, const TrialCa
   std::vector<std::pair<std::vector<Eigen::Index>, std::vector<double>>> chunk_maps(
       keep_torque_map ? static_cast<std::size_t>(std::max(1, thread_count())) : 0);
   for_chunks(static_cast<std::size_t>(n), min_chunk_for(10e-6), [&](std::size_t chunk, std::size_t begin, std::size_t end) {
-    ContactSolver solver(model, calibration, solver_options_for(o, model));
+    ContactSolver solver(model, calibration, o.solver);
     MotionFrame f;
     FrameContacts fc;
     const auto step = std::max<std::size_t>(1, (end - begin) / 100);
@@ -843,7 +838,7 @@ Messages touchdown_stage(const EstimateOptions& o, const Model& model, const Con
   }
   if (frames == 0) return out;
   const int np = static_cast<int>(raw.point_side.size());
-  ContactSolver solver(model, plan.calibration, solver_options_for(o, model));
+  ContactSolver solver(model, plan.calibration, o.solver);
   MotionFrame f;
   FrameContacts fc;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -1386,9 +1381,9 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   const double mass_kg = resolve_mass(trial, given);
   SagittalStage sag = sagittal_stage(trial, release, static_trial, set, given);
   ModelStage mod = model_stage(given, sag.landmarks, mass_kg);
-  // From here the settings in seconds and hertz are this subject's (the sagittal stage and the
-  // model read none of them).
-  const EstimateOptions o = subject_time_scaled(given, *mod.model, sag.landmarks.rate_hz, mod.messages);
+  // From here the options are this subject's (the sagittal stage and the model read none of the
+  // settings its size changes).
+  const EstimateOptions o = options_for_subject(given, *mod.model, sag.landmarks.rate_hz, mod.messages);
   // The frontal split's whole-body balance (its COM's lateral place and lateral inertial force),
   // made once the model's masses are known; the landmarks' sums and (the sagittal model) the
   // lateral axes go then, before the kinematics (a long trial's peak memory is there).

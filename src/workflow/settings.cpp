@@ -311,25 +311,28 @@ void apply_frame_range(Trial& t, const std::string& range) {
   if (colon == std::string::npos) throw malformed();
   const int a = number(range.substr(0, colon), first_file), b = number(range.substr(colon + 1), last_file);
   if (a > b) throw InputError(t.path + ": --frames " + range + ": its first frame comes after its last");
-  // The file's frames where some marker holds a sample: a cut outside them is named as such, not
-  // left to fail later as a marker set no label matches (every label is empty there) or a walker
-  // who does not travel.
+  // A cut where no marker holds a sample is named as such, with the file's frames that hold
+  // some, not left to fail later as a marker set no label matches (every label is empty there) or
+  // a walker who does not travel. The file is scanned for those frames only then.
+  const auto sampled = [&](Eigen::Index k) {
+    return std::any_of(t.markers.positions_m.begin(), t.markers.positions_m.end(), [k](const Eigen::MatrixX3d& P) { return P.row(k).allFinite(); });
+  };
+  const Eigen::Index n = t.markers.frames(), lo = std::max<Eigen::Index>(0, a - first_file), hi = std::min<Eigen::Index>(n - 1, b - first_file);
+  bool seen = false;
+  for (Eigen::Index k = lo; k <= hi && !seen; ++k) seen = sampled(k);
   Eigen::Index seen_first = -1, seen_last = -1;
-  for (Eigen::Index k = 0; k < t.markers.frames(); ++k)
-    for (const auto& P : t.markers.positions_m)
-      if (P.row(k).allFinite()) {
-        if (seen_first < 0) seen_first = k;
-        seen_last = k;
-        break;
-      }
+  if (!seen)
+    for (Eigen::Index k = 0; k < n; ++k) {
+      if (!sampled(k)) continue;
+      if (seen_first < 0) seen_first = k;
+      seen_last = k;
+    }
   try {
     t.markers = cropped(std::move(t.markers), a - first_file, b - a + 1);  // it refuses frames the recording does not hold
   } catch (const InputError& e) {
     throw InputError(t.path + ": --frames " + range + ": " + e.what());
   }
-  const bool seen = std::any_of(t.markers.positions_m.begin(), t.markers.positions_m.end(),
-                                [](const Eigen::MatrixX3d& P) { return P.array().isFinite().rowwise().all().any(); });
-  if (seen_first >= 0 && !seen)
+  if (seen_first >= 0)
     throw InputError(t.path + ": --frames " + range + ": no marker holds a sample in frames " + std::to_string(a) + "-" + std::to_string(b) +
                      " (the markers hold samples in frames " + std::to_string(first_file + seen_first) + "-" +
                      std::to_string(first_file + seen_last) + ")");
