@@ -1276,6 +1276,77 @@ TotalsStage totals_stage(const EstimateOptions& o, const ModelMotion& motion, co
 
 }  // namespace
 
+std::vector<std::string> support_notes(const std::array<FootResult, 2>& feet, const Eigen::VectorXd& vertical_sum_N, double body_weight_N,
+                       double rate_hz, double ground_level_m, int first_frame_number) {
+  std::vector<std::string> out;
+  const Eigen::Index n = vertical_sum_N.size();
+  if (!(rate_hz > 0) || !(body_weight_N > 0)) return out;
+  const auto shortest = static_cast<Eigen::Index>(std::ceil(kSupportNoteRunS * rate_hz - 1e-9));
+  const auto frames_of = [&](const IndexRun& run) {
+    char b[120];
+    std::snprintf(b, sizeof b, "frames %ld-%ld (%.2f s)", static_cast<long>(first_frame_number + run.first),
+                  static_cast<long>(first_frame_number + run.last), static_cast<double>(run.last - run.first + 1) / rate_hz);
+    return std::string(b);
+  };
+  const auto in_contact = [&](int side, Eigen::Index i) {
+    const auto& c = feet[static_cast<std::size_t>(side)].contact;
+    return static_cast<std::size_t>(i) < c.size() && c[static_cast<std::size_t>(i)];
+  };
+  for (int side = 0; side < 2; ++side) {
+    const FootResult& f = feet[static_cast<std::size_t>(side)];
+    if (f.force_N.rows() != n || f.gap_m.size() != n) continue;
+    const auto raised = [&](Eigen::Index i) {
+      return f.force_N(i, 1) > kLoadedFootFraction * body_weight_N && std::isfinite(f.gap_m[i]) && f.gap_m[i] > kRaisedSoleM;
+    };
+    std::string where;
+    Eigen::Index frames = 0;
+    double gap_lo = std::numeric_limits<double>::infinity(), gap_hi = 0, load_hi = 0;
+    for (const IndexRun& run : runs_where(n, raised)) {
+      const Eigen::Index len = run.last - run.first + 1;
+      if (len < shortest) continue;
+      where += (where.empty() ? "" : ", ") + std::to_string(first_frame_number + run.first) + "-" +
+               std::to_string(first_frame_number + run.last);
+      frames += len;
+      gap_lo = std::min(gap_lo, f.gap_m.segment(run.first, len).minCoeff());
+      gap_hi = std::max(gap_hi, f.gap_m.segment(run.first, len).maxCoeff());
+      load_hi = std::max(load_hi, f.force_N.col(1).segment(run.first, len).maxCoeff() / body_weight_N);
+    }
+    if (frames == 0) continue;
+    char head[200], tail[80];
+    std::snprintf(head, sizeof head, "%s foot: carries up to %.2f body weights while its sole stands %.0f-%.0f mm above the floor (%.3f m), frames ",
+                  side_name(side), load_hi, 1000 * gap_lo, 1000 * gap_hi, ground_level_m);
+    std::snprintf(tail, sizeof tail, " (%.2f s)", static_cast<double>(frames) / rate_hz);
+    const std::string b = head + where + tail +
+                          ": on a box, a step or a stair? kin2grf's contact is with one level floor; the load is taken where the foot is, "
+                          "its COP on the raised sole, and the GRM's lever for the fore-aft force is the floor's height (--ground-level "
+                          "sets the floor)";
+    out.emplace_back(b);
+  }
+  const auto unsupported = [&](Eigen::Index i) {
+    return vertical_sum_N[i] > kSupportedFraction * body_weight_N && !in_contact(0, i) && !in_contact(1, i);
+  };
+  for (const IndexRun& run : runs_where(n, unsupported)) {
+    if (run.last - run.first + 1 < shortest) continue;
+    const Eigen::Index len = run.last - run.first + 1;
+    double sole_lo = std::numeric_limits<double>::infinity();
+    for (const FootResult& f : feet)
+      if (f.gap_m.size() == n) sole_lo = std::min(sole_lo, f.gap_m.segment(run.first, len).minCoeff());
+    const double ask_lo = vertical_sum_N.segment(run.first, len).minCoeff() / body_weight_N;
+    const double ask_hi = vertical_sum_N.segment(run.first, len).maxCoeff() / body_weight_N;
+    char sole[80] = "";
+    if (std::isfinite(sole_lo)) std::snprintf(sole, sizeof sole, " (the lower sole at least %.0f mm above it)", 1000 * sole_lo);
+    char b[560];
+    std::snprintf(b, sizeof b,
+                  "%s: the body's kinematics ask %.2f-%.2f body weights of the ground, yet neither foot is in contact with the "
+                  "floor at %.3f m%s: something else carries the body there (a box, a step, a chair, a handrail?) or the floor "
+                  "is elsewhere (--ground-level); the ground reaction is zero there and the residual holds that load",
+                  frames_of(run).c_str(), ask_lo, ask_hi, ground_level_m, sole);
+    out.emplace_back(b);
+  }
+  return out;
+}
+
+
 FrameTotals frame_totals(const ModelMotion& motion, const std::array<FootResult, 2>& feet, double ground_level_m,
                          const Eigen::Vector2d& grm_reference_m, Eigen::Index i) {
   FrameTotals t;
@@ -1445,6 +1516,12 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m,
                               frontal ? &*frontal : nullptr);
   frontal.reset();
+  {
+    double model_mass_kg = 0;
+    for (const Body& b : mod.model->bodies) model_mass_kg += b.mass_kg;
+    append(feet.messages, support_notes(feet.feet, vertical_force_sum_N(*mod.model, kin.motion), model_mass_kg * mod.model->gravity_mps2,
+                                        kin.motion.rate_hz, ground_level_m, sag.first_frame_number));
+  }
   if (o.lateral_force()) {
     const double cutoff = lateral_cutoff(o, kin.kinematic_cutoff_hz);
     const double lateral_lag_s = o.lateral_torso_lag && sag.trunk_measured ? dyn.torso_lag_added_s : 0.0;

@@ -473,3 +473,69 @@ TEST(Contact, AFootThatDidNotComeDownIsNeverHeldBack) {
   const auto d = frames_before_touchdown(contact_from(n, 142, 250), gap, mt, 200.0, rule);
   EXPECT_EQ(std::count(d.begin(), d.end(), true), 0);
 }
+
+// kin2grf's contact is with one level floor: a foot that carries weight far above it (a box, a
+// step, a stair) or a body held up while neither foot is in contact (a chair, a handrail) is
+// named, with the frames; a foot's impact a few centimetres up for a few frames and a flight
+// (the kinematics asking nothing of the ground) are not.
+TEST(Contact, SupportTheFloorDoesNotExplainIsNamed) {
+  const double rate_hz = 100.0, weight_N = 700.0;
+  const Eigen::Index n = 100;
+  std::array<FootResult, 2> feet;
+  for (FootResult& f : feet) {
+    f.force_N = Eigen::MatrixX2d::Zero(n, 2);
+    f.gap_m = Eigen::VectorXd::Constant(n, 0.002);
+    f.contact.assign(static_cast<std::size_t>(n), true);
+  }
+  Eigen::VectorXd ask = Eigen::VectorXd::Constant(n, weight_N);
+  // The right foot on a 17 cm step for frames 10-29 (0.2 s), carrying half the body weight.
+  for (Eigen::Index i = 10; i < 30; ++i) {
+    feet[0].force_N(i, 1) = 0.5 * weight_N;
+    feet[0].gap_m[i] = 0.17;
+  }
+  // The left foot's impact 7 cm up for 5 frames (a run's landing reads so): not a step.
+  for (Eigen::Index i = 40; i < 45; ++i) {
+    feet[1].force_N(i, 1) = 1.5 * weight_N;
+    feet[1].gap_m[i] = 0.07;
+  }
+  // Frames 50-61: neither foot in contact while the kinematics ask 0.7 body weights (held up).
+  // Frames 70-89: neither in contact and the kinematics ask 0.1 (a flight): nothing to say.
+  for (Eigen::Index i = 50; i < 90; ++i)
+    for (FootResult& f : feet) {
+      f.contact[static_cast<std::size_t>(i)] = false;
+      f.gap_m[i] = 0.3;
+    }
+  ask.segment(50, 12).setConstant(0.7 * weight_N);
+  ask.segment(62, 28).setConstant(0.1 * weight_N);
+  const auto notes = support_notes(feet, ask, weight_N, rate_hz, 0.0, 1);
+  ASSERT_EQ(notes.size(), 2u) << ::testing::PrintToString(notes);
+  EXPECT_NE(notes[0].find("right foot: carries up to 0.50 body weights while its sole stands 170-170 mm above the floor"),
+            std::string::npos)
+      << notes[0];
+  EXPECT_NE(notes[0].find("frames 11-30 (0.20 s)"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[1].find("frames 51-62 (0.12 s): the body's kinematics ask 0.70-0.70 body weights of the ground, yet neither foot"),
+            std::string::npos)
+      << notes[1];
+  // Shorter than a tenth of a second, or under the height: nothing.
+  for (Eigen::Index i = 19; i < 30; ++i) feet[0].gap_m[i] = 0.04;  // 9 frames left at 17 cm
+  ask.segment(50, 12).setConstant(0.1 * weight_N);
+  ask.segment(50, 9).setConstant(0.7 * weight_N);
+  EXPECT_TRUE(support_notes(feet, ask, weight_N, rate_hz, 0.0, 1).empty());
+}
+
+// End to end: a squat on a 17 cm step with the floor held at the lab's 0 (--ground-level 0), as a
+// stair trial's upper step stands; the same squat on the floor says nothing.
+TEST(Contact, ASquatOnAStepAboveTheFloorIsNamed) {
+  for (const double step_m : {0.0, 0.17}) {
+    SyntheticOptions so;
+    so.squat_depth = 1.0;
+    Trial t = make_synthetic_trial(so);
+    for (auto& p : t.markers.positions_m) p.col(2).array() += step_m;
+    EstimateOptions o;
+    o.ground_level_m = 0.0;
+    const auto r = estimate(t, nullptr, *find_marker_set("kin2grf-example"), o);
+    int said = 0;
+    for (const auto& m : r.messages) said += m.find("mm above the floor (0.000 m), frames 1-") != std::string::npos;
+    EXPECT_EQ(said, step_m > 0 ? 2 : 0) << step_m << ::testing::PrintToString(r.messages);
+  }
+}

@@ -347,6 +347,26 @@ struct GaitEvent {
 /// Every foot's events, in time order (at one frame: the right foot first).
 std::vector<GaitEvent> gait_events(const std::array<std::vector<bool>, 2>& contact, const Eigen::VectorXd& time_s, double rate_hz);
 
+/// Where the one level floor does not explain the support (kin2grf's contact is with a single
+/// floor, Sect. 2.3), for runs of at least kSupportNoteRunS:
+/// - a foot that carries more than kLoadedFootFraction of the body weight while its lowest sole
+///   point stands more than kRaisedSoleM above the floor: on a box, a step or a stair. A foot on
+///   the floor stands within marker placement and floor calibration of it (the development
+///   trials' loaded feet within 36 mm, a run's impact within 0.1 m for under 30 ms); a kerb, a
+///   step or a box is 0.1-0.4 m. The Alart-Curnier criterion with r = 1000 N/m lets a foot that
+///   must carry W newtons do so up to W / r above the floor, so the load is taken there, silently
+///   until this note; the COP is placed on the raised sole and the GRM's lever for the fore-aft
+///   force is the floor's height.
+/// - frames whose kinematics ask more than kSupportedFraction of the body weight of the ground
+///   (the vertical force sum m (a_y + g); a flight asks under 0.2) while neither foot is in
+///   contact: something else carries the body (a box, a chair, a handrail) or the floor is not
+///   where the contact put it. The ground reaction there is zero; the residual holds the load.
+/// `vertical_sum_N`: vertical_force_sum_N; `body_weight_N`: the model's mass times g; the frame
+/// numbers in the notes are the file's (first_frame_number + index).
+inline constexpr double kLoadedFootFraction = 0.2, kRaisedSoleM = 0.05, kSupportedFraction = 0.5, kSupportNoteRunS = 0.1;
+std::vector<std::string> support_notes(const std::array<FootResult, 2>& feet, const Eigen::VectorXd& vertical_sum_N, double body_weight_N,
+                       double rate_hz, double ground_level_m, int first_frame_number);
+
 /// A walking double support: frames [first, last] where both feet are in contact, the trailing
 /// foot alone in contact on the frame before and the leading foot alone on the frame after.
 struct DoubleSupport {

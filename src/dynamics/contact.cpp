@@ -54,6 +54,20 @@ std::array<Eigen::Vector2d, 3> sole_points(const ContactCalibration& soles, cons
   return {rA + Rf * fg.heel_local, rA + Rf * fg.mt_local, rM + Rt * fg.hallux_local};
 }
 
+Eigen::VectorXd vertical_force_sum_N(const Model& model, const ModelMotion& m) {
+  const Eigen::Index n = m.frames();
+  Eigen::VectorXd out(n);
+  MotionFrame f;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    m.frame(i, f);
+    double fy = 0;
+    for (int s = 0; s < kSegmentCount; ++s)
+      fy += model.bodies[static_cast<std::size_t>(s)].mass_kg * (f.qdd(coord::com_x(s) + 1) + model.gravity_mps2);
+    out[i] = fy;
+  }
+  return out;
+}
+
 std::vector<bool> flight_frames(const Model& model, const ModelMotion& m, const ContactCalibration& soles, double flight_fraction,
                                 double window_s, double clearance_m) {
   const Eigen::Index n = m.frames();
@@ -61,13 +75,11 @@ std::vector<bool> flight_frames(const Model& model, const ModelMotion& m, const 
   for (const Body& b : model.bodies) mass += b.mass_kg;
   const double limit = flight_fraction * mass * model.gravity_mps2;
   std::vector<bool> flight(static_cast<std::size_t>(n), false), out(static_cast<std::size_t>(n), false);
+  const Eigen::VectorXd fy = vertical_force_sum_N(model, m);
   MotionFrame f;
   for (Eigen::Index i = 0; i < n; ++i) {
+    if (!(fy[i] < limit)) continue;
     m.frame(i, f);
-    double fy = 0;
-    for (int s = 0; s < kSegmentCount; ++s)
-      fy += model.bodies[static_cast<std::size_t>(s)].mass_kg * (f.qdd(coord::com_x(s) + 1) + model.gravity_mps2);
-    if (!(fy < limit)) continue;
     bool airborne = true;
     for (int side = 0; side < 2 && airborne; ++side)
       for (const Eigen::Vector2d& p : sole_points(soles, f, side)) airborne = airborne && p.y() - soles.ground_level_m > clearance_m;

@@ -292,6 +292,10 @@ inline constexpr double kTouchdownNormalStanceS = 0.75;
 /// PiG_Motion3 -120 -> 0 ms). No stance (nullopt): the fixed values.
 TouchdownStopRule touchdown_stop_rule(double fraction, std::optional<double> stance_s);
 
+/// The whole body's vertical kinematic force sum per frame, sum m (a_y + g) over the segments
+/// (N): what the ground must carry in all (zero in free fall).
+Eigen::VectorXd vertical_force_sum_N(const Model& model, const ModelMotion& motion);
+
 /// Running frames: those within `window_s` of a flight frame, where the whole body's vertical
 /// kinematic force sum m (a_y + g) is below `flight_fraction` of body weight and no sole point of
 /// either foot is within `clearance_m` of the ground. In flight the body is in free fall (0) with
