@@ -519,6 +519,7 @@ Messages smooth_torso_vertical_stage(const EstimateOptions& o, ModelMotion& moti
 /// the speed gate) and, with the touchdown rule, each foot's landing frames (landing_frames).
 struct ContactPlan {
   std::vector<bool> near_flight;              ///< frames near a flight phase (flight_frames), on every trial
+  Eigen::VectorXd vertical_sum_N;             ///< the whole body's vertical force sum per frame (vertical_force_sum_N)
   std::vector<bool> running;                  ///< frames that take the running COP function
   std::array<std::vector<bool>, 2> landing;   ///< per side, frames where the foot is still landing (landing_frames)
   TrialCalibration calibration;
@@ -539,7 +540,8 @@ ContactPlan contact_stage(const EstimateOptions& o, const Model& model, ContactC
   // --running-cop off and the speed gate's floor at its standstill value); with the defaults the
   // flight test ran anyway.
   const SpeedGateRule& gate = co.speed_gate;
-  plan.near_flight = flight_frames(model, motion, soles);
+  plan.vertical_sum_N = vertical_force_sum_N(model, motion);
+  plan.near_flight = flight_frames(model, motion, soles, plan.vertical_sum_N);
   if (running_cop) {
     plan.running = plan.near_flight;
     const auto nrun = std::count(plan.running.begin(), plan.running.end(), true);
@@ -1519,8 +1521,9 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   {
     double model_mass_kg = 0;
     for (const Body& b : mod.model->bodies) model_mass_kg += b.mass_kg;
-    append(feet.messages, support_notes(feet.feet, vertical_force_sum_N(*mod.model, kin.motion), model_mass_kg * mod.model->gravity_mps2,
+    append(feet.messages, support_notes(feet.feet, dyn.plan.vertical_sum_N, model_mass_kg * mod.model->gravity_mps2,
                                         kin.motion.rate_hz, ground_level_m, sag.first_frame_number));
+    dyn.plan.vertical_sum_N = Eigen::VectorXd();
   }
   if (o.lateral_force()) {
     const double cutoff = lateral_cutoff(o, kin.kinematic_cutoff_hz);

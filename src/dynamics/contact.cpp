@@ -1,3 +1,4 @@
+#include <stdexcept>
 #include "kin2grf/dynamics/contact.hpp"
 
 #include "kin2grf/kinematics/filter.hpp"
@@ -70,12 +71,17 @@ Eigen::VectorXd vertical_force_sum_N(const Model& model, const ModelMotion& m) {
 
 std::vector<bool> flight_frames(const Model& model, const ModelMotion& m, const ContactCalibration& soles, double flight_fraction,
                                 double window_s, double clearance_m) {
+  return flight_frames(model, m, soles, vertical_force_sum_N(model, m), flight_fraction, window_s, clearance_m);
+}
+
+std::vector<bool> flight_frames(const Model& model, const ModelMotion& m, const ContactCalibration& soles, const Eigen::VectorXd& fy,
+                                double flight_fraction, double window_s, double clearance_m) {
   const Eigen::Index n = m.frames();
+  if (fy.size() != n) throw std::invalid_argument("flight_frames: one vertical force sum per frame");
   double mass = 0;
   for (const Body& b : model.bodies) mass += b.mass_kg;
   const double limit = flight_fraction * mass * model.gravity_mps2;
   std::vector<bool> flight(static_cast<std::size_t>(n), false), out(static_cast<std::size_t>(n), false);
-  const Eigen::VectorXd fy = vertical_force_sum_N(model, m);
   MotionFrame f;
   for (Eigen::Index i = 0; i < n; ++i) {
     if (!(fy[i] < limit)) continue;

@@ -305,6 +305,11 @@ Eigen::VectorXd vertical_force_sum_N(const Model& model, const ModelMotion& moti
 /// which the force sum alone called running. 2 cm: validation's "touches the ground" height.
 std::vector<bool> flight_frames(const Model& model, const ModelMotion& motion, const ContactCalibration& soles,
                                 double flight_fraction = 0.2, double window_s = 0.4, double clearance_m = 0.02);
+/// The same with the frames' vertical force sums already made (vertical_force_sum_N of the same
+/// model and motion).
+std::vector<bool> flight_frames(const Model& model, const ModelMotion& motion, const ContactCalibration& soles,
+                                const Eigen::VectorXd& vertical_sum_N, double flight_fraction = 0.2, double window_s = 0.4,
+                                double clearance_m = 0.02);
 
 }  // namespace kin2grf
 
