@@ -1701,3 +1701,33 @@ TEST(Estimate, ADynamicallySimilarSmallerSubjectSharesItsDoubleSupportsAsTheLarg
   const EstimateResult small_scaled = estimate(small, nullptr, set, dynamically_scaled_options(legs, L));
   EXPECT_TRUE(said(small_scaled, "time scale: the leg (thigh + shank) is"));
 }
+
+// README's MATLAB section reads the CSV with readtable, which keeps a column's name as the
+// table's variable only where it is a MATLAB identifier (a letter, then letters, digits and
+// underscores, at most namelengthmax = 63 characters); any other it renames. Every column of the
+// sagittal and the 3D model's CSV must be one, with no two alike.
+TEST(Estimate, TheCsvColumnsAreMatlabIdentifiers) {
+  SyntheticWalkOptions wo;
+  wo.duration_s = 3.0;
+  const Trial walk = make_synthetic_walk(wo).trial;
+  for (const ModelKind model : {ModelKind::Sagittal, ModelKind::ThreeD}) {
+    EstimateOptions o;
+    o.model = model;
+    const std::string csv = format_results_csv(estimate(walk, nullptr, *find_marker_set("kin2grf-example"), o));
+    const std::string header = csv.substr(0, csv.find('\n'));
+    std::vector<std::string> names;
+    for (std::size_t a = 0; a <= header.size();) {
+      const std::size_t b = std::min(header.find(',', a), header.size());
+      names.push_back(header.substr(a, b - a));
+      a = b + 1;
+    }
+    EXPECT_GT(names.size(), 40u);
+    for (const std::string& n : names) {
+      const bool ok = !n.empty() && n.size() <= 63 && std::isalpha(static_cast<unsigned char>(n[0])) &&
+                      std::all_of(n.begin(), n.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+      EXPECT_TRUE(ok) << "'" << n << "'";
+    }
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(std::adjacent_find(names.begin(), names.end()), names.end());
+  }
+}
