@@ -1278,8 +1278,8 @@ TotalsStage totals_stage(const EstimateOptions& o, const ModelMotion& motion, co
 
 }  // namespace
 
-std::vector<std::string> support_notes(const std::array<FootResult, 2>& feet, const Eigen::VectorXd& vertical_sum_N, double body_weight_N,
-                       double rate_hz, double ground_level_m, int first_frame_number) {
+std::vector<std::string> support_notes(const std::array<FootResult, 2>& feet, const Eigen::VectorXd& vertical_sum_N,
+                                       double body_weight_N, double rate_hz, double ground_level_m, int first_frame_number) {
   std::vector<std::string> out;
   const Eigen::Index n = vertical_sum_N.size();
   if (!(rate_hz > 0) || !(body_weight_N > 0)) return out;
@@ -1347,7 +1347,6 @@ std::vector<std::string> support_notes(const std::array<FootResult, 2>& feet, co
   }
   return out;
 }
-
 
 FrameTotals frame_totals(const ModelMotion& motion, const std::array<FootResult, 2>& feet, double ground_level_m,
                          const Eigen::Vector2d& grm_reference_m, Eigen::Index i) {
@@ -1518,13 +1517,9 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
   FeetStage feet = feet_stage(o, std::move(dyn.raw), kin.motion, kin.kinematic_cutoff_hz, sag.first_frame_number, ground_level_m,
                               frontal ? &*frontal : nullptr);
   frontal.reset();
-  {
-    double model_mass_kg = 0;
-    for (const Body& b : mod.model->bodies) model_mass_kg += b.mass_kg;
-    append(feet.messages, support_notes(feet.feet, dyn.plan.vertical_sum_N, model_mass_kg * mod.model->gravity_mps2,
-                                        kin.motion.rate_hz, ground_level_m, sag.first_frame_number));
-    dyn.plan.vertical_sum_N = Eigen::VectorXd();
-  }
+  append(feet.messages, support_notes(feet.feet, dyn.plan.vertical_sum_N, mass_kg * mod.model->gravity_mps2, kin.motion.rate_hz,
+                                      ground_level_m, sag.first_frame_number));
+  dyn.plan.vertical_sum_N = Eigen::VectorXd();  // its last reader
   if (o.lateral_force()) {
     const double cutoff = lateral_cutoff(o, kin.kinematic_cutoff_hz);
     const double lateral_lag_s = o.lateral_torso_lag && sag.trunk_measured ? dyn.torso_lag_added_s : 0.0;

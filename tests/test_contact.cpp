@@ -488,18 +488,19 @@ TEST(Contact, SupportTheFloorDoesNotExplainIsNamed) {
     f.contact.assign(static_cast<std::size_t>(n), true);
   }
   Eigen::VectorXd ask = Eigen::VectorXd::Constant(n, weight_N);
-  // The right foot on a 17 cm step for frames 10-29 (0.2 s), carrying half the body weight.
+  // The right foot on a 17 cm step for rows 10-29 (the file's frames 11-30, 0.2 s), carrying half the
+  // body weight.
   for (Eigen::Index i = 10; i < 30; ++i) {
     feet[0].force_N(i, 1) = 0.5 * weight_N;
     feet[0].gap_m[i] = 0.17;
   }
-  // The left foot's impact 7 cm up for 5 frames (a run's landing reads so): not a step.
+  // The left foot's impact 7 cm up for 5 rows (a run's landing reads so): not a step.
   for (Eigen::Index i = 40; i < 45; ++i) {
     feet[1].force_N(i, 1) = 1.5 * weight_N;
     feet[1].gap_m[i] = 0.07;
   }
-  // Frames 50-61: neither foot in contact while the kinematics ask 0.7 body weights (held up).
-  // Frames 70-89: neither in contact and the kinematics ask 0.1 (a flight): nothing to say.
+  // Rows 50-61: neither foot in contact while the kinematics ask 0.7 body weights (held up).
+  // Rows 62-89: neither in contact and the kinematics ask 0.1 (a flight): nothing to say.
   for (Eigen::Index i = 50; i < 90; ++i)
     for (FootResult& f : feet) {
       f.contact[static_cast<std::size_t>(i)] = false;

@@ -361,11 +361,11 @@ std::vector<GaitEvent> gait_events(const std::array<std::vector<bool>, 2>& conta
 ///   (the vertical force sum m (a_y + g); a flight asks under 0.2) while neither foot is in
 ///   contact: something else carries the body (a box, a chair, a handrail) or the floor is not
 ///   where the contact put it. The ground reaction there is zero; the residual holds the load.
-/// `vertical_sum_N`: vertical_force_sum_N; `body_weight_N`: the model's mass times g; the frame
+/// `vertical_sum_N`: vertical_force_sum_N; `body_weight_N`: the body mass times g; the frame
 /// numbers in the notes are the file's (first_frame_number + index).
 inline constexpr double kLoadedFootFraction = 0.2, kRaisedSoleM = 0.05, kSupportedFraction = 0.5, kSupportNoteRunS = 0.1;
-std::vector<std::string> support_notes(const std::array<FootResult, 2>& feet, const Eigen::VectorXd& vertical_sum_N, double body_weight_N,
-                       double rate_hz, double ground_level_m, int first_frame_number);
+std::vector<std::string> support_notes(const std::array<FootResult, 2>& feet, const Eigen::VectorXd& vertical_sum_N,
+                                       double body_weight_N, double rate_hz, double ground_level_m, int first_frame_number);
 
 /// A walking double support: frames [first, last] where both feet are in contact, the trailing
 /// foot alone in contact on the frame before and the leading foot alone on the frame after.

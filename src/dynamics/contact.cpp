@@ -1,4 +1,3 @@
-#include <stdexcept>
 #include "kin2grf/dynamics/contact.hpp"
 
 #include "kin2grf/kinematics/filter.hpp"
@@ -7,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 namespace kin2grf {
