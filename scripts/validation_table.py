@@ -88,6 +88,35 @@ print("\nMean (SD) over stances; total GRM: mean (SD) over the trials that have 
       + "".join(f"; {act}: {n} stance(s) left out, with them COP {c} %, {mm} mm" for act, (n, c, mm) in suspect.items() if n)
       + ".\n")
 
+# Where the per-foot vertical error lies (session 40): each stance's RMSE over its frames in double
+# support (the other foot loaded too, by the estimate or its plate) and in single support.
+phase_rows = []
+for act in activities:
+    dbl, sgl, sq_d, sq_all = [], [], 0.0, 0.0
+    for a, name, _ in rows:
+        if a != act:
+            continue
+        j = load(name, "defaults")
+        bw = j["mass_kg"] * 9.81
+        for s in j["per_foot"]:
+            p = s.get("support_phases") or {}
+            nd, ns = p.get("double_support_frames", 0), p.get("single_support_frames", 0)
+            rd, rs = p.get("vertical_rmse_double_support_N"), p.get("vertical_rmse_single_support_N")
+            if nd and rd is not None:
+                dbl.append(100 * rd / bw)
+                sq_d += nd * rd * rd
+                sq_all += nd * rd * rd
+            if ns and rs is not None:
+                sgl.append(100 * rs / bw)
+                sq_all += ns * rs * rs
+    if dbl or sgl:
+        share = f"{100 * sq_d / sq_all:.0f} %" if sq_all > 0 else "-"
+        phase_rows.append(f"{act} {mean_sd(dbl) if dbl else '-'} / {mean_sd(sgl) if sgl else '-'} % body weight, {share}")
+if phase_rows:
+    print("Where the per-foot vertical error lies (defaults; since session 40): the vertical RMSE over each stance's frames in double "
+          "support (the other foot loaded too, by the estimate or by its plate) and in single support, mean (SD) over the stances, "
+          "and double support's share of the stances' summed squared error: " + "; ".join(phase_rows) + ".\n")
+
 cv_kinds = [k for k in ("speed-gate-ratio", "r", "split-distance", "torso-length", "torso-lag", "post-cutoff-cycles", "double-support-sta",
                                 "min-kinematic-cycles", "touchdown-fraction", "touchdown-stop", "post-cutoff-floor", "speed-gate-floor",
                                 "speed-gate-standstill", "running-sway-gain", "thigh-lag", "torso-vertical-cutoff", "double-support-angle",

@@ -389,6 +389,30 @@ void stance_timing(const EstimateResult& e, const MeasuredPlate& mp, const Candi
   s.vertical_lag_ms = vertical_lag_ms(ev, pv, a, c.run.last, rate);
 }
 
+/// StanceValidation::vertical_rmse_double_support_N and its single-support counterpart: the
+/// stance's frames with both series finite, in double support where the other foot's estimated
+/// force or its plates' measured one (v.measured_force_N, complete once every stance is compared)
+/// is above `threshold_N`.
+void split_by_support(const EstimateResult& e, const ValidationResult& v, double threshold_N, StanceValidation& s) {
+  const Eigen::VectorXd& pv = v.plates[static_cast<std::size_t>(s.plate_index)].force_N.col(1);
+  const auto& ev = e.feet[static_cast<std::size_t>(s.foot)].force_N;
+  const auto& other_e = e.feet[static_cast<std::size_t>(1 - s.foot)].force_N;
+  const auto& other_m = v.measured_force_N[static_cast<std::size_t>(1 - s.foot)];
+  double sq[2] = {0, 0};
+  int count[2] = {0, 0};
+  for (Eigen::Index k = s.first; k <= s.last; ++k) {
+    if (!std::isfinite(pv[k]) || !std::isfinite(ev(k, 1))) continue;
+    const bool both = other_e(k, 1) > threshold_N || (other_m.rows() > k && other_m(k, 1) > threshold_N);
+    const double d = ev(k, 1) - pv[k];
+    sq[both ? 0 : 1] += d * d;
+    ++count[both ? 0 : 1];
+  }
+  s.double_support_frames = count[0];
+  s.single_support_frames = count[1];
+  s.vertical_rmse_double_support_N = count[0] > 0 ? std::sqrt(sq[0] / count[0]) : kNaN;
+  s.vertical_rmse_single_support_N = count[1] > 0 ? std::sqrt(sq[1] / count[1]) : kNaN;
+}
+
 StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, const Candidate& c, const ValidationOptions& o) {
   const Eigen::Index n = e.time_s.size();
   const double bw = e.mass_kg * e.model().gravity_mps2, ground = e.ground_level_m();
@@ -699,8 +723,10 @@ ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateR
   const std::vector<Candidate> cands = assign_stances(e, v, o);
   for (const Candidate& c : cands)
     if (c.kept) (c.cut ? v.cut_stances : v.stances).push_back(compare_stance(e, v, c, o));
-  for (auto* list : {&v.stances, &v.cut_stances})
+  for (auto* list : {&v.stances, &v.cut_stances}) {
     std::sort(list->begin(), list->end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (StanceValidation& s : *list) split_by_support(e, v, o.threshold_N, s);  // every foot's plates known now
+  }
   compare_totals(e, v, cands, o);
   if (e.legs_3d) validate_joint_moments_3d(e, v);
   validate_total_3d(e, v);
@@ -832,9 +858,18 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
 MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   MeanMetrics mm;
   std::array<std::vector<double>, 5> vals;
-  std::vector<double> lateral_rmse, cop_lateral_rmse, onset_abs, loaded_span;
+  std::vector<double> lateral_rmse, cop_lateral_rmse, onset_abs, loaded_span, double_support, single_support;
+  double sq_double = 0, sq_all = 0;
   for (const auto& s : stances) {
     if (foot >= 0 && s.foot != foot) continue;
+    if (s.body_weight_N > 0) {
+      if (s.double_support_frames > 0) double_support.push_back(100 * s.vertical_rmse_double_support_N / s.body_weight_N);
+      if (s.single_support_frames > 0) single_support.push_back(100 * s.vertical_rmse_single_support_N / s.body_weight_N);
+    }
+    const double sq_d = s.double_support_frames > 0 ? s.double_support_frames * std::pow(s.vertical_rmse_double_support_N, 2) : 0.0;
+    const double sq_s = s.single_support_frames > 0 ? s.single_support_frames * std::pow(s.vertical_rmse_single_support_N, 2) : 0.0;
+    sq_double += sq_d;
+    sq_all += sq_d + sq_s;
     if (s.onset_error_ms && std::isfinite(*s.onset_error_ms)) onset_abs.push_back(std::abs(*s.onset_error_ms));
     if (s.vertical_loaded_span && std::isfinite(s.vertical_loaded_span->rrmse_percent))
       loaded_span.push_back(s.vertical_loaded_span->rrmse_percent);
@@ -858,6 +893,9 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   mm.cop_lateral_rmse_mm = mean_of(cop_lateral_rmse);
   mm.onset_abs_ms = mean_of(onset_abs);
   mm.vertical_loaded_span = mean_of(loaded_span);
+  mm.vertical_rmse_double_support_percent_bw = mean_of(double_support);
+  mm.vertical_rmse_single_support_percent_bw = mean_of(single_support);
+  mm.double_support_error_share_percent = sq_all > 0 ? 100 * sq_double / sq_all : kNaN;
   mm.lateral_rmse_percent_bw = mean_of(lateral_rmse);
   std::array<double*, 5> mean = {&mm.vertical, &mm.anterior, &mm.cop, &mm.moment, &mm.lateral};
   std::array<double*, 5> sd = {&mm.vertical_sd, &mm.anterior_sd, &mm.cop_sd, &mm.moment_sd, &mm.lateral_sd};
@@ -960,6 +998,10 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     x["loaded_span"] = {{"frames", {e.first_frame_number + s.span_first, e.first_frame_number + s.span_last}},
                         {"vertical_rrmse_percent", s.vertical_loaded_span ? num(s.vertical_loaded_span->rrmse_percent) : nlohmann::json(nullptr)},
                         {"vertical_rmse_percent_bw", s.vertical_loaded_span ? num(100 * s.vertical_loaded_span->rmse / bw) : nlohmann::json(nullptr)}};
+    x["support_phases"] = {{"double_support_frames", s.double_support_frames},
+                           {"single_support_frames", s.single_support_frames},
+                           {"vertical_rmse_double_support_N", num(s.vertical_rmse_double_support_N)},
+                           {"vertical_rmse_single_support_N", num(s.vertical_rmse_single_support_N)}};
     if (s.moments_3d) x["joint_moments_3d"] = joint_moments_json(*s.moments_3d);
     return x;
   };
@@ -986,7 +1028,10 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     const MeanMetrics m = mean_rrmse(v.stances, f);
     means[f < 0 ? "all" : side_name(f)] = {{"stances", m.n},         {"vertical", num(m.vertical)}, {"anterior", num(m.anterior)},
                                             {"cop", num(m.cop)},      {"moment", num(m.moment)},
-                                            {"vertical_loaded_span", num(m.vertical_loaded_span)}};
+                                            {"vertical_loaded_span", num(m.vertical_loaded_span)},
+                                            {"vertical_rmse_double_support_percent_bw", num(m.vertical_rmse_double_support_percent_bw)},
+                                            {"vertical_rmse_single_support_percent_bw", num(m.vertical_rmse_single_support_percent_bw)},
+                                            {"double_support_error_share_percent", num(m.double_support_error_share_percent)}};
     if (std::isfinite(m.knee_adduction)) {
       auto& x = means[f < 0 ? "all" : side_name(f)];
       x["knee_sagittal_moment"] = num(m.knee_sagittal);
@@ -1136,6 +1181,19 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
     std::snprintf(buf, sizeof buf, "%.1f", m.vertical_loaded_span);
     os << table_label("per foot, loaded span") << table_text(buf);
     std::snprintf(buf, sizeof buf, "   vertical with the foot's load before its plate's onset (%ld frames) and after its offset (%ld)\n", early, late);
+    os << buf;
+  }
+  if (m.n > 0 && std::isfinite(m.double_support_error_share_percent)) {
+    const auto pct = [](double x) {
+      char t[32];
+      if (std::isfinite(x)) std::snprintf(t, sizeof t, "%.1f", x);
+      else std::snprintf(t, sizeof t, "-");
+      return std::string(t);
+    };
+    std::snprintf(buf, sizeof buf, "  per foot, vertical RMSE in double / single support: %s / %s %% body weight; %.0f %% of the squared error "
+                                   "in double support\n",
+                  pct(m.vertical_rmse_double_support_percent_bw).c_str(), pct(m.vertical_rmse_single_support_percent_bw).c_str(),
+                  m.double_support_error_share_percent);
     os << buf;
   }
   if (std::isfinite(m.lateral_rmse_percent_bw)) format_lateral_rows(os, v, m);
