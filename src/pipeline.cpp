@@ -1284,10 +1284,13 @@ std::vector<std::string> support_notes(const std::array<FootResult, 2>& feet, co
   const Eigen::Index n = vertical_sum_N.size();
   if (!(rate_hz > 0) || !(body_weight_N > 0)) return out;
   const auto shortest = static_cast<Eigen::Index>(std::ceil(kSupportNoteRunS * rate_hz - 1e-9));
-  const auto frames_of = [&](const IndexRun& run) {
-    char b[120];
-    std::snprintf(b, sizeof b, "frames %ld-%ld (%.2f s)", static_cast<long>(first_frame_number + run.first),
-                  static_cast<long>(first_frame_number + run.last), static_cast<double>(run.last - run.first + 1) / rate_hz);
+  // A run as the file numbers its frames, "first-last".
+  const auto span = [&](const IndexRun& run) {
+    return std::to_string(first_frame_number + run.first) + "-" + std::to_string(first_frame_number + run.last);
+  };
+  const auto seconds = [&](Eigen::Index frames) {
+    char b[32];
+    std::snprintf(b, sizeof b, " (%.2f s)", static_cast<double>(frames) / rate_hz);
     return std::string(b);
   };
   const auto in_contact = [&](int side, Eigen::Index i) {
@@ -1306,19 +1309,17 @@ std::vector<std::string> support_notes(const std::array<FootResult, 2>& feet, co
     for (const IndexRun& run : runs_where(n, raised)) {
       const Eigen::Index len = run.last - run.first + 1;
       if (len < shortest) continue;
-      where += (where.empty() ? "" : ", ") + std::to_string(first_frame_number + run.first) + "-" +
-               std::to_string(first_frame_number + run.last);
+      where += (where.empty() ? "" : ", ") + span(run);
       frames += len;
       gap_lo = std::min(gap_lo, f.gap_m.segment(run.first, len).minCoeff());
       gap_hi = std::max(gap_hi, f.gap_m.segment(run.first, len).maxCoeff());
       load_hi = std::max(load_hi, f.force_N.col(1).segment(run.first, len).maxCoeff() / body_weight_N);
     }
     if (frames == 0) continue;
-    char head[200], tail[80];
+    char head[200];
     std::snprintf(head, sizeof head, "%s foot: carries up to %.2f body weights while its sole stands %.0f-%.0f mm above the floor (%.3f m), frames ",
                   side_name(side), load_hi, 1000 * gap_lo, 1000 * gap_hi, ground_level_m);
-    std::snprintf(tail, sizeof tail, " (%.2f s)", static_cast<double>(frames) / rate_hz);
-    const std::string b = head + where + tail +
+    const std::string b = head + where + seconds(frames) +
                           ": on a box, a step or a stair? kin2grf's contact is with one level floor; the load is taken where the foot is, "
                           "its COP on the raised sole, and the GRM's lever for the fore-aft force is the floor's height (--ground-level "
                           "sets the floor)";
@@ -1339,10 +1340,10 @@ std::vector<std::string> support_notes(const std::array<FootResult, 2>& feet, co
     if (std::isfinite(sole_lo)) std::snprintf(sole, sizeof sole, " (the lower sole at least %.0f mm above it)", 1000 * sole_lo);
     char b[560];
     std::snprintf(b, sizeof b,
-                  "%s: the body's kinematics ask %.2f-%.2f body weights of the ground, yet neither foot is in contact with the "
+                  "frames %s%s: the body's kinematics ask %.2f-%.2f body weights of the ground, yet neither foot is in contact with the "
                   "floor at %.3f m%s: something else carries the body there (a box, a step, a chair, a handrail?) or the floor "
                   "is elsewhere (--ground-level); the ground reaction is zero there and the residual holds that load",
-                  frames_of(run).c_str(), ask_lo, ask_hi, ground_level_m, sole);
+                  span(run).c_str(), seconds(len).c_str(), ask_lo, ask_hi, ground_level_m, sole);
     out.emplace_back(b);
   }
   return out;

@@ -124,8 +124,8 @@ double leg_length_m(const Model& model);
 /// the other side's. Outside these bounds a knee or ankle landmark is misplaced (a functional
 /// joint centre from a walk's small range of motion, a marker off its landmark, a label swapped).
 inline constexpr double kMinShankPerThigh = 0.75, kMaxShankPerThigh = 1.33, kMaxSidesApart = 0.15;
-/// What the geometry's proportions say (segment_proportions' bounds above), a line each; none
-/// when they are a leg's.
+/// What the geometry's proportions say against the bounds above, a line each; none when they are
+/// a leg's.
 std::vector<std::string> segment_proportion_notes(const BodyGeometry& geometry);
 
 /// Masses and inertias from the table; geometry as given. Built once per trial and const
