@@ -117,6 +117,50 @@ if phase_rows:
           "support (the other foot loaded too, by the estimate or by its plate) and in single support, mean (SD) over the stances, "
           "and double support's share of the stances' summed squared error: " + "; ".join(phase_rows) + ".\n")
 
+# The stance parameters a gait report tabulates (session 41): per stance, |estimate - plate| of
+# each, over the plate's stance frames; beside it the plates' mean value, for scale.
+param_rows = []
+peak_keys = ["vertical_first_peak_N", "vertical_valley_N", "vertical_second_peak_N", "braking_peak_N", "propulsive_peak_N"]
+for act in activities:
+    errs = {k: [] for k in peak_keys + ["braking_impulse_Ns", "propulsive_impulse_Ns"]}
+    plate = {k: [] for k in errs}
+    rate_err, rate_plate, n = 0.0, 0.0, 0
+    for a, name, _ in rows:
+        if a != act:
+            continue
+        j = load(name, "defaults")
+        bw = j["mass_kg"] * 9.81
+        for s in j["per_foot"]:
+            p = s.get("parameters")
+            if not p:
+                continue
+            n += 1
+            e, m = p["estimated"], p["measured"]
+            for k in errs:
+                if e.get(k) is not None and m.get(k) is not None:
+                    scale = 100 / bw if k in peak_keys else 1000 / bw  # % body weight; body weight x ms
+                    errs[k].append(abs(e[k] - m[k]) * scale)
+                    plate[k].append(abs(m[k]) * scale)
+            if e.get("loading_rate_N_per_s") is not None and m.get("loading_rate_N_per_s") is not None:
+                rate_err += abs(e["loading_rate_N_per_s"] - m["loading_rate_N_per_s"])
+                rate_plate += m["loading_rate_N_per_s"]
+    if n:
+        cell = lambda k: (f"{sum(errs[k]) / len(errs[k]):.1f} ({sum(plate[k]) / len(plate[k]):.0f})" if errs[k] else "-")
+        rate = f"{100 * rate_err / rate_plate:.0f}" if rate_plate > 0 else "-"
+        param_rows.append(f"| {act} | {n} | " + " | ".join(cell(k) for k in errs) + f" | {rate} |")
+if param_rows:
+    print("Stance parameters (defaults; since session 41): each stance's ground reaction parameters (`validate`'s `parameters`, "
+          "dynamics/stance_parameters.hpp), the estimate's against the plate's over the stance's loaded span (the plate's stance and the frames next to it where the estimate loads the foot): mean |estimate - plate| "
+          "over the stances, the plates' mean |value| in brackets; peaks and valley in % body weight (the first and second peaks: the "
+          "largest vertical force in each half of the stance; the valley: the least between them), impulses in body weight x ms, the "
+          "loading rate (20-80 % of the first peak) as the summed |error| in % of the plates' summed rate.\n")
+    print("| activity | stances | vertical first peak | valley | second peak | braking peak | propulsive peak | braking impulse | "
+          "propulsive impulse | loading rate % |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for r in param_rows:
+        print(r)
+    print()
+
 cv_kinds = [k for k in ("speed-gate-ratio", "r", "split-distance", "torso-length", "torso-lag", "post-cutoff-cycles", "double-support-sta",
                                 "min-kinematic-cycles", "touchdown-fraction", "touchdown-stop", "post-cutoff-floor", "speed-gate-floor",
                                 "speed-gate-standstill", "running-sway-gain", "thigh-lag", "torso-vertical-cutoff", "double-support-angle",

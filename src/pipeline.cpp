@@ -30,7 +30,7 @@ double progression_speed(const SagittalLandmarks& lm) {
 }
 
 namespace {
-/// One foot's stances: its runs of contact, a flicker inside a stance (under 20 ms) bridged.
+/// One foot's runs of contact, a flicker inside a stance (under 20 ms) bridged.
 std::vector<IndexRun> stance_runs(const std::vector<bool>& c, double rate_hz) {
   const auto bridge = static_cast<Eigen::Index>(0.02 * rate_hz);
   return merge_close_runs(runs_where(static_cast<Eigen::Index>(c.size()), [&](Eigen::Index i) { return c[static_cast<std::size_t>(i)]; }),
@@ -38,15 +38,21 @@ std::vector<IndexRun> stance_runs(const std::vector<bool>& c, double rate_hz) {
 }
 }  // namespace
 
+std::vector<IndexRun> gait_stances(const std::vector<bool>& c, double rate_hz) {
+  std::vector<IndexRun> out;
+  if (!(rate_hz > 0)) return out;
+  for (const IndexRun& run : stance_runs(c, rate_hz))
+    if (static_cast<double>(run.last - run.first + 1) >= 0.05 * rate_hz) out.push_back(run);  // no stance is that short
+  return out;
+}
+
 std::optional<double> median_stance_s(const std::array<std::vector<bool>, 2>& contact, double rate_hz) {
   if (!(rate_hz > 0)) return std::nullopt;
   std::vector<double> durations;
   for (const auto& c : contact) {
     const auto n = static_cast<Eigen::Index>(c.size());
-    for (const IndexRun& run : stance_runs(c, rate_hz)) {
-      const auto frames = static_cast<double>(run.last - run.first + 1);
-      if (run.first > 0 && run.last < n - 1 && frames >= 0.05 * rate_hz) durations.push_back(frames / rate_hz);
-    }
+    for (const IndexRun& run : gait_stances(c, rate_hz))
+      if (run.first > 0 && run.last < n - 1) durations.push_back(static_cast<double>(run.last - run.first + 1) / rate_hz);
   }
   if (durations.empty()) return std::nullopt;
   return median(durations);
@@ -58,8 +64,7 @@ std::vector<GaitEvent> gait_events(const std::array<std::vector<bool>, 2>& conta
   for (int side = 0; side < 2; ++side) {
     const auto& c = contact[static_cast<std::size_t>(side)];
     const auto n = static_cast<Eigen::Index>(std::min<std::size_t>(c.size(), static_cast<std::size_t>(time_s.size())));
-    for (const IndexRun& run : stance_runs(c, rate_hz)) {
-      if (static_cast<double>(run.last - run.first + 1) < 0.05 * rate_hz) continue;  // no stance is that short
+    for (const IndexRun& run : gait_stances(c, rate_hz)) {
       if (run.first > 0 && run.first < n) out.push_back({"Foot Strike", side, run.first, time_s[run.first]});
       if (run.last + 1 < n) out.push_back({"Foot Off", side, run.last + 1, time_s[run.last + 1]});
     }

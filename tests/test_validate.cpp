@@ -23,6 +23,7 @@
 #include "kin2grf/validation/cop_fit.hpp"
 #include "kin2grf/validation/metrics.hpp"
 #include "kin2grf/validation/study.hpp"
+#include "kin2grf/output/results.hpp"
 #include "kin2grf/validation/validate.hpp"
 #include "test_support.hpp"
 
@@ -762,4 +763,62 @@ TEST(Validate, EachStancesVerticalErrorIsSplitByTheSupportPhase) {
   EXPECT_EQ(phases["double_support_frames"], right.double_support_frames);
   EXPECT_NEAR(phases["vertical_rmse_single_support_N"].get<double>(), 20.0, 1e-9);
   EXPECT_NE(format_validation_table("example", v).find("vertical RMSE in double / single support"), std::string::npos);
+}
+
+// Each stance's parameters are the estimate's and the plate's over the plate's stance frames; the
+// means, the JSON and the text line read them back. The right foot's estimate is set to its plate
+// plus 30 N vertical and minus 10 N fore-aft: every peak is off by exactly that much.
+TEST(Validate, EachStancesGaitParametersAreComparedWithThePlates) {
+  const Trial walk = make_example_walk();
+  EstimateResult e = estimate(walk, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+  const auto before = validate(e, *walk.plates);
+  const auto right_of = [](const ValidationResult& r) {
+    return std::find_if(r.stances.begin(), r.stances.end(), [](const auto& x) { return x.foot == 0; });
+  };
+  ASSERT_TRUE(right_of(before) != before.stances.end());
+  const StanceValidation& r0 = *right_of(before);
+  const Eigen::MatrixX2d& plate = before.plates[static_cast<std::size_t>(r0.plate_index)].force_N;
+  for (Eigen::Index k = r0.first; k <= r0.last; ++k)
+    if (std::isfinite(plate(k, 1))) e.feet[0].force_N.row(k) = plate.row(k) + Eigen::RowVector2d(-10.0, 30.0);
+  // Unloaded next to the plate's stance, so that the loaded span is the stance.
+  for (Eigen::Index k = r0.span_first; k <= r0.span_last; ++k)
+    if (k < r0.first || k > r0.last) e.feet[0].force_N.row(k).setZero();
+  const auto v = validate(e, *walk.plates);
+  ASSERT_TRUE(right_of(v) != v.stances.end());
+  const StanceValidation& right = *right_of(v);
+  ASSERT_EQ(right.span_first, right.first);
+  ASSERT_EQ(right.span_last, right.last);
+  const StanceParameters &pe = right.parameters_estimated, &pm = right.parameters_measured;
+  ASSERT_GT(pm.vertical_first_peak_N, 0.5 * right.body_weight_N);  // a walk's stance, seen whole
+  EXPECT_NEAR(pe.vertical_first_peak_N - pm.vertical_first_peak_N, 30.0, 1e-9);
+  EXPECT_NEAR(pe.vertical_valley_N - pm.vertical_valley_N, 30.0, 1e-9);
+  EXPECT_NEAR(pe.vertical_second_peak_N - pm.vertical_second_peak_N, 30.0, 1e-9);
+  EXPECT_NEAR(pe.propulsive_peak_N - pm.propulsive_peak_N, -10.0, 1e-9);
+  EXPECT_NEAR(pe.duration_s, pm.duration_s, 1e-12);
+  EXPECT_NEAR(pe.vertical_impulse_Ns - pm.vertical_impulse_Ns, 30.0 * (pm.duration_s - 1.0 / e.motion.rate_hz), 1e-9);
+  const MeanMetrics m = mean_rrmse(v.stances, 0);
+  EXPECT_NEAR(m.parameter_peak_error_percent_bw[0], 100 * 30.0 / right.body_weight_N, 1e-9);
+  EXPECT_NEAR(m.parameter_peak_error_percent_bw[4], 100 * 10.0 / right.body_weight_N, 1e-9);
+  const auto j = validation_json("example", e, v, nlohmann::json::object());
+  const auto& params = j["per_foot"][static_cast<std::size_t>(right_of(v) - v.stances.begin())]["parameters"];
+  EXPECT_NEAR(params["estimated"]["vertical_first_peak_N"].get<double>() - params["measured"]["vertical_first_peak_N"].get<double>(),
+              30.0, 1e-9);
+  EXPECT_NEAR(params["measured"]["vertical_first_peak_bw"].get<double>(), pm.vertical_first_peak_N / right.body_weight_N, 1e-12);
+  EXPECT_NEAR(j["mean_rrmse_percent"]["right"]["parameter_errors"]["vertical_first_peak_percent_bw"].get<double>(), 100 * 30.0 / right.body_weight_N,
+              1e-9);
+  EXPECT_NE(format_validation_table("example", v).find("stance parameters' mean |estimate - plates|"), std::string::npos);
+  // The estimate's summary gives every stance of its own contact, as the gait events mark them.
+  const auto summary = results_summary(e, nlohmann::json::object());
+  const auto& stances = summary["stance_parameters"]["right"];
+  ASSERT_FALSE(stances.empty());
+  std::size_t complete = 0;
+  for (const auto& st : stances) {
+    EXPECT_GT(st["duration_s"].get<double>(), 0.05);
+    if (!st["complete"].get<bool>()) continue;
+    ++complete;
+    EXPECT_GT(st["vertical_first_peak_bw"].get<double>(), 0.8);
+    EXPECT_LT(st["braking_peak_N"].get<double>(), 0.0);
+    EXPECT_GT(st["loading_rate_bw_per_s"].get<double>(), 0.0);
+  }
+  EXPECT_GE(complete, 2u);
 }

@@ -19,6 +19,7 @@
 #include "kin2grf/kinematics/motion.hpp"
 #include "kin2grf/markers/landmarks.hpp"
 #include "kin2grf/model/model.hpp"
+#include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
 
@@ -332,6 +333,10 @@ void check_options(const EstimateOptions& options);
 /// except a run that starts at the first frame or ends at the last, whose length is not known.
 /// None when there is no complete stance (a standing trial, a single stance cut by the window).
 std::optional<double> median_stance_s(const std::array<std::vector<bool>, 2>& contact, double rate_hz);
+
+/// One foot's stances as gait_events marks them (below): its runs of contact with flickers under
+/// 20 ms bridged, runs under 50 ms left out; none without a positive rate.
+std::vector<IndexRun> gait_stances(const std::vector<bool>& contact, double rate_hz);
 
 /// A gait event from the estimate's contact states (C3D's and Vicon's names): "Foot Strike" at
 /// the first frame of a stance, "Foot Off" at the first frame after it. Stances are the runs of

@@ -195,6 +195,45 @@ nlohmann::json knee_adduction_peaks_json(const EstimateResult& r) {
 
 }  // namespace
 
+nlohmann::json stance_parameters_json(const StanceParameters& p, double body_weight_N) {
+  const auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  const auto bw = [&](double x) { return num(body_weight_N > 0 ? x / body_weight_N : std::numeric_limits<double>::quiet_NaN()); };
+  return {{"duration_s", num(p.duration_s)},
+          {"vertical_first_peak_N", num(p.vertical_first_peak_N)}, {"vertical_first_peak_bw", bw(p.vertical_first_peak_N)},
+          {"vertical_valley_N", num(p.vertical_valley_N)}, {"vertical_valley_bw", bw(p.vertical_valley_N)},
+          {"vertical_second_peak_N", num(p.vertical_second_peak_N)}, {"vertical_second_peak_bw", bw(p.vertical_second_peak_N)},
+          {"vertical_peak_N", num(p.vertical_peak_N)}, {"vertical_peak_bw", bw(p.vertical_peak_N)},
+          {"braking_peak_N", num(p.braking_peak_N)}, {"braking_peak_bw", bw(p.braking_peak_N)},
+          {"propulsive_peak_N", num(p.propulsive_peak_N)}, {"propulsive_peak_bw", bw(p.propulsive_peak_N)},
+          {"vertical_impulse_Ns", num(p.vertical_impulse_Ns)}, {"braking_impulse_Ns", num(p.braking_impulse_Ns)},
+          {"propulsive_impulse_Ns", num(p.propulsive_impulse_Ns)},
+          {"loading_rate_N_per_s", num(p.loading_rate_N_per_s)}, {"loading_rate_bw_per_s", bw(p.loading_rate_N_per_s)}};
+}
+
+namespace {
+
+/// Per side, per stance (gait_stances: the stances the gait events mark), the ground reaction's
+/// stance parameters (dynamics/stance_parameters.hpp) from the estimate's post-filtered force.
+nlohmann::json stance_parameters_by_side_json(const EstimateResult& r) {
+  nlohmann::json out = nlohmann::json::object();
+  const auto n = r.time_s.size();
+  const double body_weight_N = r.mass_kg * r.model().gravity_mps2;
+  for (int s = 0; s < 2; ++s) {
+    const FootResult& f = r.feet[static_cast<std::size_t>(s)];
+    nlohmann::json stances = nlohmann::json::array();
+    for (const auto& run : gait_stances(f.contact, r.motion.rate_hz)) {
+      nlohmann::json j = {{"start_s", r.time_s[run.first]}, {"end_s", r.time_s[run.last]},
+                          {"complete", run.first > 0 && run.last < n - 1}};
+      j.update(stance_parameters_json(stance_parameters(f.force_N, r.motion.rate_hz, run.first, run.last), body_weight_N));
+      stances.push_back(std::move(j));
+    }
+    out[side_name(s)] = std::move(stances);
+  }
+  return out;
+}
+
+}  // namespace
+
 nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings) {
   using nlohmann::json;
   json j;
@@ -227,6 +266,7 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
   for (const GaitEvent& e : gait_events({r.feet[0].contact, r.feet[1].contact}, r.time_s, r.motion.rate_hz))
     events.push_back({{"event", e.label}, {"side", side_name(e.side)}, {"frame", r.first_frame_number + e.index}, {"time_s", e.time_s}});
   j["gait_events"] = events;
+  j["stance_parameters"] = stance_parameters_by_side_json(r);
   if (r.legs_3d) j["knee_adduction_moment"] = knee_adduction_peaks_json(r);
   double mean_it = 0;
   int max_it = 0;

@@ -11,6 +11,7 @@
 
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/numeric.hpp"
+#include "kin2grf/output/results.hpp"
 
 namespace kin2grf {
 namespace {
@@ -413,6 +414,16 @@ void split_by_support(const EstimateResult& e, const ValidationResult& v, double
   s.vertical_rmse_single_support_N = count[1] > 0 ? std::sqrt(sq[1] / count[1]) : kNaN;
 }
 
+/// StanceValidation::parameters_estimated and parameters_measured: the estimate's and the plate's
+/// force over the stance's loaded span (the plate's stance and the estimate's loaded frames next to
+/// it), so that an estimate that loads the foot before the plate's onset has its rise, and its
+/// loading rate, seen too.
+void compare_parameters(const EstimateResult& e, const ValidationResult& v, StanceValidation& s) {
+  const double rate = e.motion.rate_hz;
+  s.parameters_measured = stance_parameters(v.plates[static_cast<std::size_t>(s.plate_index)].force_N, rate, s.span_first, s.span_last);
+  s.parameters_estimated = stance_parameters(e.feet[static_cast<std::size_t>(s.foot)].force_N, rate, s.span_first, s.span_last);
+}
+
 StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, const Candidate& c, const ValidationOptions& o) {
   const Eigen::Index n = e.time_s.size();
   const double bw = e.mass_kg * e.model().gravity_mps2, ground = e.ground_level_m();
@@ -725,7 +736,10 @@ ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateR
     if (c.kept) (c.cut ? v.cut_stances : v.stances).push_back(compare_stance(e, v, c, o));
   for (auto* list : {&v.stances, &v.cut_stances}) {
     std::sort(list->begin(), list->end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-    for (StanceValidation& s : *list) split_by_support(e, v, o.threshold_N, s);  // every foot's plates known now
+    for (StanceValidation& s : *list) {
+      split_by_support(e, v, o.threshold_N, s);  // every foot's plates known now
+      compare_parameters(e, v, s);
+    }
   }
   compare_totals(e, v, cands, o);
   if (e.legs_3d) validate_joint_moments_3d(e, v);
@@ -860,8 +874,33 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   std::array<std::vector<double>, 5> vals;
   std::vector<double> lateral_rmse, cop_lateral_rmse, onset_abs, loaded_span, double_support, single_support;
   double sq_double = 0, sq_all = 0;
+  // The stance parameters' |estimate - plate| (peaks, % body weight; impulses, body weight x ms)
+  // and the loading rate's |error| and plate value.
+  std::array<std::vector<double>, 5> peak_errors;
+  std::array<std::vector<double>, 2> impulse_errors;
+  double rate_error_sum = 0, rate_plate_sum = 0;
   for (const auto& s : stances) {
     if (foot >= 0 && s.foot != foot) continue;
+    if (s.body_weight_N > 0) {
+      const StanceParameters &pe = s.parameters_estimated, &pm = s.parameters_measured;
+      const std::array<std::pair<double, double>, 5> peaks = {{{pe.vertical_first_peak_N, pm.vertical_first_peak_N},
+                                                               {pe.vertical_valley_N, pm.vertical_valley_N},
+                                                               {pe.vertical_second_peak_N, pm.vertical_second_peak_N},
+                                                               {pe.braking_peak_N, pm.braking_peak_N},
+                                                               {pe.propulsive_peak_N, pm.propulsive_peak_N}}};
+      for (std::size_t k = 0; k < peaks.size(); ++k)
+        if (std::isfinite(peaks[k].first) && std::isfinite(peaks[k].second))
+          peak_errors[k].push_back(100 * std::abs(peaks[k].first - peaks[k].second) / s.body_weight_N);
+      const std::array<std::pair<double, double>, 2> impulses = {{{pe.braking_impulse_Ns, pm.braking_impulse_Ns},
+                                                                  {pe.propulsive_impulse_Ns, pm.propulsive_impulse_Ns}}};
+      for (std::size_t k = 0; k < impulses.size(); ++k)
+        if (std::isfinite(impulses[k].first) && std::isfinite(impulses[k].second))
+          impulse_errors[k].push_back(1000 * std::abs(impulses[k].first - impulses[k].second) / s.body_weight_N);
+      if (std::isfinite(pe.loading_rate_N_per_s) && std::isfinite(pm.loading_rate_N_per_s)) {
+        rate_error_sum += std::abs(pe.loading_rate_N_per_s - pm.loading_rate_N_per_s);
+        rate_plate_sum += pm.loading_rate_N_per_s;
+      }
+    }
     if (s.body_weight_N > 0) {
       if (s.double_support_frames > 0) double_support.push_back(100 * s.vertical_rmse_double_support_N / s.body_weight_N);
       if (s.single_support_frames > 0) single_support.push_back(100 * s.vertical_rmse_single_support_N / s.body_weight_N);
@@ -896,6 +935,9 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   mm.vertical_rmse_double_support_percent_bw = mean_of(double_support);
   mm.vertical_rmse_single_support_percent_bw = mean_of(single_support);
   mm.double_support_error_share_percent = sq_all > 0 ? 100 * sq_double / sq_all : kNaN;
+  for (std::size_t k = 0; k < peak_errors.size(); ++k) mm.parameter_peak_error_percent_bw[k] = mean_of(peak_errors[k]);
+  for (std::size_t k = 0; k < impulse_errors.size(); ++k) mm.parameter_impulse_error_bw_ms[k] = mean_of(impulse_errors[k]);
+  mm.loading_rate_error_percent = rate_plate_sum > 0 ? 100 * rate_error_sum / rate_plate_sum : kNaN;
   mm.lateral_rmse_percent_bw = mean_of(lateral_rmse);
   std::array<double*, 5> mean = {&mm.vertical, &mm.anterior, &mm.cop, &mm.moment, &mm.lateral};
   std::array<double*, 5> sd = {&mm.vertical_sd, &mm.anterior_sd, &mm.cop_sd, &mm.moment_sd, &mm.lateral_sd};
@@ -1002,6 +1044,8 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
                            {"single_support_frames", s.single_support_frames},
                            {"vertical_rmse_double_support_N", num(s.vertical_rmse_double_support_N)},
                            {"vertical_rmse_single_support_N", num(s.vertical_rmse_single_support_N)}};
+    x["parameters"] = {{"estimated", stance_parameters_json(s.parameters_estimated, s.body_weight_N)},
+                       {"measured", stance_parameters_json(s.parameters_measured, s.body_weight_N)}};
     if (s.moments_3d) x["joint_moments_3d"] = joint_moments_json(*s.moments_3d);
     return x;
   };
@@ -1031,7 +1075,16 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
                                             {"vertical_loaded_span", num(m.vertical_loaded_span)},
                                             {"vertical_rmse_double_support_percent_bw", num(m.vertical_rmse_double_support_percent_bw)},
                                             {"vertical_rmse_single_support_percent_bw", num(m.vertical_rmse_single_support_percent_bw)},
-                                            {"double_support_error_share_percent", num(m.double_support_error_share_percent)}};
+                                            {"double_support_error_share_percent", num(m.double_support_error_share_percent)},
+                                            {"parameter_errors",
+                                             {{"vertical_first_peak_percent_bw", num(m.parameter_peak_error_percent_bw[0])},
+                                              {"vertical_valley_percent_bw", num(m.parameter_peak_error_percent_bw[1])},
+                                              {"vertical_second_peak_percent_bw", num(m.parameter_peak_error_percent_bw[2])},
+                                              {"braking_peak_percent_bw", num(m.parameter_peak_error_percent_bw[3])},
+                                              {"propulsive_peak_percent_bw", num(m.parameter_peak_error_percent_bw[4])},
+                                              {"braking_impulse_bw_ms", num(m.parameter_impulse_error_bw_ms[0])},
+                                              {"propulsive_impulse_bw_ms", num(m.parameter_impulse_error_bw_ms[1])},
+                                              {"loading_rate_percent", num(m.loading_rate_error_percent)}}}};
     if (std::isfinite(m.knee_adduction)) {
       auto& x = means[f < 0 ? "all" : side_name(f)];
       x["knee_sagittal_moment"] = num(m.knee_sagittal);
@@ -1195,6 +1248,20 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
                   pct(m.vertical_rmse_double_support_percent_bw).c_str(), pct(m.vertical_rmse_single_support_percent_bw).c_str(),
                   m.double_support_error_share_percent);
     os << buf;
+  }
+  if (m.n > 0 && std::isfinite(m.parameter_peak_error_percent_bw[0])) {
+    const auto val = [](double x, const char* fmt) {
+      char t[32];
+      if (std::isfinite(x)) std::snprintf(t, sizeof t, fmt, x);
+      else std::snprintf(t, sizeof t, "-");
+      return std::string(t);
+    };
+    const auto& pk = m.parameter_peak_error_percent_bw;
+    os << "  per foot, stance parameters' mean |estimate - plates|: vertical first peak / valley / second peak " << val(pk[0], "%.1f")
+       << " / " << val(pk[1], "%.1f") << " / " << val(pk[2], "%.1f") << " % body weight, braking / propulsive peak " << val(pk[3], "%.1f")
+       << " / " << val(pk[4], "%.1f") << " % body weight, braking / propulsive impulse " << val(m.parameter_impulse_error_bw_ms[0], "%.1f")
+       << " / " << val(m.parameter_impulse_error_bw_ms[1], "%.1f") << " body weight ms, loading rate "
+       << val(m.loading_rate_error_percent, "%.0f") << " %\n";
   }
   if (std::isfinite(m.lateral_rmse_percent_bw)) format_lateral_rows(os, v, m);
   if (std::isfinite(m.knee_adduction)) format_joint_moment_rows(os, v, m, v.mass_kg);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "kin2grf/dynamics/stance_parameters.hpp"
 #include "kin2grf/pipeline.hpp"
 
 namespace kin2grf {
@@ -41,7 +42,12 @@ void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> out)
 void write_results_csv(std::ostream& os, const EstimateResult& r);
 void write_results_csv(const std::string& path, const EstimateResult& r);
 std::string format_results_csv(const EstimateResult& r);
+/// The JSON summary (docs/FORMATS.md); among its keys `stance_parameters`, per side and stance.
 nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings);
+/// One stance's parameters as JSON (the summary's and validate's; docs/FORMATS.md): each in its
+/// unit, the forces and the loading rate in body weights too (`*_bw`, by `body_weight_N`); null
+/// where a value does not exist.
+nlohmann::json stance_parameters_json(const StanceParameters& p, double body_weight_N);
 /// A few lines for a person: frames, mass, progression, each foot's contact intervals and peak
 /// vertical force (what `estimate` prints).
 std::string format_results_text(const EstimateResult& r);

@@ -52,6 +52,7 @@
 #include <vector>
 
 #include "kin2grf/trial.hpp"
+#include "kin2grf/dynamics/stance_parameters.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/validation/metrics.hpp"
 
@@ -210,6 +211,12 @@ struct StanceValidation {
   double vertical_rmse_double_support_N = std::numeric_limits<double>::quiet_NaN();
   double vertical_rmse_single_support_N = std::numeric_limits<double>::quiet_NaN();
   int double_support_frames = 0, single_support_frames = 0;
+  /// The stance's ground reaction parameters (dynamics/stance_parameters.hpp: the vertical
+  /// force's peaks and valley, the braking and propulsive peaks, the impulses, the loading rate)
+  /// of the estimate's force and of the plate's, over the loaded span [span_first, span_last]
+  /// (the plate's stance and the estimate's loaded frames next to it: an early estimate's rise is
+  /// seen): what a gait report tabulates.
+  StanceParameters parameters_estimated, parameters_measured;
   /// Time shift of the estimate's vertical force that best matches the plate over the stance
   /// (least RMSE over shifts of up to 60 ms, parabolic refinement between frames); + = the
   /// estimate lags, - = it leads.
@@ -310,6 +317,14 @@ struct MeanMetrics {
   /// plate-driven peak near 0 N m would make its own percentage meaningless).
   double knee_sagittal = 0, knee_adduction = 0;
   std::array<double, 2> kam_peak_error_percent{0, 0};
+  /// The stance parameters' mean |estimate - plate| over the stances (StanceValidation::
+  /// parameters_estimated): the vertical first peak, valley and second peak and the braking and
+  /// propulsive peaks in % body weight; the braking and propulsive impulses in body weight x
+  /// milliseconds; the loading rate in % of the plates' (mean |error| over mean plate value). NaN
+  /// where no stance has the value.
+  std::array<double, 5> parameter_peak_error_percent_bw{0, 0, 0, 0, 0};
+  std::array<double, 2> parameter_impulse_error_bw_ms{0, 0};
+  double loading_rate_error_percent = 0;
 };
 MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot = -1);
 
