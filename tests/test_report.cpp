@@ -16,6 +16,7 @@
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/output/report.hpp"
+#include "kin2grf/output/results.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
 #include "kin2grf/validation/cop_fit.hpp"
@@ -155,4 +156,28 @@ TEST(Report, AMisregisteredPlatesFiguresAreBracketed) {
     EXPECT_EQ(s.cop_reference_suspect, s.plate == "FP1");
     EXPECT_NE(html.find(cell), std::string::npos) << s.plate << ": " << cell;
   }
+}
+
+// Both reports tabulate the stance parameters: the estimate's a row per stance of its summary, the
+// validation's a row for kin2grf and one for the plate per plate stance.
+TEST(Report, StanceParametersAreTabulatedInBothReports) {
+  const Trial walk = make_example_walk();
+  const EstimateResult e = estimate(walk, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+  const auto rows_of = [](const std::string& html) {
+    const auto from = html.find("<h3>Stance parameters</h3>");
+    if (from == std::string::npos) return -1;
+    const std::string table = html.substr(from, html.find("</table>", from) - from);
+    int n = 0;
+    for (auto at = table.find("<tr><td"); at != std::string::npos; at = table.find("<tr><td", at + 1)) ++n;
+    return n;
+  };
+  const nlohmann::json summary = results_summary(e, nlohmann::json::object());
+  const int stances = static_cast<int>(summary["stance_parameters"]["right"].size() + summary["stance_parameters"]["left"].size());
+  ASSERT_GE(stances, 4);
+  EXPECT_EQ(rows_of(estimate_report_html("example", e, summary)), stances);
+  const ValidationResult v = validate(e, *walk.plates);
+  ASSERT_FALSE(v.stances.empty());
+  const std::string html = validation_report_html("example", e, v, validation_json("example", e, v, nlohmann::json::object()));
+  EXPECT_EQ(rows_of(html), 2 * static_cast<int>(v.stances.size()));
+  EXPECT_NE(html.find("<td class=l>plate</td>"), std::string::npos);
 }

@@ -121,6 +121,21 @@ std::string fmt_cop(const nlohmann::json& stance, const nlohmann::json& x, const
   return stance.value("cop_reference_suspect", false) && text != "-" ? "[" + text + "]" : text;
 }
 
+/// The stance parameters' table rows' cells (dynamics/stance_parameters.hpp): the vertical peaks and
+/// valley and the braking and propulsive peaks in body weights, the impulses in N s, the loading
+/// rate in body weights per second.
+std::string stance_parameter_cells(const nlohmann::json& p) {
+  std::string out;
+  for (const char* k : {"vertical_first_peak_bw", "vertical_valley_bw", "vertical_second_peak_bw", "braking_peak_bw", "propulsive_peak_bw"})
+    out += "<td>" + fmt(p.value(k, nlohmann::json()), "%.2f") + "</td>";
+  for (const char* k : {"braking_impulse_Ns", "propulsive_impulse_Ns"}) out += "<td>" + fmt(p.value(k, nlohmann::json())) + "</td>";
+  return out + "<td>" + fmt(p.value("loading_rate_bw_per_s", nlohmann::json())) + "</td>";
+}
+
+constexpr const char* kStanceParameterHeads =
+    "<th>vertical first peak BW</th><th>valley BW</th><th>second peak BW</th><th>braking peak BW</th>"
+    "<th>propulsive peak BW</th><th>braking impulse N s</th><th>propulsive impulse N s</th><th>loading rate BW/s</th>";
+
 }  // namespace
 
 std::string validation_report_html(const std::string& trial, const EstimateResult& e, const ValidationResult& v,
@@ -157,6 +172,19 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   }
   t << "<tr><td class=l colspan=3>paper, Table 1 (24 gait trials)</td><td>4.1 (1.1)</td><td>11.2 (1.7)</td><td>-</td>"
        "<td>5.3 (1.1)</td><td colspan=7></td></tr>\n</table>\n";
+  t << "<h3>Stance parameters</h3>\n<p>Each stance's ground reaction parameters, kin2grf's against the plate's over the "
+       "stance's loaded span: the vertical force's largest value in each half of the stance and the least between them, "
+       "the braking and propulsive peaks and impulses, the loading rate (20-80 % of the first peak).</p>\n"
+       "<table><tr><th class=l>foot</th><th class=l>plate</th><th class=l>from</th>"
+    << kStanceParameterHeads << "</tr>\n";
+  for (const auto& s : j["per_foot"]) {
+    if (!s.contains("parameters")) continue;
+    for (const char* from : {"estimated", "measured"})
+      t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>())
+        << "</td><td class=l>" << (std::string(from) == "estimated" ? "kin2grf" : "plate") << "</td>"
+        << stance_parameter_cells(s["parameters"][from]) << "</tr>\n";
+  }
+  t << "</table>\n";
   if (!v.excluded.empty() || !v.notes.empty()) {
     t << "<h3>Excluded and notes</h3><ul>\n";
     for (const auto& x : v.excluded) t << "<li>excluded: " << html_escape(x) << "</li>\n";
@@ -271,6 +299,18 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
     t << "<tr><td class=l>" << ev["side"].get<std::string>() << "</td><td class=l>" << ev["event"].get<std::string>() << "</td><td>"
       << ev["frame"] << "</td><td>" << fmt(ev["time_s"], "%.3f") << "</td></tr>\n";
   t << "</table>\n";
+  if (j.contains("stance_parameters")) {
+    t << "<h3>Stance parameters</h3>\n<p>Per stance (foot strike to foot off; * a stance the processed window cuts): the "
+         "vertical force's largest value in each half of the stance and the least between them, the braking and propulsive "
+         "peaks and impulses, the loading rate (20-80 % of the first peak).</p>\n"
+         "<table><tr><th class=l>side</th><th>start s</th><th>duration s</th>"
+      << kStanceParameterHeads << "</tr>\n";
+    for (int f = 0; f < 2; ++f)
+      for (const auto& p : j["stance_parameters"].value(side_name(f), nlohmann::json::array()))
+        t << "<tr><td class=l>" << side_name(f) << (p.value("complete", true) ? "" : " *") << "</td><td>"
+          << fmt(p["start_s"], "%.3f") << "</td><td>" << fmt(p["duration_s"], "%.3f") << "</td>" << stance_parameter_cells(p) << "</tr>\n";
+    t << "</table>\n";
+  }
   if (!e.messages.empty()) {
     t << "<h3>Messages</h3><ul>\n";
     for (const auto& m : e.messages) t << "<li>" << html_escape(m) << "</li>\n";
