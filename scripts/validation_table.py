@@ -88,27 +88,31 @@ print("\nMean (SD) over stances; total GRM: mean (SD) over the trials that have 
       + "".join(f"; {act}: {n} stance(s) left out, with them COP {c} %, {mm} mm" for act, (n, c, mm) in suspect.items() if n)
       + ".\n")
 
+def stances_of(act):
+    """Every plate stance of the activity's trials at the defaults, with its trial's body weight (N)."""
+    for a, name, _ in rows:
+        if a == act:
+            j = load(name, "defaults")
+            for s in j["per_foot"]:
+                yield s, j["mass_kg"] * 9.81
+
+
 # Where the per-foot vertical error lies (session 40): each stance's RMSE over its frames in double
 # support (the other foot loaded too, by the estimate or its plate) and in single support.
 phase_rows = []
 for act in activities:
     dbl, sgl, sq_d, sq_all = [], [], 0.0, 0.0
-    for a, name, _ in rows:
-        if a != act:
-            continue
-        j = load(name, "defaults")
-        bw = j["mass_kg"] * 9.81
-        for s in j["per_foot"]:
-            p = s.get("support_phases") or {}
-            nd, ns = p.get("double_support_frames", 0), p.get("single_support_frames", 0)
-            rd, rs = p.get("vertical_rmse_double_support_N"), p.get("vertical_rmse_single_support_N")
-            if nd and rd is not None:
-                dbl.append(100 * rd / bw)
-                sq_d += nd * rd * rd
-                sq_all += nd * rd * rd
-            if ns and rs is not None:
-                sgl.append(100 * rs / bw)
-                sq_all += ns * rs * rs
+    for s, bw in stances_of(act):
+        p = s.get("support_phases") or {}
+        nd, ns = p.get("double_support_frames", 0), p.get("single_support_frames", 0)
+        rd, rs = p.get("vertical_rmse_double_support_N"), p.get("vertical_rmse_single_support_N")
+        if nd and rd is not None:
+            dbl.append(100 * rd / bw)
+            sq_d += nd * rd * rd
+            sq_all += nd * rd * rd
+        if ns and rs is not None:
+            sgl.append(100 * rs / bw)
+            sq_all += ns * rs * rs
     if dbl or sgl:
         share = f"{100 * sq_d / sq_all:.0f} %" if sq_all > 0 else "-"
         phase_rows.append(f"{act} {mean_sd(dbl) if dbl else '-'} / {mean_sd(sgl) if sgl else '-'} % body weight, {share}")
@@ -118,32 +122,27 @@ if phase_rows:
           "and double support's share of the stances' summed squared error: " + "; ".join(phase_rows) + ".\n")
 
 # The stance parameters a gait report tabulates (session 41): per stance, |estimate - plate| of
-# each, over the plate's stance frames; beside it the plates' mean value, for scale.
+# each, over the stance's loaded span; beside it the plates' mean value, for scale.
 param_rows = []
 peak_keys = ["vertical_first_peak_N", "vertical_valley_N", "vertical_second_peak_N", "braking_peak_N", "propulsive_peak_N"]
 for act in activities:
     errs = {k: [] for k in peak_keys + ["braking_impulse_Ns", "propulsive_impulse_Ns"]}
     plate = {k: [] for k in errs}
     rate_err, rate_plate, n = 0.0, 0.0, 0
-    for a, name, _ in rows:
-        if a != act:
+    for s, bw in stances_of(act):
+        p = s.get("parameters")
+        if not p:
             continue
-        j = load(name, "defaults")
-        bw = j["mass_kg"] * 9.81
-        for s in j["per_foot"]:
-            p = s.get("parameters")
-            if not p:
-                continue
-            n += 1
-            e, m = p["estimated"], p["measured"]
-            for k in errs:
-                if e.get(k) is not None and m.get(k) is not None:
-                    scale = 100 / bw if k in peak_keys else 1000 / bw  # % body weight; body weight x ms
-                    errs[k].append(abs(e[k] - m[k]) * scale)
-                    plate[k].append(abs(m[k]) * scale)
-            if e.get("loading_rate_N_per_s") is not None and m.get("loading_rate_N_per_s") is not None:
-                rate_err += abs(e["loading_rate_N_per_s"] - m["loading_rate_N_per_s"])
-                rate_plate += m["loading_rate_N_per_s"]
+        n += 1
+        e, m = p["estimated"], p["measured"]
+        for k in errs:
+            if e.get(k) is not None and m.get(k) is not None:
+                scale = 100 / bw if k in peak_keys else 1000 / bw  # % body weight; body weight x ms
+                errs[k].append(abs(e[k] - m[k]) * scale)
+                plate[k].append(abs(m[k]) * scale)
+        if e.get("loading_rate_N_per_s") is not None and m.get("loading_rate_N_per_s") is not None:
+            rate_err += abs(e["loading_rate_N_per_s"] - m["loading_rate_N_per_s"])
+            rate_plate += m["loading_rate_N_per_s"]
     if n:
         cell = lambda k: (f"{sum(errs[k]) / len(errs[k]):.1f} ({sum(plate[k]) / len(plate[k]):.0f})" if errs[k] else "-")
         rate = f"{100 * rate_err / rate_plate:.0f}" if rate_plate > 0 else "-"

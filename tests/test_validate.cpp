@@ -735,13 +735,17 @@ TEST(Validate, StancesCutByTheWindowAreComparedApartFromTheMeans) {
 // example walk, the right foot's estimate set to its plate's reading plus 50 N where the left foot
 // is loaded and plus 20 N elsewhere reads back as those RMSEs, the left foot's untouched stance
 // as its own, and the means give double support its share of the squared error.
+namespace {
+/// The first right-foot stance of a validation (end() where there is none).
+std::vector<StanceValidation>::const_iterator right_of(const ValidationResult& r) {
+  return std::find_if(r.stances.begin(), r.stances.end(), [](const auto& x) { return x.foot == 0; });
+}
+}  // namespace
+
 TEST(Validate, EachStancesVerticalErrorIsSplitByTheSupportPhase) {
   const Trial walk = make_example_walk();
   EstimateResult e = estimate(walk, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
   const auto before = validate(e, *walk.plates);
-  const auto right_of = [](const ValidationResult& r) {
-    return std::find_if(r.stances.begin(), r.stances.end(), [](const auto& x) { return x.foot == 0; });
-  };
   ASSERT_TRUE(right_of(before) != before.stances.end());
   const StanceValidation& r0 = *right_of(before);
   const Eigen::VectorXd plate = before.plates[static_cast<std::size_t>(r0.plate_index)].force_N.col(1);
@@ -772,9 +776,6 @@ TEST(Validate, EachStancesGaitParametersAreComparedWithThePlates) {
   const Trial walk = make_example_walk();
   EstimateResult e = estimate(walk, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
   const auto before = validate(e, *walk.plates);
-  const auto right_of = [](const ValidationResult& r) {
-    return std::find_if(r.stances.begin(), r.stances.end(), [](const auto& x) { return x.foot == 0; });
-  };
   ASSERT_TRUE(right_of(before) != before.stances.end());
   const StanceValidation& r0 = *right_of(before);
   const Eigen::MatrixX2d& plate = before.plates[static_cast<std::size_t>(r0.plate_index)].force_N;
