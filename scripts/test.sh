@@ -8,7 +8,7 @@ bash scripts/setup.sh
 cmake --preset ci >/dev/null
 cmake --build --preset ci
 ctest --preset ci -j2
-# The readers, outputs, filters, solver and parallel tests under ASan/UBSan, built with the
+# The readers, outputs, filters, solver, stance parameters and parallel tests under ASan/UBSan, built with the
 # library the fuzzers use (one sanitizer build of it serves both; line tables only, which keep the
 # sanitizers' stack traces at a fraction of full debug information's compile time), then the fuzz
 # targets, briefly, seeded with the project's own files; scripts/fuzz.sh 600 is the long run.
@@ -17,5 +17,5 @@ ctest --preset ci -j2
 # parsers under the sanitizers; the search for bugs is scripts/fuzz.sh's own, for minutes.
 cmake --preset fuzz >/dev/null
 cmake --build --preset fuzz --target kin2grf_tests fuzz_c3d fuzz_trc fuzz_sto fuzz_mapping fuzz_cop_function fuzz_trial_list
-ctest --preset fuzz -j2 -R 'C3d|Trc|Sto|Corrupt|Fuzz|Solver|NoisyMarkers|SyntheticWalk|Parallel|Text|OutputFile|InputFile'
+ctest --preset fuzz -j2 -R 'C3d|Trc|Sto|Corrupt|Fuzz|Solver|NoisyMarkers|SyntheticWalk|Parallel|Text|OutputFile|InputFile|StanceParameters'
 bash scripts/fuzz.sh 5
