@@ -8,6 +8,7 @@
 #include <map>
 #include <random>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "kin2grf/error.hpp"
@@ -822,6 +823,33 @@ TEST(Validate, EachStancesGaitParametersAreComparedWithThePlates) {
     EXPECT_GT(st["loading_rate_bw_per_s"].get<double>(), 0.0);
   }
   EXPECT_GE(complete, 2u);
+  // The --stances CSV: the same stances, right and left in time order, every row as wide as its
+  // header, the first right stance's first peak as in the summary (to 6 significant digits).
+  const std::string csv = stance_parameters_csv(e);
+  std::istringstream lines(csv);
+  std::string line;
+  std::getline(lines, line);
+  const auto cells = [](const std::string& l) { return static_cast<std::size_t>(std::count(l.begin(), l.end(), ',')) + 1; };
+  const std::size_t width = cells(line);
+  EXPECT_EQ(width, 23u);
+  std::size_t rows = 0;
+  bool first_right = true;
+  double previous_start = -1;
+  while (std::getline(lines, line)) {
+    ++rows;
+    EXPECT_EQ(cells(line), width) << line;
+    std::vector<std::string> c;
+    std::istringstream ls(line);
+    for (std::string x; std::getline(ls, x, ',');) c.push_back(x);
+    const double start = std::stod(c[3]);
+    EXPECT_GE(start, previous_start);  // time order
+    previous_start = start;
+    if (c[0] == "right" && first_right) {
+      first_right = false;
+      EXPECT_NEAR(std::stod(c[6]), stances[0]["vertical_first_peak_N"].get<double>(), 1e-5 * std::abs(std::stod(c[6])));
+    }
+  }
+  EXPECT_EQ(rows, stances.size() + summary["stance_parameters"]["left"].size());
 }
 
 // A stance whose force is piecewise linear, so that every parameter has an exact value: the

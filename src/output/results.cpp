@@ -1,11 +1,14 @@
 #include "kin2grf/output/results.hpp"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 #include <string>
+#include <string_view>
 
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/output_file.hpp"
@@ -212,27 +215,74 @@ nlohmann::json stance_parameters_json(const StanceParameters& p, double body_wei
 
 namespace {
 
-/// Per side, per stance (gait_stances: the stances the gait events mark), the ground reaction's
-/// stance parameters (dynamics/stance_parameters.hpp) from the estimate's post-filtered force.
-nlohmann::json stance_parameters_by_side_json(const EstimateResult& r) {
-  nlohmann::json out = nlohmann::json::object();
+/// One stance of the estimate's own contact (gait_stances: the stances the gait events mark) and
+/// its parameters (dynamics/stance_parameters.hpp) from the post-filtered force.
+struct EstimatedStance {
+  int side = 0;
+  IndexRun run;
+  bool complete = false;  ///< false where the processed window cuts it
+  StanceParameters parameters;
+};
+
+/// Every foot's stances, in time order (at one frame: the right foot first).
+std::vector<EstimatedStance> estimated_stances(const EstimateResult& r) {
+  std::vector<EstimatedStance> out;
   const auto n = r.time_s.size();
-  const double body_weight_N = r.mass_kg * r.model().gravity_mps2;
   for (int s = 0; s < 2; ++s) {
     const FootResult& f = r.feet[static_cast<std::size_t>(s)];
-    nlohmann::json stances = nlohmann::json::array();
-    for (const auto& run : gait_stances(f.contact, r.motion.rate_hz)) {
-      nlohmann::json j = {{"start_s", r.time_s[run.first]}, {"end_s", r.time_s[run.last]},
-                          {"complete", run.first > 0 && run.last < n - 1}};
-      j.update(stance_parameters_json(stance_parameters(f.force_N, r.motion.rate_hz, run.first, run.last), body_weight_N));
-      stances.push_back(std::move(j));
-    }
-    out[side_name(s)] = std::move(stances);
+    for (const auto& run : gait_stances(f.contact, r.motion.rate_hz))
+      out.push_back({s, run, run.first > 0 && run.last < n - 1, stance_parameters(f.force_N, r.motion.rate_hz, run.first, run.last)});
+  }
+  std::stable_sort(out.begin(), out.end(), [](const EstimatedStance& a, const EstimatedStance& b) {
+    return a.run.first != b.run.first ? a.run.first < b.run.first : a.side < b.side;
+  });
+  return out;
+}
+
+/// The summary's `stance_parameters`: per side, its stances in time order.
+nlohmann::json stance_parameters_by_side_json(const EstimateResult& r) {
+  nlohmann::json out = {{side_name(0), nlohmann::json::array()}, {side_name(1), nlohmann::json::array()}};
+  const double body_weight_N = r.mass_kg * r.model().gravity_mps2;
+  for (const EstimatedStance& st : estimated_stances(r)) {
+    nlohmann::json j = {{"start_s", r.time_s[st.run.first]}, {"end_s", r.time_s[st.run.last]}, {"complete", st.complete}};
+    j.update(stance_parameters_json(st.parameters, body_weight_N));
+    out[side_name(st.side)].push_back(std::move(j));
   }
   return out;
 }
 
 }  // namespace
+
+std::string stance_parameters_csv(const EstimateResult& r) {
+  std::ostringstream os;
+  os << "side,frame_first,frame_last,start_s,duration_s,complete,vertical_first_peak_N,vertical_first_peak_bw,vertical_valley_N,"
+        "vertical_valley_bw,vertical_second_peak_N,vertical_second_peak_bw,vertical_peak_N,vertical_peak_bw,braking_peak_N,"
+        "braking_peak_bw,propulsive_peak_N,propulsive_peak_bw,vertical_impulse_Ns,braking_impulse_Ns,propulsive_impulse_Ns,"
+        "loading_rate_N_per_s,loading_rate_bw_per_s\n";
+  const double bw = r.mass_kg * r.model().gravity_mps2;
+  const auto cell = [&os](double x) {
+    os << ',';
+    if (!std::isfinite(x)) return;  // an empty cell: the value does not exist
+    char b[32];
+    os << std::string_view(b, static_cast<std::size_t>(std::to_chars(b, b + sizeof b, x, std::chars_format::general, 6).ptr - b));
+  };
+  for (const EstimatedStance& st : estimated_stances(r)) {
+    const StanceParameters& p = st.parameters;
+    os << side_name(st.side) << ',' << r.first_frame_number + st.run.first << ',' << r.first_frame_number + st.run.last;
+    cell(r.time_s[st.run.first]);
+    cell(p.duration_s);
+    os << ',' << (st.complete ? 1 : 0);
+    for (double f : {p.vertical_first_peak_N, p.vertical_valley_N, p.vertical_second_peak_N, p.vertical_peak_N, p.braking_peak_N,
+                     p.propulsive_peak_N}) {
+      cell(f);
+      cell(bw > 0 ? f / bw : std::numeric_limits<double>::quiet_NaN());
+    }
+    for (double x : {p.vertical_impulse_Ns, p.braking_impulse_Ns, p.propulsive_impulse_Ns, p.loading_rate_N_per_s}) cell(x);
+    cell(bw > 0 ? p.loading_rate_N_per_s / bw : std::numeric_limits<double>::quiet_NaN());
+    os << '\n';
+  }
+  return os.str();
+}
 
 nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings) {
   using nlohmann::json;

@@ -52,6 +52,12 @@ nlohmann::json stance_parameters_json(const StanceParameters& p, double body_wei
 /// vertical force (what `estimate` prints).
 std::string format_results_text(const EstimateResult& r);
 
+/// Each stance's parameters (the summary's `stance_parameters`) as CSV, one row per stance in time
+/// order: side, frame_first, frame_last (the file's frame numbers), start_s, duration_s, complete
+/// (0 where the processed window cuts the stance), then each force in N and in body weights
+/// (`_bw`), the impulses (N s) and the loading rate (N/s, body weights/s); an empty cell where a
+/// value does not exist. For spreadsheets and statistics packages (docs/FORMATS.md).
+std::string stance_parameters_csv(const EstimateResult& r);
 /// The gait events (gait_events: foot strike, foot off per side) as CSV: side,event,frame,time_s
 /// (frame: the file's frame number).
 std::string gait_events_csv(const EstimateResult& r);
