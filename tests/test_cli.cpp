@@ -23,7 +23,10 @@
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/output_file.hpp"
+#include "kin2grf/error.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/workflow/batch.hpp"
+#include "kin2grf/workflow/trial_list.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -314,12 +317,36 @@ TEST(CliBatch, RunsEveryTrialPastAFailureAndTheTableDoesNotDependOnJobs) {
   EXPECT_FALSE(j["trials"][2]["validated"].get<bool>());  // a TRC has no plates
   EXPECT_TRUE(j["trials"][2]["vertical_rrmse_percent"].is_null());
   for (const char* f : {"with-plates.csv", "with-plates_grf.mot", "with-plates.json", "with-plates_markers.trc",
-                        "with-plates_external_loads.xml", "markers-only.csv"})
+                        "with-plates_external_loads.xml", "with-plates_stances.csv", "markers-only.csv", "markers-only_stances.csv"})
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / f)) << f;
   // The batch's GRF is the OpenSim set's (one convention everywhere).
   EXPECT_NE(kin2grf::read_file_text((dir / "out" / "with-plates_grf.mot").string()).find("kin2grf_frame=OpenSim ground"),
             std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "missing.csv"));
+}
+
+// Two trials whose output names meet (trial "a" writes a_stances.csv, trial "a_stances" its own
+// a_stances.csv) are refused before anything runs, naming the file (the command line's output
+// check; run_batch's own, for the library and Python, names both trials too).
+TEST(CliBatch, TwoTrialsThatWouldWriteOneFileAreRefused) {
+  const auto dir = kin2grf::test::temp_dir("cli_batch_clash");
+  {
+    std::ofstream list(dir / "list.txt");
+    list << "squat|own|a|" << example_trc() << " --mass 70\n"
+         << "squat|own|a_stances|" << example_trc() << " --mass 70\n";
+  }
+  const CliRun r = run("batch " + (dir / "list.txt").string() + " --out-dir " + (dir / "out").string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("a_stances.csv"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "a.csv"));
+  kin2grf::BatchOptions o;
+  o.out_dir = (dir / "out").string();
+  try {
+    kin2grf::run_batch(kin2grf::read_trial_list((dir / "list.txt").string()), o);
+    ADD_FAILURE() << "the clash was not refused";
+  } catch (const kin2grf::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("trials 'a' and 'a_stances'"), std::string::npos) << e.what();
+  }
 }
 
 TEST(CliBatch, ABadLineNamesTheListAndTheLine) {

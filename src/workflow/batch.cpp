@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <mutex>
 #include <numeric>
+#include <map>
 #include <set>
 #include <sstream>
 #include <system_error>
@@ -100,7 +101,8 @@ void parse_sync(const std::string& text, ValidationOptions& vo) {
 std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir, bool c3d) {
   const auto base = (std::filesystem::path(out_dir) / file_stem(entry.name)).string();
   const auto opensim = opensim_export_paths(out_dir, file_stem(entry.name));
-  std::vector<std::string> out = {base + ".csv", opensim.grf_mot, base + ".json", opensim.markers_trc, opensim.external_loads_xml};
+  std::vector<std::string> out = {base + ".csv",         opensim.grf_mot, base + ".json", opensim.markers_trc, opensim.external_loads_xml,
+                                  base + "_stances.csv"};
   if (c3d) out.push_back(base + ".c3d");
   return out;
 }
@@ -133,6 +135,7 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
       const auto written = batch_trial_outputs(entry, options.out_dir, options.c3d);
       const std::string &csv = written[0], &json = written[2];
       write_results_csv(csv, r);
+      write_file_text(written[5], stance_parameters_csv(r));
       auto settings = settings_json(entry.settings, estimate_options);
       // The OpenSim set, as `estimate --opensim` writes it: the GRF in OpenSim's frame over the
       // whole trial, the markers, the ExternalLoads file.
@@ -191,11 +194,18 @@ std::vector<BatchRow> run_batch(const std::vector<TrialListEntry>& entries, cons
     // One trial's outputs must not replace another's, nor any trial's input (a trial's name may
     // be another's --plates file).
     std::set<std::string> stems;
+    std::map<std::string, std::string> written_by;  // output file -> the trial that writes it
     std::vector<std::string> outputs;
     for (const auto& e : entries) {
       if (!stems.insert(file_stem(e.name)).second)
         throw InputError("two trials of the batch are named '" + e.name + "': their outputs would share a name");
-      for (auto& f : batch_trial_outputs(e, options.out_dir)) outputs.push_back(std::move(f));
+      // Names can still meet across trials: trial "a" writes a_stances.csv, trial "a_stances" its a_stances.csv.
+      for (auto& f : batch_trial_outputs(e, options.out_dir, options.c3d)) {
+        const auto [at, fresh] = written_by.emplace(f, e.name);
+        if (!fresh)
+          throw InputError("trials '" + at->second + "' and '" + e.name + "' of the batch would both write " + f + ": rename one");
+        outputs.push_back(std::move(f));
+      }
     }
     ensure_no_output_is_an_input(outputs, list_input_files(entries));
     ensure_output_folder(options.out_dir);
