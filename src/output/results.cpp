@@ -268,8 +268,9 @@ std::string stance_parameters_csv(const EstimateResult& r) {
   };
   for (const EstimatedStance& st : estimated_stances(r)) {
     const StanceParameters& p = st.parameters;
-    os << side_name(st.side) << ',' << r.first_frame_number + st.run.first << ',' << r.first_frame_number + st.run.last;
-    cell(r.time_s[st.run.first]);
+    os << side_name(st.side) << ',' << r.first_frame_number + st.run.first << ',' << r.first_frame_number + st.run.last << ',';
+    char b[32];  // the start at full precision, as the gait events CSV gives times (6 digits are 1 ms at 100 s)
+    os << std::string_view(b, static_cast<std::size_t>(std::to_chars(b, b + sizeof b, r.time_s[st.run.first]).ptr - b));
     cell(p.duration_s);
     os << ',' << (st.complete ? 1 : 0);
     for (double f : {p.vertical_first_peak_N, p.vertical_valley_N, p.vertical_second_peak_N, p.vertical_peak_N, p.braking_peak_N,
