@@ -124,6 +124,20 @@ class Estimate:
     def table(self):
         return _table(self.columns, self.values)
 
+    @property
+    def stances(self):
+        """Each stance's ground reaction parameters (the summary's ``stance_parameters``: the rows of
+        ``kin2grf estimate --stances``, full precision), right and left in time order with a
+        ``side`` column: a pandas DataFrame (a list of dicts without pandas)."""
+        by_side = self.summary.get("stance_parameters", {})
+        rows = [{"side": side, **p} for side in ("right", "left") for p in by_side.get(side, [])]
+        rows.sort(key=lambda p: (p["start_s"], p["side"] != "right"))
+        try:
+            import pandas as pd
+        except ImportError:
+            return rows
+        return pd.DataFrame(rows)
+
     def __getitem__(self, column: str) -> np.ndarray:
         return self.values[:, self.columns.index(column)]
 

@@ -101,6 +101,24 @@ def test_table_and_columns(example):
     assert r.summary["mass_kg"] == 70.0
 
 
+def test_stances_are_the_cli_stances_csv(example, tmp_path):
+    """Estimate.stances: the summary's stance parameters as ``--stances`` writes them, row for row."""
+    trial = example / "example_walk.c3d"
+    r = kin2grf.estimate(trial)
+    out = tmp_path / "stances.csv"
+    subprocess.run([CLI, "estimate", str(trial), "--stances", str(out)], check=True, capture_output=True)
+    with open(out, newline="") as f:
+        rows = list(csv.DictReader(f))
+    st = r.stances
+    records = st.to_dict("records") if hasattr(st, "to_dict") else st
+    assert len(records) == len(rows) >= 4
+    for mine, theirs in zip(records, rows):
+        assert mine["side"] == theirs["side"]
+        assert int(theirs["complete"]) == int(mine["complete"])
+        for k in ("start_s", "duration_s", "vertical_first_peak_N", "braking_impulse_Ns"):
+            assert abs(float(theirs[k]) - mine[k]) <= 1e-5 * abs(mine[k]) + 1e-9, k
+
+
 def test_mediolateral_adds_the_lateral_columns(example):
     r0 = kin2grf.estimate(example / "example_walk.c3d")
     r1 = kin2grf.estimate(example / "example_walk.c3d", mediolateral=True)
