@@ -8,9 +8,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <numeric>
-#include <map>
 #include <set>
 #include <sstream>
 #include <system_error>
@@ -101,7 +101,7 @@ void parse_sync(const std::string& text, ValidationOptions& vo) {
 std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir, bool c3d) {
   const auto base = (std::filesystem::path(out_dir) / file_stem(entry.name)).string();
   const auto opensim = opensim_export_paths(out_dir, file_stem(entry.name));
-  std::vector<std::string> out = {base + ".csv",         opensim.grf_mot, base + ".json", opensim.markers_trc, opensim.external_loads_xml,
+  std::vector<std::string> out = {base + ".csv", opensim.grf_mot, base + ".json", opensim.markers_trc, opensim.external_loads_xml,
                                   base + "_stances.csv"};
   if (c3d) out.push_back(base + ".c3d");
   return out;
