@@ -883,25 +883,25 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
     if (foot >= 0 && s.foot != foot) continue;
     if (s.body_weight_N > 0) {
       const StanceParameters &pe = s.parameters_estimated, &pm = s.parameters_measured;
-      const std::array<std::pair<double, double>, 5> peaks = {{{pe.vertical_first_peak_N, pm.vertical_first_peak_N},
+      // The five peaks (x 100: % body weight), then the two impulses (x 1000: body weight x ms).
+      const std::array<std::pair<double, double>, 7> pairs = {{{pe.vertical_first_peak_N, pm.vertical_first_peak_N},
                                                                {pe.vertical_valley_N, pm.vertical_valley_N},
                                                                {pe.vertical_second_peak_N, pm.vertical_second_peak_N},
                                                                {pe.braking_peak_N, pm.braking_peak_N},
-                                                               {pe.propulsive_peak_N, pm.propulsive_peak_N}}};
-      for (std::size_t k = 0; k < peaks.size(); ++k)
-        if (std::isfinite(peaks[k].first) && std::isfinite(peaks[k].second))
-          peak_errors[k].push_back(100 * std::abs(peaks[k].first - peaks[k].second) / s.body_weight_N);
-      const std::array<std::pair<double, double>, 2> impulses = {{{pe.braking_impulse_Ns, pm.braking_impulse_Ns},
-                                                                  {pe.propulsive_impulse_Ns, pm.propulsive_impulse_Ns}}};
-      for (std::size_t k = 0; k < impulses.size(); ++k)
-        if (std::isfinite(impulses[k].first) && std::isfinite(impulses[k].second))
-          impulse_errors[k].push_back(1000 * std::abs(impulses[k].first - impulses[k].second) / s.body_weight_N);
+                                                               {pe.propulsive_peak_N, pm.propulsive_peak_N},
+                                                               {pe.braking_impulse_Ns, pm.braking_impulse_Ns},
+                                                               {pe.propulsive_impulse_Ns, pm.propulsive_impulse_Ns}}};
+      for (std::size_t k = 0; k < pairs.size(); ++k) {
+        const auto [est, plate] = pairs[k];
+        if (!(std::isfinite(est) && std::isfinite(plate))) continue;
+        const double error = std::abs(est - plate);
+        if (k < peak_errors.size()) peak_errors[k].push_back(100 * error / s.body_weight_N);
+        else impulse_errors[k - peak_errors.size()].push_back(1000 * error / s.body_weight_N);
+      }
       if (std::isfinite(pe.loading_rate_N_per_s) && std::isfinite(pm.loading_rate_N_per_s)) {
         rate_error_sum += std::abs(pe.loading_rate_N_per_s - pm.loading_rate_N_per_s);
         rate_plate_sum += pm.loading_rate_N_per_s;
       }
-    }
-    if (s.body_weight_N > 0) {
       if (s.double_support_frames > 0) double_support.push_back(100 * s.vertical_rmse_double_support_N / s.body_weight_N);
       if (s.single_support_frames > 0) single_support.push_back(100 * s.vertical_rmse_single_support_N / s.body_weight_N);
     }
@@ -1137,6 +1137,13 @@ std::string table_msd(double mean, double sd) {
   std::snprintf(b, sizeof b, "%.1f (%.1f)", mean, sd);
   return table_text(b);
 }
+/// `x` printed with `fmt`, or "-" where it does not exist (the lines under the table).
+std::string number_or_dash(double x, const char* fmt = "%.1f") {
+  char t[40];
+  if (!std::isfinite(x)) return "-";
+  std::snprintf(t, sizeof t, fmt, x);
+  return t;
+}
 std::string table_label(const std::string& l) {
   char b[64];
   std::snprintf(b, sizeof b, "  %-28s", l.c_str());
@@ -1237,31 +1244,19 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
     os << buf;
   }
   if (m.n > 0 && std::isfinite(m.double_support_error_share_percent)) {
-    const auto pct = [](double x) {
-      char t[32];
-      if (std::isfinite(x)) std::snprintf(t, sizeof t, "%.1f", x);
-      else std::snprintf(t, sizeof t, "-");
-      return std::string(t);
-    };
     std::snprintf(buf, sizeof buf, "  per foot, vertical RMSE in double / single support: %s / %s %% body weight; %.0f %% of the squared error "
                                    "in double support\n",
-                  pct(m.vertical_rmse_double_support_percent_bw).c_str(), pct(m.vertical_rmse_single_support_percent_bw).c_str(),
-                  m.double_support_error_share_percent);
+                  number_or_dash(m.vertical_rmse_double_support_percent_bw).c_str(),
+                  number_or_dash(m.vertical_rmse_single_support_percent_bw).c_str(), m.double_support_error_share_percent);
     os << buf;
   }
   if (m.n > 0 && std::isfinite(m.parameter_peak_error_percent_bw[0])) {
-    const auto val = [](double x, const char* fmt) {
-      char t[32];
-      if (std::isfinite(x)) std::snprintf(t, sizeof t, fmt, x);
-      else std::snprintf(t, sizeof t, "-");
-      return std::string(t);
-    };
     const auto& pk = m.parameter_peak_error_percent_bw;
-    os << "  per foot, stance parameters' mean |estimate - plates|: vertical first peak / valley / second peak " << val(pk[0], "%.1f")
-       << " / " << val(pk[1], "%.1f") << " / " << val(pk[2], "%.1f") << " % body weight, braking / propulsive peak " << val(pk[3], "%.1f")
-       << " / " << val(pk[4], "%.1f") << " % body weight, braking / propulsive impulse " << val(m.parameter_impulse_error_bw_ms[0], "%.1f")
-       << " / " << val(m.parameter_impulse_error_bw_ms[1], "%.1f") << " body weight ms, loading rate "
-       << val(m.loading_rate_error_percent, "%.0f") << " %\n";
+    os << "  per foot, stance parameters' mean |estimate - plates|: vertical first peak / valley / second peak " << number_or_dash(pk[0])
+       << " / " << number_or_dash(pk[1]) << " / " << number_or_dash(pk[2]) << " % body weight, braking / propulsive peak "
+       << number_or_dash(pk[3]) << " / " << number_or_dash(pk[4]) << " % body weight, braking / propulsive impulse "
+       << number_or_dash(m.parameter_impulse_error_bw_ms[0]) << " / " << number_or_dash(m.parameter_impulse_error_bw_ms[1])
+       << " body weight ms, loading rate " << number_or_dash(m.loading_rate_error_percent, "%.0f") << " %\n";
   }
   if (std::isfinite(m.lateral_rmse_percent_bw)) format_lateral_rows(os, v, m);
   if (std::isfinite(m.knee_adduction)) format_joint_moment_rows(os, v, m, v.mass_kg);
