@@ -160,6 +160,50 @@ if param_rows:
         print(r)
     print()
 
+# The sagittal joint torques against the plates' inverse dynamics (session 42): per stance whose
+# plate passes the registration check, kin2grf's own torques (the least squares') and bottom-up
+# ones from its forces, each against bottom-up from the plate on the same motion.
+torque_rows = []
+joints = ["hip", "knee", "ankle"]
+for act in activities:
+    ls, bu, rm, worst = {k: [] for k in joints}, {k: [] for k in joints}, {k: [] for k in joints}, None
+    for a, name, _ in rows:
+        if a != act:
+            continue
+        j = load(name, "defaults")
+        for s in j["per_foot"]:
+            t = s.get("joint_torques")
+            if not t:
+                continue
+            for k in joints:
+                if t[k]["least_squares"] and t[k]["least_squares"]["rrmse_percent"] is not None:
+                    ls[k].append(t[k]["least_squares"]["rrmse_percent"])
+                    rm[k].append(t[k]["least_squares"]["rmse_Nm"] / j["mass_kg"])
+                if t[k]["bottom_up"] and t[k]["bottom_up"]["rrmse_percent"] is not None:
+                    bu[k].append(t[k]["bottom_up"]["rrmse_percent"])
+            knee = t["knee"]["least_squares"]["rrmse_percent"] if t["knee"]["least_squares"] else None
+            if knee is not None and (worst is None or knee > worst[1]):
+                worst = (name, knee)
+    if ls["hip"]:
+        n = len(ls["hip"])
+        cell = lambda x: f"{sum(x) / len(x):.1f}" if x else "-"
+        torque_rows.append(f"| {act} | {n} | " + " / ".join(cell(ls[k]) for k in joints) + " | "
+                           + " / ".join(f"{sum(rm[k]) / len(rm[k]):.2f}" if rm[k] else "-" for k in joints) + " | "
+                           + " / ".join(cell(bu[k]) for k in joints) + f" | {worst[0]} {worst[1]:.1f} |")
+if torque_rows:
+    print("Sagittal joint torques (defaults; since session 42): per stance, kin2grf's hip, knee and ankle torques (the least squares' "
+          "multipliers of Eq. 7, the CSV's `torque_*`) against the torques a lab's inverse dynamics takes from the plate: bottom-up "
+          "Newton-Euler from the foot's plate on the estimate's own motion (dynamics/joint_moments_2d.hpp), so that the difference is "
+          "the estimate's ground reaction's alone; beside them the same bottom-up from kin2grf's forces (its COP on the floor), what a "
+          "lab's tool run on kin2grf's GRF file computes on this motion. Stances whose plate fails the registration check are left "
+          "out (their plate-driven torques take a misplaced COP as their lever). Mean over the stances.\n")
+    print("| activity | stances | rRMSE % hip / knee / ankle | RMSE N m/kg hip / knee / ankle | bottom-up from the estimate's forces, "
+          "rRMSE % | worst stance (knee rRMSE %) |")
+    print("|---|---|---|---|---|---|")
+    for r in torque_rows:
+        print(r)
+    print()
+
 cv_kinds = [k for k in ("speed-gate-ratio", "r", "split-distance", "torso-length", "torso-lag", "post-cutoff-cycles", "double-support-sta",
                                 "min-kinematic-cycles", "touchdown-fraction", "touchdown-stop", "post-cutoff-floor", "speed-gate-floor",
                                 "speed-gate-standstill", "running-sway-gain", "thigh-lag", "torso-vertical-cutoff", "double-support-angle",

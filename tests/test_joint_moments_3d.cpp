@@ -1,10 +1,12 @@
-// 3D ankle and knee moments (dynamics/joint_moments_3d.hpp): bottom-up Newton-Euler on the legs'
-// landmarks, guarded by cases whose answer is known without the code.
+// Joint moments by bottom-up Newton-Euler inverse dynamics, guarded by cases whose answer is known
+// without the code: the 3D ankle, knee and hip moments (dynamics/joint_moments_3d.hpp) on the legs'
+// landmarks, and the sagittal model's joint torques (dynamics/joint_moments_2d.hpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
+#include "kin2grf/dynamics/joint_moments_2d.hpp"
 #include "kin2grf/dynamics/joint_moments_3d.hpp"
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/load.hpp"
@@ -335,5 +337,97 @@ TEST(JointMoments3D, TheEstimateGivesTheSameMomentsWithOrWithoutTheLegsKinematic
   for (std::size_t k = 0; k < 2; ++k) {
     EXPECT_LT((kept.legs_3d->moments.knee_Nm[k] - blocks.legs_3d->moments.knee_Nm[k]).cwiseAbs().maxCoeff(), 1e-9);
     EXPECT_LT((kept.legs_3d->moments.hip_Nm[k] - blocks.legs_3d->moments.hip_Nm[k]).cwiseAbs().maxCoeff(), 1e-9);
+  }
+}
+
+// ---- The sagittal joint torques, bottom-up (dynamics/joint_moments_2d.hpp) ----
+
+namespace {
+
+/// The estimate's own ground reaction per foot as the solve applies it, as bottom_up_joint_torques
+/// takes it: at model 2's point D, which a tilted foot (heel strike, push-off) holds above the
+/// floor by its gap, where the outputs' COP is on the floor.
+std::array<FootWrench2D, 2> estimated_wrenches_2d(const EstimateResult& r) {
+  std::array<FootWrench2D, 2> w;
+  const Eigen::Index n = r.time_s.size();
+  for (int side = 0; side < 2; ++side) {
+    const FootResult& f = r.feet[static_cast<std::size_t>(side)];
+    FootWrench2D& fw = w[static_cast<std::size_t>(side)];
+    fw.force_N = Eigen::MatrixX2d::Zero(n, 2);
+    fw.moment_origin_Nm = Eigen::VectorXd::Zero(n);
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (f.contact[static_cast<std::size_t>(i)]) {
+        fw.force_N.row(i) = f.force_N.row(i);
+        fw.moment_origin_Nm[i] = f.cop_x_m[i] * f.force_N(i, 1) - (r.ground_level_m() + f.gap_m[i]) * f.force_N(i, 0);
+      }
+  }
+  return w;
+}
+
+}  // namespace
+
+// Where both feet are down, Eq. 7's four contact multipliers explain the whole body's three
+// equations exactly (no residual), and the least squares' joint torques are the unique ones the
+// chain's equations give: bottom-up from each foot's force, to round-off. Guards the bottom-up
+// formula's subtrees, its lever arms and its sign against the multipliers' (moment on the child,
+// counter-clockwise +). Every step after the solve that moves forces and torques apart from one
+// frame's equations (the post-filter, the double-support transition, the touchdown rule) is off.
+TEST(JointMoments2D, TheLeastSquaresTorquesAreTheBottomUpOnesWhereTheContactsExplainTheMotion) {
+  const SyntheticWalk walk = make_synthetic_walk({});
+  EstimateOptions o;
+  o.post_cutoff_cycles = 0;
+  o.post_cutoff_hz = 0;
+  o.double_support_sta_weight = 0;
+  o.frontal_split_weight = 0;
+  o.touchdown_stop_fraction = 0;
+  const EstimateResult r = estimate(walk.trial, nullptr, *recognise_marker_set(walk.trial.markers), o);
+  const Eigen::MatrixXd tau = bottom_up_joint_torques(r.motion, estimated_wrenches_2d(r));
+  ASSERT_EQ(tau.rows(), r.joint_torque_Nm.rows());
+  int compared = 0, single = 0;
+  for (Eigen::Index i = 0; i < r.time_s.size(); ++i) {
+    const bool right = r.feet[0].contact[static_cast<std::size_t>(i)], left = r.feet[1].contact[static_cast<std::size_t>(i)];
+    if (right && left) {
+      ++compared;
+      for (int j = 0; j < kJointCount; ++j) EXPECT_NEAR(tau(i, j), r.joint_torque_Nm(i, j), 1e-6) << "frame " << i << ", joint " << j;
+    }
+    // In single support the prescribed COP leaves a moment residual, which the least squares
+    // spreads over the joints and bottom-up does not: there they differ.
+    if (right != left && std::abs(frame_totals(r, i).residual.z()) > 5.0) {
+      ++single;
+      double largest = 0;
+      for (int j = 0; j < kJointCount; ++j) largest = std::max(largest, std::abs(tau(i, j) - r.joint_torque_Nm(i, j)));
+      EXPECT_GT(largest, 0.1) << "frame " << i;
+    }
+  }
+  EXPECT_GE(compared, 20);  // the walk's double supports
+  EXPECT_GE(single, 20);
+}
+
+// A leg standing still under its own weight: each joint's torque is the moment, about the joint,
+// of the weight below it and of the ground's force at the COP, known without the code. The foot
+// flat, the ground force straight up under the ankle plus 5 cm: the ankle carries that force's
+// moment less the foot's and toes' weights' moments.
+TEST(JointMoments2D, AStillLegsTorquesAreItsWeightsAndTheGroundsMoments) {
+  const SyntheticWalk walk = make_synthetic_walk({});
+  const EstimateResult r = estimate(walk.trial, nullptr, *recognise_marker_set(walk.trial.markers), {});
+  const Model& model = r.model();
+  MotionFrame m = r.motion.frame(r.time_s.size() / 2);
+  m.qdd.setZero();  // at rest
+  const double g = model.gravity_mps2;
+  for (int side = 0; side < 2; ++side) {
+    const int ankle = model.bodies[static_cast<std::size_t>(segment(side, kFoot))].proximal;
+    const double ax = m.q(coord::point_x(ankle));
+    const double fy = 600.0, cop_x = ax + 0.05;
+    const double moment_origin = cop_x * fy;  // the force straight up, its moment about the origin
+    double expected = -(cop_x - ax) * fy;      // the ground's moment about the ankle, on the foot: - of it
+    for (LegSegment k : {kFoot, kToes}) {
+      const int s = segment(side, k);
+      expected += (m.q(coord::com_x(s)) - ax) * model.bodies[static_cast<std::size_t>(s)].mass_kg * g;
+    }
+    EXPECT_NEAR(bottom_up_joint_torque(model, m, 4 * side + 2, {0.0, fy}, moment_origin), expected, 1e-9) << side_name(side);
+    // The MTP: the toes' weight alone; the ground acts on the foot (model 2's point D).
+    const int mtp = model.bodies[static_cast<std::size_t>(segment(side, kToes))].proximal, toes = segment(side, kToes);
+    EXPECT_NEAR(bottom_up_joint_torque(model, m, 4 * side + 3, {0.0, fy}, moment_origin),
+                (m.q(coord::com_x(toes)) - m.q(coord::point_x(mtp))) * model.bodies[static_cast<std::size_t>(toes)].mass_kg * g, 1e-9);
   }
 }

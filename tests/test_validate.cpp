@@ -181,6 +181,14 @@ TEST(Validate, MisregisteredPlateCopIsFlaggedNotScored) {
   EXPECT_EQ(m.cop, fp2.metrics.cop->rrmse_percent);
   EXPECT_EQ(m.moment, fp2.metrics.moment->rrmse_percent);
   EXPECT_NEAR(m.vertical, 0.0, 1e-6);
+  // The joint torques: the plates carry the estimate's own forces at its own COP, so the torques
+  // bottom-up from either are the same; the misplaced plate's, whose lever is its COP, are not scored.
+  EXPECT_FALSE(fp1.torques);
+  ASSERT_TRUE(fp2.torques);
+  for (std::size_t c = 0; c < 3; ++c) {
+    ASSERT_TRUE(fp2.torques->bottom_up[c] && fp2.torques->least_squares[c]);
+    EXPECT_LT(fp2.torques->bottom_up[c]->rmse, 1e-6) << c;
+  }
   bool noted = false;
   for (const auto& n : v.notes) noted = noted || (n.find("FP1") != std::string::npos && n.find("not seem registered") != std::string::npos);
   EXPECT_TRUE(noted);
@@ -895,4 +903,58 @@ TEST(StanceParameters, APiecewiseLinearStancesPeaksImpulsesAndLoadingRateAreExac
   f.col(0).setConstant(50.0);
   EXPECT_EQ(stance_parameters(f, 100.0, 0, 60).braking_peak_N, 0.0);
   EXPECT_EQ(stance_parameters(f, 100.0, 0, 60).braking_impulse_Ns, 0.0);
+}
+
+// The sagittal joint torques against the plates' inverse dynamics (validate_joint_torques). The
+// example walk's right foot given its plate's force and COP over the stance: the torques bottom-up
+// from the estimate and from the plate are then one; its COP then moved 2 cm forward: the ground's
+// moment about every joint of that leg grows by 0.02 m x the vertical force, so the hip's, the
+// knee's and the ankle's bottom-up torques are all off by exactly that. kin2grf's own torques (the
+// least squares', untouched here) are compared as they are.
+TEST(Validate, TheJointTorquesAreComparedWithThePlatesInverseDynamics) {
+  const Trial walk = make_example_walk();
+  EstimateResult e = estimate(walk, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+  const auto before = validate(e, *walk.plates);
+  ASSERT_TRUE(right_of(before) != before.stances.end());
+  const StanceValidation r0 = *right_of(before);
+  const MeasuredPlate& plate = before.plates[static_cast<std::size_t>(r0.plate_index)];
+  double sum_fy = 0, sum_fy2 = 0;
+  int frames = 0;
+  for (double dx : {0.0, 0.02}) {
+    for (Eigen::Index k = r0.first; k <= r0.last; ++k)
+      if (plate.force_N.row(k).allFinite() && std::isfinite(plate.cop_x_m[k])) {
+        e.feet[0].force_N.row(k) = plate.force_N.row(k);
+        e.feet[0].cop_x_m[k] = plate.cop_x_m[k] + dx;
+        e.feet[0].contact[static_cast<std::size_t>(k)] = true;
+        if (dx > 0) sum_fy += plate.force_N(k, 1), sum_fy2 += plate.force_N(k, 1) * plate.force_N(k, 1), ++frames;
+      }
+    const auto v = validate(e, *walk.plates);
+    ASSERT_TRUE(right_of(v) != v.stances.end());
+    const StanceValidation& right = *right_of(v);
+    ASSERT_TRUE(right.torques);
+    for (std::size_t c = 0; c < 3; ++c) {
+      ASSERT_TRUE(right.torques->bottom_up[c] && right.torques->least_squares[c]) << c;
+      if (dx == 0) {
+        EXPECT_LT(right.torques->bottom_up[c]->rmse, 1e-6) << c;
+      } else {
+        ASSERT_GT(frames, 30);
+        EXPECT_NEAR(right.torques->bottom_up[c]->rmse, 0.02 * std::sqrt(sum_fy2 / frames), 1e-6) << c;
+        // Ahead of the joint by 2 cm more, the upward force turns the leg less backward: each torque
+        // on its child body (counter-clockwise +) is lower by 0.02 F_y.
+        EXPECT_NEAR(right.torques->bottom_up[c]->mean_error, -0.02 * sum_fy / frames, 1e-6) << c;
+      }
+      EXPECT_GT(right.torques->least_squares[c]->rmse, 0.0) << c;
+      EXPECT_TRUE(std::isfinite(right.torques->least_squares[c]->rrmse_percent)) << c;
+    }
+    if (dx > 0) {
+      const MeanMetrics m = mean_rrmse(v.stances, 0);
+      EXPECT_NEAR(m.torque_bottom_up[1], right.torques->bottom_up[1]->rrmse_percent, 1e-12);
+      EXPECT_NEAR(m.torque_rmse_Nm_per_kg[2], right.torques->least_squares[2]->rmse / e.mass_kg, 1e-12);
+      const auto j = validation_json("example", e, v, nlohmann::json::object());
+      const auto& t = j["per_foot"][static_cast<std::size_t>(right_of(v) - v.stances.begin())]["joint_torques"];
+      EXPECT_NEAR(t["knee"]["bottom_up"]["rmse_Nm"].get<double>(), right.torques->bottom_up[1]->rmse, 1e-12);
+      EXPECT_NEAR(j["mean_rrmse_percent"]["right"]["joint_torques"]["ankle"]["least_squares"].get<double>(), m.torque_least_squares[2], 1e-12);
+      EXPECT_NE(format_validation_table("example", v).find("sagittal joint torques against the plates' inverse dynamics"), std::string::npos);
+    }
+  }
 }

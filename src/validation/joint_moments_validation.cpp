@@ -1,8 +1,12 @@
-// kin2grf validation: the 3D joint moments driven by the estimate against driven by the plates,
-// on the same leg kinematics (validate.hpp, validate_joint_moments_3d).
+// kin2grf validation: the joint moments driven by the estimate against driven by the plates, on
+// the same kinematics: in 3D (validate_joint_moments_3d) and the sagittal model's joint torques
+// (validate_joint_torques; validate.hpp).
 #include <cmath>
+#include <limits>
 #include <string>
 
+#include "kin2grf/dynamics/joint_moments_2d.hpp"
+#include "kin2grf/numeric.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/validation/validate.hpp"
 
@@ -55,6 +59,58 @@ void validate_joint_moments_3d(const EstimateResult& e, ValidationResult& v) {
     s.moments_3d = j;
   }
   v.measured_moments_3d = measured;
+}
+
+void validate_joint_torques(const EstimateResult& e, ValidationResult& v) {
+  const Eigen::Index n = e.time_s.size();
+  if (e.joint_torque_Nm.rows() != n || e.motion.frames() != n) return;
+  // One wrench series per foot and source, zero outside; each stance reads its own foot's frames.
+  std::array<FootWrench2D, 2> estimated, measured;
+  for (int side = 0; side < 2; ++side) {
+    const FootResult& f = e.feet[static_cast<std::size_t>(side)];
+    FootWrench2D& w = estimated[static_cast<std::size_t>(side)];
+    w = {Eigen::MatrixX2d::Zero(n, 2), Eigen::VectorXd::Zero(n)};
+    measured[static_cast<std::size_t>(side)] = w;
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (f.contact[static_cast<std::size_t>(i)] && std::isfinite(f.cop_x_m[i])) {
+        w.force_N.row(i) = f.force_N.row(i);
+        w.moment_origin_Nm[i] = sagittal_moment(f.cop_x_m[i], e.ground_level_m(), f.force_N(i, 0), f.force_N(i, 1));
+      }
+  }
+  bool any = false;
+  for (const StanceValidation& s : v.stances) {
+    if (s.plate_index < 0 || s.cop_reference_suspect) continue;
+    const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(s.plate_index)];
+    FootWrench2D& w = measured[static_cast<std::size_t>(s.foot)];
+    for (Eigen::Index i = s.first; i <= s.last; ++i)
+      if (mp.force_N.row(i).allFinite() && std::isfinite(mp.moment_origin_Nm[i])) {
+        w.force_N.row(i) += mp.force_N.row(i);
+        w.moment_origin_Nm[i] += mp.moment_origin_Nm[i];
+      }
+    any = true;
+  }
+  if (!any) return;
+  const Eigen::MatrixXd tau_estimated = bottom_up_joint_torques(e.motion, estimated);
+  const Eigen::MatrixXd tau_measured = bottom_up_joint_torques(e.motion, measured);
+  for (StanceValidation& s : v.stances) {
+    if (s.plate_index < 0 || s.cop_reference_suspect) continue;
+    const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(s.plate_index)];
+    const Eigen::Index a = s.first, len = s.last - s.first + 1;
+    // NaN where the plate does not read (a recording that ends inside the stance): not compared.
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    Eigen::VectorXd plate_reads = Eigen::VectorXd::Zero(len);
+    for (Eigen::Index k = 0; k < len; ++k)
+      if (!(mp.force_N.row(a + k).allFinite() && std::isfinite(mp.moment_origin_Nm[a + k]))) plate_reads[k] = nan;
+    JointTorqueValidation t;
+    t.mass_kg = e.mass_kg;
+    for (int c = 0; c < 3; ++c) {  // hip, knee, ankle: joints 4 side + c
+      const int j = 4 * s.foot + c;
+      const Eigen::VectorXd plate = tau_measured.col(j).segment(a, len) + plate_reads;
+      t.least_squares[static_cast<std::size_t>(c)] = compare_series(e.joint_torque_Nm.col(j).segment(a, len), plate);
+      t.bottom_up[static_cast<std::size_t>(c)] = compare_series(tau_estimated.col(j).segment(a, len), plate);
+    }
+    s.torques = t;
+  }
 }
 
 void validate_total_3d(const EstimateResult& e, ValidationResult& v) {

@@ -743,6 +743,7 @@ ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateR
   }
   compare_totals(e, v, cands, o);
   if (e.legs_3d) validate_joint_moments_3d(e, v);
+  validate_joint_torques(e, v);
   validate_total_3d(e, v);
   return v;
 }
@@ -862,6 +863,22 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
   };
   mm.knee_sagittal = mean(x[0]);
   mm.knee_adduction = mean(x[1]);
+  // The sagittal joint torques (every model): hip, knee, ankle.
+  std::array<std::vector<double>, 9> t;
+  for (const auto& s : stances) {
+    if ((foot >= 0 && s.foot != foot) || !s.torques) continue;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const auto &ls = s.torques->least_squares[c], &bu = s.torques->bottom_up[c];
+      if (ls && std::isfinite(ls->rrmse_percent)) t[c].push_back(ls->rrmse_percent);
+      if (bu && std::isfinite(bu->rrmse_percent)) t[3 + c].push_back(bu->rrmse_percent);
+      if (ls && std::isfinite(ls->rmse) && s.torques->mass_kg > 0) t[6 + c].push_back(ls->rmse / s.torques->mass_kg);
+    }
+  }
+  for (std::size_t c = 0; c < 3; ++c) {
+    mm.torque_least_squares[c] = mean(t[c]);
+    mm.torque_bottom_up[c] = mean(t[3 + c]);
+    mm.torque_rmse_Nm_per_kg[c] = mean(t[6 + c]);
+  }
   for (std::size_t p = 0; p < 2; ++p) {
     const double plates = mean(x[3 + 2 * p]);
     mm.kam_peak_error_percent[p] = plates > 0 ? 100 * mean(x[2 + 2 * p]) / plates : kNaN;
@@ -1047,6 +1064,12 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     x["parameters"] = {{"estimated", stance_parameters_json(s.parameters_estimated, s.body_weight_N)},
                        {"measured", stance_parameters_json(s.parameters_measured, s.body_weight_N)}};
     if (s.moments_3d) x["joint_moments_3d"] = joint_moments_json(*s.moments_3d);
+    if (s.torques) {
+      const char* joints[] = {"hip", "knee", "ankle"};
+      for (std::size_t c = 0; c < 3; ++c)
+        x["joint_torques"][joints[c]] = {{"least_squares", moment_metrics_json(s.torques->least_squares[c])},
+                                         {"bottom_up", moment_metrics_json(s.torques->bottom_up[c])}};
+    }
     return x;
   };
   j["per_foot"] = nlohmann::json::array();
@@ -1085,6 +1108,14 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
                                               {"braking_impulse_bw_ms", num(m.parameter_impulse_error_bw_ms[0])},
                                               {"propulsive_impulse_bw_ms", num(m.parameter_impulse_error_bw_ms[1])},
                                               {"loading_rate_percent", num(m.loading_rate_error_percent)}}}};
+    if (std::isfinite(m.torque_least_squares[0])) {
+      auto& x = means[f < 0 ? "all" : side_name(f)];
+      const char* joints[] = {"hip", "knee", "ankle"};
+      for (std::size_t c = 0; c < 3; ++c)
+        x["joint_torques"][joints[c]] = {{"least_squares", num(m.torque_least_squares[c])},
+                                         {"bottom_up", num(m.torque_bottom_up[c])},
+                                         {"least_squares_rmse_Nm_per_kg", num(m.torque_rmse_Nm_per_kg[c])}};
+    }
     if (std::isfinite(m.knee_adduction)) {
       auto& x = means[f < 0 ? "all" : side_name(f)];
       x["knee_sagittal_moment"] = num(m.knee_sagittal);
@@ -1257,6 +1288,15 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
        << number_or_dash(pk[3]) << " / " << number_or_dash(pk[4]) << " % body weight, braking / propulsive impulse "
        << number_or_dash(m.parameter_impulse_error_bw_ms[0]) << " / " << number_or_dash(m.parameter_impulse_error_bw_ms[1])
        << " body weight ms, loading rate " << number_or_dash(m.loading_rate_error_percent, "%.0f") << " %\n";
+  }
+  if (m.n > 0 && std::isfinite(m.torque_least_squares[0])) {
+    const auto& ls = m.torque_least_squares;
+    const auto& bu = m.torque_bottom_up;
+    os << "  per foot, sagittal joint torques against the plates' inverse dynamics, rRMSE % hip / knee / ankle: " << number_or_dash(ls[0])
+       << " / " << number_or_dash(ls[1]) << " / " << number_or_dash(ls[2]) << " (kin2grf's, RMSE "
+       << number_or_dash(m.torque_rmse_Nm_per_kg[0], "%.2f") << " / " << number_or_dash(m.torque_rmse_Nm_per_kg[1], "%.2f") << " / "
+       << number_or_dash(m.torque_rmse_Nm_per_kg[2], "%.2f") << " N m/kg); " << number_or_dash(bu[0]) << " / " << number_or_dash(bu[1])
+       << " / " << number_or_dash(bu[2]) << " bottom-up from its forces\n";
   }
   if (std::isfinite(m.lateral_rmse_percent_bw)) format_lateral_rows(os, v, m);
   if (std::isfinite(m.knee_adduction)) format_joint_moment_rows(os, v, m, v.mass_kg);

@@ -177,6 +177,18 @@ struct JointMomentValidation {
   std::array<double, 2> kam_peak_measured_Nm{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
 };
 
+/// One stance's sagittal joint torques (hip, knee, ankle; every model): against the torques a
+/// lab's inverse dynamics takes from the plate, bottom-up from the foot's plate on the estimate's
+/// own motion (dynamics/joint_moments_2d.hpp), so that the difference is the estimate's ground
+/// reaction's (and the least squares') alone. `least_squares`: kin2grf's own torques, the
+/// multipliers of Eq. 7 (EstimateResult::joint_torque_Nm, the CSV's); `bottom_up`: bottom-up from
+/// the estimate's ground reaction, its COP on the floor, as a lab's tool run on kin2grf's GRF
+/// file (the OpenSim export) computes them on this motion.
+struct JointTorqueValidation {
+  std::array<std::optional<SeriesMetrics>, 3> least_squares, bottom_up;  ///< hip, knee, ankle; N m
+  double mass_kg = 0.0;  ///< the estimate's body mass, for the RMSE in N m/kg
+};
+
 struct StanceValidation {
   int foot = 0;                 ///< 0 right, 1 left
   std::string plate;
@@ -223,6 +235,9 @@ struct StanceValidation {
   std::optional<double> vertical_lag_ms;
   Eigen::Vector2d moment_reference_m = Eigen::Vector2d::Zero();
   std::optional<JointMomentValidation> moments_3d;  ///< ModelKind::ThreeD
+  /// The sagittal joint torques (not for a stance whose plate fails the registration check: the
+  /// plate-driven torques take its COP as their lever; nor for a cut stance).
+  std::optional<JointTorqueValidation> torques;
 };
 
 struct TotalValidation {
@@ -286,6 +301,9 @@ ValidationResult validate(const EstimateResult& estimate, const ForcePlateRecord
 /// free moment included) drive joint_moments_3d on the estimate's leg kinematics, into
 /// v.measured_moments_3d, and each stance gets its JointMomentValidation.
 void validate_joint_moments_3d(const EstimateResult& estimate, ValidationResult& v);
+/// The sagittal joint torques' comparison (StanceValidation::torques), on every kept stance whose
+/// plate passes the registration check; validate calls it.
+void validate_joint_torques(const EstimateResult& estimate, ValidationResult& v);
 /// The total's frontal and transverse moments (TotalValidation::frontal_moment), estimate's
 /// (both feet's wrenches, lab_foot_frame) against the plates' (every plate's measured force and
 /// moment) over the total's frames; validate calls it when the estimate has a lateral force.
@@ -317,6 +335,10 @@ struct MeanMetrics {
   /// plate-driven peak near 0 N m would make its own percentage meaningless).
   double knee_sagittal = 0, knee_adduction = 0;
   std::array<double, 2> kam_peak_error_percent{0, 0};
+  /// The sagittal joint torques (StanceValidation::torques), hip, knee, ankle: mean rRMSE (%) of
+  /// kin2grf's least-squares torques and of the bottom-up ones from its forces, and the mean RMSE
+  /// of the least-squares ones in N m per kg of body mass. NaN where no stance has them.
+  std::array<double, 3> torque_least_squares{0, 0, 0}, torque_bottom_up{0, 0, 0}, torque_rmse_Nm_per_kg{0, 0, 0};
   /// The stance parameters' mean |estimate - plate| over the stances (StanceValidation::
   /// parameters_estimated): the vertical first peak, valley and second peak and the braking and
   /// propulsive peaks in % body weight; the braking and propulsive impulses in body weight x

@@ -1,0 +1,42 @@
+// kin2grf dynamics: the sagittal joint torques, bottom-up (dynamics/joint_moments_2d.hpp).
+#include "kin2grf/dynamics/joint_moments_2d.hpp"
+
+#include "kin2grf/numeric.hpp"
+
+namespace kin2grf {
+
+double bottom_up_joint_torque(const Model& model, const MotionFrame& m, int j, const Eigen::Vector2d& force_N,
+                              double moment_origin_Nm) {
+  const int side = j / 4, depth = j % 4;
+  const int p = model.bodies[static_cast<std::size_t>(joint_child(j))].proximal;
+  const double px = m.q(coord::point_x(p)), py = m.q(coord::point_x(p) + 1);
+  const double g = model.gravity_mps2;
+  double tau = 0.0;
+  for (int k = depth; k < 4; ++k) {
+    const int s = segment(side, static_cast<LegSegment>(k));
+    const Body& b = model.bodies[static_cast<std::size_t>(s)];
+    const double fx = b.mass_kg * m.qdd(coord::com_x(s)), fy = b.mass_kg * (m.qdd(coord::com_x(s) + 1) + g);
+    tau += sagittal_moment(m.q(coord::com_x(s)) - px, m.q(coord::com_x(s) + 1) - py, fx, fy) +
+           b.inertia_kgm2 * m.qdd(coord::theta(s));
+  }
+  // The ground acts on the foot: on every joint's subtree but the MTP's (the toes alone).
+  if (depth <= kFoot)
+    tau -= moment_origin_Nm - sagittal_moment(px, py, force_N.x(), force_N.y());
+  return tau;
+}
+
+Eigen::MatrixXd bottom_up_joint_torques(const ModelMotion& motion, const std::array<FootWrench2D, 2>& feet) {
+  const Eigen::Index n = motion.frames();
+  Eigen::MatrixXd tau(n, kJointCount);
+  MotionFrame m;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    motion.frame(i, m);
+    for (int j = 0; j < kJointCount; ++j) {
+      const FootWrench2D& w = feet[static_cast<std::size_t>(j / 4)];
+      tau(i, j) = bottom_up_joint_torque(*motion.model, m, j, w.force_N.row(i).transpose(), w.moment_origin_Nm[i]);
+    }
+  }
+  return tau;
+}
+
+}  // namespace kin2grf
