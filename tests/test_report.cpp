@@ -59,9 +59,10 @@ TEST(Report, RendersInHeadlessChromium) {
   write_file_text(html.string(), validation_report_html("synthetic", s.estimate, v, j));
   const std::string dom = rendered_dom(browser, dir, html);
   ASSERT_FALSE(dom.empty());
-  // 3 figures per foot and 2 totals, each drawn by Chart.js (the script sets the attribute
-  // only after every chart was constructed).
-  EXPECT_NE(dom.find("data-charts-rendered=\"8\""), std::string::npos) << dom.substr(0, 400);
+  // 3 figures per foot (GRF, COP), 3 per foot of joint torques and 2 totals, each drawn by
+  // Chart.js (the script sets the attribute only after every chart was constructed).
+  ASSERT_EQ(v.measured_joint_torque_Nm.rows(), s.estimate.time_s.size());
+  EXPECT_NE(dom.find("data-charts-rendered=\"14\""), std::string::npos) << dom.substr(0, 400);
   const auto p = dom.find("data-points=\"");
   ASSERT_NE(p, std::string::npos);
   EXPECT_GT(std::stoi(dom.substr(p + 13)), 1000);
@@ -180,4 +181,13 @@ TEST(Report, StanceParametersAreTabulatedInBothReports) {
   const std::string html = validation_report_html("example", e, v, validation_json("example", e, v, nlohmann::json::object()));
   EXPECT_EQ(rows_of(html), 2 * static_cast<int>(v.stances.size()));
   EXPECT_NE(html.find("<td class=l>plate</td>"), std::string::npos);
+  // The joint torques: a row per compared stance, and a figure per joint of each leg with one.
+  const auto torques = html.find("<h3>Joint torques</h3>");
+  ASSERT_NE(torques, std::string::npos);
+  const std::string table = html.substr(torques, html.find("</table>", torques) - torques);
+  int rows = 0;
+  for (auto at = table.find("<tr><td"); at != std::string::npos; at = table.find("<tr><td", at + 1)) ++rows;
+  EXPECT_EQ(rows, static_cast<int>(v.stances.size()));
+  EXPECT_NE(html.find("right knee: sagittal joint torque"), std::string::npos);
+  EXPECT_NE(html.find("left ankle: sagittal joint torque"), std::string::npos);
 }

@@ -185,6 +185,27 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
         << stance_parameter_cells(s["parameters"][from]) << "</tr>\n";
   }
   t << "</table>\n";
+  if (v.measured_joint_torque_Nm.size() != 0) {
+    t << "<h3>Joint torques</h3>\n<p>The sagittal hip, knee and ankle torques, kin2grf's (the least squares' joint "
+         "torques, the CSV's) against the torques a lab's inverse dynamics takes from the plate (bottom-up from the foot's "
+         "plate on kin2grf's own motion), and beside them the same bottom-up from kin2grf's forces: rRMSE %, RMSE N m. A "
+         "plate that fails the registration check is not compared (its torques take its COP as their lever).</p>\n"
+         "<table><tr><th class=l>foot</th><th class=l>plate</th><th>hip rRMSE %</th><th>knee rRMSE %</th><th>ankle rRMSE %</th>"
+         "<th>hip RMSE N m</th><th>knee RMSE N m</th><th>ankle RMSE N m</th><th>bottom-up from kin2grf's forces: hip / knee / ankle rRMSE %</th></tr>\n";
+    for (const auto& s : j["per_foot"]) {
+      if (!s.contains("joint_torques")) continue;
+      const auto& jt = s["joint_torques"];
+      const auto cell = [&](const char* joint, const char* from, const char* key) {
+        return jt[joint][from].is_null() ? std::string("-") : fmt(jt[joint][from][key]);
+      };
+      t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>()) << "</td>";
+      for (const char* k : {"rrmse_percent", "rmse_Nm"})
+        for (const char* joint : {"hip", "knee", "ankle"}) t << "<td>" << cell(joint, "least_squares", k) << "</td>";
+      t << "<td>" << cell("hip", "bottom_up", "rrmse_percent") << " / " << cell("knee", "bottom_up", "rrmse_percent") << " / "
+        << cell("ankle", "bottom_up", "rrmse_percent") << "</td></tr>\n";
+    }
+    t << "</table>\n";
+  }
   if (!v.excluded.empty() || !v.notes.empty()) {
     t << "<h3>Excluded and notes</h3><ul>\n";
     for (const auto& x : v.excluded) t << "<li>excluded: " << html_escape(x) << "</li>\n";
@@ -248,6 +269,20 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
       fig("COP's lateral place (+ towards the walker's right)", "m",
           fe.cop_lateral_m.size() == e.time_s.size() ? fe.cop_lateral_m : e.foot_lateral_m[k], v.measured_cop_lateral_m[k]);
     }
+    if (v.measured_joint_torque_Nm.rows() == e.time_s.size())
+      for (int c = 0; c < 3; ++c) {
+        const int joint = 4 * f + c;
+        const char* names[] = {"hip", "knee", "ankle"};
+        ReportFigure g;
+        g.title = foot + " " + names[c] + ": sagittal joint torque (on the distal segment, + counter-clockwise), kin2grf's "
+                  "and the plates' inverse dynamics";
+        g.x_label = "time (s)";
+        g.y_label = "N m";
+        g.shaded = shaded;
+        g.series.push_back({"plates, bottom-up", time, to_vec(v.measured_joint_torque_Nm.col(joint)), true});
+        g.series.push_back({"kin2grf", time, to_vec(e.joint_torque_Nm.col(joint)), false});
+        rep.figures.push_back(g);
+      }
     if (e.legs_3d && v.measured_moments_3d) {
       // Plate-driven only where a plate stance is compared (zero ground reaction elsewhere).
       Eigen::VectorXd plate = Eigen::VectorXd::Constant(e.time_s.size(), std::numeric_limits<double>::quiet_NaN());

@@ -92,15 +92,15 @@ void validate_joint_torques(const EstimateResult& e, ValidationResult& v) {
   if (!any) return;
   const Eigen::MatrixXd tau_estimated = bottom_up_joint_torques(e.motion, estimated);
   const Eigen::MatrixXd tau_measured = bottom_up_joint_torques(e.motion, measured);
+  v.measured_joint_torque_Nm = Eigen::MatrixXd::Constant(n, kJointCount, std::numeric_limits<double>::quiet_NaN());
   for (StanceValidation& s : v.stances) {
     if (s.plate_index < 0 || s.cop_reference_suspect) continue;
     const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(s.plate_index)];
     const Eigen::Index a = s.first, len = s.last - s.first + 1;
     // NaN where the plate does not read (a recording that ends inside the stance): not compared.
-    const double nan = std::numeric_limits<double>::quiet_NaN();
     Eigen::VectorXd plate_reads = Eigen::VectorXd::Zero(len);
     for (Eigen::Index k = 0; k < len; ++k)
-      if (!(mp.force_N.row(a + k).allFinite() && std::isfinite(mp.moment_origin_Nm[a + k]))) plate_reads[k] = nan;
+      if (!(mp.force_N.row(a + k).allFinite() && std::isfinite(mp.moment_origin_Nm[a + k]))) plate_reads[k] = std::numeric_limits<double>::quiet_NaN();
     JointTorqueValidation t;
     t.mass_kg = e.mass_kg;
     for (int c = 0; c < 3; ++c) {  // hip, knee, ankle: joints 4 side + c
@@ -110,6 +110,8 @@ void validate_joint_torques(const EstimateResult& e, ValidationResult& v) {
       t.bottom_up[static_cast<std::size_t>(c)] = compare_series(tau_estimated.col(j).segment(a, len), plate);
     }
     s.torques = t;
+    for (int c = 0; c < 4; ++c)  // the leg's four joints, over the stance (the MTP's is the toes' inertia alone)
+      v.measured_joint_torque_Nm.col(4 * s.foot + c).segment(a, len) = tau_measured.col(4 * s.foot + c).segment(a, len) + plate_reads;
   }
 }
 

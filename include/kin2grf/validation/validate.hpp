@@ -291,6 +291,10 @@ struct ValidationResult {
   /// ModelKind::ThreeD: the 3D joint moments driven by each foot's kept stances' plates (zero
   /// ground reaction elsewhere, so only the kept stances' frames are meaningful).
   std::optional<JointMoments3D> measured_moments_3d;
+  /// The sagittal joint torques bottom-up from the plates (validate_joint_torques; N x
+  /// kJointCount, the columns of EstimateResult::joint_torque_Nm), over the frames of each leg's
+  /// scored stances, NaN elsewhere (empty without any): the report's plots.
+  Eigen::MatrixXd measured_joint_torque_Nm;
 };
 
 ValidationResult validate(const EstimateResult& estimate, const ForcePlateRecording& plates,
