@@ -167,6 +167,7 @@ torque_rows = []
 joints = ["hip", "knee", "ankle"]
 for act in activities:
     ls, bu, rm, worst = {k: [] for k in joints}, {k: [] for k in joints}, {k: [] for k in joints}, None
+    pw, a2_err, a2_plate = {k: [] for k in joints}, [], []
     for a, name, _ in rows:
         if a != act:
             continue
@@ -181,6 +182,12 @@ for act in activities:
                     rm[k].append(t[k]["least_squares"]["rmse_Nm"] / j["mass_kg"])
                 if t[k]["bottom_up"] and t[k]["bottom_up"]["rrmse_percent"] is not None:
                     bu[k].append(t[k]["bottom_up"]["rrmse_percent"])
+                if t[k].get("power") and t[k]["power"]["rrmse_percent"] is not None:
+                    pw[k].append(t[k]["power"]["rrmse_percent"])
+            a2 = t.get("ankle_push_off_W") or {}
+            if a2.get("estimated") is not None and a2.get("measured") is not None:
+                a2_err.append(abs(a2["estimated"] - a2["measured"]) / j["mass_kg"])
+                a2_plate.append(a2["measured"] / j["mass_kg"])
             knee = t["knee"]["least_squares"]["rrmse_percent"] if t["knee"]["least_squares"] else None
             if knee is not None and (worst is None or knee > worst[1]):
                 worst = (name, knee)
@@ -189,17 +196,22 @@ for act in activities:
         cell = lambda x: f"{sum(x) / len(x):.1f}" if x else "-"
         torque_rows.append(f"| {act} | {n} | " + " / ".join(cell(ls[k]) for k in joints) + " | "
                            + " / ".join(f"{sum(rm[k]) / len(rm[k]):.2f}" if rm[k] else "-" for k in joints) + " | "
-                           + " / ".join(cell(bu[k]) for k in joints) + f" | {worst[0]} {worst[1]:.1f} |")
+                           + " / ".join(cell(bu[k]) for k in joints) + " | " + " / ".join(cell(pw[k]) for k in joints) + " | "
+                           + (f"{sum(a2_err) / len(a2_err):.2f} ({sum(a2_plate) / len(a2_plate):.2f})" if a2_err else "-")
+                           + f" | {worst[0]} {worst[1]:.1f} |")
 if torque_rows:
     print("Sagittal joint torques (defaults; since session 42): per stance, kin2grf's hip, knee and ankle torques (the least squares' "
           "multipliers of Eq. 7, the CSV's `torque_*`) against the torques a lab's inverse dynamics takes from the plate: bottom-up "
           "Newton-Euler from the foot's plate on the estimate's own motion (dynamics/joint_moments_2d.hpp), so that the difference is "
           "the estimate's ground reaction's alone; beside them the same bottom-up from kin2grf's forces (its COP on the floor), what a "
           "lab's tool run on kin2grf's GRF file computes on this motion. Stances whose plate fails the registration check are left "
-          "out (their plate-driven torques take a misplaced COP as their lever). Mean over the stances.\n")
+          "out (their plate-driven torques take a misplaced COP as their lever). The joint powers: each torque times the joint's "
+          "angular velocity (the same for both), kin2grf's against the plates'; the ankle's push-off peak (its power's largest "
+          "value in the stance's second half, the A2 burst) as mean |kin2grf - plates| in W/kg, the plates' mean in brackets. "
+          "Mean over the stances.\n")
     print("| activity | stances | rRMSE % hip / knee / ankle | RMSE N m/kg hip / knee / ankle | bottom-up from the estimate's forces, "
-          "rRMSE % | worst stance (knee rRMSE %) |")
-    print("|---|---|---|---|---|---|")
+          "rRMSE % | joint powers, rRMSE % | ankle push-off peak W/kg | worst stance (knee rRMSE %) |")
+    print("|---|---|---|---|---|---|---|---|")
     for r in torque_rows:
         print(r)
     print()

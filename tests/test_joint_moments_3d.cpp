@@ -3,6 +3,7 @@
 // landmarks, and the sagittal model's joint torques (dynamics/joint_moments_2d.hpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -430,4 +431,37 @@ TEST(JointMoments2D, AStillLegsTorquesAreItsWeightsAndTheGroundsMoments) {
     EXPECT_NEAR(bottom_up_joint_torque(model, m, 4 * side + 3, {0.0, fy}, moment_origin),
                 (m.q(coord::com_x(toes)) - m.q(coord::point_x(mtp))) * model.bodies[static_cast<std::size_t>(toes)].mass_kg * g, 1e-9);
   }
+}
+
+// The CSV's joint powers are each joint's torque times its angular velocity, phi_j' (the child's
+// angle less the parent's, differentiated as the accelerations are: central differences of the
+// filtered joint angles), and the synthetic walk's ankle generates energy at push-off (its power's
+// largest value in each right stance's second half is positive: the plantarflexors shorten under
+// load, the A2 burst).
+TEST(JointMoments2D, TheJointPowersAreTheTorquesTimesTheJointAngularVelocities) {
+  const SyntheticWalk walk = make_synthetic_walk({});
+  const EstimateResult r = estimate(walk.trial, nullptr, *recognise_marker_set(walk.trial.markers), {});
+  const ResultsTable t = results_table(r);
+  const auto col = [&](const std::string& name) {
+    const auto it = std::find(t.columns.begin(), t.columns.end(), name);
+    EXPECT_NE(it, t.columns.end()) << name;
+    return static_cast<Eigen::Index>(it - t.columns.begin());
+  };
+  const double dt = 1.0 / r.motion.rate_hz;
+  for (int j = 0; j < kJointCount; ++j) {
+    const Eigen::Index power = col(std::string("power_") + joint_name(j) + "_W"), torque = col(std::string("torque_") + joint_name(j) + "_Nm");
+    for (Eigen::Index i = 1; i + 1 < r.time_s.size(); i += 7) {
+      const double phi_dot = (r.motion.x(i + 1, 3 + j) - r.motion.x(i - 1, 3 + j)) / (2 * dt);
+      EXPECT_NEAR(t.values(i, power), t.values(i, torque) * phi_dot, 1e-9 * std::max(1.0, std::abs(t.values(i, power)))) << joint_name(j) << " frame " << i;
+    }
+  }
+  const Eigen::Index ankle = col("power_ankle_r_W");
+  int stances = 0;
+  for (const IndexRun& run : gait_stances(r.feet[0].contact, r.motion.rate_hz)) {
+    const Eigen::Index first = run.first, last = run.last;
+    if (first == 0 || last + 1 >= r.time_s.size()) continue;  // whole stances only
+    ++stances;
+    EXPECT_GT(t.values.col(ankle).segment((first + last) / 2, last - (first + last) / 2 + 1).maxCoeff(), 0.5 * r.mass_kg) << "stance at " << first;
+  }
+  EXPECT_GE(stances, 1);
 }

@@ -68,7 +68,7 @@ TEST(Report, RendersInHeadlessChromium) {
   EXPECT_GT(std::stoi(dom.substr(p + 13)), 1000);
 }
 
-// estimate's report without plates (issue 30, item 8): per foot GRF, COP and joint torques, the
+// estimate's report without plates (issue 30, item 8): per foot GRF, COP, joint torques and powers, the
 // GRM, the gait events in a table; drawn by Chart.js in headless Chromium.
 TEST(Report, AnEstimateReportWithoutPlatesRendersWithItsGaitEvents) {
   const std::string browser = chromium();
@@ -88,8 +88,9 @@ TEST(Report, AnEstimateReportWithoutPlatesRendersWithItsGaitEvents) {
   write_file_text(file.string(), html);
   const std::string dom = rendered_dom(browser, dir, file);
   ASSERT_FALSE(dom.empty());
-  // 4 figures per foot (vertical, anterior, COP, joint torques) and the GRM.
-  EXPECT_NE(dom.find("data-charts-rendered=\"9\""), std::string::npos) << dom.substr(0, 400);
+  // 5 figures per foot (vertical, anterior, COP, joint torques, joint powers) and the GRM.
+  EXPECT_NE(dom.find("data-charts-rendered=\"11\""), std::string::npos) << dom.substr(0, 400);
+  EXPECT_NE(html.find("right leg: joint powers"), std::string::npos);
 }
 
 // The 3D model's validation report (issue 28: "the HTML report plots them"): per foot the

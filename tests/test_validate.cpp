@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "kin2grf/dynamics/joint_moments_2d.hpp"
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/load.hpp"
@@ -955,6 +956,24 @@ TEST(Validate, TheJointTorquesAreComparedWithThePlatesInverseDynamics) {
       EXPECT_NEAR(t["knee"]["bottom_up"]["rmse_Nm"].get<double>(), right.torques->bottom_up[1]->rmse, 1e-12);
       EXPECT_NEAR(j["mean_rrmse_percent"]["right"]["joint_torques"]["ankle"]["least_squares"].get<double>(), m.torque_least_squares[2], 1e-12);
       EXPECT_NE(format_validation_table("example", v).find("sagittal joint torques against the plates' inverse dynamics"), std::string::npos);
+      // The powers: kin2grf's torques and the plates' (measured_joint_torque_Nm) times the same
+      // joint angular velocities; the ankle's push-off peak, the largest in the stance's second half.
+      ASSERT_EQ(v.measured_joint_torque_Nm.rows(), e.time_s.size());
+      const Eigen::Index len = right.last - right.first + 1;
+      double sq = 0, peak_e = -1e300, peak_m = -1e300;
+      for (Eigen::Index k = 0; k < len; ++k) {
+        const Eigen::Index i = right.first + k;
+        const double w = joint_angular_velocities(e.motion, i)[2];
+        const double pe = e.joint_torque_Nm(i, 2) * w, pm = v.measured_joint_torque_Nm(i, 2) * w;
+        sq += (pe - pm) * (pe - pm);
+        if (k >= len / 2) peak_e = std::max(peak_e, pe), peak_m = std::max(peak_m, pm);
+      }
+      ASSERT_TRUE(right.torques->power[2]);
+      EXPECT_NEAR(right.torques->power[2]->rmse, std::sqrt(sq / static_cast<double>(len)), 1e-9);
+      EXPECT_DOUBLE_EQ(right.torques->ankle_push_off_estimated_W, peak_e);
+      EXPECT_DOUBLE_EQ(right.torques->ankle_push_off_measured_W, peak_m);
+      EXPECT_GT(peak_m, 0.0);  // push-off generates energy at the ankle
+      EXPECT_NEAR(m.ankle_push_off_error_W_per_kg, std::abs(peak_e - peak_m) / e.mass_kg, 1e-12);
     }
   }
 }

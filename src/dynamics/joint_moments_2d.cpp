@@ -39,4 +39,13 @@ Eigen::MatrixXd bottom_up_joint_torques(const ModelMotion& motion, const std::ar
   return tau;
 }
 
+std::array<double, kJointCount> joint_angular_velocities(const ModelMotion& motion, Eigen::Index i) {
+  // Columns 3..10 of the independent coordinates are the joint angles (independent_coordinates).
+  std::array<double, 16> d1{}, d2{};
+  motion.derivatives_at(i, d1.data(), d2.data());
+  std::array<double, kJointCount> w{};
+  for (std::size_t j = 0; j < w.size(); ++j) w[j] = d1[3 + j];
+  return w;
+}
+
 }  // namespace kin2grf

@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "kin2grf/dynamics/joint_moments_2d.hpp"
 #include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
@@ -380,6 +381,15 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
       torques.push_back({kJoint[k], time, to_vec(e.joint_torque_Nm.col(4 * f + k)), false});
     }
     figure(foot + " leg: joint torques", "N m", f, std::move(torques));
+    std::vector<ReportSeries> powers;  // torque x the joint's angular velocity: + generation, - absorption
+    for (int k = 0; k < 3; ++k) {
+      static const char* const kJoint[] = {"hip", "knee", "ankle"};
+      Eigen::VectorXd p(e.time_s.size());
+      for (Eigen::Index i = 0; i < p.size(); ++i)
+        p[i] = e.joint_torque_Nm(i, 4 * f + k) * joint_angular_velocities(e.motion, i)[static_cast<std::size_t>(4 * f + k)];
+      powers.push_back({kJoint[k], time, to_vec(p), false});
+    }
+    figure(foot + " leg: joint powers (+ generation, - absorption)", "W", f, std::move(powers));
   }
   if (e.grm_Nm.size() == e.time_s.size()) {
     char b[96];

@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 
+#include "kin2grf/dynamics/joint_moments_2d.hpp"
 #include "kin2grf/io/opensim.hpp"
 #include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
@@ -70,6 +71,7 @@ std::vector<std::string> results_columns(bool mediolateral, bool moments_3d) {
     }
   c.emplace_back("grm_Nm");
   for (int j = 0; j < kJointCount; ++j) c.push_back(std::string("torque_") + joint_name(j) + "_Nm");
+  for (int j = 0; j < kJointCount; ++j) c.push_back(std::string("power_") + joint_name(j) + "_W");
   for (int j = 0; j < kJointCount; ++j) {
     c.push_back(std::string("force_") + joint_name(j) + "_x_N");
     c.push_back(std::string("force_") + joint_name(j) + "_y_N");
@@ -101,6 +103,8 @@ void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> v) {
   const FrameTotals t = held ? FrameTotals{} : frame_totals(r, i);
   v[k++] = held ? r.grm_Nm[i] : t.grm_Nm;
   for (int j = 0; j < kJointCount; ++j) v[k++] = r.joint_torque_Nm(i, j);
+  const std::array<double, kJointCount> w = joint_angular_velocities(r.motion, i);
+  for (int j = 0; j < kJointCount; ++j) v[k++] = r.joint_torque_Nm(i, j) * w[static_cast<std::size_t>(j)];
   for (int j = 0; j < 2 * kJointCount; ++j) v[k++] = held ? r.joint_force_N(i, j) : t.joint_force_N[static_cast<std::size_t>(j)];
   for (int j = 0; j < 3; ++j) v[k++] = held ? r.residual(i, j) : t.residual[j];
   v[k++] = r.iterations[static_cast<std::size_t>(i)];

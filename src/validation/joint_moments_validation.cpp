@@ -92,6 +92,11 @@ void validate_joint_torques(const EstimateResult& e, ValidationResult& v) {
   if (!any) return;
   const Eigen::MatrixXd tau_estimated = bottom_up_joint_torques(e.motion, estimated);
   const Eigen::MatrixXd tau_measured = bottom_up_joint_torques(e.motion, measured);
+  Eigen::MatrixXd omega(n, kJointCount);  // the joints' angular velocities, for the powers
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const std::array<double, kJointCount> w = joint_angular_velocities(e.motion, i);
+    for (int j = 0; j < kJointCount; ++j) omega(i, j) = w[static_cast<std::size_t>(j)];
+  }
   v.measured_joint_torque_Nm = Eigen::MatrixXd::Constant(n, kJointCount, std::numeric_limits<double>::quiet_NaN());
   for (StanceValidation& s : v.stances) {
     if (s.plate_index < 0 || s.cop_reference_suspect) continue;
@@ -108,6 +113,17 @@ void validate_joint_torques(const EstimateResult& e, ValidationResult& v) {
       const Eigen::VectorXd plate = tau_measured.col(j).segment(a, len) + plate_reads;
       t.least_squares[static_cast<std::size_t>(c)] = compare_series(e.joint_torque_Nm.col(j).segment(a, len), plate);
       t.bottom_up[static_cast<std::size_t>(c)] = compare_series(tau_estimated.col(j).segment(a, len), plate);
+      const Eigen::VectorXd w = omega.col(j).segment(a, len);
+      const Eigen::VectorXd power_estimated = e.joint_torque_Nm.col(j).segment(a, len).cwiseProduct(w);
+      const Eigen::VectorXd power_measured = plate.cwiseProduct(w);
+      t.power[static_cast<std::size_t>(c)] = compare_series(power_estimated, power_measured);
+      if (c == 2) {  // the ankle's push-off: its largest power in the stance's second half, where the plate reads
+        for (Eigen::Index k = len / 2; k < len; ++k)
+          if (std::isfinite(power_measured[k])) {  // fmax: the larger, a NaN (none yet) taken as absent
+            t.ankle_push_off_estimated_W = std::fmax(t.ankle_push_off_estimated_W, power_estimated[k]);
+            t.ankle_push_off_measured_W = std::fmax(t.ankle_push_off_measured_W, power_measured[k]);
+          }
+      }
     }
     s.torques = t;
     for (int c = 0; c < 4; ++c)  // the leg's four joints, over the stance (the MTP's is the toes' inertia alone)

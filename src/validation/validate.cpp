@@ -864,21 +864,30 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
   mm.knee_sagittal = mean(x[0]);
   mm.knee_adduction = mean(x[1]);
   // The sagittal joint torques (every model): hip, knee, ankle.
-  std::array<std::vector<double>, 9> t;
+  std::array<std::vector<double>, 14> t;
   for (const auto& s : stances) {
     if ((foot >= 0 && s.foot != foot) || !s.torques) continue;
+    const JointTorqueValidation& jt = *s.torques;
     for (std::size_t c = 0; c < 3; ++c) {
-      const auto &ls = s.torques->least_squares[c], &bu = s.torques->bottom_up[c];
+      const auto &ls = jt.least_squares[c], &bu = jt.bottom_up[c], &pw = jt.power[c];
       if (ls && std::isfinite(ls->rrmse_percent)) t[c].push_back(ls->rrmse_percent);
       if (bu && std::isfinite(bu->rrmse_percent)) t[3 + c].push_back(bu->rrmse_percent);
-      if (ls && std::isfinite(ls->rmse) && s.torques->mass_kg > 0) t[6 + c].push_back(ls->rmse / s.torques->mass_kg);
+      if (ls && std::isfinite(ls->rmse) && jt.mass_kg > 0) t[6 + c].push_back(ls->rmse / jt.mass_kg);
+      if (pw && std::isfinite(pw->rrmse_percent)) t[9 + c].push_back(pw->rrmse_percent);
+    }
+    if (std::isfinite(jt.ankle_push_off_estimated_W) && std::isfinite(jt.ankle_push_off_measured_W) && jt.mass_kg > 0) {
+      t[12].push_back(std::abs(jt.ankle_push_off_estimated_W - jt.ankle_push_off_measured_W) / jt.mass_kg);
+      t[13].push_back(jt.ankle_push_off_measured_W / jt.mass_kg);
     }
   }
   for (std::size_t c = 0; c < 3; ++c) {
     mm.torque_least_squares[c] = mean(t[c]);
     mm.torque_bottom_up[c] = mean(t[3 + c]);
     mm.torque_rmse_Nm_per_kg[c] = mean(t[6 + c]);
+    mm.power[c] = mean(t[9 + c]);
   }
+  mm.ankle_push_off_error_W_per_kg = mean(t[12]);
+  mm.ankle_push_off_plates_W_per_kg = mean(t[13]);
   for (std::size_t p = 0; p < 2; ++p) {
     const double plates = mean(x[3 + 2 * p]);
     mm.kam_peak_error_percent[p] = plates > 0 ? 100 * mean(x[2 + 2 * p]) / plates : kNaN;
@@ -1015,6 +1024,12 @@ nlohmann::json moment_metrics_json(const std::optional<SeriesMetrics>& m) {
            : nlohmann::json(nullptr);
 }
 
+/// A power's comparison: rRMSE (%), RMSE (W), r; null when there is none.
+nlohmann::json power_metrics_json(const std::optional<SeriesMetrics>& m) {
+  return m ? nlohmann::json{{"rrmse_percent", num(m->rrmse_percent)}, {"rmse_W", num(m->rmse)}, {"r", num(m->pearson_r)}}
+           : nlohmann::json(nullptr);
+}
+
 /// A stance's 3D joint moments (ModelKind::ThreeD): per joint and plane the rRMSE, RMSE (N m) and
 /// r, estimate-driven against plate-driven; the KAM's and its peaks.
 nlohmann::json joint_moments_json(const JointMomentValidation& jm) {
@@ -1068,7 +1083,10 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
       const char* joints[] = {"hip", "knee", "ankle"};
       for (std::size_t c = 0; c < 3; ++c)
         x["joint_torques"][joints[c]] = {{"least_squares", moment_metrics_json(s.torques->least_squares[c])},
-                                         {"bottom_up", moment_metrics_json(s.torques->bottom_up[c])}};
+                                         {"bottom_up", moment_metrics_json(s.torques->bottom_up[c])},
+                                         {"power", power_metrics_json(s.torques->power[c])}};
+      x["joint_torques"]["ankle_push_off_W"] = {{"estimated", num(s.torques->ankle_push_off_estimated_W)},
+                                                {"measured", num(s.torques->ankle_push_off_measured_W)}};
     }
     return x;
   };
@@ -1114,7 +1132,10 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
       for (std::size_t c = 0; c < 3; ++c)
         x["joint_torques"][joints[c]] = {{"least_squares", num(m.torque_least_squares[c])},
                                          {"bottom_up", num(m.torque_bottom_up[c])},
-                                         {"least_squares_rmse_Nm_per_kg", num(m.torque_rmse_Nm_per_kg[c])}};
+                                         {"least_squares_rmse_Nm_per_kg", num(m.torque_rmse_Nm_per_kg[c])},
+                                         {"power", num(m.power[c])}};
+      x["joint_torques"]["ankle_push_off_error_W_per_kg"] = num(m.ankle_push_off_error_W_per_kg);
+      x["joint_torques"]["ankle_push_off_plates_W_per_kg"] = num(m.ankle_push_off_plates_W_per_kg);
     }
     if (std::isfinite(m.knee_adduction)) {
       auto& x = means[f < 0 ? "all" : side_name(f)];
@@ -1297,6 +1318,10 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
        << number_or_dash(m.torque_rmse_Nm_per_kg[0], "%.2f") << " / " << number_or_dash(m.torque_rmse_Nm_per_kg[1], "%.2f") << " / "
        << number_or_dash(m.torque_rmse_Nm_per_kg[2], "%.2f") << " N m/kg); " << number_or_dash(bu[0]) << " / " << number_or_dash(bu[1])
        << " / " << number_or_dash(bu[2]) << " bottom-up from its forces\n";
+    os << "  per foot, joint powers, rRMSE % hip / knee / ankle: " << number_or_dash(m.power[0]) << " / " << number_or_dash(m.power[1])
+       << " / " << number_or_dash(m.power[2]) << "; ankle push-off peak mean |kin2grf - plates| "
+       << number_or_dash(m.ankle_push_off_error_W_per_kg, "%.2f") << " W/kg (plates " << number_or_dash(m.ankle_push_off_plates_W_per_kg, "%.2f")
+       << " W/kg)\n";
   }
   if (std::isfinite(m.lateral_rmse_percent_bw)) format_lateral_rows(os, v, m);
   if (std::isfinite(m.knee_adduction)) format_joint_moment_rows(os, v, m, v.mass_kg);

@@ -44,4 +44,11 @@ double bottom_up_joint_torque(const Model& model, const MotionFrame& m, int j, c
 /// joint_torque_Nm), each leg from its own foot's wrench (`feet`: right, left; N rows each).
 Eigen::MatrixXd bottom_up_joint_torques(const ModelMotion& motion, const std::array<FootWrench2D, 2>& feet);
 
+/// The joints' angular velocities at frame i, rad/s: phi_j' = theta_child' - theta_parent' (the
+/// motion's independent coordinates, differentiated as the dynamics' accelerations are). A joint's
+/// power is tau_j phi_j' (W): the torque on the child turns with theta_child', the parent's
+/// reaction -tau_j with theta_parent'. + the joint generates energy (its muscles shorten), - it
+/// absorbs it.
+std::array<double, kJointCount> joint_angular_velocities(const ModelMotion& motion, Eigen::Index i);
+
 }  // namespace kin2grf

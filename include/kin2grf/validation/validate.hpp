@@ -186,6 +186,13 @@ struct JointMomentValidation {
 /// file (the OpenSim export) computes them on this motion.
 struct JointTorqueValidation {
   std::array<std::optional<SeriesMetrics>, 3> least_squares, bottom_up;  ///< hip, knee, ankle; N m
+  /// The joint powers (W; joint_angular_velocities): kin2grf's torques times the joints' angular
+  /// velocities against the plates' torques times the same, hip, knee, ankle.
+  std::array<std::optional<SeriesMetrics>, 3> power;
+  /// The ankle's push-off power (the A2 burst a gait report reads: the ankle power's largest value
+  /// in the stance's second half), W, kin2grf's and the plates'.
+  double ankle_push_off_estimated_W = std::numeric_limits<double>::quiet_NaN();
+  double ankle_push_off_measured_W = std::numeric_limits<double>::quiet_NaN();
   double mass_kg = 0.0;  ///< the estimate's body mass, for the RMSE in N m/kg
 };
 
@@ -343,6 +350,10 @@ struct MeanMetrics {
   /// kin2grf's least-squares torques and of the bottom-up ones from its forces, and the mean RMSE
   /// of the least-squares ones in N m per kg of body mass. NaN where no stance has them.
   std::array<double, 3> torque_least_squares{0, 0, 0}, torque_bottom_up{0, 0, 0}, torque_rmse_Nm_per_kg{0, 0, 0};
+  /// The joint powers' mean rRMSE (%), hip, knee, ankle; the ankle push-off peak's mean |kin2grf -
+  /// plates| and the plates' mean peak, W/kg.
+  std::array<double, 3> power{0, 0, 0};
+  double ankle_push_off_error_W_per_kg = 0, ankle_push_off_plates_W_per_kg = 0;
   /// The stance parameters' mean |estimate - plate| over the stances (StanceValidation::
   /// parameters_estimated): the vertical first peak, valley and second peak and the braking and
   /// propulsive peaks in % body weight; the braking and propulsive impulses in body weight x
