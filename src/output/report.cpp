@@ -381,13 +381,16 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
       torques.push_back({kJoint[k], time, to_vec(e.joint_torque_Nm.col(4 * f + k)), false});
     }
     figure(foot + " leg: joint torques", "N m", f, std::move(torques));
-    std::vector<ReportSeries> powers;  // torque x the joint's angular velocity: + generation, - absorption
+    // The powers: each torque times its joint's angular velocity (+ generation, - absorption).
+    Eigen::MatrixX3d power(e.time_s.size(), 3);
+    for (Eigen::Index i = 0; i < power.rows(); ++i) {
+      const std::array<double, kJointCount> w = joint_angular_velocities(e.motion, i);
+      for (int k = 0; k < 3; ++k) power(i, k) = e.joint_torque_Nm(i, 4 * f + k) * w[static_cast<std::size_t>(4 * f + k)];
+    }
+    std::vector<ReportSeries> powers;
     for (int k = 0; k < 3; ++k) {
       static const char* const kJoint[] = {"hip", "knee", "ankle"};
-      Eigen::VectorXd p(e.time_s.size());
-      for (Eigen::Index i = 0; i < p.size(); ++i)
-        p[i] = e.joint_torque_Nm(i, 4 * f + k) * joint_angular_velocities(e.motion, i)[static_cast<std::size_t>(4 * f + k)];
-      powers.push_back({kJoint[k], time, to_vec(p), false});
+      powers.push_back({kJoint[k], time, to_vec(power.col(k)), false});
     }
     figure(foot + " leg: joint powers (+ generation, - absorption)", "W", f, std::move(powers));
   }
