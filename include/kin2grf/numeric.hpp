@@ -9,6 +9,9 @@
 
 namespace kin2grf {
 
+/// A missing value (no sample, not measured, not defined).
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
 /// Median (upper middle element for an even count); NaN for an empty vector.
 inline double median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();

@@ -16,11 +16,11 @@
 #include "kin2grf/io/c3d.hpp"
 #include "kin2grf/io/force_plate.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// Bounds-checked decoding of the file's bytes in the file's processor encoding.
 class Bytes {

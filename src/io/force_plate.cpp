@@ -13,9 +13,9 @@
 namespace kin2grf {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string fmt(double v) {
+/// A number for a message: four significant digits.
+std::string short_number(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.4g", v);
   return b;
@@ -100,7 +100,7 @@ PlateLoads plate_loads(const Eigen::MatrixXd& ch, const PlateDescription& d,
 
 /// The time of analog sample i, for messages.
 std::string sample_time(const AnalogData& analog, Eigen::Index i) {
-  return fmt(analog.first_time_s + static_cast<double>(i) / analog.rate_hz) + " s";
+  return short_number(analog.first_time_s + static_cast<double>(i) / analog.rate_hz) + " s";
 }
 
 /// Non-finite samples are named with their times (the force there is unknown, and a stance they
@@ -126,8 +126,8 @@ bool plate_samples_plausible(const Eigen::MatrixXd& ch, const PlateLoads& L, con
     if (std::isfinite(f) && f > peak) peak = f, at = i;
   }
   if (peak > kMaxPlausibleForceN) {
-    warnings.push_back(path + ": " + name + ": a force of " + fmt(peak) + " N at " + sample_time(analog, at) +
-                       " is no ground reaction (more than " + fmt(kMaxPlausibleForceN) +
+    warnings.push_back(path + ": " + name + ": a force of " + short_number(peak) + " N at " + sample_time(analog, at) +
+                       " is no ground reaction (more than " + short_number(kMaxPlausibleForceN) +
                        " N): check the plate's calibration (CAL_MATRIX) and its channels' SCALE; the plate is left out");
     return false;
   }

@@ -15,11 +15,11 @@
 #include "kin2grf/io/output_file.hpp"
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/parallel.hpp"
+#include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// The lines of a text, views into it (no copy), without their '\r'.
 std::vector<std::string_view> lines_of(std::string_view text) {

@@ -21,7 +21,6 @@ namespace kin2grf {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 const char* kNames[kLandmarkCount] = {"shoulder", "hip",     "knee_r", "ankle_r", "heel_r", "mt_r",
                                       "hallux_r", "knee_l", "ankle_l", "heel_l",  "mt_l",   "hallux_l"};
 

@@ -16,7 +16,6 @@
 namespace kin2grf {
 namespace {
 
-const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 
 
