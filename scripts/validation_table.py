@@ -168,6 +168,8 @@ joints = ["hip", "knee", "ankle"]
 for act in activities:
     ls, bu, rm, worst = {k: [] for k in joints}, {k: [] for k in joints}, {k: [] for k in joints}, None
     pw, a2_err, a2_plate = {k: [] for k in joints}, [], []
+    peak_keys = ["ankle_plantarflexor_moment_Nm", "knee_extensor_moment_Nm", "hip_extensor_moment_Nm", "hip_flexor_moment_Nm"]
+    mp_err = {k: [] for k in peak_keys}
     for a, name, _ in rows:
         if a != act:
             continue
@@ -184,10 +186,16 @@ for act in activities:
                     bu[k].append(t[k]["bottom_up"]["rrmse_percent"])
                 if t[k].get("power") and t[k]["power"]["rrmse_percent"] is not None:
                     pw[k].append(t[k]["power"]["rrmse_percent"])
-            a2 = t.get("ankle_push_off_W") or {}
-            if a2.get("estimated") is not None and a2.get("measured") is not None:
-                a2_err.append(abs(a2["estimated"] - a2["measured"]) / j["mass_kg"])
-                a2_plate.append(a2["measured"] / j["mass_kg"])
+            pk = t.get("peaks") or {}
+            a2e = (pk.get("estimated") or {}).get("ankle_push_off_power_W")
+            a2m = (pk.get("measured") or {}).get("ankle_push_off_power_W")
+            if a2e is not None and a2m is not None:
+                a2_err.append(abs(a2e - a2m) / j["mass_kg"])
+                a2_plate.append(a2m / j["mass_kg"])
+            for key in peak_keys:
+                pe, pm = (pk.get("estimated") or {}).get(key), (pk.get("measured") or {}).get(key)
+                if pe is not None and pm is not None:
+                    mp_err[key].append(abs(pe - pm) / j["mass_kg"])
             knee = t["knee"]["least_squares"]["rrmse_percent"] if t["knee"]["least_squares"] else None
             if knee is not None and (worst is None or knee > worst[1]):
                 worst = (name, knee)
@@ -197,7 +205,8 @@ for act in activities:
         torque_rows.append(f"| {act} | {n} | " + " / ".join(cell(ls[k]) for k in joints) + " | "
                            + " / ".join(f"{sum(rm[k]) / len(rm[k]):.2f}" if rm[k] else "-" for k in joints) + " | "
                            + " / ".join(cell(bu[k]) for k in joints) + " | " + " / ".join(cell(pw[k]) for k in joints) + " | "
-                           + (f"{sum(a2_err) / len(a2_err):.2f} ({sum(a2_plate) / len(a2_plate):.2f})" if a2_err else "-")
+                           + (f"{sum(a2_err) / len(a2_err):.2f} ({sum(a2_plate) / len(a2_plate):.2f})" if a2_err else "-") + " | "
+                           + " / ".join(f"{sum(mp_err[k]) / len(mp_err[k]):.2f}" if mp_err[k] else "-" for k in peak_keys)
                            + f" | {worst[0]} {worst[1]:.1f} |")
 if torque_rows:
     print("Sagittal joint torques (defaults; since session 42): per stance, kin2grf's hip, knee and ankle torques (the least squares' "
@@ -207,11 +216,14 @@ if torque_rows:
           "lab's tool run on kin2grf's GRF file computes on this motion. Stances whose plate fails the registration check are left "
           "out (their plate-driven torques take a misplaced COP as their lever). The joint powers: each torque times the joint's "
           "angular velocity (the same for both), kin2grf's against the plates'; the ankle's push-off peak (its power's largest "
-          "value in the stance's second half, the A2 burst) as mean |kin2grf - plates| in W/kg, the plates' mean in brackets. "
-          "Mean over the stances.\n")
+          "value in the stance's second half, the A2 burst) as mean |kin2grf - plates| in W/kg, the plates' mean in brackets; "
+          "the moment peaks a gait report reads (`joint_kinetics`: the ankle's plantarflexor moment over the stance, the knee's "
+          "extensor and the hip's extensor moments in its first half, the hip's flexor moment in its second) as mean "
+          "|kin2grf - plates| in N m/kg. Mean over the stances.\n")
     print("| activity | stances | rRMSE % hip / knee / ankle | RMSE N m/kg hip / knee / ankle | bottom-up from the estimate's forces, "
-          "rRMSE % | joint powers, rRMSE % | ankle push-off peak W/kg | worst stance (knee rRMSE %) |")
-    print("|---|---|---|---|---|---|---|---|")
+          "rRMSE % | joint powers, rRMSE % | ankle push-off peak W/kg | moment peaks N m/kg: ankle plantarflexor / knee "
+          "extensor / hip extensor / hip flexor | worst stance (knee rRMSE %) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for r in torque_rows:
         print(r)
     print()

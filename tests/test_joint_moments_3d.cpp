@@ -465,3 +465,52 @@ TEST(JointMoments2D, TheJointPowersAreTheTorquesTimesTheJointAngularVelocities) 
   }
   EXPECT_GE(stances, 1);
 }
+
+// Each stance's joint kinetic peaks in the summary (`stance_parameters`' `joint_kinetics`) and in
+// the --stances CSV: the largest of each moment in its clinical sense (plantarflexor -tau_ankle,
+// knee extensor +tau_knee and hip extensor -tau_hip in the first half, hip flexor +tau_hip in the
+// second) and of the ankle's power in the second half, read back from the CSV's own columns.
+TEST(JointMoments2D, EachStancesKineticPeaksAreTheTorquesAndPowersPeaksInTheirSenses) {
+  const SyntheticWalk walk = make_synthetic_walk({});
+  const EstimateResult r = estimate(walk.trial, nullptr, *recognise_marker_set(walk.trial.markers), {});
+  const ResultsTable t = results_table(r);
+  const auto col = [&](const std::string& name) {
+    return static_cast<Eigen::Index>(std::find(t.columns.begin(), t.columns.end(), name) - t.columns.begin());
+  };
+  const nlohmann::json summary = results_summary(r, nlohmann::json::object());
+  const auto& stances = summary["stance_parameters"]["right"];
+  ASSERT_GE(stances.size(), 2u);
+  int checked = 0;
+  for (const auto& s : stances) {
+    if (!s["complete"].get<bool>()) continue;
+    Eigen::Index a = 0, b = 0;
+    while (r.time_s[a] < s["start_s"].get<double>()) ++a;
+    while (r.time_s[b] < s["end_s"].get<double>()) ++b;
+    const Eigen::Index mid = a + (b - a + 1) / 2;
+    const auto largest = [&](Eigen::Index c, double sign, Eigen::Index from, Eigen::Index to) {
+      return (sign * t.values.col(c).segment(from, to - from + 1)).maxCoeff();
+    };
+    const auto& k = s["joint_kinetics"];
+    EXPECT_DOUBLE_EQ(k["ankle_plantarflexor_moment_Nm"].get<double>(), largest(col("torque_ankle_r_Nm"), -1, a, b));
+    EXPECT_DOUBLE_EQ(k["ankle_push_off_power_W"].get<double>(), largest(col("power_ankle_r_W"), 1, mid, b));
+    EXPECT_DOUBLE_EQ(k["knee_extensor_moment_Nm"].get<double>(), largest(col("torque_knee_r_Nm"), 1, a, mid - 1));
+    EXPECT_DOUBLE_EQ(k["hip_extensor_moment_Nm"].get<double>(), largest(col("torque_hip_r_Nm"), -1, a, mid - 1));
+    EXPECT_DOUBLE_EQ(k["hip_flexor_moment_Nm"].get<double>(), largest(col("torque_hip_r_Nm"), 1, mid, b));
+    EXPECT_DOUBLE_EQ(k["ankle_push_off_power_W_per_kg"].get<double>(), k["ankle_push_off_power_W"].get<double>() / r.mass_kg);
+    ++checked;
+  }
+  EXPECT_GE(checked, 1);
+  // The --stances CSV carries them per kg, in its last five columns.
+  const std::string csv = stance_parameters_csv(r);
+  const std::string header = csv.substr(0, csv.find('\n'));
+  EXPECT_NE(header.find(",ankle_plantarflexor_moment_Nm_per_kg,ankle_push_off_power_W_per_kg,knee_extensor_moment_Nm_per_kg,"
+                        "hip_extensor_moment_Nm_per_kg,hip_flexor_moment_Nm_per_kg"),
+            std::string::npos)
+      << header;
+  // A moment that never acts in a sense has no peak in it (NaN, not the least negative value).
+  Eigen::MatrixXd positive = Eigen::MatrixXd::Constant(r.time_s.size(), kJointCount, 10.0);
+  const JointKineticPeaks none = joint_kinetic_peaks(positive, r.motion, 0, 10, 60);
+  EXPECT_TRUE(std::isnan(none.ankle_plantarflexor_moment_Nm));
+  EXPECT_TRUE(std::isnan(none.hip_extensor_moment_Nm));
+  EXPECT_DOUBLE_EQ(none.knee_extensor_moment_Nm, 10.0);
+}

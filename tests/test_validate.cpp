@@ -840,7 +840,7 @@ TEST(Validate, EachStancesGaitParametersAreComparedWithThePlates) {
   std::getline(lines, line);
   const auto cells = [](const std::string& l) { return static_cast<std::size_t>(std::count(l.begin(), l.end(), ',')) + 1; };
   const std::size_t width = cells(line);
-  EXPECT_EQ(width, 23u);
+  EXPECT_EQ(width, 28u);  // 23 ground reaction columns, then the 5 joint kinetic peaks
   std::size_t rows = 0;
   bool first_right = true;
   double previous_start = -1;
@@ -960,20 +960,30 @@ TEST(Validate, TheJointTorquesAreComparedWithThePlatesInverseDynamics) {
       // joint angular velocities; the ankle's push-off peak, the largest in the stance's second half.
       ASSERT_EQ(v.measured_joint_torque_Nm.rows(), e.time_s.size());
       const Eigen::Index len = right.last - right.first + 1;
-      double sq = 0, peak_e = -1e300, peak_m = -1e300;
+      double sq = 0, peak_e = -1e300, peak_m = -1e300, plantar_m = -1e300, knee_m = -1e300;
       for (Eigen::Index k = 0; k < len; ++k) {
         const Eigen::Index i = right.first + k;
         const double w = joint_angular_velocities(e.motion, i)[2];
         const double pe = e.joint_torque_Nm(i, 2) * w, pm = v.measured_joint_torque_Nm(i, 2) * w;
         sq += (pe - pm) * (pe - pm);
         if (k >= len / 2) peak_e = std::max(peak_e, pe), peak_m = std::max(peak_m, pm);
+        plantar_m = std::max(plantar_m, -v.measured_joint_torque_Nm(i, 2));
+        if (k < len / 2) knee_m = std::max(knee_m, v.measured_joint_torque_Nm(i, 1));
       }
       ASSERT_TRUE(right.torques->power[2]);
       EXPECT_NEAR(right.torques->power[2]->rmse, std::sqrt(sq / static_cast<double>(len)), 1e-9);
-      EXPECT_DOUBLE_EQ(right.torques->ankle_push_off_estimated_W, peak_e);
-      EXPECT_DOUBLE_EQ(right.torques->ankle_push_off_measured_W, peak_m);
-      EXPECT_GT(peak_m, 0.0);  // push-off generates energy at the ankle
+      // The peaks a gait report reads: push-off generates energy at the ankle (A2), the
+      // plantarflexors and the knee extensors act in their senses.
+      const JointKineticPeaks &ke = right.torques->peaks_estimated, &km = right.torques->peaks_measured;
+      ASSERT_GT(peak_m, 0.0);
+      EXPECT_DOUBLE_EQ(ke.ankle_push_off_power_W, peak_e);
+      EXPECT_DOUBLE_EQ(km.ankle_push_off_power_W, peak_m);
+      EXPECT_DOUBLE_EQ(km.ankle_plantarflexor_moment_Nm, plantar_m);
+      EXPECT_DOUBLE_EQ(km.knee_extensor_moment_Nm, knee_m);
+      EXPECT_GT(km.ankle_plantarflexor_moment_Nm, 0.5 * e.mass_kg);  // a walk's push-off: over 0.5 N m/kg
       EXPECT_NEAR(m.ankle_push_off_error_W_per_kg, std::abs(peak_e - peak_m) / e.mass_kg, 1e-12);
+      EXPECT_NEAR(m.moment_peak_error_Nm_per_kg[0], std::abs(ke.ankle_plantarflexor_moment_Nm - plantar_m) / e.mass_kg, 1e-12);
+      EXPECT_NEAR(t["peaks"]["measured"]["knee_extensor_moment_Nm_per_kg"].get<double>(), knee_m / e.mass_kg, 1e-12);
     }
   }
 }

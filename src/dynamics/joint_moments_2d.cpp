@@ -1,6 +1,8 @@
 // kin2grf dynamics: the sagittal joint torques, bottom-up (dynamics/joint_moments_2d.hpp).
 #include "kin2grf/dynamics/joint_moments_2d.hpp"
 
+#include <cmath>
+
 #include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
@@ -46,6 +48,30 @@ std::array<double, kJointCount> joint_angular_velocities(const ModelMotion& moti
   std::array<double, kJointCount> w{};
   for (std::size_t j = 0; j < w.size(); ++j) w[j] = d1[3 + j];
   return w;
+}
+
+JointKineticPeaks joint_kinetic_peaks(const Eigen::MatrixXd& torque_Nm, const ModelMotion& motion, int side, Eigen::Index first,
+                                      Eigen::Index last) {
+  JointKineticPeaks p;
+  if (first < 0 || last < first || last >= torque_Nm.rows() || last >= motion.frames()) return p;
+  const int hip = 4 * side, knee = hip + 1, ankle = hip + 2;
+  const Eigen::Index mid = first + (last - first + 1) / 2;  // the second half starts here
+  // The largest positive value of x over the frames, NaN without one (fmax skips the NaN start).
+  const auto peak = [](double& best, double x) {
+    if (x > 0) best = std::fmax(best, x);
+  };
+  for (Eigen::Index i = first; i <= last; ++i) {
+    const bool second = i >= mid;
+    peak(p.ankle_plantarflexor_moment_Nm, -torque_Nm(i, ankle));
+    if (second) {
+      peak(p.ankle_push_off_power_W, torque_Nm(i, ankle) * joint_angular_velocities(motion, i)[static_cast<std::size_t>(ankle)]);
+      peak(p.hip_flexor_moment_Nm, torque_Nm(i, hip));
+    } else {
+      peak(p.knee_extensor_moment_Nm, torque_Nm(i, knee));
+      peak(p.hip_extensor_moment_Nm, -torque_Nm(i, hip));
+    }
+  }
+  return p;
 }
 
 }  // namespace kin2grf

@@ -217,6 +217,17 @@ nlohmann::json stance_parameters_json(const StanceParameters& p, double body_wei
           {"loading_rate_N_per_s", num(p.loading_rate_N_per_s)}, {"loading_rate_bw_per_s", bw(p.loading_rate_N_per_s)}};
 }
 
+nlohmann::json joint_kinetic_peaks_json(const JointKineticPeaks& p, double mass_kg) {
+  const auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  const auto kg = [&](double x) { return num(mass_kg > 0 ? x / mass_kg : std::numeric_limits<double>::quiet_NaN()); };
+  return {{"ankle_plantarflexor_moment_Nm", num(p.ankle_plantarflexor_moment_Nm)},
+          {"ankle_plantarflexor_moment_Nm_per_kg", kg(p.ankle_plantarflexor_moment_Nm)},
+          {"ankle_push_off_power_W", num(p.ankle_push_off_power_W)}, {"ankle_push_off_power_W_per_kg", kg(p.ankle_push_off_power_W)},
+          {"knee_extensor_moment_Nm", num(p.knee_extensor_moment_Nm)}, {"knee_extensor_moment_Nm_per_kg", kg(p.knee_extensor_moment_Nm)},
+          {"hip_extensor_moment_Nm", num(p.hip_extensor_moment_Nm)}, {"hip_extensor_moment_Nm_per_kg", kg(p.hip_extensor_moment_Nm)},
+          {"hip_flexor_moment_Nm", num(p.hip_flexor_moment_Nm)}, {"hip_flexor_moment_Nm_per_kg", kg(p.hip_flexor_moment_Nm)}};
+}
+
 namespace {
 
 /// One stance of the estimate's own contact (gait_stances: the stances the gait events mark) and
@@ -226,6 +237,7 @@ struct EstimatedStance {
   IndexRun run;
   bool complete = false;  ///< false where the processed window cuts it
   StanceParameters parameters;
+  JointKineticPeaks kinetics;  ///< from the joint torques and powers
 };
 
 /// Every foot's stances, in time order (at one frame: the right foot first).
@@ -235,7 +247,8 @@ std::vector<EstimatedStance> estimated_stances(const EstimateResult& r) {
   for (int s = 0; s < 2; ++s) {
     const FootResult& f = r.feet[static_cast<std::size_t>(s)];
     for (const auto& run : gait_stances(f.contact, r.motion.rate_hz))
-      out.push_back({s, run, run.first > 0 && run.last < n - 1, stance_parameters(f.force_N, r.motion.rate_hz, run.first, run.last)});
+      out.push_back({s, run, run.first > 0 && run.last < n - 1, stance_parameters(f.force_N, r.motion.rate_hz, run.first, run.last),
+                     joint_kinetic_peaks(r.joint_torque_Nm, r.motion, s, run.first, run.last)});
   }
   std::stable_sort(out.begin(), out.end(), [](const EstimatedStance& a, const EstimatedStance& b) {
     return a.run.first != b.run.first ? a.run.first < b.run.first : a.side < b.side;
@@ -250,6 +263,7 @@ nlohmann::json stance_parameters_by_side_json(const EstimateResult& r) {
   for (const EstimatedStance& st : estimated_stances(r)) {
     nlohmann::json j = {{"start_s", r.time_s[st.run.first]}, {"end_s", r.time_s[st.run.last]}, {"complete", st.complete}};
     j.update(stance_parameters_json(st.parameters, body_weight_N));
+    j["joint_kinetics"] = joint_kinetic_peaks_json(st.kinetics, r.mass_kg);
     out[side_name(st.side)].push_back(std::move(j));
   }
   return out;
@@ -262,7 +276,8 @@ std::string stance_parameters_csv(const EstimateResult& r) {
   os << "side,frame_first,frame_last,start_s,duration_s,complete,vertical_first_peak_N,vertical_first_peak_bw,vertical_valley_N,"
         "vertical_valley_bw,vertical_second_peak_N,vertical_second_peak_bw,vertical_peak_N,vertical_peak_bw,braking_peak_N,"
         "braking_peak_bw,propulsive_peak_N,propulsive_peak_bw,vertical_impulse_Ns,braking_impulse_Ns,propulsive_impulse_Ns,"
-        "loading_rate_N_per_s,loading_rate_bw_per_s\n";
+        "loading_rate_N_per_s,loading_rate_bw_per_s,ankle_plantarflexor_moment_Nm_per_kg,ankle_push_off_power_W_per_kg,"
+        "knee_extensor_moment_Nm_per_kg,hip_extensor_moment_Nm_per_kg,hip_flexor_moment_Nm_per_kg\n";
   const double bw = r.mass_kg * r.model().gravity_mps2;
   const auto cell = [&os](double x) {
     os << ',';
@@ -284,6 +299,10 @@ std::string stance_parameters_csv(const EstimateResult& r) {
     }
     for (double x : {p.vertical_impulse_Ns, p.braking_impulse_Ns, p.propulsive_impulse_Ns, p.loading_rate_N_per_s}) cell(x);
     cell(bw > 0 ? p.loading_rate_N_per_s / bw : std::numeric_limits<double>::quiet_NaN());
+    const JointKineticPeaks& k = st.kinetics;
+    for (double x : {k.ankle_plantarflexor_moment_Nm, k.ankle_push_off_power_W, k.knee_extensor_moment_Nm, k.hip_extensor_moment_Nm,
+                     k.hip_flexor_moment_Nm})
+      cell(r.mass_kg > 0 ? x / r.mass_kg : std::numeric_limits<double>::quiet_NaN());
     os << '\n';
   }
   return os.str();

@@ -117,17 +117,12 @@ void validate_joint_torques(const EstimateResult& e, ValidationResult& v) {
       const Eigen::VectorXd power_estimated = e.joint_torque_Nm.col(j).segment(a, len).cwiseProduct(w);
       const Eigen::VectorXd power_measured = plate.cwiseProduct(w);
       t.power[static_cast<std::size_t>(c)] = compare_series(power_estimated, power_measured);
-      if (c == 2) {  // the ankle's push-off: its largest power in the stance's second half, where the plate reads
-        for (Eigen::Index k = len / 2; k < len; ++k)
-          if (std::isfinite(power_measured[k])) {  // fmax: the larger, a NaN (none yet) taken as absent
-            t.ankle_push_off_estimated_W = std::fmax(t.ankle_push_off_estimated_W, power_estimated[k]);
-            t.ankle_push_off_measured_W = std::fmax(t.ankle_push_off_measured_W, power_measured[k]);
-          }
-      }
     }
-    s.torques = t;
     for (int c = 0; c < 4; ++c)  // the leg's four joints, over the stance (the MTP's is the toes' inertia alone)
       v.measured_joint_torque_Nm.col(4 * s.foot + c).segment(a, len) = tau_measured.col(4 * s.foot + c).segment(a, len) + plate_reads;
+    t.peaks_measured = joint_kinetic_peaks(v.measured_joint_torque_Nm, e.motion, s.foot, s.first, s.last);
+    t.peaks_estimated = joint_kinetic_peaks(e.joint_torque_Nm, e.motion, s.foot, s.first, s.last);
+    s.torques = t;
   }
 }
 

@@ -863,7 +863,7 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
   mm.knee_sagittal = mean(x[0]);
   mm.knee_adduction = mean(x[1]);
   // The sagittal joint torques (every model): hip, knee, ankle.
-  std::array<std::vector<double>, 14> t;
+  std::array<std::vector<double>, 22> t;
   for (const auto& s : stances) {
     if ((foot >= 0 && s.foot != foot) || !s.torques) continue;
     const JointTorqueValidation& jt = *s.torques;
@@ -874,10 +874,17 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
       if (ls && std::isfinite(ls->rmse) && jt.mass_kg > 0) t[6 + c].push_back(ls->rmse / jt.mass_kg);
       if (pw && std::isfinite(pw->rrmse_percent)) t[9 + c].push_back(pw->rrmse_percent);
     }
-    if (std::isfinite(jt.ankle_push_off_estimated_W) && std::isfinite(jt.ankle_push_off_measured_W) && jt.mass_kg > 0) {
-      t[12].push_back(std::abs(jt.ankle_push_off_estimated_W - jt.ankle_push_off_measured_W) / jt.mass_kg);
-      t[13].push_back(jt.ankle_push_off_measured_W / jt.mass_kg);
-    }
+    const JointKineticPeaks &pe = jt.peaks_estimated, &pm = jt.peaks_measured;
+    const std::array<std::pair<double, double>, 5> peaks = {{{pe.ankle_push_off_power_W, pm.ankle_push_off_power_W},
+                                                             {pe.ankle_plantarflexor_moment_Nm, pm.ankle_plantarflexor_moment_Nm},
+                                                             {pe.knee_extensor_moment_Nm, pm.knee_extensor_moment_Nm},
+                                                             {pe.hip_extensor_moment_Nm, pm.hip_extensor_moment_Nm},
+                                                             {pe.hip_flexor_moment_Nm, pm.hip_flexor_moment_Nm}}};
+    for (std::size_t k = 0; k < peaks.size(); ++k)  // |error| and the plates' value, per kg: 12-13, 14-15, ...
+      if (std::isfinite(peaks[k].first) && std::isfinite(peaks[k].second) && jt.mass_kg > 0) {
+        t[12 + 2 * k].push_back(std::abs(peaks[k].first - peaks[k].second) / jt.mass_kg);
+        t[13 + 2 * k].push_back(peaks[k].second / jt.mass_kg);
+      }
   }
   for (std::size_t c = 0; c < 3; ++c) {
     mm.torque_least_squares[c] = mean(t[c]);
@@ -887,6 +894,10 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
   }
   mm.ankle_push_off_error_W_per_kg = mean(t[12]);
   mm.ankle_push_off_plates_W_per_kg = mean(t[13]);
+  for (std::size_t k = 0; k < 4; ++k) {
+    mm.moment_peak_error_Nm_per_kg[k] = mean(t[14 + 2 * k]);
+    mm.moment_peak_plates_Nm_per_kg[k] = mean(t[15 + 2 * k]);
+  }
   for (std::size_t p = 0; p < 2; ++p) {
     const double plates = mean(x[3 + 2 * p]);
     mm.kam_peak_error_percent[p] = plates > 0 ? 100 * mean(x[2 + 2 * p]) / plates : kNaN;
@@ -1084,8 +1095,8 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
         x["joint_torques"][joints[c]] = {{"least_squares", moment_metrics_json(s.torques->least_squares[c])},
                                          {"bottom_up", moment_metrics_json(s.torques->bottom_up[c])},
                                          {"power", power_metrics_json(s.torques->power[c])}};
-      x["joint_torques"]["ankle_push_off_W"] = {{"estimated", num(s.torques->ankle_push_off_estimated_W)},
-                                                {"measured", num(s.torques->ankle_push_off_measured_W)}};
+      x["joint_torques"]["peaks"] = {{"estimated", joint_kinetic_peaks_json(s.torques->peaks_estimated, s.torques->mass_kg)},
+                                     {"measured", joint_kinetic_peaks_json(s.torques->peaks_measured, s.torques->mass_kg)}};
     }
     return x;
   };
@@ -1135,6 +1146,10 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
                                          {"power", num(m.power[c])}};
       x["joint_torques"]["ankle_push_off_error_W_per_kg"] = num(m.ankle_push_off_error_W_per_kg);
       x["joint_torques"]["ankle_push_off_plates_W_per_kg"] = num(m.ankle_push_off_plates_W_per_kg);
+      const char* moments[] = {"ankle_plantarflexor", "knee_extensor", "hip_extensor", "hip_flexor"};
+      for (std::size_t k = 0; k < 4; ++k)
+        x["joint_torques"]["moment_peaks"][moments[k]] = {{"error_Nm_per_kg", num(m.moment_peak_error_Nm_per_kg[k])},
+                                                          {"plates_Nm_per_kg", num(m.moment_peak_plates_Nm_per_kg[k])}};
     }
     if (std::isfinite(m.knee_adduction)) {
       auto& x = means[f < 0 ? "all" : side_name(f)];
@@ -1321,6 +1336,10 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
        << " / " << number_or_dash(m.power[2]) << "; ankle push-off peak mean |kin2grf - plates| "
        << number_or_dash(m.ankle_push_off_error_W_per_kg, "%.2f") << " W/kg (plates " << number_or_dash(m.ankle_push_off_plates_W_per_kg, "%.2f")
        << " W/kg)\n";
+    const auto& pe = m.moment_peak_error_Nm_per_kg;
+    os << "  per foot, moment peaks' mean |kin2grf - plates|: ankle plantarflexor / knee extensor / hip extensor / hip flexor "
+       << number_or_dash(pe[0], "%.2f") << " / " << number_or_dash(pe[1], "%.2f") << " / " << number_or_dash(pe[2], "%.2f") << " / "
+       << number_or_dash(pe[3], "%.2f") << " N m/kg\n";
   }
   if (std::isfinite(m.lateral_rmse_percent_bw)) format_lateral_rows(os, v, m);
   if (std::isfinite(m.knee_adduction)) format_joint_moment_rows(os, v, m, v.mass_kg);

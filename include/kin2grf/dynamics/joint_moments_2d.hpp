@@ -24,6 +24,7 @@
 
 #include <Eigen/Dense>
 #include <array>
+#include <limits>
 
 #include "kin2grf/kinematics/motion.hpp"
 
@@ -50,5 +51,25 @@ Eigen::MatrixXd bottom_up_joint_torques(const ModelMotion& motion, const std::ar
 /// reaction -tau_j with theta_parent'. + the joint generates energy (its muscles shorten), - it
 /// absorbs it.
 std::array<double, kJointCount> joint_angular_velocities(const ModelMotion& motion, Eigen::Index i);
+
+/// One stance's sagittal joint kinetics as a gait report reads them: the peaks of the internal
+/// moments in their clinical senses, N m, and of the ankle's power, W (NaN: no such value, e.g. a
+/// moment that never acts in that sense). The sagittal frame's x points forward and torques are
+/// counter-clockwise + on the distal segment, so a plantarflexor moment (toes pushed down) is
+/// -tau_ankle, a knee extensor moment +tau_knee, a hip extensor moment -tau_hip and a hip flexor
+/// moment +tau_hip. Halves of the stance as the stance parameters' (dynamics/stance_parameters.hpp):
+/// the loading response's peaks in the first half, push-off's in the second.
+struct JointKineticPeaks {
+  double ankle_plantarflexor_moment_Nm = std::numeric_limits<double>::quiet_NaN();  ///< over the stance
+  double ankle_push_off_power_W = std::numeric_limits<double>::quiet_NaN();         ///< second half (the A2 burst)
+  double knee_extensor_moment_Nm = std::numeric_limits<double>::quiet_NaN();        ///< first half
+  double hip_extensor_moment_Nm = std::numeric_limits<double>::quiet_NaN();         ///< first half
+  double hip_flexor_moment_Nm = std::numeric_limits<double>::quiet_NaN();           ///< second half
+};
+/// The peaks of side `side`'s stance over frames first..last (inclusive) of `torque_Nm` (N x
+/// kJointCount, EstimateResult::joint_torque_Nm's columns) on `motion`. A peak in a sense the
+/// moment never takes is NaN (the largest of -tau where tau stays positive is not a peak).
+JointKineticPeaks joint_kinetic_peaks(const Eigen::MatrixXd& torque_Nm, const ModelMotion& motion, int side, Eigen::Index first,
+                                      Eigen::Index last);
 
 }  // namespace kin2grf

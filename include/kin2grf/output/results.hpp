@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "kin2grf/dynamics/joint_moments_2d.hpp"
 #include "kin2grf/dynamics/stance_parameters.hpp"
 #include "kin2grf/pipeline.hpp"
 
@@ -48,6 +49,9 @@ nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& se
 /// unit, the forces and the loading rate in body weights too (`*_bw`, by `body_weight_N`); null
 /// where a value does not exist.
 nlohmann::json stance_parameters_json(const StanceParameters& p, double body_weight_N);
+/// A stance's joint kinetic peaks (dynamics/joint_moments_2d.hpp) as JSON: each in its unit (N m,
+/// W) and per kg of `mass_kg` (`*_per_kg`); null where a value does not exist.
+nlohmann::json joint_kinetic_peaks_json(const JointKineticPeaks& p, double mass_kg);
 /// A few lines for a person: frames, mass, progression, each foot's contact intervals and peak
 /// vertical force (what `estimate` prints).
 std::string format_results_text(const EstimateResult& r);

@@ -52,6 +52,7 @@
 #include <vector>
 
 #include "kin2grf/trial.hpp"
+#include "kin2grf/dynamics/joint_moments_2d.hpp"
 #include "kin2grf/dynamics/stance_parameters.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/validation/metrics.hpp"
@@ -189,10 +190,10 @@ struct JointTorqueValidation {
   /// The joint powers (W; joint_angular_velocities): kin2grf's torques times the joints' angular
   /// velocities against the plates' torques times the same, hip, knee, ankle.
   std::array<std::optional<SeriesMetrics>, 3> power;
-  /// The ankle's push-off power (the A2 burst a gait report reads: the ankle power's largest value
-  /// in the stance's second half), W, kin2grf's and the plates'.
-  double ankle_push_off_estimated_W = std::numeric_limits<double>::quiet_NaN();
-  double ankle_push_off_measured_W = std::numeric_limits<double>::quiet_NaN();
+  /// The joint kinetic peaks a gait report reads (joint_kinetic_peaks: the ankle's plantarflexor
+  /// moment, its push-off power, the A2 burst, the knee's extensor moment, the hip's extensor and
+  /// flexor moments), kin2grf's and the plates' (over the frames where the plate reads).
+  JointKineticPeaks peaks_estimated, peaks_measured;
   double mass_kg = 0.0;  ///< the estimate's body mass, for the RMSE in N m/kg
 };
 
@@ -354,6 +355,9 @@ struct MeanMetrics {
   /// plates| and the plates' mean peak, W/kg.
   std::array<double, 3> power{0, 0, 0};
   double ankle_push_off_error_W_per_kg = 0, ankle_push_off_plates_W_per_kg = 0;
+  /// The moment peaks' mean |kin2grf - plates| and the plates' mean, N m/kg: the ankle's
+  /// plantarflexor, the knee's extensor, the hip's extensor and flexor moments (JointKineticPeaks).
+  std::array<double, 4> moment_peak_error_Nm_per_kg{0, 0, 0, 0}, moment_peak_plates_Nm_per_kg{0, 0, 0, 0};
   /// The stance parameters' mean |estimate - plate| over the stances (StanceValidation::
   /// parameters_estimated): the vertical first peak, valley and second peak and the braking and
   /// propulsive peaks in % body weight; the braking and propulsive impulses in body weight x
