@@ -750,15 +750,33 @@ namespace {
 std::vector<StanceValidation>::const_iterator right_of(const ValidationResult& r) {
   return std::find_if(r.stances.begin(), r.stances.end(), [](const auto& x) { return x.foot == 0; });
 }
+/// The example walk, its estimate and that estimate's validation, with the right foot's first
+/// stance: the tests below set the right foot's estimate to its plate's reading, then change it.
+struct ExampleWalkValidated {
+  Trial walk;
+  EstimateResult estimate;
+  ValidationResult before;
+  StanceValidation right;
+  [[nodiscard]] const MeasuredPlate& plate() const { return before.plates[static_cast<std::size_t>(right.plate_index)]; }
+};
+ExampleWalkValidated example_walk_validated() {
+  ExampleWalkValidated x{make_example_walk(), {}, {}, {}};
+  x.estimate = estimate(x.walk, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
+  x.before = validate(x.estimate, *x.walk.plates);
+  const auto r = right_of(x.before);
+  EXPECT_TRUE(r != x.before.stances.end());
+  if (r != x.before.stances.end()) x.right = *r;
+  return x;
+}
 }  // namespace
 
 TEST(Validate, EachStancesVerticalErrorIsSplitByTheSupportPhase) {
-  const Trial walk = make_example_walk();
-  EstimateResult e = estimate(walk, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
-  const auto before = validate(e, *walk.plates);
-  ASSERT_TRUE(right_of(before) != before.stances.end());
-  const StanceValidation& r0 = *right_of(before);
-  const Eigen::VectorXd plate = before.plates[static_cast<std::size_t>(r0.plate_index)].force_N.col(1);
+  ExampleWalkValidated x = example_walk_validated();
+  ASSERT_FALSE(HasFailure());
+  const Trial& walk = x.walk;
+  EstimateResult& e = x.estimate;
+  const StanceValidation& r0 = x.right;
+  const Eigen::VectorXd plate = x.plate().force_N.col(1);
   for (Eigen::Index k = r0.first; k <= r0.last; ++k)
     if (std::isfinite(plate[k])) e.feet[0].force_N(k, 1) = plate[k] + (e.feet[1].force_N(k, 1) > 20.0 ? 50.0 : 20.0);
   const auto v = validate(e, *walk.plates);
@@ -783,12 +801,12 @@ TEST(Validate, EachStancesVerticalErrorIsSplitByTheSupportPhase) {
 // means, the JSON and the text line read them back. The right foot's estimate is set to its plate
 // plus 30 N vertical and minus 10 N fore-aft: every peak is off by exactly that much.
 TEST(Validate, EachStancesGaitParametersAreComparedWithThePlates) {
-  const Trial walk = make_example_walk();
-  EstimateResult e = estimate(walk, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
-  const auto before = validate(e, *walk.plates);
-  ASSERT_TRUE(right_of(before) != before.stances.end());
-  const StanceValidation& r0 = *right_of(before);
-  const Eigen::MatrixX2d& plate = before.plates[static_cast<std::size_t>(r0.plate_index)].force_N;
+  ExampleWalkValidated x = example_walk_validated();
+  ASSERT_FALSE(HasFailure());
+  const Trial& walk = x.walk;
+  EstimateResult& e = x.estimate;
+  const StanceValidation& r0 = x.right;
+  const Eigen::MatrixX2d& plate = x.plate().force_N;
   for (Eigen::Index k = r0.first; k <= r0.last; ++k)
     if (std::isfinite(plate(k, 1))) e.feet[0].force_N.row(k) = plate.row(k) + Eigen::RowVector2d(-10.0, 30.0);
   // Unloaded next to the plate's stance, so that the loaded span is the stance.
@@ -849,7 +867,7 @@ TEST(Validate, EachStancesGaitParametersAreComparedWithThePlates) {
     EXPECT_EQ(cells(line), width) << line;
     std::vector<std::string> c;
     std::istringstream ls(line);
-    for (std::string x; std::getline(ls, x, ',');) c.push_back(x);
+    for (std::string cell; std::getline(ls, cell, ',');) c.push_back(cell);
     const double start = std::stod(c[3]);
     EXPECT_GE(start, previous_start);  // time order
     previous_start = start;
@@ -913,12 +931,12 @@ TEST(StanceParameters, APiecewiseLinearStancesPeaksImpulsesAndLoadingRateAreExac
 // knee's and the ankle's bottom-up torques are all off by exactly that. kin2grf's own torques (the
 // least squares', untouched here) are compared as they are.
 TEST(Validate, TheJointTorquesAreComparedWithThePlatesInverseDynamics) {
-  const Trial walk = make_example_walk();
-  EstimateResult e = estimate(walk, nullptr, *find_marker_set("kin2grf-example"), EstimateOptions{});
-  const auto before = validate(e, *walk.plates);
-  ASSERT_TRUE(right_of(before) != before.stances.end());
-  const StanceValidation r0 = *right_of(before);
-  const MeasuredPlate& plate = before.plates[static_cast<std::size_t>(r0.plate_index)];
+  ExampleWalkValidated x = example_walk_validated();
+  ASSERT_FALSE(HasFailure());
+  const Trial& walk = x.walk;
+  EstimateResult& e = x.estimate;
+  const StanceValidation& r0 = x.right;
+  const MeasuredPlate& plate = x.plate();
   double sum_fy = 0, sum_fy2 = 0;
   int frames = 0;
   for (double dx : {0.0, 0.02}) {

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "kin2grf/dynamics/stance_parameters.hpp"
 #include "kin2grf/numeric.hpp"
 
 namespace kin2grf {
@@ -55,7 +56,7 @@ JointKineticPeaks joint_kinetic_peaks(const Eigen::MatrixXd& torque_Nm, const Mo
   JointKineticPeaks p;
   if (first < 0 || last < first || last >= torque_Nm.rows() || last >= motion.frames()) return p;
   const int hip = 4 * side, knee = hip + 1, ankle = hip + 2;
-  const Eigen::Index mid = first + (last - first + 1) / 2;  // the second half starts here
+  const Eigen::Index mid = stance_second_half(first, last);
   // The largest positive value of x over the frames, NaN without one (fmax skips the NaN start).
   const auto peak = [](double& best, double x) {
     if (x > 0) best = std::fmax(best, x);

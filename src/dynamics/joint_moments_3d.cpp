@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "kin2grf/dynamics/stance_parameters.hpp"
 #include "kin2grf/error.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 
@@ -185,7 +186,7 @@ LegMotion3D leg_motion_3d(const Model& model, const std::array<Eigen::MatrixX3d,
 }
 
 std::array<double, 2> stance_peaks(const Eigen::VectorXd& kam, Eigen::Index first, Eigen::Index last) {
-  const Eigen::Index mid = first + (last - first + 1) / 2;
+  const Eigen::Index mid = stance_second_half(first, last);
   const auto peak = [&](Eigen::Index from, Eigen::Index to) {
     double best = std::numeric_limits<double>::quiet_NaN();
     for (Eigen::Index i = from; i <= to; ++i)

@@ -41,7 +41,7 @@ StanceParameters stance_parameters(const Eigen::MatrixX2d& force_N, double rate_
   const auto fx = force_N.col(0), fy = force_N.col(1);
   p.duration_s = static_cast<double>(last - first + 1) * dt;
 
-  const Eigen::Index mid = first + (last - first + 1) / 2;  // as the knee adduction moment's halves
+  const Eigen::Index mid = stance_second_half(first, last);
   const Eigen::Index peak = argmax(fy, first, last);
   if (peak >= 0) p.vertical_peak_N = fy[peak];
   const Eigen::Index p1 = mid > first ? argmax(fy, first, mid - 1) : -1, p2 = argmax(fy, mid, last);

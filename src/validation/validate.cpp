@@ -1028,17 +1028,15 @@ nlohmann::json component_json(const ComponentMetrics& c, double bw) {
   return j;
 }
 
-/// A moment's comparison: rRMSE (%), RMSE (N m), r; null when there is none.
-nlohmann::json moment_metrics_json(const std::optional<SeriesMetrics>& m) {
-  return m ? nlohmann::json{{"rrmse_percent", num(m->rrmse_percent)}, {"rmse_Nm", num(m->rmse)}, {"r", num(m->pearson_r)}}
+/// A series' comparison: rRMSE (%), RMSE (under `rmse_key`, in the series' unit), r; null when
+/// there is none.
+nlohmann::json metrics_json(const std::optional<SeriesMetrics>& m, const char* rmse_key) {
+  return m ? nlohmann::json{{"rrmse_percent", num(m->rrmse_percent)}, {rmse_key, num(m->rmse)}, {"r", num(m->pearson_r)}}
            : nlohmann::json(nullptr);
 }
-
-/// A power's comparison: rRMSE (%), RMSE (W), r; null when there is none.
-nlohmann::json power_metrics_json(const std::optional<SeriesMetrics>& m) {
-  return m ? nlohmann::json{{"rrmse_percent", num(m->rrmse_percent)}, {"rmse_W", num(m->rmse)}, {"r", num(m->pearson_r)}}
-           : nlohmann::json(nullptr);
-}
+/// A moment's (RMSE in N m) and a power's (W).
+nlohmann::json moment_metrics_json(const std::optional<SeriesMetrics>& m) { return metrics_json(m, "rmse_Nm"); }
+nlohmann::json power_metrics_json(const std::optional<SeriesMetrics>& m) { return metrics_json(m, "rmse_W"); }
 
 /// A stance's 3D joint moments (ModelKind::ThreeD): per joint and plane the rRMSE, RMSE (N m) and
 /// r, estimate-driven against plate-driven; the KAM's and its peaks.

@@ -31,6 +31,11 @@
 
 namespace kin2grf {
 
+/// Where a stance's second half begins: frames [first, last] split into [first, mid - 1] and
+/// [mid, last], the second taking the odd frame. One rule for every per-half value: the vertical
+/// force's first and second peaks, the knee adduction moment's peaks, the joint kinetic peaks.
+inline Eigen::Index stance_second_half(Eigen::Index first, Eigen::Index last) { return first + (last - first + 1) / 2; }
+
 struct StanceParameters {
   static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   double duration_s = kNaN;  ///< (last - first + 1) / rate: foot strike to foot off, as the gait events mark them
