@@ -20,8 +20,10 @@ for row in "${TRIALS[@]}"; do
   # 3d: the 3D model (--model 3d) at its defaults; 3d-lcX: its lateral force's cut-off at X Hz (0:
   # the kinematic cut-off), 3d-load: the split by load alone, 3d-lumped: the arms and head in the
   # torso, 3d-nolag: the torso's lateral share not delayed, 3d-split: a landing's bilateral stance
-  # split as everywhere else, for the leave-one-lab-out choices.
-  for config in defaults paper 3d 3d-lc0 3d-lc2 3d-lc3 3d-lc3.5 3d-lc4 3d-lc5 3d-load 3d-lumped 3d-nolag 3d-split; do
+  # split as everywhere else, 3d-toeX: the COP's medial turn past the MT heads at X m/m, for the
+  # leave-one-lab-out choices.
+  for config in defaults paper 3d 3d-lc0 3d-lc2 3d-lc3 3d-lc3.5 3d-lc4 3d-lc5 3d-load 3d-lumped 3d-nolag 3d-split \
+    3d-toe0 3d-toe0.5 3d-toe0.75 3d-toe1; do
     extra=""
     [ "$config" = paper ] && extra="--paper"
     [ "$config" = 3d ] && extra="--model 3d"
@@ -30,6 +32,7 @@ for row in "${TRIALS[@]}"; do
     [ "$config" = 3d-lumped ] && extra="--model 3d --upper-body lumped"
     [ "$config" = 3d-nolag ] && extra="--model 3d --lateral-lag none"
     [ "$config" = 3d-split ] && extra="--model 3d --lateral-bilateral split"
+    [[ "$config" == 3d-toe* ]] && extra="--model 3d --toe-medial-slope ${config#3d-toe}"
     # shellcheck disable=SC2086
     if ! $BIN validate $args $extra --json "$OUT/$name.$config.json" >"$OUT/$name.$config.txt" 2>"$OUT/$name.$config.log"; then
       echo "validate-all: $name ($config) failed:" >&2; cat "$OUT/$name.$config.log" >&2; exit 1

@@ -495,6 +495,7 @@ def trial_3d(j, mass):
         "r": m([s["r"]["lateral"] for s in st if s["r"]["lateral"] is not None]),
         "cop_mm": m([s["rmse"]["cop_lateral_mm"] for s in placed if s["rmse"].get("cop_lateral_mm") is not None]),
         "kam": m([k["rrmse_percent"] for k in kam if k.get("rrmse_percent") is not None]),
+        "kam_rmse": m([k["rmse_Nm"] / j["mass_kg"] for k in kam if k.get("rmse_Nm") is not None]),
         "knee_sagittal": m([x["knee"]["sagittal"]["rrmse_percent"] for x in jm if x["knee"]["sagittal"].get("rrmse_percent") is not None]),
         "hip_frontal": m([x["hip"]["frontal"]["rrmse_percent"] for x in jm
                           if x.get("hip") and x["hip"]["frontal"] and x["hip"]["frontal"].get("rrmse_percent") is not None]),
@@ -513,16 +514,17 @@ def total_moment(j, key):
     return x.get("rrmse_percent")
 
 
-def lateral_criterion(config, held_lab):
-    """Mean over the labs (each weighing the same) of their trials' mean per-foot lateral rRMSE."""
+def lateral_criterion(config, held_lab, key="lateral"):
+    """Mean over the labs (each weighing the same) of their trials' mean of a 3D figure (trial_3d's
+    `key`; the per-foot lateral rRMSE by default)."""
     per_lab = {}
     for a, name, args in rows:
         if lab_of[name] == held_lab:
             continue
         j = load_or_none(name, config)
         t = j and trial_3d(j, j["mass_kg"])
-        if t:
-            per_lab.setdefault(lab_of[name], []).append(t["lateral"])
+        if t and t[key] is not None:
+            per_lab.setdefault(lab_of[name], []).append(t[key])
     return statistics.mean(statistics.mean(v) for v in per_lab.values())
 
 
@@ -535,7 +537,8 @@ print("The sagittal figures above are the 3D model's too: it adds to them, per f
       "one is, away from flight phases), each "
       "foot in contact carrying its own lower leg's lateral inertia and the rest shared by vertical load (in a landing's "
       "bilateral stance, the paper's least squares with the legs' 3D joint moments). The COP's lateral place: on the line from the heel to the forefoot's "
-      "midline at the COP's place along the foot. Lateral knee, ankle and 5th-metatarsal markers are moved to the "
+      "midline at the COP's place along the foot, turning medially past the MT heads (0.25 m per m ahead of them, towards "
+      "the hallux the push-off rolls onto; since session 43). Lateral knee, ankle and 5th-metatarsal markers are moved to the "
       "joint centres and the foot's midline (docs/MARKERSETS.md, \"surface\"). Per stance: the lateral force's "
       "rRMSE %, RMSE in % body weight, r; the lateral COP's RMSE in mm (frames above 5 % body weight); the external "
       "knee adduction moment (KAM), estimate-driven against plate-driven: rRMSE %, and its first peak (the largest "
@@ -545,7 +548,7 @@ print("The sagittal figures above are the 3D model's too: it adds to them, per f
       "(a .mot without torque columns reads 0). The lateral COP, the joint moments and the free moment leave out the "
       "stances whose plate fails the registration check, as the sagittal COP does (their plate-driven moments take the "
       "misplaced COP as their lever: Camargo's four, since session 26); the lateral force keeps them. No value of the 3D model "
-      "was fitted except the lateral cut-off, the split's rule, the arms' and head's segments, the torso's lateral lag (on or off; its delay is the fore-aft one's) and a landing's bilateral split, chosen leave-one-lab-out (below); the joint and foot geometry are anatomical ratios.\n")
+      "was fitted except the lateral cut-off, the split's rule, the arms' and head's segments, the torso's lateral lag (on or off; its delay is the fore-aft one's), a landing's bilateral split and the COP's medial turn past the MT heads, chosen leave-one-lab-out (below); the joint and foot geometry are anatomical ratios.\n")
 print("| activity | trial | lab | stances | lateral force rRMSE % | RMSE %BW | r | lateral COP RMSE mm | "
       "KAM rRMSE % | KAM 1st peak est / plates N m/kg | knee sagittal rRMSE % | hip frontal rRMSE % | total frontal / transverse moment rRMSE % | free moment RMSE N m |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -588,42 +591,74 @@ LATERAL_SPLITS = {"load": "3d-load", "own-leg": "3d"}
 UPPER_BODY = {"lumped": "3d-lumped", "segments": "3d"}
 LATERAL_LAG = {"none": "3d-nolag", "torso": "3d"}
 LATERAL_BILATERAL = {"least-squares": "3d", "split": "3d-split"}
+TOE_SLOPES = {"0": "3d-toe0", "0.25": "3d", "0.5": "3d-toe0.5", "0.75": "3d-toe0.75", "1": "3d-toe1"}
 
 
-def lolo_table(title, intro, configs, label):
-    """A setting of the lateral force chosen leave-one-lab-out among `configs` (name -> run): the criterion
-    per candidate, the choices, and per activity the first candidate, in-sample and held-out figures."""
+def held_out_criterion(configs, choice, key):
+    """lateral_criterion's figure with each lab's trials at the choice made without it (choice: lab -> candidate)."""
+    per_lab = []
+    for lab in labs:
+        ts = [trial_3d(load_or_none(n, configs[choice[lab]]), 1) for _, n, _ in rows if lab_of[n] == lab]
+        vals = [t[key] for t in ts if t and t[key] is not None]
+        if vals:
+            per_lab.append(statistics.mean(vals))
+    return statistics.mean(per_lab)
+
+
+LOLO_CRITERIA = {"lateral": ("the per-foot lateral force's rRMSE", "%", "{:.2f}", "{:.1f}"),
+                 "cop_mm": ("the lateral COP's RMSE", "mm", "{:.2f}", "{:.1f}"),
+                 "kam": ("the knee adduction moment's rRMSE", "%", "{:.2f}", "{:.1f}"),
+                 "kam_rmse": ("the knee adduction moment's RMSE", "N m/kg", "{:.4f}", "{:.3f}"),
+                 "hip_frontal": ("the hip's frontal moment's rRMSE", "%", "{:.2f}", "{:.1f}"),
+                 "frontal": ("the total frontal moment's rRMSE", "%", "{:.2f}", "{:.1f}")}
+
+
+def lolo_table(title, intro, configs, label, key="lateral", beside=()):
+    """A setting of the lateral force chosen leave-one-lab-out among `configs` (name -> run) by the 3D
+    figure `key` (LOLO_CRITERIA): the criterion per candidate, the choices, and per activity the first
+    candidate, in-sample and held-out figures; `beside`: other figures, held out at the same choices."""
     if not all(load_or_none(rows[0][1], c) is not None for c in configs.values()):
         return
+    what, unit, crit_fmt, _ = LOLO_CRITERIA[key]
     print(f"\n### {title}, leave-one-lab-out\n")
-    print(intro + " Chosen by the per-foot lateral force's rRMSE (per lab, the mean over its trials; then the mean "
+    print(intro + f" Chosen by {what} (per lab, the mean over its trials; then the mean "
           "over the labs, all activities pooled). In-sample: every trial at the choice made on every lab; held-out: "
           "each lab's trials at the choice made without it.\n")
-    crit = {k: lateral_criterion(c, None) for k, c in configs.items()}
+    crit = {k: lateral_criterion(c, None, key) for k, c in configs.items()}
     print(f"| {label} | " + " | ".join(crit) + " |")
     print("|---|" + "---|" * len(crit))
-    print("| criterion % | " + " | ".join(f"{v:.2f}" for v in crit.values()) + " |")
+    print(f"| criterion {unit} | " + " | ".join(crit_fmt.format(v) for v in crit.values()) + " |")
+    for b in beside:
+        print(f"| {LOLO_CRITERIA[b][0]}, {LOLO_CRITERIA[b][1]} | "
+              + " | ".join(LOLO_CRITERIA[b][2].format(lateral_criterion(c, None, b)) for c in configs.values()) + " |")
     in_sample = min(crit, key=crit.get)
-    choice = {lab: min(configs, key=lambda k: lateral_criterion(configs[k], lab)) for lab in labs}
+    # A tie keeps the first candidate (the listing puts kin2grf's default or the paper's first).
+    choice = {lab: min(configs, key=lambda k: lateral_criterion(configs[k], lab, key)) for lab in labs}
     print("\nIn-sample choice: " + in_sample + "; held out: " + ", ".join(f"{lab} {c}" for lab, c in choice.items()) + ".\n")
     first = next(iter(configs))
-    print(f"| activity | {first} | in-sample | held-out | worst trial held-out |")
-    print("|---|---|---|---|---|")
+    for k in (key,) + tuple(beside):
+        print(f"Held out, {LOLO_CRITERIA[k][0]}: {LOLO_CRITERIA[k][2].format(held_out_criterion(configs, choice, k))} "
+              f"{LOLO_CRITERIA[k][1]} ({first} on every lab: {LOLO_CRITERIA[k][2].format(lateral_criterion(configs[first], None, k))}).\n")
+    print(f"| activity | figure | {first} | in-sample | held-out | worst trial held-out |")
+    print("|---|---|---|---|---|---|")
     for a in dict.fromkeys(a for a, _, _ in rows):
-        base, ins, held = [], [], []
-        for b, name, _ in rows:
-            if b != a:
-                continue
-            ts = {k: load_or_none(name, c) for k, c in configs.items()}
-            if ts[first] is None or trial_3d(ts[first], 1) is None:
-                continue
-            base.append(trial_3d(ts[first], 1)["lateral"])
-            ins.append(trial_3d(ts[in_sample], 1)["lateral"])
-            held.append((trial_3d(ts[choice[lab_of[name]]], 1)["lateral"], name))
-        if held:
-            worst = max(held)
-            print(f"| {a} | {statistics.mean(base):.1f} | {statistics.mean(ins):.1f} | "
-                  f"{statistics.mean(h for h, _ in held):.1f} | {worst[1]} {worst[0]:.1f} |")
+        for k in (key,) + tuple(beside):
+            base, ins, held = [], [], []
+            for b, name, _ in rows:
+                if b != a:
+                    continue
+                ts = {c: load_or_none(name, cfg) for c, cfg in configs.items()}
+                if ts[first] is None or trial_3d(ts[first], 1) is None or trial_3d(ts[first], 1)[k] is None:
+                    continue
+                base.append(trial_3d(ts[first], 1)[k])
+                ins.append(trial_3d(ts[in_sample], 1)[k])
+                held.append((trial_3d(ts[choice[lab_of[name]]], 1)[k], name))
+            if held:
+                worst = max(held)
+                f = LOLO_CRITERIA[k][3]
+                print(f"| {a} | {LOLO_CRITERIA[k][0]}, {LOLO_CRITERIA[k][1]} | {f.format(statistics.mean(base))} | "
+                      f"{f.format(statistics.mean(ins))} | {f.format(statistics.mean(h for h, _ in held))} | "
+                      f"{worst[1]} {f.format(worst[0])} |")
 
 
 lolo_table("The lateral force's cut-off", "The whole body's lateral acceleration's low-pass cut-off (`--lateral-cutoff`), "
@@ -651,6 +686,16 @@ lolo_table("A landing's bilateral stance", "`--lateral-bilateral`: least-squares
            "drop jump has such frames (92); every other trial ties. Applied to every bilateral stance (quiet standing too) it "
            "cost Camargo's gait initiation 27.0 -> 28.2 % and held out lost 21.58 against 21.55 %; in walking handovers it is "
            "worse on every walk (docs/METHOD-NOTES.md).", LATERAL_BILATERAL, "bilateral stance")
+lolo_table("The COP's medial turn at push-off", "`--toe-medial-slope`: past the forefoot's midline end (the MT heads) "
+           "the COP's lateral place turns medially by this many metres per metre ahead of it, towards the hallux the push-off "
+           "rolls onto (session 43; 0 until then: it stayed on the midline). Anatomy bounds it by about 0.6 (the hallux's pad "
+           "2-3 cm medial of the midline, 4-5 cm ahead of the heads); the plates of 15 of the 16 walking stances move medially "
+           "there (docs/METHOD-NOTES.md). What the lateral COP moves is given beside, at the same choices: the knee adduction "
+           "moment (its rRMSE divides by the plate-driven moment's range, which on walking2, its first peak 0.03 N m/kg, is a "
+           "few newton metres), the hip's frontal moment, the total frontal moment, and the lateral force, which the COP "
+           "moves in a landing's bilateral stance alone (the least squares with the legs' joint moments: the drop jump's "
+           "47.0 -> 51.5 %, its landing on the forefeet and its jump's push-off past the MT heads).",
+           TOE_SLOPES, "slope", key="cop_mm", beside=("kam_rmse", "kam", "hip_frontal", "frontal", "lateral"))
 
 print("\n## Excluded stances and notes (defaults)\n")
 for a, name, args in rows:

@@ -41,6 +41,11 @@ const std::vector<NumericOption>& numeric_options() {
        "A landing foot carries no load before its heel or MT head, seen at 15 Hz, has stopped descending: its descent fallen to "
        "this fraction of its recent peak and under 0.1 m/s (0 = off, the paper); the load the kinematics ask for before is dropped",
        {0.0, 0.1, 0.2, 0.3, 0.5}, "%.1f of the peak", 1.0, "off"},
+      // No study grid: the sagittal criterion does not see it; scripts/validate-all.sh's 3d-toe runs
+      // choose it leave-one-lab-out by the lateral COP (docs/VALIDATION.md).
+      {"toe-medial-slope", "toe_medial_slope", [](O& o) -> double& { return o.toe_medial_slope; }, -2.0, 2.0, std::nullopt,
+       "With the lateral COP (--model 3d, --mediolateral): past the forefoot's midline end (the MT heads) the COP turns medially, "
+       "towards the hallux the push-off rolls onto, by this many m per m ahead of it (default 0.25; 0 = it stays on the midline)"},
       {"still-foot", "still_foot_rad_per_s", [](O& o) -> double& { return o.contact.still_foot_rad_per_s; }, 0.0, 10.0, 0.0,
        "The contact calibration's foot-flat reference from frames where the foot is also still, its angle turning slower than "
        "this, rad/s (0 = every frame with the heel and MT near the floor, the paper)",

@@ -160,6 +160,7 @@ void check_options(const EstimateOptions& o) {
           "still foot rate", o.contact.still_foot_rad_per_s, "between 0 (off, the paper) and 10 rad/s");
   require(finite(o.touchdown_stop_fraction) && o.touchdown_stop_fraction >= 0 && o.touchdown_stop_fraction <= 1,
           "touchdown stop fraction", o.touchdown_stop_fraction, "between 0 (off, the paper) and 1");
+  require(finite(o.toe_medial_slope) && std::abs(o.toe_medial_slope) <= 2, "toe medial slope", o.toe_medial_slope, "between -2 and 2");
   require(o.grm_reference_m.allFinite(), "GRM reference (m)", o.grm_reference_m.x() + o.grm_reference_m.y(), "finite");
   if (o.mass_kg)
     require(finite(*o.mass_kg) && *o.mass_kg > 0 && (o.allow_unusual_mass || (*o.mass_kg >= kMassRangeKg[0] && *o.mass_kg <= kMassRangeKg[1])),
@@ -1249,10 +1250,10 @@ std::vector<bool> bilateral_frames(const std::array<FootResult, 2>& feet, double
 }
 
 /// Each foot's COP's lateral coordinate on its lateral line (FootResult::cop_lateral_m).
-void lateral_cop_stage(const std::array<Eigen::MatrixX4d, 2>& foot_line, std::array<FootResult, 2>& feet) {
+void lateral_cop_stage(const std::array<Eigen::MatrixX4d, 2>& foot_line, double toe_medial_slope, std::array<FootResult, 2>& feet) {
   for (int k = 0; k < 2; ++k) {
     FootResult& f = feet[static_cast<std::size_t>(k)];
-    f.cop_lateral_m = cop_lateral_on_foot_line(foot_line[static_cast<std::size_t>(k)], f.cop_x_m);
+    f.cop_lateral_m = cop_lateral_on_foot_line(foot_line[static_cast<std::size_t>(k)], f.cop_x_m, toe_medial_slope, k);
   }
 }
 
@@ -1532,7 +1533,7 @@ EstimateResult estimate_impl(const Trial& trial, Trial* release, const Trial* st
     mediolateral_stage(kin.motion, sag, cutoff, kin.kinematic_cutoff_hz, o.lateral_own_leg_inertia, lateral_lag_s, dyn.plan.near_flight,
                        anthropometric_table(o.anthropometry),
                        feet.feet, kin.messages);
-    lateral_cop_stage(sag.foot_line, feet.feet);
+    lateral_cop_stage(sag.foot_line, o.toe_medial_slope, feet.feet);
   }
   // The 3D model's legs: validate drives their kinematics again with the plates, so the result
   // keeps them (keep_all_series); otherwise they are made a block at a time (about 1.2 kB a frame
@@ -1626,15 +1627,17 @@ EstimateResult estimate(Trial&& trial, const Trial* static_trial, const MarkerSe
   return naming_the_trial(path, [&] { return estimate_impl(trial, &trial, static_trial, set, o); });
 }
 
-Eigen::VectorXd cop_lateral_on_foot_line(const Eigen::MatrixX4d& line, const Eigen::VectorXd& cop_x_m) {
+Eigen::VectorXd cop_lateral_on_foot_line(const Eigen::MatrixX4d& line, const Eigen::VectorXd& cop_x_m, double toe_medial_slope, int side) {
   const Eigen::Index n = cop_x_m.size();
   if (line.rows() != n) throw InputError("the COP's lateral line and the COP differ in frames");
   Eigen::VectorXd out = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
   for (Eigen::Index i = 0; i < n; ++i) {
     if (!std::isfinite(cop_x_m[i])) continue;
     const double span = line(i, 2) - line(i, 0);
-    const double t = std::abs(span) > 1e-6 ? std::clamp((cop_x_m[i] - line(i, 0)) / span, 0.0, 1.0) : 0.5;
+    const double u = std::abs(span) > 1e-6 ? (cop_x_m[i] - line(i, 0)) / span : 0.5, t = std::clamp(u, 0.0, 1.0);
     out[i] = line(i, 1) + t * (line(i, 3) - line(i, 1));
+    // Ahead of the forefoot end by (u - 1)|span|: medial is -lateral for the right foot.
+    if (u > 1) out[i] -= (side == 0 ? 1.0 : -1.0) * toe_medial_slope * (u - 1) * std::abs(span);
   }
   return out;
 }

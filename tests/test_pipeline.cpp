@@ -1578,18 +1578,30 @@ TEST(Mediolateral, AWalkTurnedAboutTheVerticalGivesTheSameForces) {
 
 // The 3D COP's lateral place (FootResult::cop_lateral_m) follows the foot's line from the heel to
 // the forefoot's midline at the COP's place along it: a COP at the heel takes the heel's lateral
-// coordinate, one at the MT head the forefoot's, past either end it stays there.
+// coordinate, one at the MT head the forefoot's, behind the heel it stays there; past the MT
+// head it turns medially by the toe slope (the push-off's roll onto the hallux), to the walker's
+// left for a right foot and to the right for a left one (the lateral axis points right).
 TEST(LateralCop, TheCopsLateralPlaceFollowsTheFootsLineAtItsPlaceAlongIt) {
-  Eigen::MatrixX4d line(5, 4);
+  Eigen::MatrixX4d line(6, 4);
   line.rowwise() = Eigen::RowVector4d(0.0, 0.10, 0.20, 0.14);  // heel x, heel lat, forefoot x, forefoot lat
-  Eigen::VectorXd cop(5);
-  cop << 0.0, 0.10, 0.20, -0.05, std::numeric_limits<double>::quiet_NaN();
+  Eigen::VectorXd cop(6);
+  cop << 0.0, 0.10, 0.20, -0.05, std::numeric_limits<double>::quiet_NaN(), 0.24;
   const Eigen::VectorXd lat = cop_lateral_on_foot_line(line, cop);
   EXPECT_NEAR(lat[0], 0.10, 1e-12);
   EXPECT_NEAR(lat[1], 0.12, 1e-12);
   EXPECT_NEAR(lat[2], 0.14, 1e-12);
   EXPECT_NEAR(lat[3], 0.10, 1e-12);  // behind the heel: the heel's
   EXPECT_TRUE(std::isnan(lat[4]));   // no contact
+  EXPECT_NEAR(lat[5], 0.14, 1e-12);  // no slope: the forefoot end's
+  const Eigen::VectorXd right = cop_lateral_on_foot_line(line, cop, 0.25, 0), left = cop_lateral_on_foot_line(line, cop, 0.25, 1);
+  EXPECT_NEAR(right[5], 0.14 - 0.25 * 0.04, 1e-12);  // 4 cm past the MT head: 1 cm medial
+  EXPECT_NEAR(left[5], 0.14 + 0.25 * 0.04, 1e-12);
+  for (Eigen::Index i : {0, 1, 2, 3}) EXPECT_EQ(right[i], lat[i]) << "only past the MT head";
+  EXPECT_NEAR(right[2], left[2], 1e-15);
+  // A walker going the other way along x (a line whose forefoot lies at lower x): the same.
+  Eigen::MatrixX4d back(1, 4);
+  back << 0.0, 0.10, -0.20, 0.14;
+  EXPECT_NEAR(cop_lateral_on_foot_line(back, Eigen::VectorXd::Constant(1, -0.24), 0.25, 0)[0], 0.13, 1e-12);
   EXPECT_THROW((void)cop_lateral_on_foot_line(line.topRows(3), cop), InputError);
 }
 
