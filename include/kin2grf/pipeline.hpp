@@ -219,11 +219,12 @@ struct EstimateOptions {
   /// medial turn, m per m ahead of the MT heads (kin2grf, session 43). At push-off the COP rolls
   /// from the metatarsal heads onto the hallux, which lies medial of the foot's midline (anatomy:
   /// its pad 2-3 cm medial of the midline, 4-5 cm ahead of the heads, a slope of at most about
-  /// 0.6); the plates of 15 of the 16 development walking stances move medially there, by 2-20 mm
-  /// within 2 cm past the heads. 0.25, chosen leave-one-lab-out by the lateral COP's RMSE (every
-  /// lab but Stanford's chooses it without itself, Stanford's 0.5; `validate --model 3d
-  /// --toe-medial-slope`, docs/VALIDATION.md): the held-out criterion 12.6 -> 11.6 mm, the knee
-  /// adduction moment's RMSE 0.147 -> 0.145 N m/kg. 0: it stays on the midline (sessions 20-42).
+  /// 0.6); the plates of 15 of the 16 development walking stances move medially there, by 2-22 mm
+  /// from 2 cm behind the heads to 1-2 cm past them. 0.25, chosen leave-one-lab-out by the lateral
+  /// COP's RMSE (every lab but Stanford's chooses it without itself, Stanford's 0.5; `validate
+  /// --model 3d --toe-medial-slope`, docs/VALIDATION.md): held out 12.6 -> 11.6 mm, the knee
+  /// adduction moment's RMSE 0.147 -> 0.146 N m/kg; a landing's least-squares lateral split moves
+  /// with it (the drop jump's lateral force 47 -> 51 %). 0: it stays on the midline (sessions 20-42).
   double toe_medial_slope = 0.25;
   /// The arms and the head as segments of their own in the lateral force, where the marker set
   /// names their markers and the file holds them (MarkerSet::upper_body); false: lumped into the
