@@ -541,7 +541,7 @@ print("The sagittal figures above are the 3D model's too: it adds to them, per f
       "the hallux the push-off rolls onto; since session 43). Lateral knee, ankle and 5th-metatarsal markers are moved to the "
       "joint centres and the foot's midline (docs/MARKERSETS.md, \"surface\"). Per stance: the lateral force's "
       "rRMSE %, RMSE in % body weight, r; the lateral COP's RMSE in mm (frames above 5 % body weight); the external "
-      "knee adduction moment (KAM), estimate-driven against plate-driven: rRMSE %, and its first peak (the largest "
+      "knee adduction moment (KAM), estimate-driven against plate-driven: rRMSE % and RMSE in N m/kg (an rRMSE divides by the plate-driven moment's range, a few N m on walking2), and its first peak (the largest "
       "value in the stance's first half) in N m/kg; the knee's sagittal moment's and the hip's frontal moment's rRMSE %; per trial, the total ground "
       "reaction's frontal and transverse moments about the GRM reference on the walker's midline, where every loaded "
       "foot is on a plate (the estimate's free moment is zero, the plates' is in theirs); per stance, the free moment's RMSE, which with the estimate's zero is the plate's own RMS "
@@ -550,7 +550,7 @@ print("The sagittal figures above are the 3D model's too: it adds to them, per f
       "misplaced COP as their lever: Camargo's four, since session 26); the lateral force keeps them. No value of the 3D model "
       "was fitted except the lateral cut-off, the split's rule, the arms' and head's segments, the torso's lateral lag (on or off; its delay is the fore-aft one's), a landing's bilateral split and the COP's medial turn past the MT heads, chosen leave-one-lab-out (below); the joint and foot geometry are anatomical ratios.\n")
 print("| activity | trial | lab | stances | lateral force rRMSE % | RMSE %BW | r | lateral COP RMSE mm | "
-      "KAM rRMSE % | KAM 1st peak est / plates N m/kg | knee sagittal rRMSE % | hip frontal rRMSE % | total frontal / transverse moment rRMSE % | free moment RMSE N m |")
+      "KAM rRMSE % (RMSE N m/kg) | KAM 1st peak est / plates N m/kg | knee sagittal rRMSE % | hip frontal rRMSE % | total frontal / transverse moment rRMSE % | free moment RMSE N m |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 by_activity = {}
 for a, name, args in rows:
@@ -563,13 +563,14 @@ for a, name, args in rows:
         continue
     g = lambda k, fmt="{:.1f}": "-" if t[k] is None else fmt.format(t[k])
     print(f"| {a} | {name} | {lab_of[name]} | {t['stances']} | {g('lateral')} | {g('lateral_bw')} | {g('r', '{:.2f}')} | "
-          f"{g('cop_mm', '{:.0f}')} | {g('kam')} | {g('kam1_est', '{:.2f}')} / {g('kam1_plates', '{:.2f}')} | {g('knee_sagittal')} | "
+          f"{g('cop_mm', '{:.0f}')} | {g('kam')} ({g('kam_rmse', '{:.2f}')}) | {g('kam1_est', '{:.2f}')} / {g('kam1_plates', '{:.2f}')} | {g('knee_sagittal')} | "
           f"{g('hip_frontal')} | {g('frontal')} / {g('transverse')} | {g('free')} |")
     by_activity.setdefault(a, []).append((name, t))
 print("\n| activity | trials | lateral force rRMSE % (worst trial) | lateral COP RMSE mm (worst) | KAM rRMSE % (worst) | "
+      "KAM RMSE N m/kg (worst) | "
       "KAM 1st peak mean abs error N m/kg, % of the plates' mean (the mean estimated peak against the mean plate-driven one) | knee sagittal rRMSE % | hip frontal rRMSE % (worst) | "
       "total frontal moment rRMSE % (worst) |")
-print("|---|---|---|---|---|---|---|---|---|")
+print("|---|---|---|---|---|---|---|---|---|---|")
 for a, xs in by_activity.items():
     def summary(key, fmt):
         have = [(n, t[key]) for n, t in xs if t[key] is not None]
@@ -583,7 +584,7 @@ for a, xs in by_activity.items():
                                        f"({100 * (statistics.mean(t['kam1_est'] for t in peaks) / statistics.mean(t['kam1_plates'] for t in peaks) - 1):+.0f} %)")
     ks = [t["knee_sagittal"] for _, t in xs if t["knee_sagittal"] is not None]
     print(f"| {a} | {len(xs)} | {summary('lateral', '{:.1f}')} | {summary('cop_mm', '{:.0f}')} | {summary('kam', '{:.1f}')} | "
-          f"{peak_text} | {'-' if not ks else f'{statistics.mean(ks):.1f}'} | {summary('hip_frontal', '{:.1f}')} | "
+          f"{summary('kam_rmse', '{:.2f}')} | {peak_text} | {'-' if not ks else f'{statistics.mean(ks):.1f}'} | {summary('hip_frontal', '{:.1f}')} | "
           f"{summary('frontal', '{:.1f}')} |")
 
 labs = sorted({lab_of[name] for _, name, _ in rows})
