@@ -1605,6 +1605,39 @@ TEST(LateralCop, TheCopsLateralPlaceFollowsTheFootsLineAtItsPlaceAlongIt) {
   EXPECT_THROW((void)cop_lateral_on_foot_line(line.topRows(3), cop), InputError);
 }
 
+// The medial turn past the MT head reaches each foot's estimate, medial for each (the right foot's
+// to -lateral, the left's to +), on the push-off frames past its MT landmark alone, and moves
+// nothing sagittal.
+TEST(LateralCop, EachFootsCopTurnsMediallyPastItsMtHeadInTheEstimate) {
+  const Trial t = make_example_walk(kin2grf::test::walk_3d_options());
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  EstimateOptions midline, turned;
+  midline.model = turned.model = ModelKind::ThreeD;
+  midline.toe_medial_slope = 0.0;
+  ASSERT_EQ(turned.toe_medial_slope, 0.25);  // the default
+  const EstimateResult a = estimate(t, nullptr, set, midline), b = estimate(t, nullptr, set, turned);
+  for (int k = 0; k < 2; ++k) {
+    const FootResult &fa = a.feet[static_cast<std::size_t>(k)], &fb = b.feet[static_cast<std::size_t>(k)];
+    EXPECT_EQ(fa.force_N, fb.force_N);
+    for (Eigen::Index i = 0; i < fa.cop_x_m.size(); ++i)
+      ASSERT_TRUE(fa.cop_x_m[i] == fb.cop_x_m[i] || (std::isnan(fa.cop_x_m[i]) && std::isnan(fb.cop_x_m[i]))) << "frame " << i;
+    const Eigen::VectorXd& mt_x = a.landmarks.p[k ? kMtL : kMtR].col(0);
+    int turned_frames = 0;
+    for (Eigen::Index i = 0; i < fa.cop_x_m.size(); ++i) {
+      if (!std::isfinite(fa.cop_x_m[i])) continue;
+      const double d = fb.cop_lateral_m[i] - fa.cop_lateral_m[i], past = fa.cop_x_m[i] - mt_x[i];
+      if (past < -0.002) {
+        EXPECT_EQ(d, 0.0) << side_name(k) << " frame " << i << ": behind the MT head";
+        continue;
+      }
+      if (d != 0.0) ++turned_frames;
+      EXPECT_LE(d * (k == 0 ? 1.0 : -1.0), 0.0) << side_name(k) << " frame " << i << ": medial";
+      EXPECT_NEAR(std::abs(d), 0.25 * std::max(0.0, past), 1e-3) << side_name(k) << " frame " << i;
+    }
+    EXPECT_GT(turned_frames, 3) << side_name(k) << ": the push-off reaches past the MT head";
+  }
+}
+
 // A marker set's "surface": "lateral" (issue 28's landmarks): a 5th-metatarsal marker moves the
 // COP's lateral line's forefoot end medially by kLateralMtToMidline of the heel-MT length, and
 // lateral knee and ankle markers move the 3D joint centres medially by half the joint's width
