@@ -633,7 +633,7 @@ def lolo_table(title, intro, configs, label, key="lateral", beside=()):
         print(f"| {LOLO_CRITERIA[b][0]}, {LOLO_CRITERIA[b][1]} | "
               + " | ".join(LOLO_CRITERIA[b][2].format(lateral_criterion(c, None, b)) for c in configs.values()) + " |")
     in_sample = min(crit, key=crit.get)
-    # A tie keeps the first candidate (the listing puts kin2grf's default or the paper's first).
+    # A tie keeps the first candidate listed: the paper's way or the simpler one, which a rule must beat.
     choice = {lab: min(configs, key=lambda k: lateral_criterion(configs[k], lab, key)) for lab in labs}
     print("\nIn-sample choice: " + in_sample + "; held out: " + ", ".join(f"{lab} {c}" for lab, c in choice.items()) + ".\n")
     first = next(iter(configs))
