@@ -44,11 +44,20 @@ Eigen::MatrixXd bottom_up_joint_torques(const ModelMotion& motion, const std::ar
 
 std::array<double, kJointCount> joint_angular_velocities(const ModelMotion& motion, Eigen::Index i) {
   // Columns 3..10 of the independent coordinates are the joint angles (independent_coordinates).
-  std::array<double, 16> d1{}, d2{};
+  std::array<double, kMaxIndependent> d1{}, d2{};
   motion.derivatives_at(i, d1.data(), d2.data());
   std::array<double, kJointCount> w{};
   for (std::size_t j = 0; j < w.size(); ++j) w[j] = d1[3 + j];
   return w;
+}
+
+Eigen::MatrixXd joint_angular_velocity_series(const ModelMotion& motion) {
+  Eigen::MatrixXd omega(motion.frames(), kJointCount);
+  for (Eigen::Index i = 0; i < omega.rows(); ++i) {
+    const std::array<double, kJointCount> w = joint_angular_velocities(motion, i);
+    for (int j = 0; j < kJointCount; ++j) omega(i, j) = w[static_cast<std::size_t>(j)];
+  }
+  return omega;
 }
 
 JointKineticPeaks joint_kinetic_peaks(const Eigen::MatrixXd& torque_Nm, const ModelMotion& motion, int side, Eigen::Index first,

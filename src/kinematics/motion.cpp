@@ -33,9 +33,6 @@ std::array<double, 3> torso_scale(const ModelMotion& m, Eigen::Index i, const do
   return {m.x(i, 11) / L0, xd_i[11] / L0, xdd_i[11] / L0};
 }
 
-/// The most independent coordinates a motion has (the torso's length as the 12th).
-constexpr Eigen::Index kMaxIndependent = 12;
-
 /// The acceleration along `axis` (0 fore-aft, 1 vertical) of a segment's COM hanging from the hip
 /// (the torso or a thigh) as frame() places it, every frame: the hip's, with the segment's
 /// absolute angle (a thigh's the torso's plus its hip joint's) and its COM offset (the torso's

@@ -369,29 +369,23 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
     g.series = std::move(series);
     rep.figures.push_back(std::move(g));
   };
+  const Eigen::MatrixXd omega = joint_angular_velocity_series(e.motion);  // for the powers
   for (int f = 0; f < 2; ++f) {
     const std::string foot = side_name(f);
     const auto& fe = e.feet[static_cast<std::size_t>(f)];
     figure(foot + " foot: vertical GRF", "N", f, {{"kin2grf estimate", time, to_vec(fe.force_N.col(1)), false}});
     figure(foot + " foot: anterior GRF", "N", f, {{"kin2grf estimate", time, to_vec(fe.force_N.col(0)), false}});
     figure(foot + " foot: COP along progression", "m", f, {{"kin2grf estimate", time, to_vec(fe.cop_x_m), false}});
-    std::vector<ReportSeries> torques;
-    for (int k = 0; k < 3; ++k) {  // hip, knee, ankle of this side (joint_torque_Nm: per side hip, knee, ankle, MTP)
-      static const char* const kJoint[] = {"hip", "knee", "ankle"};
-      torques.push_back({kJoint[k], time, to_vec(e.joint_torque_Nm.col(4 * f + k)), false});
+    // Hip, knee, ankle of this side (joint_torque_Nm: per side hip, knee, ankle, MTP); the powers,
+    // each torque times its joint's angular velocity (+ generation, - absorption).
+    static const char* const kJoint[] = {"hip", "knee", "ankle"};
+    std::vector<ReportSeries> torques, powers;
+    for (int k = 0; k < 3; ++k) {
+      const int joint = 4 * f + k;
+      torques.push_back({kJoint[k], time, to_vec(e.joint_torque_Nm.col(joint)), false});
+      powers.push_back({kJoint[k], time, to_vec(e.joint_torque_Nm.col(joint).cwiseProduct(omega.col(joint))), false});
     }
     figure(foot + " leg: joint torques", "N m", f, std::move(torques));
-    // The powers: each torque times its joint's angular velocity (+ generation, - absorption).
-    Eigen::MatrixX3d power(e.time_s.size(), 3);
-    for (Eigen::Index i = 0; i < power.rows(); ++i) {
-      const std::array<double, kJointCount> w = joint_angular_velocities(e.motion, i);
-      for (int k = 0; k < 3; ++k) power(i, k) = e.joint_torque_Nm(i, 4 * f + k) * w[static_cast<std::size_t>(4 * f + k)];
-    }
-    std::vector<ReportSeries> powers;
-    for (int k = 0; k < 3; ++k) {
-      static const char* const kJoint[] = {"hip", "knee", "ankle"};
-      powers.push_back({kJoint[k], time, to_vec(power.col(k)), false});
-    }
     figure(foot + " leg: joint powers (+ generation, - absorption)", "W", f, std::move(powers));
   }
   if (e.grm_Nm.size() == e.time_s.size()) {

@@ -77,13 +77,15 @@ void validate_joint_torques(const EstimateResult& e, ValidationResult& v) {
         w.moment_origin_Nm[i] = sagittal_moment(f.cop_x_m[i], e.ground_level_m(), f.force_N(i, 0), f.force_N(i, 1));
       }
   }
+  // Where the plate reads (not past the end of a recording that stops inside the stance).
+  const auto reads = [](const MeasuredPlate& mp, Eigen::Index i) { return mp.force_N.row(i).allFinite() && std::isfinite(mp.moment_origin_Nm[i]); };
   bool any = false;
   for (const StanceValidation& s : v.stances) {
     if (s.plate_index < 0 || s.cop_reference_suspect) continue;
     const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(s.plate_index)];
     FootWrench2D& w = measured[static_cast<std::size_t>(s.foot)];
     for (Eigen::Index i = s.first; i <= s.last; ++i)
-      if (mp.force_N.row(i).allFinite() && std::isfinite(mp.moment_origin_Nm[i])) {
+      if (reads(mp, i)) {
         w.force_N.row(i) += mp.force_N.row(i);
         w.moment_origin_Nm[i] += mp.moment_origin_Nm[i];
       }
@@ -92,20 +94,16 @@ void validate_joint_torques(const EstimateResult& e, ValidationResult& v) {
   if (!any) return;
   const Eigen::MatrixXd tau_estimated = bottom_up_joint_torques(e.motion, estimated);
   const Eigen::MatrixXd tau_measured = bottom_up_joint_torques(e.motion, measured);
-  Eigen::MatrixXd omega(n, kJointCount);  // the joints' angular velocities, for the powers
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const std::array<double, kJointCount> w = joint_angular_velocities(e.motion, i);
-    for (int j = 0; j < kJointCount; ++j) omega(i, j) = w[static_cast<std::size_t>(j)];
-  }
+  const Eigen::MatrixXd omega = joint_angular_velocity_series(e.motion);  // for the powers
   v.measured_joint_torque_Nm = Eigen::MatrixXd::Constant(n, kJointCount, std::numeric_limits<double>::quiet_NaN());
   for (StanceValidation& s : v.stances) {
     if (s.plate_index < 0 || s.cop_reference_suspect) continue;
     const MeasuredPlate& mp = v.plates[static_cast<std::size_t>(s.plate_index)];
     const Eigen::Index a = s.first, len = s.last - s.first + 1;
-    // NaN where the plate does not read (a recording that ends inside the stance): not compared.
+    // NaN where the plate does not read: not compared.
     Eigen::VectorXd plate_reads = Eigen::VectorXd::Zero(len);
     for (Eigen::Index k = 0; k < len; ++k)
-      if (!(mp.force_N.row(a + k).allFinite() && std::isfinite(mp.moment_origin_Nm[a + k]))) plate_reads[k] = std::numeric_limits<double>::quiet_NaN();
+      if (!reads(mp, a + k)) plate_reads[k] = std::numeric_limits<double>::quiet_NaN();
     JointTorqueValidation t;
     t.mass_kg = e.mass_kg;
     for (int c = 0; c < 3; ++c) {  // hip, knee, ankle: joints 4 side + c

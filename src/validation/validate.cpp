@@ -863,16 +863,19 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
   mm.knee_sagittal = mean(x[0]);
   mm.knee_adduction = mean(x[1]);
   // The sagittal joint torques (every model): hip, knee, ankle.
-  std::array<std::vector<double>, 22> t;
+  std::array<std::vector<double>, 3> least_squares, bottom_up, rmse_per_kg, power;
+  // The kinetic peaks per kg, |kin2grf - plates| and the plates': the ankle's push-off power, then
+  // the moments (MeanMetrics::moment_peak_*'s order).
+  std::array<std::vector<double>, 5> peak_error, peak_plates;
   for (const auto& s : stances) {
     if ((foot >= 0 && s.foot != foot) || !s.torques) continue;
     const JointTorqueValidation& jt = *s.torques;
     for (std::size_t c = 0; c < 3; ++c) {
       const auto &ls = jt.least_squares[c], &bu = jt.bottom_up[c], &pw = jt.power[c];
-      if (ls && std::isfinite(ls->rrmse_percent)) t[c].push_back(ls->rrmse_percent);
-      if (bu && std::isfinite(bu->rrmse_percent)) t[3 + c].push_back(bu->rrmse_percent);
-      if (ls && std::isfinite(ls->rmse) && jt.mass_kg > 0) t[6 + c].push_back(ls->rmse / jt.mass_kg);
-      if (pw && std::isfinite(pw->rrmse_percent)) t[9 + c].push_back(pw->rrmse_percent);
+      if (ls && std::isfinite(ls->rrmse_percent)) least_squares[c].push_back(ls->rrmse_percent);
+      if (bu && std::isfinite(bu->rrmse_percent)) bottom_up[c].push_back(bu->rrmse_percent);
+      if (ls && std::isfinite(ls->rmse) && jt.mass_kg > 0) rmse_per_kg[c].push_back(ls->rmse / jt.mass_kg);
+      if (pw && std::isfinite(pw->rrmse_percent)) power[c].push_back(pw->rrmse_percent);
     }
     const JointKineticPeaks &pe = jt.peaks_estimated, &pm = jt.peaks_measured;
     const std::array<std::pair<double, double>, 5> peaks = {{{pe.ankle_push_off_power_W, pm.ankle_push_off_power_W},
@@ -880,23 +883,23 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
                                                              {pe.knee_extensor_moment_Nm, pm.knee_extensor_moment_Nm},
                                                              {pe.hip_extensor_moment_Nm, pm.hip_extensor_moment_Nm},
                                                              {pe.hip_flexor_moment_Nm, pm.hip_flexor_moment_Nm}}};
-    for (std::size_t k = 0; k < peaks.size(); ++k)  // |error| and the plates' value, per kg: 12-13, 14-15, ...
+    for (std::size_t k = 0; k < peaks.size(); ++k)
       if (std::isfinite(peaks[k].first) && std::isfinite(peaks[k].second) && jt.mass_kg > 0) {
-        t[12 + 2 * k].push_back(std::abs(peaks[k].first - peaks[k].second) / jt.mass_kg);
-        t[13 + 2 * k].push_back(peaks[k].second / jt.mass_kg);
+        peak_error[k].push_back(std::abs(peaks[k].first - peaks[k].second) / jt.mass_kg);
+        peak_plates[k].push_back(peaks[k].second / jt.mass_kg);
       }
   }
   for (std::size_t c = 0; c < 3; ++c) {
-    mm.torque_least_squares[c] = mean(t[c]);
-    mm.torque_bottom_up[c] = mean(t[3 + c]);
-    mm.torque_rmse_Nm_per_kg[c] = mean(t[6 + c]);
-    mm.power[c] = mean(t[9 + c]);
+    mm.torque_least_squares[c] = mean(least_squares[c]);
+    mm.torque_bottom_up[c] = mean(bottom_up[c]);
+    mm.torque_rmse_Nm_per_kg[c] = mean(rmse_per_kg[c]);
+    mm.power[c] = mean(power[c]);
   }
-  mm.ankle_push_off_error_W_per_kg = mean(t[12]);
-  mm.ankle_push_off_plates_W_per_kg = mean(t[13]);
+  mm.ankle_push_off_error_W_per_kg = mean(peak_error[0]);
+  mm.ankle_push_off_plates_W_per_kg = mean(peak_plates[0]);
   for (std::size_t k = 0; k < 4; ++k) {
-    mm.moment_peak_error_Nm_per_kg[k] = mean(t[14 + 2 * k]);
-    mm.moment_peak_plates_Nm_per_kg[k] = mean(t[15 + 2 * k]);
+    mm.moment_peak_error_Nm_per_kg[k] = mean(peak_error[1 + k]);
+    mm.moment_peak_plates_Nm_per_kg[k] = mean(peak_plates[1 + k]);
   }
   for (std::size_t p = 0; p < 2; ++p) {
     const double plates = mean(x[3 + 2 * p]);

@@ -51,6 +51,9 @@ Eigen::MatrixXd bottom_up_joint_torques(const ModelMotion& motion, const std::ar
 /// reaction -tau_j with theta_parent'. + the joint generates energy (its muscles shorten), - it
 /// absorbs it.
 std::array<double, kJointCount> joint_angular_velocities(const ModelMotion& motion, Eigen::Index i);
+/// The same over every frame, N x kJointCount (the columns of EstimateResult::joint_torque_Nm):
+/// a whole trial's powers are joint_torque_Nm.cwiseProduct(this).
+Eigen::MatrixXd joint_angular_velocity_series(const ModelMotion& motion);
 
 /// One stance's sagittal joint kinetics as a gait report reads them: the peaks of the internal
 /// moments in their clinical senses, N m, and of the ankle's power, W (NaN: no such value, e.g. a

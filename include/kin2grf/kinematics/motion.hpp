@@ -51,6 +51,10 @@ BodyGeometry measure_geometry(const SagittalLandmarks& lm);
 /// hip-shoulder distance (m), N x 12.
 Eigen::MatrixXd independent_coordinates(const SagittalLandmarks& lm);
 
+/// The most independent coordinates a motion has (independent_coordinates: the torso's length as
+/// the 12th): the size of a frame's derivatives (ModelMotion::derivatives_at).
+inline constexpr std::size_t kMaxIndependent = 12;
+
 /// q, qd, qdd of one frame (63 each, on the stack: the per-frame solve allocates nothing).
 struct MotionFrame {
   Eigen::Matrix<double, coord::kCount, 1> q, qd, qdd;
