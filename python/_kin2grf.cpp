@@ -83,11 +83,12 @@ py::dict estimate(const std::string& trial, const std::vector<std::string>& word
 }
 
 py::dict validate(const std::string& trial, const std::vector<std::string>& words, const std::string& plates,
-                  double threshold_N, const std::string& zero_offset, const std::string& sync) {
+                  double threshold_N, const std::string& zero_offset, const std::string& sync, const std::string& timing) {
   const auto s = settings_from(trial, words);
   kin2grf::ValidationOptions vo;
   vo.threshold_N = threshold_N;
   kin2grf::parse_sync(sync, vo);
+  kin2grf::parse_timing(timing, vo);
   std::optional<kin2grf::ValidationRun> run;
   {
     py::gil_scoped_release nogil;
@@ -144,7 +145,7 @@ PYBIND11_MODULE(_kin2grf, m) {
   m.def("estimate", &estimate, py::arg("trial"), py::arg("words"), py::arg("opensim_dir") = std::string(),
         py::arg("mot_path") = std::string(), py::arg("lab_frame") = false, py::arg("c3d_path") = std::string());
   m.def("validate", &validate, py::arg("trial"), py::arg("words"), py::arg("plates"), py::arg("threshold_N"),
-        py::arg("zero_offset"), py::arg("sync"));
+        py::arg("zero_offset"), py::arg("sync"), py::arg("timing") = std::string("auto"));
   m.def("batch_lines", &batch_lines, py::arg("lines"), py::arg("jobs"), py::arg("out_dir"));
   // What `kin2grf info --json` prints (docs/FORMATS.md), the marker set estimate would take included.
   m.def(

@@ -408,12 +408,24 @@ def br(s, k):
 
 
 def export_mark(j, plate):
-    """'*' where the plate's signal looks low-pass filtered before export, '**' where it was set to zero
-    below a threshold (validate's step 7): onsets against it are the export's, not the contact's."""
+    """'*' where the plate's signal looks low-pass filtered before export (its stances timed by the
+    ramps' intercepts), '**' where it was set to zero below a threshold, unfiltered (validate's step 7)."""
     for r in j.get("plate_onsets", []):
         if r["plate"] == plate:
             return "*" if r["filtered"] else "**" if r["zero_below_threshold"] else ""
     return ""
+
+
+def timing_cell(j, s, key):
+    """A stance's onset or offset (ms), marked as export_mark; a stance timed by the ramps has the
+    threshold crossings' figure in brackets."""
+    t = s["timing_ms"]
+    if t[key] is None:
+        return "-"
+    cell = str(round(t[key])) + (export_mark(j, s["plate"]) if key == "onset" else "")
+    if t.get("timed_by") == "ramp" and t.get(key + "_crossing") is not None:
+        cell += f" ({round(t[key + '_crossing'])})"
+    return cell
 
 
 print("## Per trial and foot (defaults)\n")
@@ -433,8 +445,7 @@ for a, name, _ in rows:
         print(f"| {a} | {name} | {s['foot']} | {s['plate']} | {s['frames'][0]}-{s['frames'][1]} | "
               f"{f1(s['rrmse_percent']['vertical'])} | {span} | {f1(s['rrmse_percent']['anterior'])} | {br(s, 'cop')} | "
               f"{br(s, 'moment')} | {f1(s['rmse_percent_bw']['vertical'])} | "
-              f"{'-' if t['onset'] is None else str(round(t['onset'])) + export_mark(j, s['plate'])} | "
-              f"{'-' if t['offset'] is None else round(t['offset'])} | "
+              f"{timing_cell(j, s, 'onset')} | {timing_cell(j, s, 'offset')} | "
               f"{'-' if t.get('vertical_lag') is None else round(t['vertical_lag'])} | {paper} |")
     if j["total"] is not None:
         t = j["total"]
@@ -443,21 +454,31 @@ for a, name, _ in rows:
         print(f"| {a} | {name} | total | GRM | {t['frames_compared']} frames | {f1(t['rrmse_percent']['vertical'])} | | "
               f"{f1(t['rrmse_percent']['anterior'])} | | {f1(t['rrmse_percent']['moment'])} | | | | | {paper} |")
 
-onsets = {"raw": [], "export": []}
+onsets = {"raw": [], "filtered": [], "filtered_crossing": [], "thresholded": []}
 for a, name, _ in rows:
     if a != "walking":
         continue
     j = load(name, "defaults")
     for s in j["per_foot"]:
-        if s["timing_ms"]["onset"] is not None:
-            onsets["export" if export_mark(j, s["plate"]) else "raw"].append(abs(s["timing_ms"]["onset"]))
-if onsets["raw"] or onsets["export"]:
+        t = s["timing_ms"]
+        if t["onset"] is None:
+            continue
+        mark = export_mark(j, s["plate"])
+        kind = "filtered" if mark == "*" else "thresholded" if mark == "**" else "raw"
+        onsets[kind].append(abs(t["onset"]))
+        if kind == "filtered" and t.get("onset_crossing") is not None:
+            onsets["filtered_crossing"].append(abs(t["onset_crossing"]))
+if any(onsets.values()):
     m = lambda xs: f"{statistics.mean(xs):.0f} ms ({len(xs)} stances)" if xs else "-"
-    print(f"\nOnset ms: + = the estimate's contact begins after the plate's. * the plate's signal was low-pass filtered "
-          f"before export (it rises from 0.2 to 20 N over more than 15 ms; a raw plate's in a few), ** it was set to zero "
-          f"below a threshold before export (validate's step 7): their onsets are the export's, which lead the foot's "
-          f"contact when filtered. Walking, mean |onset| against raw plate signals {m(onsets['raw'])}, against the "
-          f"exports {m(onsets['export'])}.\n")
+    print(f"\nOnset and offset ms: + = the estimate's contact begins (ends) after the plate's. * the plate's signal was "
+          f"low-pass filtered before export (validate's step 7: it rises from 0.2 to 20 N over more than 15 ms, or carries "
+          f"under 0.05 N RMS above 50 Hz under load, where a raw plate's noise is 0.3 N or more): a filtered signal's 20 N "
+          f"crossings lead the foot's contact (and lag its lift-off) by the filter's spread, so its stances are timed by the "
+          f"loading and unloading ramps' zero intercepts (20-80 % of the peak, the same rule on the estimate; since session "
+          f"44), the threshold crossings' figure in brackets. ** set to zero below a threshold before export, unfiltered: "
+          f"timed by the crossings. Walking, mean |onset| against raw plate signals {m(onsets['raw'])}, against the filtered "
+          f"exports {m(onsets['filtered'])} by their ramps ({m(onsets['filtered_crossing'])} by their crossings), against "
+          f"thresholded ones {m(onsets['thresholded'])}.\n")
 
 LATERAL_CUTOFFS = {"kinematic": "3d-lc0", "2 Hz": "3d-lc2", "2.5 Hz": "3d", "3 Hz": "3d-lc3", "3.5 Hz": "3d-lc3.5",
                    "4 Hz": "3d-lc4", "5 Hz": "3d-lc5"}

@@ -1,6 +1,7 @@
 // Tests of validation/metrics: rRMSE, RMSE, threshold crossings.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/text.hpp"
+#include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/output/report.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/synth/example.hpp"
@@ -58,4 +60,37 @@ TEST(Metrics, ThresholdCrossingsAreInterpolated) {
   EXPECT_NEAR(*rising_crossing(v, t, 20.0, 0, 5), 0.015, 1e-12);
   EXPECT_NEAR(*falling_crossing(v, t, 20.0, 0, 5), 0.04 + 0.01 * 10.0 / 30.0, 1e-12);
   EXPECT_FALSE(rising_crossing(v, t, 60.0, 0, 5));
+}
+
+// A filtered export's threshold crossing leads the foot's contact (and lags its lift-off) by the
+// filter's spread; the loading ramp's zero intercept (20-80 % of the peak) moves by less: a zero-lag
+// filter leaves a ramp's straight part where it was and spreads only its corners. A stance as a
+// plate sees it: nothing until 0.30 s, a ramp to 800 N, a plateau, a ramp down to nothing at 0.90 s;
+// then through a 6 Hz zero-lag low-pass, as Rajagopal's and subject01's GRF .mot files were (their
+// onsets creep 25-28 ms). A 50 ms ramp's crossing moves 22 ms, its intercept 14; a 90 ms ramp's 14
+// and 4.
+TEST(Metrics, TheLoadingRampsInterceptMovesLessThanAThresholdCrossingUnderAZeroLagFilter) {
+  const double rate = 1000.0, on = 0.30, off = 0.90;
+  const Eigen::Index n = 1200, mid = 600;
+  Eigen::VectorXd t(n), raw(n);
+  for (double ramp : {0.05, 0.09}) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      t[i] = static_cast<double>(i) / rate;
+      raw[i] = 800.0 * std::clamp(std::min(t[i] - on, off - t[i]) / ramp, 0.0, 1.0);
+    }
+    const Eigen::VectorXd filtered = butterworth_filtfilt(raw, rate, 6.0);
+    // The raw ramps' intercepts are the contact and the lift-off.
+    EXPECT_NEAR(*loading_ramp_onset(raw, t, 0, mid, n - 1), on, 1e-3);
+    EXPECT_NEAR(*unloading_ramp_offset(raw, t, 0, mid, n - 1), off, 1e-3);
+    // Filtered: the 20 N crossings move by more than 10 ms, the intercepts by under 0.7 of that.
+    const double crossing_lead = on - *rising_crossing(filtered, t, 20.0, 0, n - 1);
+    const double crossing_lag = *falling_crossing(filtered, t, 20.0, 0, n - 1) - off;
+    EXPECT_GT(crossing_lead, 0.010);
+    EXPECT_GT(crossing_lag, 0.010);
+    EXPECT_LT(std::abs(*loading_ramp_onset(filtered, t, 0, mid, n - 1) - on), 0.7 * crossing_lead) << ramp;
+    EXPECT_LT(std::abs(*unloading_ramp_offset(filtered, t, 0, mid, n - 1) - off), 0.7 * crossing_lag) << ramp;
+  }
+  // Nothing to time: no load, or no rise in the span.
+  EXPECT_FALSE(loading_ramp_onset(Eigen::VectorXd::Zero(n), t, 0, mid, n - 1));
+  EXPECT_FALSE(loading_ramp_onset(raw, t, mid, mid + 10, n - 1));
 }

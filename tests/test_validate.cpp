@@ -585,10 +585,11 @@ TEST(SharedValidate, APlateClockShiftedBy40msIsFoundOnARecordedWalk) {
   }
 }
 
-// Step 7: a raw plate's foot strike rises through the threshold in a few ms; the same signal
-// low-pass filtered before export creeps there over tens of ms and is said to; an export set to
-// zero below 20 N steps from exact zeros and is said to be thresholded; a plate never at its floor
-// (an offset) has no rise to measure.
+// Step 7: a raw plate's foot strike rises through the threshold in a few ms and carries its noise;
+// the same signal low-pass filtered before export creeps there over tens of ms and has no noise
+// left above 50 Hz, and is said to be filtered; an export set to zero below 20 N steps from exact
+// zeros and is said to be thresholded (and filtered, when its noise is gone); a plate never at its
+// floor (an offset) has no rise to measure.
 TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
   const double rate = 1000.0;
   const Eigen::Index n = 2000;
@@ -614,7 +615,10 @@ TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
   for (Eigen::Index i = 0; i < n; ++i)
     if (thresholded[i] < 20.0) thresholded[i] = 0.0;
   const Eigen::VectorXd offset = (raw.array() + 5.0).matrix();  // an unzeroed plate: 5 N before any contact
-  for (const auto& [name, f] : {std::pair{"raw", raw}, {"filtered", filtered}, {"thresholded", thresholded}, {"offset", offset}}) {
+  // The raw signal set to zero under 20 N, unfiltered: its crossings are the threshold's own.
+  const Eigen::VectorXd raw_thresholded = raw.unaryExpr([](double x) { return x < 20.0 ? 0.0 : x; });
+  for (const auto& [name, f] : {std::pair{"raw", raw}, {"filtered", filtered}, {"thresholded", thresholded}, {"offset", offset},
+                                {"raw thresholded", raw_thresholded}}) {
     ForcePlate p;
     p.name = name;
     p.force_N = Eigen::MatrixX3d::Zero(n, 3);
@@ -622,25 +626,108 @@ TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
     rec.plates.push_back(p);
   }
   const auto r = plate_onset_rises(rec, Eigen::Vector3d::UnitZ(), 20.0);
-  ASSERT_EQ(r.size(), 4u);
+  ASSERT_EQ(r.size(), 5u);
   EXPECT_EQ(r[0].onsets, 2);
   EXPECT_LT(r[0].rise_ms, 10.0);
+  EXPECT_GT(r[0].high_frequency_rms_N, 0.5);  // its noise, above 50 Hz
   EXPECT_FALSE(r[0].filtered());
   EXPECT_FALSE(r[0].zero_below_threshold);
+  // Filtered: by its rise and by its noise (none left).
   EXPECT_EQ(r[1].onsets, 2);
   EXPECT_GT(r[1].rise_ms, kFilteredRiseMs);
-  EXPECT_TRUE(r[1].filtered());
+  EXPECT_TRUE(r[1].filtered_by_rise());
+  EXPECT_TRUE(r[1].filtered_by_noise());
+  // Filtered, then thresholded: its rise is a step, its noise still gone (measured inside the
+  // loaded runs, clear of the step).
   EXPECT_EQ(r[2].onsets, 2);
   EXPECT_TRUE(r[2].zero_below_threshold);
-  EXPECT_FALSE(r[2].filtered());
-  // Never at its floor: no rise to measure, nothing claimed.
+  EXPECT_FALSE(r[2].filtered_by_rise());
+  EXPECT_TRUE(r[2].filtered_by_noise()) << r[2].high_frequency_rms_N;
+  // Never at its floor: no rise to measure; its noise says raw.
   EXPECT_EQ(r[3].onsets, 0);
   EXPECT_FALSE(r[3].filtered());
   EXPECT_FALSE(r[3].zero_below_threshold);
+  // Thresholded, unfiltered: said to be thresholded, not filtered.
+  EXPECT_TRUE(r[4].zero_below_threshold);
+  EXPECT_FALSE(r[4].filtered()) << r[4].high_frequency_rms_N;
   // Upside down (a plate whose up is -z in its lab): no onsets, nothing claimed.
   const auto flipped = plate_onset_rises(rec, -Eigen::Vector3d::UnitZ(), 20.0);
   EXPECT_EQ(flipped[0].onsets, 0);
   EXPECT_FALSE(flipped[0].filtered());
+}
+
+// A plate exported through a zero-lag low-pass (Rajagopal's and subject01's GRF .mot files) has its
+// threshold crossings moved by the filter's spread, which a stance timed by them reads as the
+// estimate's lateness. validate tells such a plate by its noise (step 7), times its stances by the
+// loading and unloading ramps' zero intercepts (ValidationOptions::Timing::Auto), keeps both
+// timings, and times a raw plate's stances by its crossings. The example walk's plates, raw and
+// exported.
+TEST(Validate, AFilteredExportsStancesAreTimedByTheirRampsNotTheirCrossings) {
+  const Trial example = make_example_walk();
+  const EstimateResult e = estimate(example, nullptr, *find_marker_set("kin2grf-example"), {});
+  // Raw: the example's plates at 1 kHz (linear between its 100 Hz samples) with a plate's noise
+  // (1 N RMS at every frequency).
+  const ForcePlateRecording& at100 = *example.plates;
+  ForcePlateRecording raw_plates = at100;
+  const Eigen::Index n = 10 * (at100.samples() - 1) + 1;
+  raw_plates.rate_hz = 10 * at100.rate_hz;
+  raw_plates.time_s = Eigen::VectorXd::LinSpaced(n, at100.time_s[0], at100.time_s[at100.samples() - 1]);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (std::size_t k = 0; k < raw_plates.plates.size(); ++k) {
+    ForcePlate& p = raw_plates.plates[k];
+    const ForcePlate& q = at100.plates[k];
+    for (Eigen::MatrixX3d* m : {&p.force_N, &p.moment_centre_Nm, &p.cop_m, &p.free_moment_Nm}) m->resize(n, 3);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index j = std::min<Eigen::Index>(i / 10, at100.samples() - 2);
+      const double w = static_cast<double>(i - 10 * j) / 10.0;
+      p.force_N.row(i) = (1 - w) * q.force_N.row(j) + w * q.force_N.row(j + 1);
+      p.force_N(i, 2) += noise(rng);
+      p.moment_centre_Nm.row(i) = (1 - w) * q.moment_centre_Nm.row(j) + w * q.moment_centre_Nm.row(j + 1);
+      p.cop_m.row(i) = (w < 0.5 ? q.cop_m.row(j) : q.cop_m.row(j + 1));
+      p.free_moment_Nm.row(i) = (1 - w) * q.free_moment_Nm.row(j) + w * q.free_moment_Nm.row(j + 1);
+    }
+  }
+  // Exported as OpenCap's GRF files were: the unloaded noise zeroed, a 6 Hz zero-lag low-pass,
+  // everything under 20 N set to zero.
+  ForcePlateRecording exported = raw_plates;
+  for (auto& p : exported.plates) {
+    Eigen::MatrixXd F = p.force_N.unaryExpr([](double x) { return std::abs(x) < 5.0 ? 0.0 : x; });
+    p.force_N = butterworth_filtfilt(std::move(F), exported.rate_hz, 6.0);
+    for (Eigen::Index i = 0; i < p.force_N.rows(); ++i)
+      if (p.force_N(i, 2) < 20.0) p.force_N.row(i).setZero();
+    p.moment_centre_Nm = butterworth_filtfilt(Eigen::MatrixXd(p.moment_centre_Nm), exported.rate_hz, 6.0);
+  }
+  ValidationOptions by_crossing;
+  by_crossing.timing = ValidationOptions::Timing::Crossing;
+  const auto raw = validate(e, raw_plates), crossed = validate(e, exported, by_crossing), v = validate(e, exported);
+  ASSERT_EQ(raw.stances.size(), 2u);
+  ASSERT_EQ(crossed.stances.size(), 2u);
+  ASSERT_EQ(v.stances.size(), 2u);
+  // Step 7 tells the export by its noise: none left above 50 Hz.
+  for (const auto& r : raw.plate_onsets) EXPECT_FALSE(r.filtered()) << r.plate << " " << r.high_frequency_rms_N << " N";
+  for (const auto& r : v.plate_onsets) EXPECT_TRUE(r.filtered_by_noise()) << r.plate << " " << r.high_frequency_rms_N << " N";
+  for (std::size_t k = 0; k < 2; ++k) {
+    const StanceValidation &r = raw.stances[k], &c = crossed.stances[k], &a = v.stances[k];
+    EXPECT_FALSE(r.timed_by_ramp);
+    EXPECT_FALSE(c.timed_by_ramp);
+    EXPECT_TRUE(a.timed_by_ramp);
+    ASSERT_TRUE(r.onset_crossing_error_ms && r.offset_crossing_error_ms && r.onset_ramp_error_ms && r.offset_ramp_error_ms);
+    ASSERT_TRUE(a.onset_crossing_error_ms && a.offset_crossing_error_ms && a.onset_ramp_error_ms && a.offset_ramp_error_ms);
+    // Each stance is scored by its own timing, and both are kept.
+    EXPECT_EQ(*r.onset_error_ms, *r.onset_crossing_error_ms);
+    EXPECT_EQ(*a.onset_error_ms, *a.onset_ramp_error_ms);
+    EXPECT_EQ(*a.offset_error_ms, *a.offset_ramp_error_ms);
+    EXPECT_DOUBLE_EQ(*a.onset_crossing_error_ms, *c.onset_error_ms);
+    // The export moved the crossings (the same estimate reads later at the onset and earlier at
+    // the offset). How much less it moves the ramps depends on how sharp the rise is against the
+    // filter (Metrics.TheLoadingRampsIntercept...): this walk's half-cosine rise over 100 ms is
+    // as smooth as a 6 Hz filter's own spread, and its intercept moves about as much.
+    EXPECT_GT(*a.onset_crossing_error_ms - *r.onset_crossing_error_ms, 5.0);
+    EXPECT_GT(*r.offset_crossing_error_ms - *a.offset_crossing_error_ms, 5.0);
+  }
+  // The figures elsewhere do not depend on the timing.
+  EXPECT_DOUBLE_EQ(v.stances[0].metrics.vertical->rrmse_percent, crossed.stances[0].metrics.vertical->rrmse_percent);
 }
 
 // The means carry the contact timing beside the rRMSEs (which start at the plate's onset and so

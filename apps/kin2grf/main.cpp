@@ -101,6 +101,12 @@ int main(int argc, char** argv) {
         "--sync", [&val](const std::string& t) { kin2grf::parse_sync(t, val.options); },
         "Marker-plate time offset: none (compare as recorded; the offset is reported), auto (compare after shifting the plates "
         "by the estimated offset) or SECONDS (shift the plates by this; + when the plates led)");
+    validate->add_option_function<std::string>(
+        "--timing", [&val](const std::string& t) { kin2grf::parse_timing(t, val.options); },
+        "How onsets and offsets are timed: crossing (the threshold's crossings of the estimate and the plates), ramp (the loading "
+        "and unloading ramps' zero intercepts, 20-80 % of the peak, of both) or auto (the default: the ramps on a plate whose "
+        "export filtered or thresholded its signal, which moves its crossings; the crossings elsewhere)")
+        ->check(CLI::IsMember({"auto", "crossing", "ramp"}));
   }
 
   kin2grf::StudyJob study_args;

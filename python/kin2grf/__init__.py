@@ -154,13 +154,16 @@ def estimate(trial: str | os.PathLike, opensim: str | os.PathLike | None = None,
 
 
 def validate(trial: str | os.PathLike, plates: str | os.PathLike | None = None, threshold: float = 20.0,
-             zero_offset: str = "unloaded", sync: str | float = "none", **settings) -> dict:
+             zero_offset: str = "unloaded", sync: str | float = "none", timing: str = "auto", **settings) -> dict:
     """Estimate, then compare with the trial's plates (or `plates`, a GRF .mot or C3D), as
     `kin2grf validate`. Returns the ``--json`` document, with the estimate under "estimate".
     `sync`: "none" (compare as recorded; the marker-plate offset is reported under "sync"),
-    "auto" (compare after shifting the plates by it) or a shift in seconds (+ when the plates led)."""
+    "auto" (compare after shifting the plates by it) or a shift in seconds (+ when the plates led).
+    `timing`: how onsets and offsets are timed, as ``--timing``: "auto" (the loading ramps' zero
+    intercepts on a filtered or thresholded export, the threshold's crossings elsewhere),
+    "crossing" or "ramp"."""
     d = _kin2grf.validate(os.fspath(trial), _words(settings), os.fspath(plates) if plates else "", float(threshold), zero_offset,
-                          _text(sync))
+                          _text(sync), timing)
     out = d["validation"]
     out["estimate"] = Estimate(d["estimate"], os.fspath(trial), _words(settings))
     return out

@@ -147,7 +147,9 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   t << "<h2>Errors against the force plates</h2>\n<p>rRMSE and RMSE as in the paper's Eqs. 11-12, per plate stance "
        "(measured vertical force above the threshold) and in total where every loaded foot stands on a plate. "
        "COP compared where the plate carries at least 5 % of body weight; moment about the plate centre (total: GRM about "
-       "the midpoint of the plates in use). Timing: estimate minus plate, + = late. Loaded span: the stance with the frames "
+       "the midpoint of the plates in use). Timing: estimate minus plate, + = late; on a plate filtered before export, by "
+       "the loading and unloading ramps' zero intercepts (20-80 % of the peak, on both), the threshold crossings' figure in "
+       "brackets. Loaded span: the stance with the frames "
        "next to it where the estimate loads the foot while the plate reads under the threshold (a landing loaded before "
        "it lands), against the plate's reading there. In brackets: a plate whose COP is "
        "not where the markers put the foot (validate's registration check), kept for the record, left out of the "
@@ -155,13 +157,20 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   t << "<table><tr><th class=l>foot</th><th class=l>plate</th><th>frames</th><th>vertical rRMSE %</th><th>anterior rRMSE %</th>"
        "<th>COP rRMSE %</th><th>moment rRMSE %</th><th>vertical RMSE N</th><th>anterior RMSE N</th><th>COP RMSE mm</th>"
        "<th>vertical r</th><th>onset ms</th><th>offset ms</th><th>vertical rRMSE % over the loaded span</th></tr>\n";
+  // A stance timed by the ramps' intercepts (a filtered export's) is marked, the crossings' figure beside it.
+  const auto timing = [](const nlohmann::json& s, const std::string& key) {
+    const auto& tm = s["timing_ms"];
+    std::string cell = fmt(tm[key], "%.0f");
+    if (tm.value("timed_by", "") == "ramp") cell += " ramp (" + fmt(tm[key + "_crossing"], "%.0f") + ")";
+    return cell;
+  };
   for (const auto& s : j["per_foot"]) {
     t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>())
       << "</td><td>" << s["frames"][0] << "-" << s["frames"][1] << "</td><td>" << fmt(s["rrmse_percent"]["vertical"]) << "</td><td>"
       << fmt(s["rrmse_percent"]["anterior"]) << "</td><td>" << fmt_cop(s, s["rrmse_percent"]["cop"]) << "</td><td>"
       << fmt_cop(s, s["rrmse_percent"]["moment"]) << "</td><td>" << fmt(s["rmse"]["vertical_N"]) << "</td><td>"
       << fmt(s["rmse"]["anterior_N"]) << "</td><td>" << fmt_cop(s, s["rmse"]["cop_mm"]) << "</td><td>" << fmt(s["r"]["vertical"], "%.3f")
-      << "</td><td>" << fmt(s["timing_ms"]["onset"], "%.0f") << "</td><td>" << fmt(s["timing_ms"]["offset"], "%.0f") << "</td><td>"
+      << "</td><td>" << timing(s, "onset") << "</td><td>" << timing(s, "offset") << "</td><td>"
       << fmt(s.contains("loaded_span") ? s["loaded_span"]["vertical_rrmse_percent"] : nlohmann::json()) << "</td></tr>\n";
   }
   if (!j["total"].is_null()) {

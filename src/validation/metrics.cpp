@@ -66,4 +66,32 @@ std::optional<double> falling_crossing(const Eigen::VectorXd& v, const Eigen::Ve
   return std::nullopt;
 }
 
+namespace {
+/// The largest finite value of v over [from, to] (clamped to v), or NaN.
+double peak_over(const Eigen::VectorXd& v, Eigen::Index from, Eigen::Index to) {
+  double peak = std::numeric_limits<double>::quiet_NaN();
+  for (Eigen::Index i = std::max<Eigen::Index>(from, 0); i <= std::min<Eigen::Index>(to, v.size() - 1); ++i)
+    if (std::isfinite(v[i]) && !(v[i] <= peak)) peak = v[i];
+  return peak;
+}
+}  // namespace
+
+std::optional<double> loading_ramp_onset(const Eigen::VectorXd& v, const Eigen::VectorXd& t, Eigen::Index from, Eigen::Index mid,
+                                         Eigen::Index to, double lo, double hi) {
+  const double peak = peak_over(v, from, mid);
+  if (!(peak > 0) || !(hi > lo)) return std::nullopt;
+  const auto t_lo = rising_crossing(v, t, lo * peak, from, to), t_hi = rising_crossing(v, t, hi * peak, from, to);
+  if (!t_lo || !t_hi || !(*t_hi > *t_lo)) return std::nullopt;
+  return *t_lo - (*t_hi - *t_lo) * lo / (hi - lo);
+}
+
+std::optional<double> unloading_ramp_offset(const Eigen::VectorXd& v, const Eigen::VectorXd& t, Eigen::Index from, Eigen::Index mid,
+                                            Eigen::Index to, double lo, double hi) {
+  const double peak = peak_over(v, mid, to);
+  if (!(peak > 0) || !(hi > lo)) return std::nullopt;
+  const auto t_lo = falling_crossing(v, t, lo * peak, from, to), t_hi = falling_crossing(v, t, hi * peak, from, to);
+  if (!t_lo || !t_hi || !(*t_lo > *t_hi)) return std::nullopt;
+  return *t_lo + (*t_lo - *t_hi) * lo / (hi - lo);
+}
+
 }  // namespace kin2grf

@@ -357,7 +357,10 @@ double stance_foot_length_m(const EstimateResult& e, const Candidate& c) {
 
 /// Contact timing: threshold crossings of the estimate near the plate's (+ = estimate late), and
 /// the vertical force's best time shift.
-void stance_timing(const EstimateResult& e, const MeasuredPlate& mp, const Candidate& c, const ValidationOptions& o, StanceValidation& s) {
+/// `by_ramp`: the stance is scored by the ramps' intercepts (ValidationOptions::Timing); both
+/// timings are kept.
+void stance_timing(const EstimateResult& e, const MeasuredPlate& mp, const Candidate& c, const ValidationOptions& o, bool by_ramp,
+                   StanceValidation& s) {
   const Eigen::Index n = e.time_s.size(), a = c.run.first;
   const double rate = e.landmarks.rate_hz;
   const Eigen::Index search = static_cast<Eigen::Index>(std::lround(0.2 * rate));
@@ -366,10 +369,24 @@ void stance_timing(const EstimateResult& e, const MeasuredPlate& mp, const Candi
   const auto m_on = rising_crossing(pv, e.time_s, o.threshold_N, a - 1, c.run.last);
   const auto m_off = falling_crossing(pv, e.time_s, o.threshold_N, a, c.run.last + 1);
   const Eigen::Index from = std::max<Eigen::Index>(0, a - search), to = std::min<Eigen::Index>(n - 1, c.run.last + search);
-  if (m_on && !(ev[from] > o.threshold_N))
-    if (const auto e_on = rising_crossing(ev, e.time_s, o.threshold_N, from, c.run.last)) s.onset_error_ms = 1000 * (*e_on - *m_on);
-  if (m_off && !(ev[to] > o.threshold_N))
-    if (const auto e_off = falling_crossing(ev, e.time_s, o.threshold_N, a, to)) s.offset_error_ms = 1000 * (*e_off - *m_off);
+  const Eigen::Index mid = (a + c.run.last) / 2;
+  const auto ms = [](double estimated_s, double measured_s) { return 1000 * (estimated_s - measured_s); };
+  // Only where the estimate was unloaded at the search's start (end): its rise (fall) is in it.
+  if (!(ev[from] > o.threshold_N)) {
+    if (m_on)
+      if (const auto e_on = rising_crossing(ev, e.time_s, o.threshold_N, from, c.run.last)) s.onset_crossing_error_ms = ms(*e_on, *m_on);
+    if (const auto p0 = loading_ramp_onset(pv, e.time_s, a - 1, mid, c.run.last))
+      if (const auto e0 = loading_ramp_onset(ev, e.time_s, from, mid, c.run.last)) s.onset_ramp_error_ms = ms(*e0, *p0);
+  }
+  if (!(ev[to] > o.threshold_N)) {
+    if (m_off)
+      if (const auto e_off = falling_crossing(ev, e.time_s, o.threshold_N, a, to)) s.offset_crossing_error_ms = ms(*e_off, *m_off);
+    if (const auto p0 = unloading_ramp_offset(pv, e.time_s, a, mid, c.run.last + 1))
+      if (const auto e0 = unloading_ramp_offset(ev, e.time_s, a, mid, to)) s.offset_ramp_error_ms = ms(*e0, *p0);
+  }
+  s.timed_by_ramp = by_ramp;
+  s.onset_error_ms = by_ramp ? s.onset_ramp_error_ms : s.onset_crossing_error_ms;
+  s.offset_error_ms = by_ramp ? s.offset_ramp_error_ms : s.offset_crossing_error_ms;
   // The loaded span: the estimate's load on the foot next to its stance, while the plate it lands
   // on (or leaves) reads below the threshold, counted against that reading (a NaN plate stops it).
   // Only a landing's or a lift-off's: the estimate's load must begin (end) within the search, so
@@ -421,6 +438,14 @@ void compare_parameters(const EstimateResult& e, const ValidationResult& v, Stan
   const double rate = e.motion.rate_hz;
   s.parameters_measured = stance_parameters(v.plates[static_cast<std::size_t>(s.plate_index)].force_N, rate, s.span_first, s.span_last);
   s.parameters_estimated = stance_parameters(e.feet[static_cast<std::size_t>(s.foot)].force_N, rate, s.span_first, s.span_last);
+}
+
+/// Whether a stance on plate `name` is timed by the ramps (ValidationOptions::Timing): with Auto,
+/// when step 7 found the plate filtered before export.
+bool timed_by_ramp(const ValidationResult& v, const std::string& name, const ValidationOptions& o) {
+  if (o.timing != ValidationOptions::Timing::Auto) return o.timing == ValidationOptions::Timing::Ramp;
+  return std::any_of(v.plate_onsets.begin(), v.plate_onsets.end(),
+                     [&](const PlateOnsetRise& r) { return r.plate == name && r.filtered(); });
 }
 
 StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, const Candidate& c, const ValidationOptions& o) {
@@ -484,11 +509,11 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
     mm[i] = mp.moment_origin_Nm[k] - sagittal_moment(rx, ry, mp.force_N(k, 0), mp.force_N(k, 1));
   }
   s.metrics.moment = compare_series(me, mm);
-  stance_timing(e, mp, c, o, s);
+  stance_timing(e, mp, c, o, timed_by_ramp(v, mp.name, o), s);
   if (c.cut) {
     // The plate's onset (offset) lies outside the window: the crossing found at its edge is none.
-    if (c.run.first == 0) s.onset_error_ms.reset();
-    if (c.run.last == n - 1) s.offset_error_ms.reset();
+    if (c.run.first == 0) s.onset_error_ms.reset(), s.onset_crossing_error_ms.reset(), s.onset_ramp_error_ms.reset();
+    if (c.run.last == n - 1) s.offset_error_ms.reset(), s.offset_crossing_error_ms.reset(), s.offset_ramp_error_ms.reset();
   }
   for (Eigen::Index i = 0; i < len; ++i) {
     auto& mf = v.measured_force_N[static_cast<std::size_t>(c.foot)];
@@ -717,6 +742,8 @@ ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateR
   v.first_frame_number = e.first_frame_number;
   const Eigen::Index n = e.time_s.size();
   v.plates = resample_plates(rec, e.frame, e.time_s, rec.cop_threshold_N, e.first_index);
+  // Step 7 first: a plate's rise decides how its stances are timed. A time shift does not change it.
+  v.plate_onsets = plate_onset_rises(rec, e.frame.up, o.threshold_N);
   for (int f = 0; f < 2; ++f) {
     v.measured_force_N[static_cast<std::size_t>(f)] = Eigen::MatrixX2d::Constant(n, 2, kNaN);
     v.measured_cop_x_m[static_cast<std::size_t>(f)] = Eigen::VectorXd::Constant(n, kNaN);
@@ -756,6 +783,8 @@ std::vector<PlateOnsetRise> plate_onset_rises(const ForcePlateRecording& rec, co
   // (an offset, someone standing on it) gives no rise there, and a long trial's many onsets
   // cost one short look each.
   const auto reach = static_cast<Eigen::Index>(std::ceil(0.1 * rec.rate_hz));
+  // Where level is crossed between samples a and a + 1, in samples after a.
+  const auto between = [](double fa, double fb, double level) { return fb != fa ? (level - fa) / (fb - fa) : 0.0; };
   for (const ForcePlate& p : rec.plates) {
     PlateOnsetRise r;
     r.plate = p.name;
@@ -767,13 +796,31 @@ std::vector<PlateOnsetRise> plate_onset_rises(const ForcePlateRecording& rec, co
       Eigen::Index k = i - 1;
       while (k > 0 && i - k < reach && f[k] > floor_N) --k;
       if (!(f[k] <= floor_N)) continue;  // no rise from the floor within reach
-      rises.push_back(1000.0 * static_cast<double>(i - k) / rec.rate_hz);
+      const double samples = static_cast<double>(i - 1 - k) + between(f[i - 1], f[i], threshold_N) - between(f[k], f[k + 1], floor_N);
+      rises.push_back(1000.0 * samples / rec.rate_hz);
       all_zero_steps = all_zero_steps && k == i - 1 && f[k] == 0.0 && (k == 0 || f[k - 1] == 0.0);
     }
     r.onsets = static_cast<int>(rises.size());
     if (!rises.empty()) {
       r.rise_ms = median(rises);
       r.zero_below_threshold = all_zero_steps;
+    }
+    // The noise above kNoiseBandHz under load (a filtered export keeps none of it), inside the
+    // loaded runs, two of the band's periods clear of their ends: a thresholded export's step at
+    // the threshold, and the filter's ringing about it, are not noise.
+    if (rec.rate_hz >= kNoiseRateHz && f.allFinite()) {
+      const Eigen::VectorXd smooth = butterworth_filtfilt(f, rec.rate_hz, kNoiseBandHz);
+      const auto clear = static_cast<Eigen::Index>(std::ceil(2.0 * rec.rate_hz / kNoiseBandHz));
+      double sum = 0;
+      long loaded = 0;
+      Eigen::Index run = 0;  // loaded samples up to and including i
+      for (Eigen::Index i = 0; i < f.size(); ++i) {
+        run = f[i] > threshold_N ? run + 1 : 0;
+        // Sample i - clear is inside when the run reaches clear samples on both of its sides.
+        const Eigen::Index c = i - clear;
+        if (run > 2 * clear) sum += (f[c] - smooth[c]) * (f[c] - smooth[c]), ++loaded;
+      }
+      if (loaded > 0) r.high_frequency_rms_N = std::sqrt(sum / static_cast<double>(loaded));
     }
     out.push_back(std::move(r));
   }
@@ -800,24 +847,38 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
   v.sync = sync;
   v.plate_shift_s = shift;
   // Step 7: a plate whose export moved its onsets (only the plates a kept stance stands on).
-  v.plate_onsets = plate_onset_rises(rec, e.frame.up, o.threshold_N);
   for (const PlateOnsetRise& r : v.plate_onsets) {
     const bool used = std::any_of(v.stances.begin(), v.stances.end(), [&](const StanceValidation& s) { return s.plate == r.plate; });
     if (!used) continue;
+    // What the timing does with it (ValidationOptions::Timing).
+    const std::string timed = timed_by_ramp(v, r.plate, o)
+                                  ? "; its stances' onsets and offsets are timed by the loading and unloading ramps' zero intercepts "
+                                    "(20-80 % of the peak, on the estimate too), which such a filter moves less"
+                              : o.timing == ValidationOptions::Timing::Crossing ? "; its stances are timed by the threshold's crossings (--timing crossing)"
+                                                                                 : "";
     if (r.filtered()) {
-      std::snprintf(b, sizeof b,
-                    "plate %s: its vertical force takes a median %.0f ms to rise from %.1f to %.0f N at its %d onset(s) (a raw plate's "
-                    "signal takes a few ms at a foot strike): it looks low-pass filtered before export, so its onsets lead the "
-                    "foot's contact and the estimate's onset errors against it read late by up to that much",
-                    r.plate.c_str(), r.rise_ms, 0.01 * o.threshold_N, o.threshold_N, r.onsets);
-      v.notes.emplace_back(b);
+      if (r.filtered_by_rise())
+        std::snprintf(b, sizeof b,
+                      "plate %s: its vertical force takes a median %.0f ms to rise from %.1f to %.0f N at its %d onset(s) (a raw plate's "
+                      "signal takes a few ms at a foot strike): it looks low-pass filtered before export, so its threshold crossings "
+                      "lead the foot's contact (and lag its lift-off) by up to that much",
+                      r.plate.c_str(), r.rise_ms, 0.01 * o.threshold_N, o.threshold_N, r.onsets);
+      else
+        std::snprintf(b, sizeof b,
+                      "plate %s: its vertical force carries %.3f N RMS above %.0f Hz under load (a raw plate's noise is 0.3 N or more): "
+                      "it looks low-pass filtered before export, so its threshold crossings lead the foot's contact (and lag its "
+                      "lift-off) by the filter's spread",
+                      r.plate.c_str(), r.high_frequency_rms_N, kNoiseBandHz);
+      v.notes.emplace_back(b + timed);
     } else if (r.zero_below_threshold) {
       std::snprintf(b, sizeof b,
                     "plate %s: its vertical force is exactly 0 N before each onset and then steps past %.0f N: it was set to zero "
                     "below a threshold before export, so its onsets are that threshold's crossing (of a signal that may have "
                     "been filtered)",
                     r.plate.c_str(), o.threshold_N);
-      v.notes.emplace_back(b);
+      v.notes.emplace_back(b + timed);
+    } else if (timed_by_ramp(v, r.plate, o)) {
+      v.notes.emplace_back("plate " + r.plate + ": timed by the loading and unloading ramps' zero intercepts (--timing ramp)");
     }
   }
   // An offset beyond a frame and 10 ms that the data pin down is worth a word when not applied.
@@ -1079,7 +1140,14 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     x["foot_length_mm"] = num(1000 * s.foot_length_m);
     x["cop_rmse_percent_foot"] = s.metrics.cop ? num(100 * s.metrics.cop->rmse / s.foot_length_m) : nlohmann::json(nullptr);
     x["cop_reference_suspect"] = s.cop_reference_suspect;
-    x["timing_ms"] = {{"onset", opt(s.onset_error_ms)}, {"offset", opt(s.offset_error_ms)}, {"vertical_lag", opt(s.vertical_lag_ms)}};
+    x["timing_ms"] = {{"onset", opt(s.onset_error_ms)},
+                      {"offset", opt(s.offset_error_ms)},
+                      {"timed_by", s.timed_by_ramp ? "ramp" : "crossing"},
+                      {"onset_crossing", opt(s.onset_crossing_error_ms)},
+                      {"offset_crossing", opt(s.offset_crossing_error_ms)},
+                      {"onset_ramp", opt(s.onset_ramp_error_ms)},
+                      {"offset_ramp", opt(s.offset_ramp_error_ms)},
+                      {"vertical_lag", opt(s.vertical_lag_ms)}};
     x["loaded_span"] = {{"frames", {e.first_frame_number + s.span_first, e.first_frame_number + s.span_last}},
                         {"vertical_rrmse_percent", s.vertical_loaded_span ? num(s.vertical_loaded_span->rrmse_percent) : nlohmann::json(nullptr)},
                         {"vertical_rmse_percent_bw", s.vertical_loaded_span ? num(100 * s.vertical_loaded_span->rmse / bw) : nlohmann::json(nullptr)}};
@@ -1176,7 +1244,11 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     j["sync"] = {{"estimated_offset_ms", nullptr}, {"applied_shift_ms", 1000 * v.plate_shift_s}};
   nlohmann::json rises = nlohmann::json::array();
   for (const PlateOnsetRise& r : v.plate_onsets)
-    rises.push_back({{"plate", r.plate}, {"onsets", r.onsets}, {"rise_ms", num(r.rise_ms)}, {"zero_below_threshold", r.zero_below_threshold},
+    rises.push_back({{"plate", r.plate},
+                     {"onsets", r.onsets},
+                     {"rise_ms", num(r.rise_ms)},
+                     {"high_frequency_rms_N", num(r.high_frequency_rms_N)},
+                     {"zero_below_threshold", r.zero_below_threshold},
                      {"filtered", r.filtered()}});
   j["plate_onsets"] = rises;
   j["excluded"] = v.excluded;
@@ -1316,6 +1388,23 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
                   number_or_dash(m.vertical_rmse_double_support_percent_bw).c_str(),
                   number_or_dash(m.vertical_rmse_single_support_percent_bw).c_str(), m.double_support_error_share_percent);
     os << buf;
+  }
+  if (m.n > 0) {
+    // Contact timing: the mean |onset| and |offset|, and which reference timed them (Timing).
+    double on = 0, off = 0;
+    int n_on = 0, n_off = 0, by_ramp = 0;
+    for (const auto& s : v.stances) {
+      if (s.onset_error_ms) on += std::abs(*s.onset_error_ms), ++n_on;
+      if (s.offset_error_ms) off += std::abs(*s.offset_error_ms), ++n_off;
+      by_ramp += s.timed_by_ramp ? 1 : 0;
+    }
+    std::snprintf(buf, sizeof buf, "  per foot, contact timing, mean |estimate - plates|: onset %s ms, offset %s ms (",
+                  number_or_dash(n_on ? on / n_on : std::nan(""), "%.0f").c_str(), number_or_dash(n_off ? off / n_off : std::nan(""), "%.0f").c_str());
+    os << buf;
+    const auto count = static_cast<int>(v.stances.size());
+    if (by_ramp == 0) os << "the threshold's crossings)\n";
+    else if (by_ramp == count) os << "the loading and unloading ramps' zero intercepts)\n";
+    else os << by_ramp << " stance(s) by the ramps' zero intercepts, " << count - by_ramp << " by the threshold's crossings)\n";
   }
   if (m.n > 0 && std::isfinite(m.parameter_peak_error_percent_bw[0])) {
     const auto& pk = m.parameter_peak_error_percent_bw;

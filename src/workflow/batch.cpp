@@ -80,6 +80,7 @@ ValidationRun validate_trial(const Settings& s, const std::string& plates_file, 
   run.settings["sync"] = vo.sync == ValidationOptions::Sync::None   ? nlohmann::json("none")
                          : vo.sync == ValidationOptions::Sync::Auto ? nlohmann::json("auto")
                                                                     : nlohmann::json(vo.plate_shift_s);
+  run.settings["timing"] = timing_name(vo.timing);
   run.plates_path = source.path;
   return run;
 }
@@ -96,6 +97,22 @@ void parse_sync(const std::string& text, ValidationOptions& vo) {
     vo.sync = ValidationOptions::Sync::Fixed;
     vo.plate_shift_s = shift;
   }
+}
+
+void parse_timing(const std::string& text, ValidationOptions& vo) {
+  if (text == "auto") vo.timing = ValidationOptions::Timing::Auto;
+  else if (text == "crossing") vo.timing = ValidationOptions::Timing::Crossing;
+  else if (text == "ramp") vo.timing = ValidationOptions::Timing::Ramp;
+  else throw InputError("--timing " + text + ": must be auto, crossing or ramp");
+}
+
+const char* timing_name(ValidationOptions::Timing timing) {
+  switch (timing) {
+    case ValidationOptions::Timing::Crossing: return "crossing";
+    case ValidationOptions::Timing::Ramp: return "ramp";
+    case ValidationOptions::Timing::Auto: break;
+  }
+  return "auto";
 }
 
 std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir, bool c3d) {

@@ -35,4 +35,21 @@ std::optional<double> rising_crossing(const Eigen::VectorXd& v, const Eigen::Vec
 std::optional<double> falling_crossing(const Eigen::VectorXd& v, const Eigen::VectorXd& time_s, double threshold,
                                        Eigen::Index from, Eigen::Index to);
 
+/// The loading ramp's onset (s): the line through the rising crossings of lo and hi times the
+/// first peak P (the largest value in [from, mid]) extended back to zero,
+///   t_0 = t_lo - (t_hi - t_lo) lo / (hi - lo),
+/// over the loading rate's own span (20-80 % of the first peak, dynamics/stance_parameters.hpp).
+/// A zero-lag low-pass filter leaves a ramp's straight part where it was and spreads only its
+/// corners, so it moves t_0 less than a threshold crossing, which it moves earlier by its whole
+/// spread: at 6 Hz a 50 ms ramp's 20 N crossing by 22 ms and t_0 by 14, a 90 ms ramp's by 14 and
+/// 4 (test Metrics.TheLoadingRampsIntercept...). nullopt without a positive peak or either
+/// crossing in [from, to].
+inline constexpr double kRampLowFraction = 0.2, kRampHighFraction = 0.8;
+std::optional<double> loading_ramp_onset(const Eigen::VectorXd& v, const Eigen::VectorXd& time_s, Eigen::Index from, Eigen::Index mid,
+                                         Eigen::Index to, double lo = kRampLowFraction, double hi = kRampHighFraction);
+/// The unloading ramp's end (s), the same rule mirrored: the last falling crossings of hi and lo
+/// times the last peak (the largest value in [mid, to]) in [from, to], extended forward to zero.
+std::optional<double> unloading_ramp_offset(const Eigen::VectorXd& v, const Eigen::VectorXd& time_s, Eigen::Index from, Eigen::Index mid,
+                                            Eigen::Index to, double lo = kRampLowFraction, double hi = kRampHighFraction);
+
 }  // namespace kin2grf

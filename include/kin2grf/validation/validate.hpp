@@ -108,6 +108,14 @@ struct ValidationOptions {
   /// estimated offset; Auto compares after shifting the plates by it; Fixed by plate_shift_s.
   enum class Sync { None, Auto, Fixed } sync = Sync::None;
   double plate_shift_s = 0.0;  ///< Sync::Fixed: added to the plates' times (+: the plates led the markers)
+  /// How each stance's onset and offset are timed (StanceValidation::onset_error_ms): Crossing,
+  /// the threshold's crossings of the estimate and of the plate; Ramp, the loading and unloading
+  /// ramps' zero intercepts of both (loading_ramp_onset), which a zero-lag low-pass filter moves a
+  /// third to two thirds as much; Auto, the ramps on the stances of a plate filtered before export
+  /// (step 7: PlateOnsetRise::filtered), the crossings elsewhere. A raw plate's crossing is the
+  /// foot's contact; a filtered export's leads it by the filter's spread (25-28 ms on the
+  /// development data's .mot files), which an onset compared with it would read as the estimate's.
+  enum class Timing { Auto, Crossing, Ramp } timing = Timing::Auto;
 };
 
 /// Step 6: the time offset between the markers and the plates, from the whole body. The plates'
@@ -129,28 +137,45 @@ struct SyncEstimate {
   int frames = 0;  ///< frames compared
 };
 
-/// Step 7: how a plate's vertical force rises through the stance threshold, from its own samples.
-/// A raw plate's signal leaves its noise (about 1 N) for the threshold within a few ms at a foot
-/// strike: from a hundredth of the threshold to the threshold in 1-10.5 ms on the development
-/// trials' C3D analog channels and Camargo's export (the impact loads a plate at several N/ms). A
-/// signal low-pass filtered before export has no noise left and creeps there from its smoothed
-/// tail: 25-28.5 ms on Rajagopal's and subject01's GRF .mot files. Its threshold crossing then
-/// leads the foot's contact, and an onset compared with it reads late by up to that much. Only a
-/// spread beyond kFilteredRiseMs is told: a 6 Hz filter over a sharp foot strike (8 N/ms) spreads
-/// it by about 11 ms and passes for raw, over a soft one (3 N/ms) by more than 15. A signal exactly
-/// zero before its onsets and stepping to at least the threshold was set to zero below some level
-/// before export (OpenCap's GRF .mot files: 0 N, then 20.7 N): its onsets are that level's
-/// crossing, whatever the signal's filtering was.
+/// Step 7: whether a plate's signal was low-pass filtered before export, from its own samples. A
+/// filtered signal's threshold crossings lead the foot's contact (and lag its lift-off) by the
+/// filter's spread, which an onset compared with them would read as the estimate's lateness
+/// (ValidationOptions::Timing). Either of two signs tells it:
+/// - The rise. A raw plate's signal leaves its noise (about 1 N) for the threshold within a few
+///   ms at a foot strike: from a hundredth of the threshold to the threshold (both crossings
+///   interpolated between samples) in 0.5-10 ms on the development trials' C3D analog channels and
+///   Camargo's export (the impact loads a plate at several N/ms). A signal low-pass filtered before
+///   export creeps there from its smoothed tail: 24-28 ms on Rajagopal's and subject01's GRF .mot
+///   files. Only a rise beyond kFilteredRiseMs is told: a 6 Hz filter over a sharp foot strike
+///   (8 N/ms) spreads it by about 11 ms and passes for raw, over a soft one (3 N/ms) by more than 15.
+/// - The noise. A raw plate carries its amplifier's and converter's noise at every frequency: 0.3-21
+///   N RMS above 50 Hz under load on the development trials (their C3D channels, and the GRF files
+///   of Stanford's run, OpenCap and UFABC), where a signal filtered below 50 Hz keeps only its
+///   rounding: 0.008-0.016 N on Rajagopal's and subject01's files. Under kRawNoiseFloorN it is
+///   filtered. Measured where the plate's rate is at least kNoiseRateHz (50 Hz a fifth of it), so
+///   not on plates resampled to a marker rate, where only the rise tells.
+/// A signal exactly zero before its onsets and stepping to at least the threshold was set to zero
+/// below some level before export (OpenCap's GRF .mot files: 0 N, then 20.7 N): its onsets are that
+/// level's crossing, the stance threshold's own when the level is it, so it is said, not corrected;
+/// such a file can be filtered too (the signs above then tell it; OpenCap's are not: 0.56 N RMS
+/// above 50 Hz).
 inline constexpr double kFilteredRiseMs = 15.0;
+inline constexpr double kRawNoiseFloorN = 0.05, kNoiseRateHz = 250.0, kNoiseBandHz = 50.0;
 struct PlateOnsetRise {
   std::string plate;
   int onsets = 0;  ///< rising crossings of the threshold in the recording that rise from the floor within 0.1 s
-  /// Median time (ms) from the last sample at or below a hundredth of the threshold (the floor) to
-  /// the crossing.
+  /// Median time (ms) from the signal's last rise through a hundredth of the threshold (the floor)
+  /// to its crossing of the threshold, both interpolated between samples.
   double rise_ms = std::numeric_limits<double>::quiet_NaN();
+  /// RMS (N) of the vertical force above kNoiseBandHz (its residual from a zero-lag low-pass
+  /// there) over the samples above the threshold; NaN where not measured (a rate under
+  /// kNoiseRateHz, non-finite samples, no load).
+  double high_frequency_rms_N = std::numeric_limits<double>::quiet_NaN();
   /// Every onset comes from exact zeros with a step to at least the threshold (a thresholded export).
   bool zero_below_threshold = false;
-  [[nodiscard]] bool filtered() const { return onsets > 0 && rise_ms > kFilteredRiseMs; }
+  [[nodiscard]] bool filtered_by_rise() const { return onsets > 0 && rise_ms > kFilteredRiseMs; }
+  [[nodiscard]] bool filtered_by_noise() const { return high_frequency_rms_N < kRawNoiseFloorN; }
+  [[nodiscard]] bool filtered() const { return filtered_by_rise() || filtered_by_noise(); }
 };
 /// Each plate's onsets in `rec` (vertical: the force along `up`, lab frame).
 std::vector<PlateOnsetRise> plate_onset_rises(const ForcePlateRecording& rec, const Eigen::Vector3d& up, double threshold_N);
@@ -215,7 +240,13 @@ struct StanceValidation {
   /// sole series): the COP's RMSE is also given in % of it.
   double foot_length_m = std::numeric_limits<double>::quiet_NaN();
   ComponentMetrics metrics;
-  std::optional<double> onset_error_ms, offset_error_ms;  ///< estimate - plate; + = late
+  /// Contact timing, estimate - plate (ms; + = late): the threshold's crossings or, when
+  /// timed_by_ramp, the loading and unloading ramps' zero intercepts (ValidationOptions::Timing).
+  std::optional<double> onset_error_ms, offset_error_ms;
+  bool timed_by_ramp = false;
+  /// Both timings, whichever scores the stance: the threshold's crossings of both series, and the
+  /// ramps' intercepts of both (loading_ramp_onset, unloading_ramp_offset).
+  std::optional<double> onset_crossing_error_ms, offset_crossing_error_ms, onset_ramp_error_ms, offset_ramp_error_ms;
   /// The loaded span: the stance's frames with the estimate's loaded frames next to them (its
   /// vertical force above the stance threshold while the plate reads below it, at most 0.2 s on
   /// each side), in the estimate's window, inclusive. The vertical rRMSE above compares the plate's

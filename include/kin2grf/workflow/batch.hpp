@@ -64,6 +64,11 @@ ValidationRun validate_trial(const Settings& settings, const std::string& plates
 /// after shifting the plates by it) or a shift in seconds (+: the plates led the markers);
 /// InputError naming the value otherwise.
 void parse_sync(const std::string& text, ValidationOptions& validation);
+/// `--timing` as the user gives it: "auto", "crossing" or "ramp" (ValidationOptions::Timing);
+/// InputError naming the value otherwise.
+void parse_timing(const std::string& text, ValidationOptions& validation);
+/// Its name in the settings JSON and the text ("auto", "crossing", "ramp").
+const char* timing_name(ValidationOptions::Timing timing);
 
 /// The files a trial of the batch writes into `out_dir`: NAME.csv, NAME_grf.mot (OpenSim's frame), NAME.json,
 /// NAME_markers.trc and NAME_external_loads.xml (the OpenSim set, as `estimate --opensim` writes it),
