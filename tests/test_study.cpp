@@ -467,6 +467,42 @@ TEST(Study, ToeAblationStudyReplacesToeMarkersByVirtualToes) {
   }
 }
 
+// The plate-export study: every trial's plates through a 6 and a 10 Hz zero-lag low-pass, as a GRF
+// file exported after filtering has them, the stances timed by the crossings and by validate's
+// default. The estimate is the same in every row; on the example walk the filtered plates'
+// crossings lead its foot strikes, so the crossings' onsets read later, more at 6 Hz than at 10;
+// each stance keeps both timings whichever scores it.
+TEST(Study, PlateExportStudyFiltersThePlatesNotTheEstimate) {
+  const Trial walk = make_example_walk();
+  StudyTrial t;
+  t.name = "walk", t.activity = "walking", t.lab = "lab", t.trial = &walk, t.plates = &*walk.plates;
+  t.marker_set = find_marker_set("kin2grf-example");
+  const StudyResult r = run_study("plate-export", {t});
+  ASSERT_EQ(r.rows.size(), 5u);
+  EXPECT_TRUE(r.rows[0].is_default);
+  ASSERT_TRUE(r.failures.empty()) << r.failures.front();
+  const auto mean_onset = [&](std::size_t row) {
+    double sum = 0;
+    int n = 0;
+    for (const StanceValidation& st : r.per_trial[row][0].stances)
+      if (st.onset_crossing_error_ms) sum += *st.onset_crossing_error_ms, ++n;
+    return n ? sum / n : std::nan("");
+  };
+  const double recorded = mean_onset(0), at6 = mean_onset(1), at10 = mean_onset(3);
+  EXPECT_GT(at6, recorded + 5.0);
+  EXPECT_GT(at6, at10);
+  EXPECT_GT(at10, recorded);
+  for (std::size_t row = 0; row < r.rows.size(); ++row) {
+    ASSERT_EQ(r.per_trial[row][0].stances.size(), r.per_trial[0][0].stances.size()) << r.rows[row].label;
+    for (const StanceValidation& st : r.per_trial[row][0].stances) {
+      EXPECT_TRUE(st.onset_crossing_error_ms && st.onset_ramp_error_ms) << r.rows[row].label;
+      if (row == 1 || row == 3) {  // "crossings"
+        EXPECT_FALSE(st.timed_by_ramp) << r.rows[row].label;
+      }
+    }
+  }
+}
+
 // The subject-scale study makes each trial's subject dynamically similar at 0.6, 0.8 and 1.2 of
 // its size (dynamically_scaled: lengths x L, times x sqrt(L), forces x L^3, moments x L^4) and
 // scales the validation's own thresholds alike: on the example walk every row keeps its stances,

@@ -1,5 +1,7 @@
 #include "kin2grf/validation/study.hpp"
 
+#include "kin2grf/kinematics/filter.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -39,6 +41,11 @@ struct Setting {
   /// The `subject-scale` study: the trial's subject made dynamically similar at this length scale
   /// (dynamically_scaled in trial.hpp; 1: as recorded).
   double body_scale = 1.0;
+  /// The `plate-export` study: every plate's forces and moments through a zero-lag low-pass at this
+  /// cut-off (Hz; 0: as recorded), as a GRF file exported after filtering has them, and the
+  /// stances timed this way.
+  double plate_export_hz = 0.0;
+  ValidationOptions::Timing timing = ValidationOptions::Timing::Auto;
 };
 
 /// Marks the settings that leave the fields `get` reads at kin2grf's defaults (the added marker
@@ -241,6 +248,36 @@ MarkerTrajectories cut_to_plates(const MarkerTrajectories& m, const ForcePlateRe
   return cropped(m, a, b - a + 1);
 }
 
+/// What validate's timing makes of a plate filtered before export (validate's step 7,
+/// ValidationOptions::Timing): every trial's plates as recorded, and exported through a 6 and a 10
+/// Hz zero-lag low-pass (the cut-offs OpenSim's example GRF files and gait pipelines use), the
+/// stances timed by the threshold's crossings and as validate does by default. The estimate is the
+/// same in every row: what moves is the reference its onsets and offsets are compared with. The
+/// plates' COP stays as recorded.
+std::vector<Setting> plate_export_settings() {
+  std::vector<Setting> s{{"as recorded", 0, [](EstimateOptions&) {}, 0.0, true}};
+  for (const double hz : {6.0, 10.0})
+    for (const auto timing : {ValidationOptions::Timing::Crossing, ValidationOptions::Timing::Auto}) {
+      char b[64];
+      std::snprintf(b, sizeof b, "%.0f Hz export, %s", hz, timing == ValidationOptions::Timing::Crossing ? "crossings" : "auto");
+      Setting c{b, hz, [](EstimateOptions&) {}};
+      c.plate_export_hz = hz;
+      c.timing = timing;
+      s.push_back(std::move(c));
+    }
+  return s;
+}
+
+/// plate_export_settings' export: each plate's force, moment and free moment columns (those
+/// finite throughout) through butterworth_filtfilt at `cutoff_hz`.
+ForcePlateRecording exported_plates(ForcePlateRecording rec, double cutoff_hz) {
+  for (ForcePlate& p : rec.plates)
+    for (Eigen::MatrixX3d* m : {&p.force_N, &p.moment_centre_Nm, &p.free_moment_Nm})
+      for (Eigen::Index c = 0; c < m->cols(); ++c)
+        if (m->rows() > 0 && m->col(c).allFinite()) m->col(c) = butterworth_filtfilt(Eigen::VectorXd(m->col(c)), rec.rate_hz, cutoff_hz);
+  return rec;
+}
+
 /// What the COP owes to a toe marker (a lab whose set has none): every trial as recorded, and with
 /// each hallux landmark made of a marker replaced by the presets' virtual toes (kVirtualToeShare of
 /// the ankle-MT length). Trials whose sets have virtual toes already are the same in both rows.
@@ -357,6 +394,7 @@ const std::vector<StudyKind>& special_studies() {
       {"trial-cut", trial_cut_settings},
       {"marker-gaps", marker_gaps_settings},
       {"toe-ablation", toe_ablation_settings},
+      {"plate-export", plate_export_settings},
       {"subject-scale", subject_scale_settings},
       {"torso-length", torso_length_settings},
       {"kinematic-edges", kinematic_edges_settings},
@@ -459,6 +497,8 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
       o.allow_unusual_mass = true;  // a 47.5 kg subject at 0.6 weighs 10 kg
       vo = scaled_validation(L);
     }
+    if (s.plate_export_hz > 0) scaled_plates = exported_plates(*d.plates, s.plate_export_hz);
+    vo.timing = s.timing;
     const Trial* static_trial = scaled_static ? &*scaled_static : d.static_trial;
     const ForcePlateRecording& plates = scaled_plates ? *scaled_plates : *d.plates;
     for (int seed = 1; seed <= draws; ++seed) {
@@ -717,8 +757,8 @@ std::string format_study_table(const StudyResult& s) {
   if (s.rows.empty()) return os.str();
   for (std::size_t a = 0; a < s.rows.front().cells.size(); ++a) {
     const auto& c0 = s.rows.front().cells[a];
-    std::snprintf(b, sizeof b, "\n%s (%d trials, %d stances)\n%-24s %9s %9s %9s %9s %10s\n", c0.activity.c_str(), c0.trials,
-                  c0.per_foot.n, "setting", "vertical", "anterior", "COP", "moment", "total GRM");
+    std::snprintf(b, sizeof b, "\n%s (%d trials, %d stances)\n%-24s %9s %9s %9s %9s %10s %12s\n", c0.activity.c_str(), c0.trials,
+                  c0.per_foot.n, "setting", "vertical", "anterior", "COP", "moment", "total GRM", "|onset| ms");
     os << b;
     for (const auto& r : s.rows) {
       const auto& c = r.cells[a];
@@ -728,6 +768,10 @@ std::string format_study_table(const StudyResult& s) {
       // No trial with a total window (validate says why): a dash, not "nan".
       if (std::isfinite(c.total_grm)) std::snprintf(b, sizeof b, " %10.1f", c.total_grm);
       else std::snprintf(b, sizeof b, " %10s", "-");
+      os << b;
+      // The mean |onset| over the stances that have one (validate's timing).
+      if (std::isfinite(c.per_foot.onset_abs_ms)) std::snprintf(b, sizeof b, " %12.0f", c.per_foot.onset_abs_ms);
+      else std::snprintf(b, sizeof b, " %12s", "-");
       os << b;
       // With --mediolateral: its rRMSE and RMSE in % body weight, and the lateral COP's RMSE.
       if (std::isfinite(c.per_foot.lateral_rmse_percent_bw)) {

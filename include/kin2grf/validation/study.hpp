@@ -1,8 +1,8 @@
 // kin2grf validation: the paper's parameter studies (Sect. 4) on any trials with plates.
 //
 // A study runs estimate + validate on every trial for each value of one setting and reports the
-// mean per-stance rRMSE (vertical, anterior, COP, moment about the plate centre) and the mean
-// total-GRM rRMSE, per activity. Kinds:
+// mean per-stance rRMSE (vertical, anterior, COP, moment about the plate centre), the mean
+// total-GRM rRMSE and the mean |onset|, per activity. Kinds:
 //   r             activation parameter r of Eq. 8, 10^1 .. 10^6 N/m (paper: Fig. 7 discussion)
 //   ground-shift  the ground moved by -1 cm, 0, +1 cm (paper: robustness to the ground level)
 //   cutoff        the post-filter cut-off (paper: 12 Hz)
@@ -15,6 +15,9 @@
 //   marker-gaps   the heel or the MT markers lost for 0.2 s at every plate stance, the rigid fill
 //                 off and on (robustness to occlusions)
 //   toe-ablation  each toe marker replaced by virtual toes (a lab whose set has none)
+//   plate-export  the plates through a 6 and a 10 Hz zero-lag low-pass, as a filtered GRF export,
+//                 timed by the threshold's crossings and by validate's default (its timing, not the
+//                 estimate, is what moves)
 //   split-distance  kin2grf's side-by-side feet distance, off .. 0.2 m (not in the paper)
 //   torso-length  the torso's hip-shoulder length fixed (the paper) or measured per frame
 //   kinematic-edges  the kinematics' filter past the window's ends: the odd reflection (the ends'
