@@ -308,6 +308,41 @@ TEST(SharedValidate, ALandingIsNotLoadedBeforeItsRawPlatesOnset) {
   }
 }
 
+// Step 7 on the development files (docs/METHOD-NOTES.md, session 44): the GRF .mot files that were
+// low-pass filtered before export are told by their noise (under 0.05 N RMS above 50 Hz under
+// load: 0.001-0.009 N), Rajagopal's and subject01's by their rise too; OpenCap's walking file, also
+// set to zero below 20 N, by its noise alone; the raw C3D channels carry 0.7-4 N and are not.
+TEST(SharedValidate, TheFilteredExportsAreToldByTheirNoise) {
+  KIN2GRF_REQUIRE_DATA();
+  struct Case {
+    const char* file;
+    Eigen::Vector3d up;
+    bool filtered, by_rise;
+  };
+  const Case cases[] = {
+      {"rajagopal2016_overground_walk/grf_walk.mot", Eigen::Vector3d::UnitY(), true, true},
+      {"opensim_subject01_treadmill_walk/subject01_walk1_grf.mot", Eigen::Vector3d::UnitY(), true, true},
+      {"opencap_dropjump_walk/walking1_grf.mot", Eigen::Vector3d::UnitY(), true, false},
+      {"opensim_c3d_overground_walk/walking2.c3d", Eigen::Vector3d::UnitZ(), false, false},
+      {"btk_plugingait_walk/PiG_Motion3_FF.c3d", Eigen::Vector3d::UnitZ(), false, false},
+  };
+  LoadOptions lo;
+  lo.c3d.zero_offset = ZeroOffset::Unloaded;
+  for (const Case& c : cases) {
+    const Trial t = load_trial(test::data_file(c.file), lo);
+    ASSERT_TRUE(t.plates) << c.file;
+    int stepped_on = 0;
+    for (const PlateOnsetRise& r : plate_onset_rises(*t.plates, c.up, 20.0)) {
+      if (r.onsets == 0) continue;  // a plate nobody stepped on
+      ++stepped_on;
+      EXPECT_EQ(r.filtered(), c.filtered) << c.file << " " << r.plate << ": " << r.high_frequency_rms_N << " N, rise " << r.rise_ms << " ms";
+      EXPECT_EQ(r.filtered_by_rise(), c.by_rise) << c.file << " " << r.plate;
+      EXPECT_TRUE(c.filtered ? r.high_frequency_rms_N < 0.02 : r.high_frequency_rms_N > 0.3) << c.file << " " << r.plate;
+    }
+    EXPECT_GE(stepped_on, 2) << c.file;
+  }
+}
+
 // Feet side by side share the load by the whole body's frontal balance (EstimateOptions::
 // frontal_split_weight), on a second lab's trial: Camargo's circuit ends in 5 s of quiet standing
 // (12.7-15.3 s), the right foot on ground_force_3 (380-741 N as the walker shifts weight), the left
