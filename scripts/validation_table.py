@@ -472,7 +472,7 @@ if any(onsets.values()):
     m = lambda xs: f"{statistics.mean(xs):.0f} ms ({len(xs)} stances)" if xs else "-"
     print(f"\nOnset and offset ms: + = the estimate's contact begins (ends) after the plate's. * the plate's signal was "
           f"low-pass filtered before export (validate's step 7: it rises from 0.2 to 20 N over more than 15 ms, or carries "
-          f"under 0.05 N RMS above 50 Hz under load, where a raw plate's noise is 0.3 N or more): a filtered signal's 20 N "
+          f"under 0.05 N RMS above 50 Hz under load, where a raw plate's noise is 0.2 N or more): a filtered signal's 20 N "
           f"crossings lead the foot's contact (and lag its lift-off) by the filter's spread, so its stances are timed by the "
           f"loading and unloading ramps' zero intercepts (20-80 % of the peak, the same rule on the estimate; since session "
           f"44), the threshold crossings' figure in brackets. ** set to zero below a threshold before export, unfiltered: "

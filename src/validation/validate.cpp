@@ -865,7 +865,7 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
                       r.plate.c_str(), r.rise_ms, 0.01 * o.threshold_N, o.threshold_N, r.onsets);
       else
         std::snprintf(b, sizeof b,
-                      "plate %s: its vertical force carries %.3f N RMS above %.0f Hz under load (a raw plate's noise is 0.3 N or more): "
+                      "plate %s: its vertical force carries %.3f N RMS above %.0f Hz under load (a raw plate's noise is 0.2 N or more): "
                       "it looks low-pass filtered before export, so its threshold crossings lead the foot's contact (and lag its "
                       "lift-off) by the filter's spread",
                       r.plate.c_str(), r.high_frequency_rms_N, kNoiseBandHz);

@@ -148,17 +148,19 @@ struct SyncEstimate {
 ///   export creeps there from its smoothed tail: 24-28 ms on Rajagopal's and subject01's GRF .mot
 ///   files. Only a rise beyond kFilteredRiseMs is told: a 6 Hz filter over a sharp foot strike
 ///   (8 N/ms) spreads it by about 11 ms and passes for raw, over a soft one (3 N/ms) by more than 15.
-/// - The noise. A raw plate carries its amplifier's and converter's noise at every frequency: 0.3-21
-///   N RMS above 50 Hz under load on the development trials (their C3D channels, and the GRF files
-///   of Stanford's run, OpenCap and UFABC), where a signal filtered below 50 Hz keeps only its
-///   rounding: 0.008-0.016 N on Rajagopal's and subject01's files. Under kRawNoiseFloorN it is
-///   filtered. Measured where the plate's rate is at least kNoiseRateHz (50 Hz a fifth of it), so
-///   not on plates resampled to a marker rate, where only the rise tells.
+/// - The noise. A raw plate carries its amplifier's and converter's noise at every frequency, where
+///   a signal filtered below 50 Hz keeps only its rounding. The vertical force's RMS above 50 Hz,
+///   over the loaded samples two 50 Hz periods clear of each loaded run's ends (a thresholded
+///   export's step there is not noise): 0.24-15 N on the development trials' raw plates (their C3D
+///   channels, and the GRF files of Stanford's run, UFABC and OpenCap's drop jump), 0.001-0.009 N on
+///   Rajagopal's, subject01's and OpenCap's walking files. Under kRawNoiseFloorN (a fifth of the
+///   quietest raw plate, five times the noisiest filtered one) it is filtered. Measured where the
+///   plate's rate is at least kNoiseRateHz (50 Hz a fifth of it), so not on plates resampled to a
+///   marker rate, where only the rise tells.
 /// A signal exactly zero before its onsets and stepping to at least the threshold was set to zero
 /// below some level before export (OpenCap's GRF .mot files: 0 N, then 20.7 N): its onsets are that
-/// level's crossing, the stance threshold's own when the level is it, so it is said, not corrected;
-/// such a file can be filtered too (the signs above then tell it; OpenCap's are not: 0.56 N RMS
-/// above 50 Hz).
+/// level's crossing, the stance threshold's own when the level is it, so it is said, not corrected.
+/// Such a file can be filtered too, and the signs above then tell it (OpenCap's walking files).
 inline constexpr double kFilteredRiseMs = 15.0;
 inline constexpr double kRawNoiseFloorN = 0.05, kNoiseRateHz = 250.0, kNoiseBandHz = 50.0;
 struct PlateOnsetRise {
