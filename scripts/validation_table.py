@@ -423,7 +423,7 @@ def timing_cell(j, s, key):
     if t[key] is None:
         return "-"
     cell = str(round(t[key])) + (export_mark(j, s["plate"]) if key == "onset" else "")
-    if t.get("timed_by") == "ramp" and t.get(key + "_crossing") is not None:
+    if t.get(key + "_timed_by") == "ramp" and t.get(key + "_crossing") is not None:
         cell += f" ({round(t[key + '_crossing'])})"
     return cell
 
@@ -473,10 +473,10 @@ if any(onsets.values()):
     print(f"\nOnset and offset ms: + = the estimate's contact begins (ends) after the plate's. * the plate's signal was "
           f"low-pass filtered before export (validate's step 7: it rises from 0.2 to 20 N over more than 15 ms, or carries "
           f"under 0.05 N RMS above 50 Hz under load, where a raw plate's noise is 0.2 N or more): a filtered signal's 20 N "
-          f"crossings lead the foot's contact (and lag its lift-off) by the filter's spread, so its stances are timed by the "
-          f"loading and unloading ramps' zero intercepts (20-80 % of the peak, the same rule on the estimate; since session "
-          f"44), the threshold crossings' figure in brackets. ** set to zero below a threshold before export, unfiltered: "
-          f"timed by the crossings. Walking, mean |onset| against raw plate signals {m(onsets['raw'])}, against the filtered "
+          f"crossings lead the foot's contact by the filter's spread, so its stances' onsets are timed by the loading ramp's "
+          f"zero intercept (20-80 % of the peak, the same rule on the estimate; since session 44), the threshold crossing's "
+          f"figure in brackets; offsets by the crossings (a push-off unloads smoothly: the export moves them little). ** set to "
+          f"zero below a threshold before export, unfiltered: timed by the crossings. Walking, mean |onset| against raw plate signals {m(onsets['raw'])}, against the filtered "
           f"exports {m(onsets['filtered'])} by their ramps ({m(onsets['filtered_crossing'])} by their crossings), against "
           f"thresholded ones {m(onsets['thresholded'])}.\n")
 

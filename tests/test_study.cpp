@@ -497,7 +497,7 @@ TEST(Study, PlateExportStudyFiltersThePlatesNotTheEstimate) {
     for (const StanceValidation& st : r.per_trial[row][0].stances) {
       EXPECT_TRUE(st.onset_crossing_error_ms && st.onset_ramp_error_ms) << r.rows[row].label;
       if (row == 1 || row == 3) {  // "crossings"
-        EXPECT_FALSE(st.timed_by_ramp) << r.rows[row].label;
+        EXPECT_FALSE(st.onset_by_ramp) << r.rows[row].label;
       }
     }
   }

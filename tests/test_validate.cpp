@@ -693,11 +693,11 @@ TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
 
 // A plate exported through a zero-lag low-pass (Rajagopal's and subject01's GRF .mot files) has its
 // threshold crossings moved by the filter's spread, which a stance timed by them reads as the
-// estimate's lateness. validate tells such a plate by its noise (step 7), times its stances by the
-// loading and unloading ramps' zero intercepts (ValidationOptions::Timing::Auto), keeps both
-// timings, and times a raw plate's stances by its crossings. The example walk's plates, raw and
-// exported.
-TEST(Validate, AFilteredExportsStancesAreTimedByTheirRampsNotTheirCrossings) {
+// estimate's lateness. validate tells such a plate by its noise (step 7), times its stances' onsets
+// by the loading ramp's zero intercept (ValidationOptions::Timing::Auto; the offsets by the
+// crossings, which a filter moves little at a smooth unloading), keeps both timings, and times a
+// raw plate's stances by its crossings. The example walk's plates, raw and exported.
+TEST(Validate, AFilteredExportsOnsetsAreTimedByTheirRampsNotTheirCrossings) {
   const Trial example = make_example_walk();
   const EstimateResult e = estimate(example, nullptr, *find_marker_set("kin2grf-example"), {});
   // Raw: the example's plates at 1 kHz (linear between its 100 Hz samples) with a plate's noise
@@ -742,17 +742,26 @@ TEST(Validate, AFilteredExportsStancesAreTimedByTheirRampsNotTheirCrossings) {
   // Step 7 tells the export by its noise: none left above 50 Hz.
   for (const auto& r : raw.plate_onsets) EXPECT_FALSE(r.filtered()) << r.plate << " " << r.high_frequency_rms_N << " N";
   for (const auto& r : v.plate_onsets) EXPECT_TRUE(r.filtered_by_noise()) << r.plate << " " << r.high_frequency_rms_N << " N";
+  ValidationOptions by_ramp;
+  by_ramp.timing = ValidationOptions::Timing::Ramp;
+  const auto ramped = validate(e, exported, by_ramp);
+  ASSERT_EQ(ramped.stances.size(), 2u);
   for (std::size_t k = 0; k < 2; ++k) {
-    const StanceValidation &r = raw.stances[k], &c = crossed.stances[k], &a = v.stances[k];
-    EXPECT_FALSE(r.timed_by_ramp);
-    EXPECT_FALSE(c.timed_by_ramp);
-    EXPECT_TRUE(a.timed_by_ramp);
+    const StanceValidation &r = raw.stances[k], &c = crossed.stances[k], &a = v.stances[k], &m = ramped.stances[k];
+    // By default: a raw plate's onsets by its crossings, a filtered export's by its loading ramp,
+    // every offset by the crossings; --timing ramp times both by the ramps.
+    EXPECT_FALSE(r.onset_by_ramp);
+    EXPECT_FALSE(c.onset_by_ramp);
+    EXPECT_TRUE(a.onset_by_ramp);
+    EXPECT_FALSE(r.offset_by_ramp || c.offset_by_ramp || a.offset_by_ramp);
+    EXPECT_TRUE(m.onset_by_ramp && m.offset_by_ramp);
     ASSERT_TRUE(r.onset_crossing_error_ms && r.offset_crossing_error_ms && r.onset_ramp_error_ms && r.offset_ramp_error_ms);
     ASSERT_TRUE(a.onset_crossing_error_ms && a.offset_crossing_error_ms && a.onset_ramp_error_ms && a.offset_ramp_error_ms);
     // Each stance is scored by its own timing, and both are kept.
     EXPECT_EQ(*r.onset_error_ms, *r.onset_crossing_error_ms);
     EXPECT_EQ(*a.onset_error_ms, *a.onset_ramp_error_ms);
-    EXPECT_EQ(*a.offset_error_ms, *a.offset_ramp_error_ms);
+    EXPECT_EQ(*a.offset_error_ms, *a.offset_crossing_error_ms);
+    EXPECT_EQ(*m.offset_error_ms, *m.offset_ramp_error_ms);
     EXPECT_DOUBLE_EQ(*a.onset_crossing_error_ms, *c.onset_error_ms);
     // The export moved the crossings (the same estimate reads later at the onset and earlier at
     // the offset). How much less it moves the ramps depends on how sharp the rise is against the

@@ -104,8 +104,9 @@ int main(int argc, char** argv) {
     validate->add_option_function<std::string>(
         "--timing", [&val](const std::string& t) { kin2grf::parse_timing(t, val.options); },
         "How onsets and offsets are timed: crossing (the threshold's crossings of the estimate and the plates), ramp (the loading "
-        "and unloading ramps' zero intercepts, 20-80 % of the peak, of both) or auto (the default: the ramps on a plate low-pass "
-        "filtered before export, told from its rise or its noise, whose crossings the filter moved; the crossings elsewhere)")
+        "and unloading ramps' zero intercepts, 20-80 % of the peak, of both) or auto (the default: the loading ramp for the onsets "
+        "on a plate low-pass filtered before export, told from its rise or its noise, whose crossings the filter moved; the "
+        "crossings for every other onset and every offset)")
         ->check(CLI::IsMember({"auto", "crossing", "ramp"}));
   }
 

@@ -159,9 +159,9 @@ def validate(trial: str | os.PathLike, plates: str | os.PathLike | None = None, 
     `kin2grf validate`. Returns the ``--json`` document, with the estimate under "estimate".
     `sync`: "none" (compare as recorded; the marker-plate offset is reported under "sync"),
     "auto" (compare after shifting the plates by it) or a shift in seconds (+ when the plates led).
-    `timing`: how onsets and offsets are timed, as ``--timing``: "auto" (the loading ramps' zero
-    intercepts on a plate low-pass filtered before export, the threshold's crossings elsewhere),
-    "crossing" or "ramp"."""
+    `timing`: how onsets and offsets are timed, as ``--timing``: "auto" (the loading ramp's zero
+    intercept for the onsets on a plate low-pass filtered before export, the threshold's crossings
+    elsewhere), "crossing" or "ramp"."""
     d = _kin2grf.validate(os.fspath(trial), _words(settings), os.fspath(plates) if plates else "", float(threshold), zero_offset,
                           _text(sync), timing)
     out = d["validation"]

@@ -147,9 +147,9 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   t << "<h2>Errors against the force plates</h2>\n<p>rRMSE and RMSE as in the paper's Eqs. 11-12, per plate stance "
        "(measured vertical force above the threshold) and in total where every loaded foot stands on a plate. "
        "COP compared where the plate carries at least 5 % of body weight; moment about the plate centre (total: GRM about "
-       "the midpoint of the plates in use). Timing: estimate minus plate, + = late; on a plate filtered before export, by "
-       "the loading and unloading ramps' zero intercepts (20-80 % of the peak, on both), the threshold crossings' figure in "
-       "brackets. Loaded span: the stance with the frames "
+       "the midpoint of the plates in use). Timing: estimate minus plate, + = late; an onset on a plate filtered before "
+       "export by the loading ramp's zero intercept (20-80 % of the peak, on both; \"ramp\"), the threshold crossings' figure "
+       "in brackets. Loaded span: the stance with the frames "
        "next to it where the estimate loads the foot while the plate reads under the threshold (a landing loaded before "
        "it lands), against the plate's reading there. In brackets: a plate whose COP is "
        "not where the markers put the foot (validate's registration check), kept for the record, left out of the "
@@ -161,7 +161,7 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   const auto timing = [](const nlohmann::json& s, const std::string& key) {
     const auto& tm = s["timing_ms"];
     std::string cell = fmt(tm[key], "%.0f");
-    if (tm.value("timed_by", "") == "ramp") cell += " ramp (" + fmt(tm[key + "_crossing"], "%.0f") + ")";
+    if (tm.value(key + "_timed_by", "") == "ramp") cell += " ramp (" + fmt(tm[key + "_crossing"], "%.0f") + ")";
     return cell;
   };
   for (const auto& s : j["per_foot"]) {

@@ -357,10 +357,10 @@ double stance_foot_length_m(const EstimateResult& e, const Candidate& c) {
 
 /// Contact timing: threshold crossings of the estimate near the plate's (+ = estimate late), and
 /// the vertical force's best time shift.
-/// `by_ramp`: the stance is scored by the ramps' intercepts (ValidationOptions::Timing); both
-/// timings are kept.
-void stance_timing(const EstimateResult& e, const MeasuredPlate& mp, const Candidate& c, const ValidationOptions& o, bool by_ramp,
-                   StanceValidation& s) {
+/// `onset_by_ramp`, `offset_by_ramp`: which are scored by the ramps' intercepts
+/// (ValidationOptions::Timing); both timings are kept.
+void stance_timing(const EstimateResult& e, const MeasuredPlate& mp, const Candidate& c, const ValidationOptions& o, bool onset_by_ramp,
+                   bool offset_by_ramp, StanceValidation& s) {
   const Eigen::Index n = e.time_s.size(), a = c.run.first;
   const double rate = e.landmarks.rate_hz;
   const Eigen::Index search = static_cast<Eigen::Index>(std::lround(0.2 * rate));
@@ -384,9 +384,10 @@ void stance_timing(const EstimateResult& e, const MeasuredPlate& mp, const Candi
     if (const auto p0 = unloading_ramp_offset(pv, e.time_s, a, mid, c.run.last + 1))
       if (const auto e0 = unloading_ramp_offset(ev, e.time_s, a, mid, to)) s.offset_ramp_error_ms = ms(*e0, *p0);
   }
-  s.timed_by_ramp = by_ramp;
-  s.onset_error_ms = by_ramp ? s.onset_ramp_error_ms : s.onset_crossing_error_ms;
-  s.offset_error_ms = by_ramp ? s.offset_ramp_error_ms : s.offset_crossing_error_ms;
+  s.onset_by_ramp = onset_by_ramp;
+  s.offset_by_ramp = offset_by_ramp;
+  s.onset_error_ms = onset_by_ramp ? s.onset_ramp_error_ms : s.onset_crossing_error_ms;
+  s.offset_error_ms = offset_by_ramp ? s.offset_ramp_error_ms : s.offset_crossing_error_ms;
   // The loaded span: the estimate's load on the foot next to its stance, while the plate it lands
   // on (or leaves) reads below the threshold, counted against that reading (a NaN plate stops it).
   // Only a landing's or a lift-off's: the estimate's load must begin (end) within the search, so
@@ -440,13 +441,15 @@ void compare_parameters(const EstimateResult& e, const ValidationResult& v, Stan
   s.parameters_estimated = stance_parameters(e.feet[static_cast<std::size_t>(s.foot)].force_N, rate, s.span_first, s.span_last);
 }
 
-/// Whether a stance on plate `name` is timed by the ramps (ValidationOptions::Timing): with Auto,
-/// when step 7 found the plate filtered before export.
-bool timed_by_ramp(const ValidationResult& v, const std::string& name, const ValidationOptions& o) {
+/// Whether the onsets of the stances on plate `name` are timed by the loading ramp
+/// (ValidationOptions::Timing): with Auto, when step 7 found the plate filtered before export.
+bool onset_by_ramp(const ValidationResult& v, const std::string& name, const ValidationOptions& o) {
   if (o.timing != ValidationOptions::Timing::Auto) return o.timing == ValidationOptions::Timing::Ramp;
   return std::any_of(v.plate_onsets.begin(), v.plate_onsets.end(),
                      [&](const PlateOnsetRise& r) { return r.plate == name && r.filtered(); });
 }
+/// And their offsets: by the unloading ramp only when asked (Ramp).
+bool offset_by_ramp(const ValidationOptions& o) { return o.timing == ValidationOptions::Timing::Ramp; }
 
 StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, const Candidate& c, const ValidationOptions& o) {
   const Eigen::Index n = e.time_s.size();
@@ -509,7 +512,7 @@ StanceValidation compare_stance(const EstimateResult& e, ValidationResult& v, co
     mm[i] = mp.moment_origin_Nm[k] - sagittal_moment(rx, ry, mp.force_N(k, 0), mp.force_N(k, 1));
   }
   s.metrics.moment = compare_series(me, mm);
-  stance_timing(e, mp, c, o, timed_by_ramp(v, mp.name, o), s);
+  stance_timing(e, mp, c, o, onset_by_ramp(v, mp.name, o), offset_by_ramp(o), s);
   if (c.cut) {
     // The plate's onset (offset) lies outside the window: the crossing found at its edge is none.
     if (c.run.first == 0) s.onset_error_ms.reset(), s.onset_crossing_error_ms.reset(), s.onset_ramp_error_ms.reset();
@@ -851,23 +854,27 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
     const bool used = std::any_of(v.stances.begin(), v.stances.end(), [&](const StanceValidation& s) { return s.plate == r.plate; });
     if (!used) continue;
     // What the timing does with it (ValidationOptions::Timing).
-    const std::string timed = timed_by_ramp(v, r.plate, o)
-                                  ? "; its stances' onsets and offsets are timed by the loading and unloading ramps' zero intercepts "
-                                    "(20-80 % of the peak, on the estimate too), which such a filter moves less"
-                              : o.timing == ValidationOptions::Timing::Crossing ? "; its stances are timed by the threshold's crossings (--timing crossing)"
-                                                                                 : "";
+    const bool ramp_onsets = onset_by_ramp(v, r.plate, o);
+    const std::string timed =
+        ramp_onsets && offset_by_ramp(o) ? "; its stances' onsets and offsets are timed by the loading and unloading ramps' zero "
+                                           "intercepts (--timing ramp)"
+        : ramp_onsets ? "; its stances' onsets are timed by the loading ramp's zero intercept (20-80 % of the peak, on the estimate "
+                        "too), which such a filter moves less, their offsets by the crossings, which it moves little at a smooth "
+                        "unloading"
+        : o.timing == ValidationOptions::Timing::Crossing ? "; its stances are timed by the threshold's crossings (--timing crossing)"
+                                                          : "";
     if (r.filtered()) {
       if (r.filtered_by_rise())
         std::snprintf(b, sizeof b,
                       "plate %s: its vertical force takes a median %.0f ms to rise from %.1f to %.0f N at its %d onset(s) (a raw plate's "
                       "signal takes a few ms at a foot strike): it looks low-pass filtered before export, so its threshold crossings "
-                      "lead the foot's contact (and lag its lift-off) by up to that much",
+                      "lead the foot's contact by up to that much",
                       r.plate.c_str(), r.rise_ms, 0.01 * o.threshold_N, o.threshold_N, r.onsets);
       else
         std::snprintf(b, sizeof b,
                       "plate %s: its vertical force carries %.3f N RMS above %.0f Hz under load (a raw plate's noise is 0.2 N or more): "
-                      "it looks low-pass filtered before export, so its threshold crossings lead the foot's contact (and lag its "
-                      "lift-off) by the filter's spread",
+                      "it looks low-pass filtered before export, so its threshold crossings lead the foot's contact by the filter's "
+                      "spread",
                       r.plate.c_str(), r.high_frequency_rms_N, kNoiseBandHz);
       v.notes.emplace_back(b + timed);
     } else if (r.zero_below_threshold) {
@@ -877,7 +884,7 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
                     "been filtered)",
                     r.plate.c_str(), o.threshold_N);
       v.notes.emplace_back(b + timed);
-    } else if (timed_by_ramp(v, r.plate, o)) {
+    } else if (ramp_onsets) {
       v.notes.emplace_back("plate " + r.plate + ": timed by the loading and unloading ramps' zero intercepts (--timing ramp)");
     }
   }
@@ -1142,7 +1149,8 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
     x["cop_reference_suspect"] = s.cop_reference_suspect;
     x["timing_ms"] = {{"onset", opt(s.onset_error_ms)},
                       {"offset", opt(s.offset_error_ms)},
-                      {"timed_by", s.timed_by_ramp ? "ramp" : "crossing"},
+                      {"onset_timed_by", s.onset_by_ramp ? "ramp" : "crossing"},
+                      {"offset_timed_by", s.offset_by_ramp ? "ramp" : "crossing"},
                       {"onset_crossing", opt(s.onset_crossing_error_ms)},
                       {"offset_crossing", opt(s.offset_crossing_error_ms)},
                       {"onset_ramp", opt(s.onset_ramp_error_ms)},
@@ -1392,19 +1400,23 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
   if (m.n > 0) {
     // Contact timing: the mean |onset| and |offset|, and which reference timed them (Timing).
     double on = 0, off = 0;
-    int n_on = 0, n_off = 0, by_ramp = 0;
+    int n_on = 0, n_off = 0, on_ramp = 0, off_ramp = 0;
     for (const auto& s : v.stances) {
       if (s.onset_error_ms) on += std::abs(*s.onset_error_ms), ++n_on;
       if (s.offset_error_ms) off += std::abs(*s.offset_error_ms), ++n_off;
-      by_ramp += s.timed_by_ramp ? 1 : 0;
+      on_ramp += s.onset_by_ramp ? 1 : 0;
+      off_ramp += s.offset_by_ramp ? 1 : 0;
     }
-    std::snprintf(buf, sizeof buf, "  per foot, contact timing, mean |estimate - plates|: onset %s ms, offset %s ms (",
-                  number_or_dash(n_on ? on / n_on : std::nan(""), "%.0f").c_str(), number_or_dash(n_off ? off / n_off : std::nan(""), "%.0f").c_str());
-    os << buf;
     const auto count = static_cast<int>(v.stances.size());
-    if (by_ramp == 0) os << "the threshold's crossings)\n";
-    else if (by_ramp == count) os << "the loading and unloading ramps' zero intercepts)\n";
-    else os << by_ramp << " stance(s) by the ramps' zero intercepts, " << count - by_ramp << " by the threshold's crossings)\n";
+    const auto by = [count](int ramps, const char* ramp) {
+      if (ramps == 0) return std::string("the threshold's crossings");
+      if (ramps == count) return std::string(ramp);
+      return std::to_string(ramps) + " by " + ramp + ", " + std::to_string(count - ramps) + " by the crossings";
+    };
+    os << "  per foot, contact timing, mean |estimate - plates|: onset " << number_or_dash(n_on ? on / n_on : std::nan(""), "%.0f")
+       << " ms (" << by(on_ramp, "the loading ramp's zero intercept") << "), offset "
+       << number_or_dash(n_off ? off / n_off : std::nan(""), "%.0f") << " ms (" << by(off_ramp, "the unloading ramp's zero intercept")
+       << ")\n";
   }
   if (m.n > 0 && std::isfinite(m.parameter_peak_error_percent_bw[0])) {
     const auto& pk = m.parameter_peak_error_percent_bw;

@@ -110,11 +110,14 @@ struct ValidationOptions {
   double plate_shift_s = 0.0;  ///< Sync::Fixed: added to the plates' times (+: the plates led the markers)
   /// How each stance's onset and offset are timed (StanceValidation::onset_error_ms): Crossing,
   /// the threshold's crossings of the estimate and of the plate; Ramp, the loading and unloading
-  /// ramps' zero intercepts of both (loading_ramp_onset), which a zero-lag low-pass filter moves a
-  /// third to two thirds as much; Auto, the ramps on the stances of a plate filtered before export
-  /// (step 7: PlateOnsetRise::filtered), the crossings elsewhere. A raw plate's crossing is the
-  /// foot's contact; a filtered export's leads it by the filter's spread (25-28 ms on the
-  /// development data's .mot files), which an onset compared with it would read as the estimate's.
+  /// ramps' zero intercepts of both (loading_ramp_onset); Auto, the loading ramp for the onsets of
+  /// the stances on a plate filtered before export (step 7: PlateOnsetRise::filtered), the
+  /// crossings for every other onset and every offset. A raw plate's crossing is the foot's
+  /// contact; a filtered export's leads it by the filter's spread, which an onset compared with it
+  /// would read as the estimate's lateness. Measured on the raw-plate walks exported through 6 Hz
+  /// (`kin2grf study plate-export`; docs/METHOD-NOTES.md, session 44): the export moves the onsets
+  /// timed by the crossings 23-25 ms, by the ramps 8 ms; the offsets by the crossings 5 ms, by the
+  /// ramps 8 (a push-off unloads smoothly: little for a filter to spread), so offsets keep theirs.
   enum class Timing { Auto, Crossing, Ramp } timing = Timing::Auto;
 };
 
@@ -243,9 +246,10 @@ struct StanceValidation {
   double foot_length_m = std::numeric_limits<double>::quiet_NaN();
   ComponentMetrics metrics;
   /// Contact timing, estimate - plate (ms; + = late): the threshold's crossings or, when
-  /// timed_by_ramp, the loading and unloading ramps' zero intercepts (ValidationOptions::Timing).
+  /// onset_by_ramp (offset_by_ramp), the loading (unloading) ramp's zero intercepts
+  /// (ValidationOptions::Timing).
   std::optional<double> onset_error_ms, offset_error_ms;
-  bool timed_by_ramp = false;
+  bool onset_by_ramp = false, offset_by_ramp = false;
   /// Both timings, whichever scores the stance: the threshold's crossings of both series, and the
   /// ramps' intercepts of both (loading_ramp_onset, unloading_ramp_offset).
   std::optional<double> onset_crossing_error_ms, offset_crossing_error_ms, onset_ramp_error_ms, offset_ramp_error_ms;
