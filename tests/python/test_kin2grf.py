@@ -151,6 +151,18 @@ def test_validate_compares_the_example_plates(example):
     assert shifted["sync"]["applied_shift_ms"] == pytest.approx(20.0)
     with pytest.raises(kin2grf.InputError, match="--sync"):
         kin2grf.validate(example / "example_walk.c3d", sync="sometimes")
+    # How onsets are timed: by default, each stance says which reference timed it; "ramp" times all
+    # by the ramps, with the crossings' figures kept beside.
+    for s in v["per_foot"]:
+        assert s["timing_ms"]["onset_timed_by"] in ("crossing", "ramp")
+        assert s["timing_ms"]["offset_timed_by"] == "crossing"
+    ramped = kin2grf.validate(example / "example_walk.c3d", timing="ramp")
+    assert ramped["settings"]["timing"] == "ramp"
+    for s in ramped["per_foot"]:
+        assert s["timing_ms"]["onset_timed_by"] == "ramp" and s["timing_ms"]["offset_timed_by"] == "ramp"
+        assert s["timing_ms"]["onset"] == s["timing_ms"]["onset_ramp"]
+    with pytest.raises(kin2grf.InputError, match="--timing"):
+        kin2grf.validate(example / "example_walk.c3d", timing="sometimes")
     assert isinstance(v["estimate"], kin2grf.Estimate)
     with pytest.raises(kin2grf.InputError, match="no force plates"):
         kin2grf.validate(example / "example_walk.trc", mass=70)
