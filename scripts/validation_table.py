@@ -471,8 +471,9 @@ for a, name, _ in rows:
 if any(onsets.values()):
     m = lambda xs: f"{statistics.mean(xs):.0f} ms ({len(xs)} stances)" if xs else "-"
     print(f"\nOnset and offset ms: + = the estimate's contact begins (ends) after the plate's. * the plate's signal was "
-          f"low-pass filtered before export (validate's step 7: it rises from 0.2 to 20 N over more than 15 ms, or carries "
-          f"under 0.05 N RMS above 50 Hz under load, where a raw plate's noise is 0.2 N or more): a filtered signal's 20 N "
+          f"low-pass filtered before export (validate's step 7: it carries under 0.05 N RMS above 50 Hz under load, where a "
+          f"raw plate's noise is 0.2 N or more, or, sampled under 250 Hz, rises from 0.2 to 20 N over more than 15 ms): a "
+          f"filtered signal's 20 N "
           f"crossings lead the foot's contact by the filter's spread, so its stances' onsets are timed by the loading ramp's "
           f"zero intercept (20-80 % of the peak, the same rule on the estimate; since session 44), the threshold crossing's "
           f"figure in brackets; offsets by the crossings (a push-off unloads smoothly: the export moves them little). ** set to "

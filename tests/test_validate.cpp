@@ -624,7 +624,7 @@ TEST(SharedValidate, APlateClockShiftedBy40msIsFoundOnARecordedWalk) {
 // the same signal low-pass filtered before export creeps there over tens of ms and has no noise
 // left above 50 Hz, and is said to be filtered; an export set to zero below 20 N steps from exact
 // zeros and is said to be thresholded (and filtered, when its noise is gone); a plate never at its
-// floor (an offset) has no rise to measure.
+// floor (an offset) has no rise to measure; a soft landing's slow rise does not outvote its noise.
 TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
   const double rate = 1000.0;
   const Eigen::Index n = 2000;
@@ -652,8 +652,14 @@ TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
   const Eigen::VectorXd offset = (raw.array() + 5.0).matrix();  // an unzeroed plate: 5 N before any contact
   // The raw signal set to zero under 20 N, unfiltered: its crossings are the threshold's own.
   const Eigen::VectorXd raw_thresholded = raw.unaryExpr([](double x) { return x < 20.0 ? 0.0 : x; });
+  // A raw plate under a very soft landing (0.8 N/ms: a slow walker's flat foot), its noise kept.
+  Eigen::VectorXd soft(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / rate;
+    soft[i] = std::min(700.0, std::max(0.0, 800.0 * (t - 0.5))) * (t < 1.6 ? 1.0 : 0.0) + noise(rng);
+  }
   for (const auto& [name, f] : {std::pair{"raw", raw}, {"filtered", filtered}, {"thresholded", thresholded}, {"offset", offset},
-                                {"raw thresholded", raw_thresholded}}) {
+                                {"raw thresholded", raw_thresholded}, {"soft", soft}}) {
     ForcePlate p;
     p.name = name;
     p.force_N = Eigen::MatrixX3d::Zero(n, 3);
@@ -661,7 +667,7 @@ TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
     rec.plates.push_back(p);
   }
   const auto r = plate_onset_rises(rec, Eigen::Vector3d::UnitZ(), 20.0);
-  ASSERT_EQ(r.size(), 5u);
+  ASSERT_EQ(r.size(), 6u);
   EXPECT_EQ(r[0].onsets, 2);
   EXPECT_LT(r[0].rise_ms, 10.0);
   EXPECT_GT(r[0].high_frequency_rms_N, 0.5);  // its noise, above 50 Hz
@@ -685,6 +691,10 @@ TEST(Validate, APlatesFilteredOrThresholdedExportIsToldFromItsOnsets) {
   // Thresholded, unfiltered: said to be thresholded, not filtered.
   EXPECT_TRUE(r[4].zero_below_threshold);
   EXPECT_FALSE(r[4].filtered()) << r[4].high_frequency_rms_N;
+  // A soft landing rises as slowly as a filtered strike, but its noise says raw, and the noise decides.
+  EXPECT_TRUE(r[5].filtered_by_rise()) << r[5].rise_ms;
+  EXPECT_FALSE(r[5].filtered_by_noise());
+  EXPECT_FALSE(r[5].filtered());
   // Upside down (a plate whose up is -z in its lab): no onsets, nothing claimed.
   const auto flipped = plate_onset_rises(rec, -Eigen::Vector3d::UnitZ(), 20.0);
   EXPECT_EQ(flipped[0].onsets, 0);

@@ -864,7 +864,8 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
         : o.timing == ValidationOptions::Timing::Crossing ? "; its stances are timed by the threshold's crossings (--timing crossing)"
                                                           : "";
     if (r.filtered()) {
-      if (r.filtered_by_rise())
+      // The sign that decided (PlateOnsetRise::filtered): the noise where measured, else the rise.
+      if (!std::isfinite(r.high_frequency_rms_N))
         std::snprintf(b, sizeof b,
                       "plate %s: its vertical force takes a median %.0f ms to rise from %.1f to %.0f N at its %d onset(s) (a raw plate's "
                       "signal takes a few ms at a foot strike): it looks low-pass filtered before export, so its threshold crossings "

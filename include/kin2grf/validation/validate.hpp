@@ -46,6 +46,7 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <string>
@@ -143,7 +144,8 @@ struct SyncEstimate {
 /// Step 7: whether a plate's signal was low-pass filtered before export, from its own samples. A
 /// filtered signal's threshold crossings lead the foot's contact (and lag its lift-off) by the
 /// filter's spread, which an onset compared with them would read as the estimate's lateness
-/// (ValidationOptions::Timing). Either of two signs tells it:
+/// (ValidationOptions::Timing). Two signs tell it, the noise where it can be measured, the rise
+/// elsewhere (a raw plate under a soft landing rises slowly and keeps its noise):
 /// - The rise. A raw plate's signal leaves its noise (about 1 N) for the threshold within a few
 ///   ms at a foot strike: from a hundredth of the threshold to the threshold (both crossings
 ///   interpolated between samples) in 0.5-10 ms on the development trials' C3D analog channels and
@@ -180,7 +182,8 @@ struct PlateOnsetRise {
   bool zero_below_threshold = false;
   [[nodiscard]] bool filtered_by_rise() const { return onsets > 0 && rise_ms > kFilteredRiseMs; }
   [[nodiscard]] bool filtered_by_noise() const { return high_frequency_rms_N < kRawNoiseFloorN; }
-  [[nodiscard]] bool filtered() const { return filtered_by_rise() || filtered_by_noise(); }
+  /// By its noise where measured, by its rise elsewhere.
+  [[nodiscard]] bool filtered() const { return std::isfinite(high_frequency_rms_N) ? filtered_by_noise() : filtered_by_rise(); }
 };
 /// Each plate's onsets in `rec` (vertical: the force along `up`, lab frame).
 std::vector<PlateOnsetRise> plate_onset_rises(const ForcePlateRecording& rec, const Eigen::Vector3d& up, double threshold_N);
