@@ -745,7 +745,7 @@ ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateR
   v.first_frame_number = e.first_frame_number;
   const Eigen::Index n = e.time_s.size();
   v.plates = resample_plates(rec, e.frame, e.time_s, rec.cop_threshold_N, e.first_index);
-  // Step 7 first: a plate's rise decides how its stances are timed. A time shift does not change it.
+  // Step 7 first: a plate's noise and rise decide how its onsets are timed. A time shift does not change them.
   v.plate_onsets = plate_onset_rises(rec, e.frame.up, o.threshold_N);
   for (int f = 0; f < 2; ++f) {
     v.measured_force_N[static_cast<std::size_t>(f)] = Eigen::MatrixX2d::Constant(n, 2, kNaN);
