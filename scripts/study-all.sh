@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 DATA=${1:-../shared/data}
 shift || true
 KINDS=("$@")
-[ ${#KINDS[@]} -gt 0 ] || KINDS=(r ground-shift cutoff post-cutoff-cycles kinematic-cutoff speed-gate speed-gate-ratio noise marker-rate marker-labels min-kinematic-cycles split-distance torso-length torso-lag thigh-lag torso-vertical-cutoff running-sway-gain double-support-sta double-support-angle foot-model)
+[ ${#KINDS[@]} -gt 0 ] || KINDS=(r ground-shift cutoff post-cutoff-cycles kinematic-cutoff speed-gate speed-gate-ratio noise marker-rate marker-labels min-kinematic-cycles split-distance torso-length torso-lag thigh-lag torso-vertical-cutoff running-sway-gain double-support-sta double-support-angle foot-model plate-export)
 [ -d "$DATA" ] || { echo "study-all: no data folder $DATA" >&2; exit 1; }
 cmake --preset release >/dev/null
 cmake --build --preset release >/dev/null
