@@ -20,7 +20,9 @@
 // 4. Per stance: vertical and anterior GRF, COP along progression (frames loaded above
 //    cop_min_force_fraction of body weight: a barely loaded plate's COP is noise), and the
 //    sagittal moment about the plate centre (without geometry: about the stance's mean
-//    measured COP). Contact onset/offset: threshold crossings, interpolated, estimate - plate.
+//    measured COP). Contact onset/offset, estimate - plate: threshold crossings, interpolated;
+//    the onsets on a plate filtered before export (step 7) by the loading ramp's zero intercept
+//    (ValidationOptions::Timing).
 //    Registration check: under more than half the body weight a foot's COP lies between its heel
 //    and toe markers, which sit within 1-2 cm of the sole's ends, except briefly at push-off. When
 //    the median over those frames of the plate COP's distance beyond that span exceeds
@@ -38,9 +40,10 @@
 //    centre on a treadmill).
 // 6. The marker-plate time offset (SyncEstimate, below), reported always; applied only when
 //    asked (ValidationOptions::sync).
-// 7. How each plate's signal rises at its onsets (PlateOnsetRise, below): a plate exported after
-//    low-pass filtering, or set to zero below a threshold, moves the onsets the estimate's are
-//    compared with; said in `notes`, never corrected.
+// 7. Whether each plate was low-pass filtered before export, from its noise or its rise
+//    (PlateOnsetRise, below): such a plate's threshold crossings lead the contact, so its onsets
+//    are timed by the loading ramp (step 4), with a note; one set to zero below a threshold is
+//    said in `notes`. The plates' forces are never altered.
 #pragma once
 
 #include <Eigen/Dense>
