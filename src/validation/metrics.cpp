@@ -74,6 +74,9 @@ double peak_over(const Eigen::VectorXd& v, Eigen::Index from, Eigen::Index to) {
     if (std::isfinite(v[i]) && !(v[i] <= peak)) peak = v[i];
   return peak;
 }
+/// Where the line through (t_lo, lo) and (t_hi, hi) (fractions of a peak) reaches zero; both ramps
+/// take it, the loading one with t_hi after t_lo, the unloading one before.
+double zero_intercept(double t_lo, double t_hi, double lo, double hi) { return t_lo - (t_hi - t_lo) * lo / (hi - lo); }
 }  // namespace
 
 std::optional<double> loading_ramp_onset(const Eigen::VectorXd& v, const Eigen::VectorXd& t, Eigen::Index from, Eigen::Index mid,
@@ -82,7 +85,7 @@ std::optional<double> loading_ramp_onset(const Eigen::VectorXd& v, const Eigen::
   if (!(peak > 0) || !(hi > lo)) return std::nullopt;
   const auto t_lo = rising_crossing(v, t, lo * peak, from, to), t_hi = rising_crossing(v, t, hi * peak, from, to);
   if (!t_lo || !t_hi || !(*t_hi > *t_lo)) return std::nullopt;
-  return *t_lo - (*t_hi - *t_lo) * lo / (hi - lo);
+  return zero_intercept(*t_lo, *t_hi, lo, hi);
 }
 
 std::optional<double> unloading_ramp_offset(const Eigen::VectorXd& v, const Eigen::VectorXd& t, Eigen::Index from, Eigen::Index mid,
@@ -91,7 +94,7 @@ std::optional<double> unloading_ramp_offset(const Eigen::VectorXd& v, const Eige
   if (!(peak > 0) || !(hi > lo)) return std::nullopt;
   const auto t_lo = falling_crossing(v, t, lo * peak, from, to), t_hi = falling_crossing(v, t, hi * peak, from, to);
   if (!t_lo || !t_hi || !(*t_lo > *t_hi)) return std::nullopt;
-  return *t_lo + (*t_lo - *t_hi) * lo / (hi - lo);
+  return zero_intercept(*t_lo, *t_hi, lo, hi);
 }
 
 }  // namespace kin2grf

@@ -739,14 +739,16 @@ std::optional<SyncEstimate> estimate_sync(const EstimateResult& e, const Validat
   return s;
 }
 
-ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateRecording& rec, const ValidationOptions& o) {
+/// `rises`: step 7 on `rec` (plate_onset_rises), made first because a plate's noise and rise
+/// decide how its onsets are timed, and made once: a time shift of the plates does not change it.
+ValidationResult validate_as_recorded(const EstimateResult& e, const ForcePlateRecording& rec, const ValidationOptions& o,
+                                      const std::vector<PlateOnsetRise>& rises) {
   ValidationResult v;
   v.mass_kg = e.mass_kg;
   v.first_frame_number = e.first_frame_number;
   const Eigen::Index n = e.time_s.size();
   v.plates = resample_plates(rec, e.frame, e.time_s, rec.cop_threshold_N, e.first_index);
-  // Step 7 first: a plate's noise and rise decide how its onsets are timed. A time shift does not change them.
-  v.plate_onsets = plate_onset_rises(rec, e.frame.up, o.threshold_N);
+  v.plate_onsets = rises;
   for (int f = 0; f < 2; ++f) {
     v.measured_force_N[static_cast<std::size_t>(f)] = Eigen::MatrixX2d::Constant(n, 2, kNaN);
     v.measured_cop_x_m[static_cast<std::size_t>(f)] = Eigen::VectorXd::Constant(n, kNaN);
@@ -831,7 +833,8 @@ std::vector<PlateOnsetRise> plate_onset_rises(const ForcePlateRecording& rec, co
 }
 
 ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& rec, const ValidationOptions& o) {
-  ValidationResult v = validate_as_recorded(e, rec, o);
+  const std::vector<PlateOnsetRise> rises = plate_onset_rises(rec, e.frame.up, o.threshold_N);
+  ValidationResult v = validate_as_recorded(e, rec, o, rises);
   const std::optional<SyncEstimate> sync = estimate_sync(e, v, o.threshold_N);
   double shift = 0.0;
   if (o.sync == ValidationOptions::Sync::Fixed) shift = o.plate_shift_s;
@@ -840,7 +843,7 @@ ValidationResult validate(const EstimateResult& e, const ForcePlateRecording& re
   if (shift != 0.0) {
     ForcePlateRecording shifted = rec;
     shifted.time_s.array() += shift;
-    v = validate_as_recorded(e, shifted, o);
+    v = validate_as_recorded(e, shifted, o, rises);
     std::snprintf(b, sizeof b, "compared with the plates shifted by %+.1f ms (%s)", 1000 * shift,
                   o.sync == ValidationOptions::Sync::Auto ? "--sync auto: the estimated marker-plate offset" : "--sync");
     v.notes.emplace_back(b);

@@ -1,6 +1,7 @@
 #include "kin2grf/workflow/batch.hpp"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <atomic>
 #include <cctype>
@@ -15,6 +16,7 @@
 #include <sstream>
 #include <system_error>
 #include <thread>
+#include <utility>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/output_file.hpp"
@@ -99,19 +101,24 @@ void parse_sync(const std::string& text, ValidationOptions& vo) {
   }
 }
 
+namespace {
+/// --timing's names, one table for the parser and the settings JSON.
+constexpr std::array<std::pair<const char*, ValidationOptions::Timing>, 3> kTimingNames{
+    {{"auto", ValidationOptions::Timing::Auto}, {"crossing", ValidationOptions::Timing::Crossing}, {"ramp", ValidationOptions::Timing::Ramp}}};
+}  // namespace
+
 void parse_timing(const std::string& text, ValidationOptions& vo) {
-  if (text == "auto") vo.timing = ValidationOptions::Timing::Auto;
-  else if (text == "crossing") vo.timing = ValidationOptions::Timing::Crossing;
-  else if (text == "ramp") vo.timing = ValidationOptions::Timing::Ramp;
-  else throw InputError("--timing " + text + ": must be auto, crossing or ramp");
+  for (const auto& [name, timing] : kTimingNames)
+    if (text == name) {
+      vo.timing = timing;
+      return;
+    }
+  throw InputError("--timing " + text + ": must be auto, crossing or ramp");
 }
 
 const char* timing_name(ValidationOptions::Timing timing) {
-  switch (timing) {
-    case ValidationOptions::Timing::Crossing: return "crossing";
-    case ValidationOptions::Timing::Ramp: return "ramp";
-    case ValidationOptions::Timing::Auto: break;
-  }
+  for (const auto& [name, t] : kTimingNames)
+    if (t == timing) return name;
   return "auto";
 }
 
