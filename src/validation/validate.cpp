@@ -369,7 +369,8 @@ void stance_timing(const EstimateResult& e, const MeasuredPlate& mp, const Candi
   const auto m_on = rising_crossing(pv, e.time_s, o.threshold_N, a - 1, c.run.last);
   const auto m_off = falling_crossing(pv, e.time_s, o.threshold_N, a, c.run.last + 1);
   const Eigen::Index from = std::max<Eigen::Index>(0, a - search), to = std::min<Eigen::Index>(n - 1, c.run.last + search);
-  const Eigen::Index mid = (a + c.run.last) / 2;
+  // The first peak is looked for before mid, the last from it: the one rule for halves.
+  const Eigen::Index mid = stance_second_half(a, c.run.last);
   const auto ms = [](double estimated_s, double measured_s) { return 1000 * (estimated_s - measured_s); };
   // Only where the estimate was unloaded at the search's start (end): its rise (fall) is in it.
   if (!(ev[from] > o.threshold_N)) {
