@@ -22,6 +22,16 @@ def load(name, config):
 def f1(x):
     return "-" if x is None else f"{x:.1f}"
 
+def grm_cell(t):
+    """The total GRM's rRMSE with its RMSE in N m and the range it divides by (Eq. 12: the mean of
+    the two series' ranges) beside it: a window of single support spans a few tens of N m, where a
+    few N m read as many percent."""
+    r = t["rrmse_percent"]["moment"]
+    e = (t.get("rmse") or {}).get("moment_Nm")
+    if r is None or e is None:
+        return f1(r)
+    return f"{f1(r)} ({e:.0f} N m, range {e / (r / 100):.0f})" if r > 0 else f1(r)
+
 
 def mean_sd(xs):
     xs = [x for x in xs if x is not None]
@@ -429,6 +439,11 @@ def timing_cell(j, s, key):
 
 
 print("## Per trial and foot (defaults)\n")
+print("A trial's total row gives the whole body's vertical and anterior force and, in the moment column, the total GRM about "
+      "validate's reference: its rRMSE, then its RMSE in N m and the range Eq. 12 divides by (the mean of the estimate's and "
+      "the plates' ranges; since session 45). A window of single support spans a few tens of N m (Plug-in Gait's flat-foot "
+      "walk, UWA's walks), where a few N m read as many percent, and one or two frames at a window's edge can carry most of "
+      "the error (walking5: docs/METHOD-NOTES.md, session 45).\n")
 print("| activity | trial | foot | plate | frames | vertical | vertical, loaded span | anterior | COP | moment | vertical RMSE %BW | onset ms | offset ms | lag ms | `--paper` vertical / anterior / COP |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 for a, name, _ in rows:
@@ -452,7 +467,7 @@ for a, name, _ in rows:
         pt = p["total"]
         paper = "-" if pt is None else f"GRM {f1(pt['rrmse_percent']['moment'])}"
         print(f"| {a} | {name} | total | GRM | {t['frames_compared']} frames | {f1(t['rrmse_percent']['vertical'])} | | "
-              f"{f1(t['rrmse_percent']['anterior'])} | | {f1(t['rrmse_percent']['moment'])} | | | | | {paper} |")
+              f"{f1(t['rrmse_percent']['anterior'])} | | {grm_cell(t)} | | | | | {paper} |")
 
 onsets = {"raw": [], "filtered": [], "filtered_crossing": [], "thresholded": []}
 for a, name, _ in rows:

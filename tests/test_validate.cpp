@@ -428,6 +428,17 @@ TEST(SyntheticWalk, PlatesCarryTheKinematicTotalsOneStanceEach) {
   EXPECT_GT(v.total->frames.size(), 50u);
   // The totals agree up to the post-filter: the plates carry the kinematic totals.
   EXPECT_LT(v.total->metrics.vertical->rrmse_percent, 8.0);
+  // The text's total row gives the GRM's RMSE in N m and the range its rRMSE divides by (Eq. 12),
+  // which a window of single support makes small.
+  ASSERT_TRUE(v.total->metrics.moment);
+  const auto& g = *v.total->metrics.moment;
+  char expected[96];
+  std::snprintf(expected, sizeof expected, "GRM RMSE %.1f N m of a %.0f N m range", g.rmse, g.rmse / (g.rrmse_percent / 100));
+  const std::string table = kin2grf::format_validation_table("walk", v);
+  const auto row = table.find("total, GRM");
+  ASSERT_NE(row, std::string::npos) << table;
+  EXPECT_NE(table.substr(row, table.find('\n', row) - row).find(expected), std::string::npos) << table;
+  EXPECT_GT(g.rmse, 0.0);
 }
 
 // Issue 28's synthetic 3D walk: the example walk with a narrower step, a 2.5 cm sway toward the

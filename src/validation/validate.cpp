@@ -1348,6 +1348,17 @@ void format_joint_moment_rows(std::ostream& os, const ValidationResult& v, const
   os << table_label("per foot, mean; peaks |error|") << cell(m.knee_sagittal, "") << cell(m.knee_adduction, "")
      << cell(m.kam_peak_error_percent[0], " %") << cell(m.kam_peak_error_percent[1], " %") << "\n";
 }
+
+/// The total GRM row's tail: its RMSE in N m and the range Eq. 12 divides by (the mean of the
+/// estimate's and the plates' ranges). A window of single support spans a few tens of N m, where a
+/// few N m read as many percent; the N m say which.
+std::string total_grm_note(const TotalValidation& t) {
+  const auto& m = t.metrics.moment;
+  if (!m || !(m->rrmse_percent > 0)) return "";
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "   GRM RMSE %.1f N m of a %.0f N m range", m->rmse, m->rmse / (m->rrmse_percent / 100));
+  return buf;
+}
 }  // namespace
 
 std::string format_validation_table(const std::string& trial, const ValidationResult& v) {
@@ -1452,7 +1463,7 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
   if (std::isfinite(m.knee_adduction)) format_joint_moment_rows(os, v, m, v.mass_kg);
   if (v.total)
     os << table_label("total, GRM (" + std::to_string(v.total->frames.size()) + " frames)") << table_cell(v.total->metrics.vertical)
-       << table_cell(v.total->metrics.anterior) << table_text("-") << table_cell(v.total->metrics.moment) << "\n";
+       << table_cell(v.total->metrics.anterior) << table_text("-") << table_cell(v.total->metrics.moment) << total_grm_note(*v.total) << "\n";
   os << table_label("paper, Table 1 (24 gait)") << table_text("4.1 (1.1)") << table_text("11.2 (1.7)") << table_text("-") << table_text("5.3 (1.1)") << "\n";
   os << table_label("Fluit et al. (paper's Tab. 1)") << table_text("2.7") << table_text("9.3") << table_text("-") << table_text("7.4") << "\n";
   if (v.sync) {
