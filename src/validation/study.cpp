@@ -281,11 +281,18 @@ ForcePlateRecording exported_plates(ForcePlateRecording rec, double cutoff_hz) {
 /// What the COP owes to a toe marker (a lab whose set has none): every trial as recorded, and with
 /// each hallux landmark made of a marker replaced by the presets' virtual toes (kVirtualToeShare of
 /// the ankle-MT length). Trials whose sets have virtual toes already are the same in both rows.
+/// A third row removes the trunk and arm markers too (without_trunk_markers).
 std::vector<Setting> toe_ablation_settings() {
   std::vector<Setting> s{{"as recorded", 0, [](EstimateOptions&) {}, 0.0, true}};
   Setting c{"toe markers removed", 1, [](EstimateOptions&) {}};
   c.virtual_toes = kVirtualToeShare;
-  s.push_back(std::move(c));
+  s.push_back(c);
+  // The sets the held-out labs use most (lower-body Plug-in Gait, Helen-Hayes): no trunk, arm or
+  // toe markers. Both ablations at once, since their costs need not add up.
+  Setting lower{"lower body, virtual toes", 2, [](EstimateOptions&) {}};
+  lower.virtual_toes = kVirtualToeShare;
+  lower.without_trunk = true;
+  s.push_back(std::move(lower));
   return s;
 }
 

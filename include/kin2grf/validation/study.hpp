@@ -14,7 +14,9 @@
 //                 pooled (robustness)
 //   marker-gaps   the heel or the MT markers lost for 0.2 s at every plate stance, the rigid fill
 //                 off and on (robustness to occlusions)
-//   toe-ablation  each toe marker replaced by virtual toes (a lab whose set has none)
+//   toe-ablation  each toe marker replaced by virtual toes (a lab whose set has none), then with the
+//                 trunk and arm markers removed too (a lower-body clinical set: Plug-in Gait lower
+//                 body, Helen-Hayes)
 //   plate-export  the plates through a 6 and a 10 Hz zero-lag low-pass, as a filtered GRF export,
 //                 timed by the threshold's crossings and by validate's default (its timing, not the
 //                 estimate, is what moves)
