@@ -49,11 +49,17 @@ std::string rendered_dom(const std::string& browser, const std::filesystem::path
 }  // namespace
 
 TEST(Report, RendersInHeadlessChromium) {
-  const std::string browser = chromium();
-  if (browser.empty()) GTEST_SKIP() << "no Chromium found (scripts/setup.sh installs Debian's chromium)";
   const auto s = synthetic_with_exact_plates();
   const auto v = validate(s.estimate, s.plates);
   const auto j = validation_json("synthetic", s.estimate, v, nlohmann::json::object());
+  // The total row gives the GRM's RMSE in N m beside its rRMSE.
+  ASSERT_TRUE(v.total && v.total->metrics.moment);
+  const std::string page = validation_report_html("synthetic", s.estimate, v, j);
+  const auto total = page.find("<td class=l>total</td>");
+  ASSERT_NE(total, std::string::npos);
+  EXPECT_NE(page.substr(total, page.find("</tr>", total) - total).find(" N m)</td>"), std::string::npos);
+  const std::string browser = chromium();
+  if (browser.empty()) GTEST_SKIP() << "no Chromium found (scripts/setup.sh installs Debian's chromium)";
   const auto dir = test::temp_dir("report");
   const auto html = dir / "report.html";
   write_file_text(html.string(), validation_report_html("synthetic", s.estimate, v, j));

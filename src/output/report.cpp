@@ -177,7 +177,8 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
     const auto& s = j["total"];
     t << "<tr><td class=l>total</td><td class=l>GRM</td><td>" << s["frames_compared"] << " frames</td><td>"
       << fmt(s["rrmse_percent"]["vertical"]) << "</td><td>" << fmt(s["rrmse_percent"]["anterior"]) << "</td><td>-</td><td>"
-      << fmt(s["rrmse_percent"]["moment"]) << "</td><td>" << fmt(s["rmse"]["vertical_N"]) << "</td><td>"
+      // The GRM's RMSE in N m beside its rRMSE: a window of single support spans a few tens of N m.
+      << fmt(s["rrmse_percent"]["moment"]) << " (" << fmt(s["rmse"]["moment_Nm"]) << " N m)</td><td>" << fmt(s["rmse"]["vertical_N"]) << "</td><td>"
       << fmt(s["rmse"]["anterior_N"]) << "</td><td>-</td><td>" << fmt(s["r"]["vertical"], "%.3f") << "</td><td></td><td></td><td></td></tr>\n";
   }
   t << "<tr><td class=l colspan=3>paper, Table 1 (24 gait trials)</td><td>4.1 (1.1)</td><td>11.2 (1.7)</td><td>-</td>"
