@@ -74,27 +74,30 @@ double peak_over(const Eigen::VectorXd& v, Eigen::Index from, Eigen::Index to) {
     if (std::isfinite(v[i]) && !(v[i] <= peak)) peak = v[i];
   return peak;
 }
-/// Where the line through (t_lo, lo) and (t_hi, hi) (fractions of a peak) reaches zero; both ramps
-/// take it, the loading one with t_hi after t_lo, the unloading one before.
-double zero_intercept(double t_lo, double t_hi, double lo, double hi) { return t_lo - (t_hi - t_lo) * lo / (hi - lo); }
+/// The ramp through v's crossings of lo and hi times `peak` in [from, to], extended to zero: the
+/// rising crossings with t_hi after t_lo (`loading`), else the falling ones with t_hi before.
+/// nullopt without a positive peak, either crossing, or that order.
+std::optional<double> ramp_zero(const Eigen::VectorXd& v, const Eigen::VectorXd& t, double peak, Eigen::Index from, Eigen::Index to,
+                                double lo, double hi, bool loading) {
+  if (!(peak > 0) || !(hi > lo)) return std::nullopt;
+  const auto crossing = [&](double level) {
+    return loading ? rising_crossing(v, t, level * peak, from, to) : falling_crossing(v, t, level * peak, from, to);
+  };
+  const auto t_lo = crossing(lo), t_hi = crossing(hi);
+  if (!t_lo || !t_hi || !(loading ? *t_hi > *t_lo : *t_lo > *t_hi)) return std::nullopt;
+  // Where the line through (t_lo, lo) and (t_hi, hi) reaches zero.
+  return *t_lo - (*t_hi - *t_lo) * lo / (hi - lo);
+}
 }  // namespace
 
 std::optional<double> loading_ramp_onset(const Eigen::VectorXd& v, const Eigen::VectorXd& t, Eigen::Index from, Eigen::Index mid,
                                          Eigen::Index to, double lo, double hi) {
-  const double peak = peak_over(v, from, mid);
-  if (!(peak > 0) || !(hi > lo)) return std::nullopt;
-  const auto t_lo = rising_crossing(v, t, lo * peak, from, to), t_hi = rising_crossing(v, t, hi * peak, from, to);
-  if (!t_lo || !t_hi || !(*t_hi > *t_lo)) return std::nullopt;
-  return zero_intercept(*t_lo, *t_hi, lo, hi);
+  return ramp_zero(v, t, peak_over(v, from, mid), from, to, lo, hi, true);
 }
 
 std::optional<double> unloading_ramp_offset(const Eigen::VectorXd& v, const Eigen::VectorXd& t, Eigen::Index from, Eigen::Index mid,
                                             Eigen::Index to, double lo, double hi) {
-  const double peak = peak_over(v, mid, to);
-  if (!(peak > 0) || !(hi > lo)) return std::nullopt;
-  const auto t_lo = falling_crossing(v, t, lo * peak, from, to), t_hi = falling_crossing(v, t, hi * peak, from, to);
-  if (!t_lo || !t_hi || !(*t_lo > *t_hi)) return std::nullopt;
-  return zero_intercept(*t_lo, *t_hi, lo, hi);
+  return ramp_zero(v, t, peak_over(v, mid, to), from, to, lo, hi, false);
 }
 
 }  // namespace kin2grf
