@@ -49,7 +49,7 @@ for kind in speed-gate-ratio r split-distance torso-length torso-lag post-cutoff
   echo "cross-validated $kind"
 done
 # The walking COP function: the built-in one beside a refit without each trial's lab.
-$BIN fit-cop --trial-list "$OUT/trials.txt" --activity walking --fit-angles --leave-one-out -o "$OUT/cv-cop-function.json" \
+$BIN fit-cop --trial-list "$OUT/trials.txt" --activity walking --fit-angles --fit-com --leave-one-out -o "$OUT/cv-cop-function.json" \
   >"$OUT/cv-cop-function.txt" 2>/dev/null
 echo "cross-validated the COP function"
 /usr/bin/python3 scripts/validation_table.py "$OUT" "$DATA" "$(git rev-parse --short HEAD)$(git diff --quiet HEAD -- src include data || echo '+local changes')" >"$OUT/VALIDATION.md"

@@ -203,6 +203,48 @@ TEST(Contact, GroundLevelIsTheLabFloorUnlessTheFeetSayOtherwise) {
   EXPECT_NEAR(estimate_ground_level(lifted(-0.30)).level_m, -0.30 + lowest, 0.01) << "the origin above the floor";
 }
 
+// Model 2's COP follows the body over the foot (kin2grf's centre-of-mass term, session 46): in one
+// frame, the same foot at the same angle with the body's centre of mass moved forward puts the COP
+// further along the sole by the gain times the move in sole lengths; with a gain of 0 (the
+// paper's function) it stays where the angle puts it. The failure it guards: a foot-flat in
+// which the body rolls over the foot while the angle, and with it the COP, stands still.
+TEST(Contact, TheCopFollowsTheBodysCentreOfMassOverTheFoot) {
+  const Trial t = make_synthetic_trial({});
+  const auto r = run({});
+  const Model& model = r.model();
+  const ModelMotion motion = compute_motion(model, synthetic_landmarks(t), 6.0);
+  double mass = 0.0;
+  for (const Body& b : model.bodies) mass += b.mass_kg;
+  const double shift = 0.05, com_shift = model.bodies[kTorso].mass_kg / mass * shift;  // the torso moved 5 cm forward
+  for (const CopFunction& F : {CopFunction{}, CopFunction::paper()}) {
+    ContactModelOptions co;
+    co.cop = F;
+    co.running_cop.reset();
+    int compared = 0;
+    for (Eigen::Index i = 0; i < motion.frames(); i += 11) {
+      MotionFrame f0 = motion.frame(i), f1 = f0;
+      f1.q(coord::com_x(kTorso)) += shift;
+      EXPECT_NEAR(whole_body_com_x(model, f1) - whole_body_com_x(model, f0), com_shift, 1e-12);
+      FrameContacts c0, c1;
+      contact_frame(model, r.calibration.contact, co, false, f0, c0);
+      contact_frame(model, r.calibration.contact, co, false, f1, c1);
+      for (int side = 0; side < 2; ++side) {
+        const auto& sp = c0.sole[static_cast<std::size_t>(side)];
+        const double L = (sp[1] - sp[0]).norm() + (sp[2] - sp[1]).norm();
+        const double s0 = c0.cop_fraction[side], s1 = c1.cop_fraction[side];
+        if (s0 <= 0.0 || s1 >= 1.25 || s0 >= 1.25) continue;  // at the sole's ends the fraction is held
+        ++compared;
+        EXPECT_NEAR(s1 - s0, F.com_gain * com_shift / L, 1e-12) << "frame " << i << " side " << side;
+        const double dx = c1.points[static_cast<std::size_t>(side)].position.x() - c0.points[static_cast<std::size_t>(side)].position.x();
+        if (F.com_gain > 0) EXPECT_GT(dx, 0.0) << "frame " << i << " side " << side;
+        else EXPECT_EQ(dx, 0.0) << "frame " << i << " side " << side;
+      }
+    }
+    EXPECT_GE(compared, 20);
+  }
+  EXPECT_GT(CopFunction{}.com_gain, 0.0);  // the default has the term
+}
+
 // The pipeline makes each frame's contacts as it solves the frame, reusing one FrameContacts and
 // one MotionFrame: they are a fresh frame's to the bit (the reused FrameContacts keeps no point
 // of the frame before), and D* goes into the reused frame as into a fresh one.

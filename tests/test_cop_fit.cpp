@@ -46,6 +46,46 @@ TEST(CopFit, RecoversTheEventPositionsOfNoiseFreeSamples) {
   EXPECT_THROW(fit_cop_function(few, CopFunction::paper()), InputError);
 }
 
+// The centre-of-mass term: samples whose COP follows the body over the foot at a known gain,
+// the body at varied places for one angle (a foot-flat in which the body rolls on). Fitted with
+// the term, the gain and the positions come back; the angle alone cannot tell those samples apart
+// and leaves an error of the term's own size.
+TEST(CopFit, RecoversTheCentreOfMassGainOfSamplesThatFollowTheBody) {
+  CopFunction truth = CopFunction::paper();
+  truth.s_hs = 0.1, truth.s_ho = 0.35, truth.s_mo = 0.7, truth.s_to = 0.95, truth.com_gain = 0.12;
+  CopSamples smp;
+  for (int k = 0; k <= 200; ++k)
+    for (double com : {-0.5, 0.0, 0.5, 1.5}) {  // within the sole: no clamp
+      const double th = -0.5 + 1.7 * k / 200.0;
+      smp.theta_rad.push_back(th);
+      smp.com_place.push_back(com);
+      smp.fraction.push_back(truth.fraction(th, com));
+    }
+  const auto fit = fit_cop_function(smp, CopFunction::paper(), true);
+  EXPECT_NEAR(fit.function.com_gain, 0.12, 1e-5);
+  EXPECT_NEAR(fit.function.s_ho, 0.35, 1e-5);
+  EXPECT_NEAR(fit.function.s_mo, 0.7, 1e-5);
+  EXPECT_LT(fit.rms_fraction, 1e-6);
+  const auto alone = fit_cop_function(smp, CopFunction::paper());
+  EXPECT_EQ(alone.function.com_gain, 0.0);
+  EXPECT_GT(alone.rms_fraction, 0.05);  // 0.12 x the places' spread (SD 0.74): about 0.09
+  // Samples without the body's place cannot fit the term.
+  CopSamples bare = smp;
+  bare.com_place.clear();
+  EXPECT_THROW((void)fit_cop_function(bare, CopFunction::paper(), true), InputError);
+}
+
+// The term's arithmetic: added to the angle's fraction, kept within the sole's 0..1.25, and off
+// (the paper's function exactly) at a gain of 0.
+TEST(CopFit, TheCentreOfMassTermAddsToTheAnglesFractionWithinTheSole) {
+  CopFunction f = CopFunction::paper();
+  EXPECT_DOUBLE_EQ(f.fraction(0.05, 3.0), f.fraction(0.05));
+  f.com_gain = 0.1;
+  EXPECT_NEAR(f.fraction(0.05, 0.8) - f.fraction(0.05, 0.0), 0.08, 1e-12);
+  EXPECT_DOUBLE_EQ(f.fraction(-1.0, -5.0), 0.0);   // the body far behind the heel: at the heel
+  EXPECT_DOUBLE_EQ(f.fraction(2.0, 10.0), 1.25);   // far ahead: the sole's end
+}
+
 TEST(CopFit, JsonRoundTripAndFieldErrors) {
   const CopFunction f = CopFunction::paper();
   const CopFunction g = cop_function_from_json(cop_function_json(f), "x.json");
@@ -63,6 +103,23 @@ TEST(CopFit, JsonRoundTripAndFieldErrors) {
   j = cop_function_json(f);
   j["delta_mo"] = 2.0;  // after delta_to
   EXPECT_THROW((void)cop_function_from_json(j, "cop.json"), InputError);
+  // The centre-of-mass gain: kept through a round trip; absent, 0 (a file of the angle alone keeps
+  // its meaning, whatever the built-in function's gain); outside 0..1 refused, naming the field.
+  CopFunction h = CopFunction::paper();
+  h.com_gain = 0.13;
+  EXPECT_DOUBLE_EQ(cop_function_from_json(cop_function_json(h), "x.json").com_gain, 0.13);
+  EXPECT_FALSE(cop_function_json(f).contains("com_gain"));
+  EXPECT_EQ(cop_function_from_json(cop_function_json(f), "x.json").com_gain, 0.0);
+  for (double bad : {-0.1, 1.5}) {
+    j = cop_function_json(h);
+    j["com_gain"] = bad;
+    try {
+      (void)cop_function_from_json(j, "cop.json");
+      FAIL() << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("com_gain"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(CopFit, BuiltInDefaultIsTheCommittedFit) {
@@ -70,9 +127,12 @@ TEST(CopFit, BuiltInDefaultIsTheCommittedFit) {
   const CopFunction f = read_cop_function(std::string(KIN2GRF_SOURCE_DIR) + "/data/cop-function/walking-fitted.json");
   const CopFunction d;
   for (auto [a, b] : {std::pair{f.delta_hs, d.delta_hs}, {f.delta_ho, d.delta_ho}, {f.delta_mo, d.delta_mo}, {f.delta_to, d.delta_to},
-                      {f.s_hs, d.s_hs}, {f.s_ho, d.s_ho}, {f.s_mo, d.s_mo}, {f.s_to, d.s_to}})
+                      {f.s_hs, d.s_hs}, {f.s_ho, d.s_ho}, {f.s_mo, d.s_mo}, {f.s_to, d.s_to}, {f.com_gain, d.com_gain}})
     EXPECT_NEAR(a, b, 5e-4);
-  // The running function likewise.
+  EXPECT_GT(d.com_gain, 0.0);
+  // The running function likewise (the angle alone).
+  EXPECT_EQ(CopFunction::running().com_gain, 0.0);
+  EXPECT_EQ(CopFunction::paper().com_gain, 0.0);
   const CopFunction fr = read_cop_function(std::string(KIN2GRF_SOURCE_DIR) + "/data/cop-function/running-fitted.json");
   const CopFunction dr = CopFunction::running();
   for (auto [a, b] : {std::pair{fr.delta_hs, dr.delta_hs}, {fr.delta_ho, dr.delta_ho}, {fr.delta_mo, dr.delta_mo},

@@ -989,6 +989,10 @@ TEST(Estimate, TheTouchdownRuleDropsTheLoadBeforeHeelStrikeAndLeavesTheHandoverA
   off.keep_all_series = on.keep_all_series = true;
   off.touchdown_stop_fraction = 0.0;
   on.touchdown_stop_fraction = 0.1;
+  // The function of the angle alone (kin2grf's default before session 46): with the default's
+  // centre-of-mass term this synthetic walk's landings take no load before their heel strikes
+  // even without the rule, which would then have nothing to drop here.
+  off.contact.cop = on.contact.cop = CopFunction{-0.20, -0.06, 0.08, 1.08, 0.138, 0.260, 0.761, 1.012, 0.0};
   ASSERT_GT(off.double_support_sta_weight, 0.0);  // the default's handover
   const EstimateResult a = estimate(w.trial, nullptr, set, off), b = estimate(w.trial, nullptr, set, on);
   const Eigen::Index n = a.time_s.size();

@@ -141,9 +141,12 @@ void contact_frame(const Model& model, const ContactCalibration& soles, const Co
       continue;
     }
     // Model 2: D at arc fraction s of A -> B -> C, at the lowest sole point's height (Eq. 2).
-    const double s = (running && o.running_cop ? *o.running_cop : o.cop).fraction(fc.foot_inclination_rad[side]);
-    fc.cop_fraction[side] = s;
+    const CopFunction& F = running && o.running_cop ? *o.running_cop : o.cop;
     const double l1 = (sp[1] - sp[0]).norm(), l2 = (sp[2] - sp[1]).norm();
+    double com_place = 0.0;
+    if (F.com_gain != 0.0 && l1 + l2 > 0) com_place = (whole_body_com_x(model, f) - sp[0].x()) / (l1 + l2);
+    const double s = F.fraction(fc.foot_inclination_rad[side], com_place);
+    fc.cop_fraction[side] = s;
     const double along = s * (l1 + l2);
     const Eigen::Vector2d on = along <= l1 ? sp[0] + (sp[1] - sp[0]) * (l1 > 0 ? along / l1 : 0.0)
                                            : sp[1] + (sp[2] - sp[1]) * (l2 > 0 ? (along - l1) / l2 : 0.0);

@@ -1,5 +1,6 @@
 #include "kin2grf/model/foot_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace kin2grf {
@@ -9,12 +10,15 @@ double half_cosine(double a, double b, double u) { return a + (b - a) * 0.5 * (1
 }  // namespace
 
 // Eq. 2's F: half-cosine HS->HO and HO->MO, linear MO->TO, constant outside.
-double CopFunction::fraction(double th) const {
-  if (th <= delta_hs) return s_hs;
-  if (th <= delta_ho) return half_cosine(s_hs, s_ho, (th - delta_hs) / (delta_ho - delta_hs));
-  if (th <= delta_mo) return half_cosine(s_ho, s_mo, (th - delta_ho) / (delta_mo - delta_ho));
-  if (th <= delta_to) return s_mo + (s_to - s_mo) * (th - delta_mo) / (delta_to - delta_mo);
-  return s_to;
+double CopFunction::fraction(double th, double com_place) const {
+  double s;
+  if (th <= delta_hs) s = s_hs;
+  else if (th <= delta_ho) s = half_cosine(s_hs, s_ho, (th - delta_hs) / (delta_ho - delta_hs));
+  else if (th <= delta_mo) s = half_cosine(s_ho, s_mo, (th - delta_ho) / (delta_mo - delta_ho));
+  else if (th <= delta_to) s = s_mo + (s_to - s_mo) * (th - delta_mo) / (delta_to - delta_mo);
+  else s = s_to;
+  if (com_gain == 0.0) return s;
+  return std::clamp(s + com_gain * com_place, 0.0, 1.25);
 }
 
 }  // namespace kin2grf

@@ -55,28 +55,38 @@ void collect_cop_samples(const EstimateResult& e, const ValidationResult& v, dou
       along = std::min(along, kMaxFraction * (l1 + l2));
       out.theta_rad.push_back(f.inclination_rad[i]);
       out.fraction.push_back(along / (l1 + l2));
+      out.com_place.push_back((whole_body_com_x(e.model(), e.motion.frame(i)) - A.x()) / (l1 + l2));
     }
   }
 }
 
-CopFit fit_cop_function(const CopSamples& smp, const CopFunction& start) {
+CopFit fit_cop_function(const CopSamples& smp, const CopFunction& start, bool fit_com) {
   const Eigen::Index n = static_cast<Eigen::Index>(smp.theta_rad.size());
   if (n < 20) throw InputError("COP fit: only " + std::to_string(n) + " samples (need 20 or more loaded plate-stance frames)");
-  Eigen::MatrixXd W(n, 4);
+  const bool with_com = smp.com_place.size() == smp.theta_rad.size();
+  if (fit_com && !with_com) throw InputError("COP fit: the samples carry no centre-of-mass place");
+  const int p = fit_com ? 5 : 4;
+  Eigen::MatrixXd W(n, p);
   Eigen::VectorXd y(n);
+  auto com = [&](Eigen::Index i) { return with_com ? smp.com_place[static_cast<std::size_t>(i)] : 0.0; };
   for (Eigen::Index i = 0; i < n; ++i) {
-    W.row(i) = weights(start, smp.theta_rad[static_cast<std::size_t>(i)]).transpose();
+    W.row(i).head<4>() = weights(start, smp.theta_rad[static_cast<std::size_t>(i)]).transpose();
     y[i] = smp.fraction[static_cast<std::size_t>(i)];
+    if (fit_com) W(i, 4) = com(i);
+    else y[i] -= start.com_gain * com(i);
   }
   // Events no sample reaches keep their starting position (a tiny ridge towards it).
   const double ridge = 1e-6;
-  Eigen::MatrixXd Wa(n + 4, 4);
-  Eigen::VectorXd ya(n + 4);
-  Wa << W, ridge * Eigen::Matrix4d::Identity();
-  ya << y, ridge * Eigen::Vector4d(start.s_hs, start.s_ho, start.s_mo, start.s_to);
-  const Eigen::Vector4d s = Wa.colPivHouseholderQr().solve(ya);
+  Eigen::MatrixXd Wa(n + p, p);
+  Eigen::VectorXd ya(n + p), s0(p);
+  s0.head<4>() = Eigen::Vector4d(start.s_hs, start.s_ho, start.s_mo, start.s_to);
+  if (fit_com) s0[4] = start.com_gain;
+  Wa << W, ridge * Eigen::MatrixXd::Identity(p, p);
+  ya << y, ridge * s0;
+  const Eigen::VectorXd s = Wa.colPivHouseholderQr().solve(ya);
   CopFit fit;
   fit.function = start;
+  if (fit_com) fit.function.com_gain = s[4];
   fit.function.s_hs = std::clamp(s[0], 0.0, kMaxFraction);
   fit.function.s_ho = std::clamp(s[1], 0.0, kMaxFraction);
   fit.function.s_mo = std::clamp(s[2], 0.0, kMaxFraction);
@@ -84,17 +94,17 @@ CopFit fit_cop_function(const CopSamples& smp, const CopFunction& start) {
   fit.samples = static_cast<int>(n);
   double e0 = 0, e1 = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
-    const double th = smp.theta_rad[static_cast<std::size_t>(i)];
-    e0 += std::pow(start.fraction(th) - y[i], 2);
-    e1 += std::pow(fit.function.fraction(th) - y[i], 2);
+    const double th = smp.theta_rad[static_cast<std::size_t>(i)], yi = smp.fraction[static_cast<std::size_t>(i)];
+    e0 += std::pow(start.fraction(th, com(i)) - yi, 2);
+    e1 += std::pow(fit.function.fraction(th, com(i)) - yi, 2);
   }
   fit.rms_fraction_before = std::sqrt(e0 / static_cast<double>(n));
   fit.rms_fraction = std::sqrt(e1 / static_cast<double>(n));
   return fit;
 }
 
-CopFit fit_cop_function_and_angles(const CopSamples& smp, const CopFunction& start) {
-  CopFit best = fit_cop_function(smp, start);
+CopFit fit_cop_function_and_angles(const CopSamples& smp, const CopFunction& start, bool fit_com) {
+  CopFit best = fit_cop_function(smp, start, fit_com);
   const double before = best.rms_fraction_before;
   for (double step : {0.08, 0.04, 0.02, 0.01}) {
     bool improved = true;
@@ -106,7 +116,7 @@ CopFit fit_cop_function_and_angles(const CopSamples& smp, const CopFunction& sta
           double* a[4] = {&f.delta_hs, &f.delta_ho, &f.delta_mo, &f.delta_to};
           *a[k] += d;
           if (!(f.delta_hs < f.delta_ho && f.delta_ho < f.delta_mo && f.delta_mo < f.delta_to)) continue;
-          const CopFit c = fit_cop_function(smp, f);
+          const CopFit c = fit_cop_function(smp, f, fit_com);
           if (c.rms_fraction < best.rms_fraction - 1e-6) {
             best = c;
             improved = true;
@@ -119,7 +129,7 @@ CopFit fit_cop_function_and_angles(const CopSamples& smp, const CopFunction& sta
 }
 
 CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const CopFunction& start, double min_force,
-                                 bool fit_angles, bool leave_one_out) {
+                                 bool fit_angles, bool leave_one_out, bool fit_com) {
   const std::size_t n = trials.size();
   std::vector<CopSamples> per(n);
   CopFitOnTrials out;
@@ -141,10 +151,13 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
       if (skip < n && lab(k) == lab(skip)) continue;
       all.theta_rad.insert(all.theta_rad.end(), per[k].theta_rad.begin(), per[k].theta_rad.end());
       all.fraction.insert(all.fraction.end(), per[k].fraction.begin(), per[k].fraction.end());
+      all.com_place.insert(all.com_place.end(), per[k].com_place.begin(), per[k].com_place.end());
     }
     return all;
   };
-  auto fit_fn = [&](const CopSamples& smp) { return fit_angles ? fit_cop_function_and_angles(smp, start) : fit_cop_function(smp, start); };
+  auto fit_fn = [&](const CopSamples& smp) {
+    return fit_angles ? fit_cop_function_and_angles(smp, start, fit_com) : fit_cop_function(smp, start, fit_com);
+  };
   out.fit = fit_fn(pooled(n));
   if (!leave_one_out) return out;
   for (std::size_t k = 0; k < n; ++k) {
@@ -201,6 +214,10 @@ std::string format_cop_fit(const CopFitOnTrials& res, const std::vector<StudyTri
   std::snprintf(b, sizeof b, "  positions (fraction) HS %.3f  HO %.3f  MO %.3f  TO %.3f   (start %.3f %.3f %.3f %.3f)\n", f.s_hs, f.s_ho,
                 f.s_mo, f.s_to, start.s_hs, start.s_ho, start.s_mo, start.s_to);
   out += b;
+  if (f.com_gain != 0.0 || start.com_gain != 0.0) {
+    std::snprintf(b, sizeof b, "  centre-of-mass gain   %.3f per sole length ahead of the heel   (start %.3f)\n", f.com_gain, start.com_gain);
+    out += b;
+  }
   std::snprintf(b, sizeof b, "  RMS of F(theta) - s: %.3f (start: %.3f)\n", res.fit.rms_fraction, res.fit.rms_fraction_before);
   out += b;
   if (!res.leave_one_out.empty()) {

@@ -197,10 +197,10 @@ int fit_cop_job(const FitCopJob& a, std::ostream& out) {
   const auto trials = study_trials(inputs);
   // Start (and, without --fit-angles, keep) the paper's event angles.
   const CopFunction start = CopFunction::paper();
-  const auto res = fit_cop_on_trials(trials, start, a.min_force, a.fit_angles, a.leave_one_out);
+  const auto res = fit_cop_on_trials(trials, start, a.min_force, a.fit_angles, a.leave_one_out, a.fit_com);
   CopFitProvenance prov;
   prov.command = "kin2grf fit-cop --trial-list " + a.trial_list + " --activity " + a.activity + (a.fit_angles ? " --fit-angles" : "") +
-                 (a.leave_one_out ? " --leave-one-out" : "");
+                 (a.fit_com ? " --fit-com" : "") + (a.leave_one_out ? " --leave-one-out" : "");
   prov.activity = a.activity;
   prov.min_force_fraction = a.min_force;
   prov.fit_angles = a.fit_angles;

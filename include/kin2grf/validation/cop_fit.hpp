@@ -25,7 +25,9 @@ namespace kin2grf {
 inline constexpr double kMaxFraction = 1.25;
 
 struct CopSamples {
-  std::vector<double> theta_rad, fraction;
+  /// com_place: the whole body's centre of mass ahead of the heel point A, in sole lengths
+  /// (CopFunction::fraction's second argument).
+  std::vector<double> theta_rad, fraction, com_place;
 };
 
 /// Append the samples of one validated trial.
@@ -40,11 +42,12 @@ struct CopFit {
 
 /// Least-squares event positions for the event angles of `start` (its positions are only the
 /// reference for rms_fraction_before). Throws InputError with fewer than 20 samples.
-CopFit fit_cop_function(const CopSamples& samples, const CopFunction& start);
+/// fit_com: com_gain fitted with them (otherwise start's is kept).
+CopFit fit_cop_function(const CopSamples& samples, const CopFunction& start, bool fit_com = false);
 
 /// Also the event angles: a coordinate search (steps of 0.01 rad, order kept) around `start`'s,
 /// each candidate with its least-squares positions. Not the paper's fixed angles: for studies.
-CopFit fit_cop_function_and_angles(const CopSamples& samples, const CopFunction& start);
+CopFit fit_cop_function_and_angles(const CopSamples& samples, const CopFunction& start, bool fit_com = false);
 
 /// fit-cop on a set of trials with plates: samples from each trial's kept stances (estimated
 /// with the trial's own options), one pooled fit and, on request, leave-one-lab-out: each
@@ -61,7 +64,7 @@ struct CopFitOnTrials {
   std::vector<LeaveOneOut> leave_one_out;
 };
 CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const CopFunction& start, double min_force_fraction,
-                                 bool fit_angles, bool leave_one_out);
+                                 bool fit_angles, bool leave_one_out, bool fit_com = false);
 
 /// How a fit was made, written with it.
 struct CopFitProvenance {

@@ -41,7 +41,7 @@ struct StudyJob {
 struct FitCopJob {
   std::string trial_list, activity = "walking", out;
   double min_force = 0.2;
-  bool leave_one_out = false, fit_angles = false;
+  bool leave_one_out = false, fit_angles = false, fit_com = false;
 };
 
 struct BatchJob {
