@@ -254,9 +254,9 @@ if cv_kinds:
           "The walking COP function (last row, COP only): in-sample is the built-in function (since session 46 its "
           "event angles, positions and centre-of-mass gain fitted on all the walks here, `kin2grf fit-cop --fit-angles "
           "--fit-com`, so in-sample), held-out each trial's COP with the function refitted so on the other labs' walking "
-          "trials (mean over trials); the function of the angle alone, refitted so (`--fit-angles`), scored 6.9 % held "
-          "out, and through the whole pipeline over the stances walking goes 5.22 / 7.48 / 7.16 %, GRM 4.89 % -> "
-          "5.20 / 7.27 / 6.62 %, GRM 4.78 % held out (docs/METHOD-NOTES.md). "
+          "trials, the trial estimated with it: vertical / anterior / COP, GRM, mean over trials); the function of the "
+          "angle alone, refitted so (`--fit-angles`), scored 5.0 / 7.3 / 6.9 %, GRM 4.9 % held out (over the stances "
+          "5.22 / 7.48 / 7.16 %, GRM 4.89 % -> 5.20 / 7.27 / 6.62 %, GRM 4.78 %; docs/METHOD-NOTES.md). "
           "speed-gate-ratio, the ratio alone at the default floors: since session 23 a walk's gate has no floor above 0.1 m/s, so ratios "
           "under 0.7 act on the walks too; in session 28 0.5 x speed won the criterion on all trials by 0.02 point (8.281 "
           "against 8.298 %; walking 5.7 / 7.6 / 6.3 %, GRM 4.8 %, mean |onset| 18 against 24 ms), but held out three labs chose "
@@ -406,8 +406,14 @@ if cv_kinds:
         if loo:
             worst = max(loo, key=lambda x: x["other_labs"])
             mean = lambda k: statistics.mean(x[k] for x in loo)
+            forces = "- / -"
+            grm = "-"
+            if all(x.get("other_labs_vertical") is not None for x in loo):
+                forces = f"{mean('other_labs_vertical'):.1f} / {mean('other_labs_anterior'):.1f}"
+                g = [x["other_labs_total_grm"] for x in loo if x.get("other_labs_total_grm") is not None]
+                grm = f"{statistics.mean(g):.1f}" if g else "-"
             print(f"| cop-function | built in (10 walks, angle and centre of mass, session 46) | walking | - / - / {mean('builtin'):.1f}, - | "
-                  f"- / - / {mean('other_labs'):.1f}, - | - | - | {worst['trial']} {worst['other_labs']:.1f} (COP) | - |")
+                  f"{forces} / {mean('other_labs'):.1f}, {grm} | - | - | {worst['trial']} {worst['other_labs']:.1f} (COP) | - |")
     if held:
         print("\nThe figure a default changes by, the criterion with each lab at the choice made without it, against "
               "kin2grf's default on every lab (%; in brackets the criterion whose vertical force is over the loaded span, "

@@ -165,4 +165,20 @@ TEST(CopFit, LeaveOneLabOutReportsTheBuiltInFunctionBesideTheRefits) {
     EXPECT_NE(l.start, l.builtin) << l.trial;  // the paper's function is not the built-in one
     EXPECT_TRUE(std::isfinite(l.others)) << l.trial;
   }
+  // Beside the COP, the forces and the GRM the held-out fit gives the trial: here both labs hold
+  // the same walk, so the fit without one lab is the pooled fit (to round-off: one copy of the
+  // samples against two), and the figures are its run's.
+  EstimateOptions with_fit = o;
+  with_fit.contact.cop = res.fit.function;
+  const ValidationResult v = validate(estimate(walk, nullptr, set, with_fit), *walk.plates);
+  const MeanMetrics m = mean_rrmse(v.stances);
+  ASSERT_TRUE(v.total && v.total->metrics.moment);
+  for (const auto& l : res.leave_one_out) {
+    EXPECT_NEAR(l.others, m.cop, 1e-9) << l.trial;
+    EXPECT_NEAR(l.others_vertical, m.vertical, 1e-9) << l.trial;
+    EXPECT_NEAR(l.others_anterior, m.anterior, 1e-9) << l.trial;
+    EXPECT_NEAR(l.others_grm, v.total->metrics.moment->rrmse_percent, 1e-9) << l.trial;
+  }
+  const auto j = cop_fit_json(res, trials, CopFunction::paper(), CopFitProvenance{});
+  EXPECT_TRUE(j["provenance"]["leave_one_lab_out_cop_rrmse_percent"][0].contains("other_labs_vertical"));
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "kin2grf/error.hpp"
 #include "kin2grf/io/cop_function.hpp"
@@ -165,15 +166,21 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
     const auto others = pooled(k);
     if (others.theta_rad.size() < 20) continue;
     const StudyTrialData d = t.data();
-    auto cop_rrmse = [&](const CopFunction& f) {
+    auto validated = [&](const CopFunction& f) {
       EstimateOptions o = t.options;
       o.contact.cop = f;
       o.contact.running_cop.reset();  // the candidate alone, on every frame
       const auto e = estimate(*d.trial, d.static_trial, *d.marker_set, o);
-      return mean_rrmse(validate(e, *d.plates).stances).cop;
+      return validate(e, *d.plates);
     };
-    out.leave_one_out.push_back(
-        {t.name, cop_rrmse(start), cop_rrmse(CopFunction{}), cop_rrmse(out.fit.function), cop_rrmse(fit_fn(others).function)});
+    auto cop_rrmse = [&](const CopFunction& f) { return mean_rrmse(validated(f).stances).cop; };
+    const ValidationResult held = validated(fit_fn(others).function);
+    const MeanMetrics m = mean_rrmse(held.stances);
+    CopFitOnTrials::LeaveOneOut l{t.name, cop_rrmse(start), cop_rrmse(CopFunction{}), cop_rrmse(out.fit.function), m.cop};
+    l.others_vertical = m.vertical, l.others_anterior = m.anterior;
+    l.others_grm = held.total && held.total->metrics.moment ? held.total->metrics.moment->rrmse_percent
+                                                             : std::numeric_limits<double>::quiet_NaN();
+    out.leave_one_out.push_back(l);
   }
   return out;
 }
@@ -195,7 +202,16 @@ nlohmann::json cop_fit_json(const CopFitOnTrials& res, const std::vector<StudyTr
   prov["start"] = cop_function_json(start);
   if (!res.leave_one_out.empty()) {
     nlohmann::json loo = nlohmann::json::array();
-    for (const auto& l : res.leave_one_out) loo.push_back({{"trial", l.trial}, {"start", l.start}, {"builtin", l.builtin}, {"all", l.all}, {"other_labs", l.others}});
+    auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+    for (const auto& l : res.leave_one_out)
+      loo.push_back({{"trial", l.trial},
+                     {"start", l.start},
+                     {"builtin", l.builtin},
+                     {"all", l.all},
+                     {"other_labs", l.others},
+                     {"other_labs_vertical", num(l.others_vertical)},
+                     {"other_labs_anterior", num(l.others_anterior)},
+                     {"other_labs_total_grm", num(l.others_grm)}});
     prov["leave_one_lab_out_cop_rrmse_percent"] = loo;
   }
   j["provenance"] = prov;
@@ -206,7 +222,7 @@ std::string format_cop_fit(const CopFitOnTrials& res, const std::vector<StudyTri
                            const CopFitProvenance& how) {
   const CopFunction& f = res.fit.function;
   std::string out;
-  char b[256];
+  char b[512];
   std::snprintf(b, sizeof b, "COP function fitted on %d samples of %zu trials (%s)\n", res.fit.samples, trials.size(), how.activity.c_str());
   out += b;
   std::snprintf(b, sizeof b, "  event angles (rad)   HS %.3f  HO %.3f  MO %.3f  TO %.3f\n", f.delta_hs, f.delta_ho, f.delta_mo, f.delta_to);
@@ -223,12 +239,14 @@ std::string format_cop_fit(const CopFitOnTrials& res, const std::vector<StudyTri
   if (!res.leave_one_out.empty()) {
     std::snprintf(b, sizeof b,
                   "\nleave-one-lab-out: COP rRMSE %% (mean over the trial's stances; 'built-in': kin2grf's default function;\n"
-                  "'all': this fit; 'other labs': fitted without the trial's lab)\n"
-                  "%-26s %8s %9s %8s %11s\n",
-                  "trial", "start", "built-in", "all", "other labs");
+                  "'all': this fit; 'other labs': fitted without the trial's lab, with the trial's vertical and\n"
+                  "anterior rRMSE %% and total GRM rRMSE %% under that fit)\n"
+                  "%-26s %8s %9s %8s %11s %9s %9s %6s\n",
+                  "trial", "start", "built-in", "all", "other labs", "vertical", "anterior", "GRM");
     out += b;
     for (const auto& l : res.leave_one_out) {
-      std::snprintf(b, sizeof b, "%-26s %8.1f %9.1f %8.1f %11.1f\n", l.trial.c_str(), l.start, l.builtin, l.all, l.others);
+      std::snprintf(b, sizeof b, "%-26s %8.1f %9.1f %8.1f %11.1f %9.1f %9.1f %6.1f\n", l.trial.c_str(), l.start, l.builtin, l.all, l.others,
+                    l.others_vertical, l.others_anterior, l.others_grm);
       out += b;
     }
   }

@@ -59,7 +59,10 @@ struct CopFitOnTrials {
   std::vector<std::size_t> samples_per_trial;
   struct LeaveOneOut {
     std::string trial;
-    double start = 0, builtin = 0, all = 0, others = 0;
+    double start = 0, builtin = 0, all = 0, others = 0;  ///< COP rRMSE %
+    /// With the fit on the other labs: the trial's mean vertical and anterior rRMSE (%) and its
+    /// total GRM rRMSE (%, NaN without a total window): what the COP's place does to the forces.
+    double others_vertical = 0, others_anterior = 0, others_grm = 0;
   };
   std::vector<LeaveOneOut> leave_one_out;
 };
