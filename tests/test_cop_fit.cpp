@@ -69,6 +69,13 @@ TEST(CopFit, RecoversTheCentreOfMassGainOfSamplesThatFollowTheBody) {
   const auto alone = fit_cop_function(smp, CopFunction::paper());
   EXPECT_EQ(alone.function.com_gain, 0.0);
   EXPECT_GT(alone.rms_fraction, 0.05);  // 0.12 x the places' spread (SD 0.74): about 0.09
+  // A COP that rolls back as the body moves on (a negative gain) is not a function a file may
+  // hold (0..1): the fit keeps the gain at 0 and fits the positions for it.
+  CopSamples back = smp;
+  for (std::size_t k = 0; k < back.fraction.size(); ++k) back.fraction[k] = CopFunction::paper().fraction(back.theta_rad[k]) - 0.05 * back.com_place[k];
+  const auto bounded = fit_cop_function(back, CopFunction::paper(), true);
+  EXPECT_EQ(bounded.function.com_gain, 0.0);
+  EXPECT_NO_THROW((void)cop_function_from_json(cop_function_json(bounded.function), "fit.json"));
   // Samples without the body's place cannot fit the term.
   CopSamples bare = smp;
   bare.com_place.clear();

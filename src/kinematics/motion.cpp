@@ -16,6 +16,7 @@ double whole_body_com_x(const Model& model, const MotionFrame& f) {
   for (int b = 0; b < kSegmentCount; ++b) mx += model.bodies[b].mass_kg * f.q(coord::com_x(b)), m += model.bodies[b].mass_kg;
   return m > 0 ? mx / m : 0.0;
 }
+
 namespace {
 
 double angle_of(const Eigen::Vector2d& d) { return std::atan2(d.y(), d.x()); }

@@ -9,7 +9,8 @@ namespace {
 double half_cosine(double a, double b, double u) { return a + (b - a) * 0.5 * (1.0 - std::cos(M_PI * u)); }
 }  // namespace
 
-// Eq. 2's F: half-cosine HS->HO and HO->MO, linear MO->TO, constant outside.
+// Eq. 2's F: half-cosine HS->HO and HO->MO, linear MO->TO, constant outside; then kin2grf's
+// centre-of-mass term (foot_model.hpp), kept on the sole.
 double CopFunction::fraction(double th, double com_place) const {
   double s;
   if (th <= delta_hs) s = s_hs;

@@ -85,6 +85,13 @@ CopFit fit_cop_function(const CopSamples& smp, const CopFunction& start, bool fi
   Wa << W, ridge * Eigen::MatrixXd::Identity(p, p);
   ya << y, ridge * s0;
   const Eigen::VectorXd s = Wa.colPivHouseholderQr().solve(ya);
+  if (fit_com && (s[4] < 0.0 || s[4] > 1.0)) {
+    // Outside what a COP function may hold (io/cop_function.hpp: a COP rolling back as the body
+    // moves on, or outrunning it): the gain at its bound, the positions fitted for it.
+    CopFunction bounded = start;
+    bounded.com_gain = std::clamp(s[4], 0.0, 1.0);
+    return fit_cop_function(smp, bounded, false);
+  }
   CopFit fit;
   fit.function = start;
   if (fit_com) fit.function.com_gain = s[4];

@@ -23,8 +23,9 @@ enum class FootModel { Cop, ThreePoint };
 /// The defaults are kin2grf's fit to the plate COPs of the 10 development walking trials (7 labs;
 /// 1272 frames of the plate stances loaded above 20 % body weight; event angles, positions and
 /// com_gain fitted; `kin2grf fit-cop --fit-angles --fit-com`). Leave-one-lab-out (each lab scored
-/// with the function refitted on the other labs), walking COP rRMSE 7.16 % with the angle alone
-/// and 6.62 % with the centre-of-mass term; the gain refitted so is 0.117-0.153 in every fold.
+/// with the function refitted on the other labs; `fit-cop --leave-one-out`, mean over the trials),
+/// walking COP rRMSE 6.9 % with the angle alone and 6.4 % with the centre-of-mass term (over the
+/// stances 7.16 and 6.62 %); the gain refitted so is 0.117-0.153 in every fold.
 /// Provenance and the command that remakes it: data/cop-function/walking-fitted.json and
 /// docs/METHOD-NOTES.md. paper() keeps the paper's event angles (-0.3, 0, 0.15, 1 rad) with
 /// positions fitted for them and no centre-of-mass term (--paper).

@@ -42,7 +42,8 @@ struct CopFit {
 
 /// Least-squares event positions for the event angles of `start` (its positions are only the
 /// reference for rms_fraction_before). Throws InputError with fewer than 20 samples.
-/// fit_com: com_gain fitted with them (otherwise start's is kept).
+/// fit_com: com_gain fitted with them (otherwise start's is kept); a least-squares gain outside
+/// 0..1 is held at the bound it passes.
 CopFit fit_cop_function(const CopSamples& samples, const CopFunction& start, bool fit_com = false);
 
 /// Also the event angles: a coordinate search (steps of 0.01 rad, order kept) around `start`'s,
