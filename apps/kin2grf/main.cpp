@@ -144,7 +144,8 @@ int main(int argc, char** argv) {
     fit_cop = app.add_subcommand("fit-cop", "Fit foot model 2's COP function to the plate COPs of trials with plates");
     fit_cop->add_option("--trial-list", fit_args.trial_list, "File of lines 'activity|lab|name|TRIAL [options]'")->required();
     fit_cop->add_option("--activity", fit_args.activity, "Use the trials of this activity ('' = all)")->capture_default_str();
-    fit_cop->add_option("--min-force", fit_args.min_force, "Frames where the plate carries at least this fraction of body weight")
+    fit_cop->add_option("--min-force", fit_args.min_force,
+                        "Frames where the plate carries at least this fraction of body weight (validate's COP threshold)")
         ->capture_default_str();
     fit_cop->add_flag("--fit-angles", fit_args.fit_angles, "Fit the event angles too (default: the paper's, fixed)");
     fit_cop->add_flag("--fit-com", fit_args.fit_com,

@@ -199,8 +199,10 @@ int fit_cop_job(const FitCopJob& a, std::ostream& out) {
   const CopFunction start = CopFunction::paper();
   const auto res = fit_cop_on_trials(trials, start, a.min_force, a.fit_angles, a.leave_one_out, a.fit_com);
   CopFitProvenance prov;
+  char min_force[32];
+  std::snprintf(min_force, sizeof min_force, "%g", a.min_force);
   prov.command = "kin2grf fit-cop --trial-list " + a.trial_list + " --activity " + a.activity + (a.fit_angles ? " --fit-angles" : "") +
-                 (a.fit_com ? " --fit-com" : "") + (a.leave_one_out ? " --leave-one-out" : "");
+                 (a.fit_com ? " --fit-com" : "") + " --min-force " + min_force + (a.leave_one_out ? " --leave-one-out" : "");
   prov.activity = a.activity;
   prov.min_force_fraction = a.min_force;
   prov.fit_angles = a.fit_angles;

@@ -40,7 +40,11 @@ struct StudyJob {
 
 struct FitCopJob {
   std::string trial_list, activity = "walking", out;
-  double min_force = 0.2;
+  /// The frames fitted: the plate above this fraction of body weight. validate's COP threshold
+  /// (ValidationOptions::cop_min_force_fraction): the function is fitted on the frames its COP is
+  /// judged on (0.2 until session 46, which left the heel strike's and push-off's ends to
+  /// extrapolation: held out 6.44 -> 6.23 % walking COP, docs/METHOD-NOTES.md).
+  double min_force = ValidationOptions{}.cop_min_force_fraction;
   bool leave_one_out = false, fit_angles = false, fit_com = false;
 };
 
