@@ -73,7 +73,7 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
 /// How a fit was made, written with it.
 struct CopFitProvenance {
   std::string command, activity;
-  double min_force_fraction = 0.2;
+  double min_force_fraction = ValidationOptions{}.cop_min_force_fraction;
   bool fit_angles = false;
 };
 /// The fitted function as a COP-function file (io/cop_function.hpp) with its provenance: the
