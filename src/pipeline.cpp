@@ -1033,9 +1033,7 @@ Messages frontal_split(double w, double split_distance_m, double angle, const Fr
     const double weight = w * (1 - side_by_side_sagittal_weight(xmax - xmin, split_distance_m));
     if (!(weight > 0)) continue;
     motion.frame(k, f);
-    double com_y = 0;
-    for (int b = 0; b < kSegmentCount; ++b) com_y += model.bodies[static_cast<std::size_t>(b)].mass_kg * f.q[coord::com_x(b) + 1];
-    com_y /= model.body_mass_kg;
+    const double com_y = whole_body_com(model, f).y();
     const double total = fy[0] + fy[1];
     const double share = frontal_balance_right_share(fb.com_lateral_m[k], com_y - ground_level_m, fb.lateral_total_N[k], total,
                                                      fb.foot_lateral_m[0][k], fb.foot_lateral_m[1][k]);

@@ -224,7 +224,7 @@ TEST(Contact, TheCopFollowsTheBodysCentreOfMassOverTheFoot) {
     for (Eigen::Index i = 0; i < motion.frames(); i += 11) {
       MotionFrame f0 = motion.frame(i), f1 = f0;
       f1.q(coord::com_x(kTorso)) += shift;
-      EXPECT_NEAR(whole_body_com_x(model, f1) - whole_body_com_x(model, f0), com_shift, 1e-12);
+      EXPECT_NEAR(whole_body_com(model, f1).x() - whole_body_com(model, f0).x(), com_shift, 1e-12);
       FrameContacts c0, c1;
       contact_frame(model, r.calibration.contact, co, false, f0, c0);
       contact_frame(model, r.calibration.contact, co, false, f1, c1);

@@ -109,6 +109,9 @@ void contact_frame(const Model& model, const ContactCalibration& soles, const Co
                    FrameContacts& fc) {
   const double ground = soles.ground_level_m + o.ground_shift_m;
   fc.points.clear();
+  // Model 2's COP function, and the body's centre of mass its term reads: one per frame.
+  const CopFunction& F = running && o.running_cop ? *o.running_cop : o.cop;
+  const double com_x = o.foot_model == FootModel::Cop && F.com_gain != 0.0 ? whole_body_com(model, f).x() : 0.0;
   for (int side = 0; side < 2; ++side) {
     const int foot = segment(side, kFoot), toes = segment(side, kToes);
     const auto sp = sole_points(soles, f, side);
@@ -141,10 +144,8 @@ void contact_frame(const Model& model, const ContactCalibration& soles, const Co
       continue;
     }
     // Model 2: D at arc fraction s of A -> B -> C, at the lowest sole point's height (Eq. 2).
-    const CopFunction& F = running && o.running_cop ? *o.running_cop : o.cop;
     const double l1 = (sp[1] - sp[0]).norm(), l2 = (sp[2] - sp[1]).norm();
-    double com_place = 0.0;
-    if (F.com_gain != 0.0 && l1 + l2 > 0) com_place = (whole_body_com_x(model, f) - sp[0].x()) / (l1 + l2);
+    const double com_place = F.com_gain != 0.0 && l1 + l2 > 0 ? (com_x - sp[0].x()) / (l1 + l2) : 0.0;
     const double s = F.fraction(fc.foot_inclination_rad[side], com_place);
     fc.cop_fraction[side] = s;
     const double along = s * (l1 + l2);

@@ -11,10 +11,15 @@
 
 namespace kin2grf {
 
-double whole_body_com_x(const Model& model, const MotionFrame& f) {
-  double mx = 0.0, m = 0.0;
-  for (int b = 0; b < kSegmentCount; ++b) mx += model.bodies[b].mass_kg * f.q(coord::com_x(b)), m += model.bodies[b].mass_kg;
-  return m > 0 ? mx / m : 0.0;
+Eigen::Vector2d whole_body_com(const Model& model, const MotionFrame& f) {
+  Eigen::Vector2d mr = Eigen::Vector2d::Zero();
+  double m = 0.0;
+  for (int b = 0; b < kSegmentCount; ++b) {
+    const double mb = model.bodies[static_cast<std::size_t>(b)].mass_kg;
+    mr += mb * Eigen::Vector2d(f.q(coord::com_x(b)), f.q(coord::com_x(b) + 1));
+    m += mb;
+  }
+  return m > 0 ? Eigen::Vector2d(mr / m) : Eigen::Vector2d::Zero();
 }
 
 namespace {

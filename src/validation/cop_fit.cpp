@@ -56,7 +56,7 @@ void collect_cop_samples(const EstimateResult& e, const ValidationResult& v, dou
       along = std::min(along, kMaxFraction * (l1 + l2));
       out.theta_rad.push_back(f.inclination_rad[i]);
       out.fraction.push_back(along / (l1 + l2));
-      out.com_place.push_back((whole_body_com_x(e.model(), e.motion.frame(i)) - A.x()) / (l1 + l2));
+      out.com_place.push_back((whole_body_com(e.model(), e.motion.frame(i)).x() - A.x()) / (l1 + l2));
     }
   }
 }

@@ -63,8 +63,8 @@ struct MotionFrame {
   std::array<double, 2> cop_foot_angle_rad{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
 };
 
-/// The whole body's centre of mass along progression (m) in frame f: sum m_s x_G,s / sum m_s.
-double whole_body_com_x(const Model& model, const MotionFrame& f);
+/// The whole body's centre of mass (x forward, y up; m) in frame f: sum m_s r_G,s / sum m_s.
+Eigen::Vector2d whole_body_com(const Model& model, const MotionFrame& f);
 
 /// The model's motion over a trial, held as what determines it: the independent coordinates and
 /// their derivatives (N x 11 or 12 each) and the HAT COM's fore-aft acceleration as used (N: the
