@@ -11,6 +11,7 @@
 #include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/kinematics/motion.hpp"
+#include "kin2grf/markers/landmarks.hpp"
 #include "kin2grf/io/marker_presets.hpp"
 #include "kin2grf/numeric.hpp"
 #include "kin2grf/pipeline.hpp"
@@ -230,7 +231,8 @@ TEST(Contact, TheCopFollowsTheBodysCentreOfMassOverTheFoot) {
       contact_frame(model, r.calibration.contact, co, false, f1, c1);
       for (int side = 0; side < 2; ++side) {
         const auto& sp = c0.sole[static_cast<std::size_t>(side)];
-        const double L = (sp[1] - sp[0]).norm() + (sp[2] - sp[1]).norm();
+        const double L = cop_length_m(F.length, r.calibration.contact.feet[static_cast<std::size_t>(side)], (sp[1] - sp[0]).norm(),
+                                      (sp[2] - sp[1]).norm());
         const double s0 = c0.cop_fraction[side], s1 = c1.cop_fraction[side];
         if (s0 <= 0.0 || s1 >= 1.25 || s0 >= 1.25) continue;  // at the sole's ends the fraction is held
         ++compared;
@@ -243,6 +245,81 @@ TEST(Contact, TheCopFollowsTheBodysCentreOfMassOverTheFoot) {
     EXPECT_GE(compared, 20);
   }
   EXPECT_GT(CopFunction{}.com_gain, 0.0);  // the default has the term
+}
+
+// The built-in walking function counts the COP's place in heel-to-MT-heads lengths (CopLength::
+// HeelMt, session 47): a toe marker placed further along the toes does not move the COP behind the
+// MT head, where the paper's sole lengths move it with the toe; and a 5th-metatarsal MT marker
+// (which lies behind the 2nd head) lengthens the unit by mt_head_ahead_share of the ankle-MT
+// length, as the 2nd head lies that far ahead of it. The failure it guards: one foot's COP placed
+// 2-3 cm apart by two labs' toe markers, in the stance phases the toes do not carry.
+TEST(Contact, TheCopIsCountedInHeelToMetatarsalHeadLengthsNotTheToeMarkers) {
+  const Trial t = make_synthetic_trial({});
+  const auto r = run({});
+  const Model& model = r.model();
+  SagittalLandmarks lm = synthetic_landmarks(t);
+  const ModelMotion motion = compute_motion(model, lm, 6.0);
+  // The calibration's unit: |AB|, plus the share of the ankle-MT length for a 5th-MT marker.
+  const ContactCalibration plain = calibrate_contact(lm, r.ground_level_m());
+  lm.mt_head_ahead_share = {0.2, 0.0};
+  const ContactCalibration lateral = calibrate_contact(lm, r.ground_level_m());
+  const auto& fp = plain.feet[0];
+  EXPECT_NEAR(fp.heel_mt_length_m, (fp.mt_local - fp.heel_local).norm(), 1e-12);
+  const double ankle_mt = model.bodies[kFootR].length_m;  // the foot segment: ankle to MT head
+  EXPECT_NEAR(lateral.feet[0].heel_mt_length_m - fp.heel_mt_length_m, 0.2 * ankle_mt, 0.01 * ankle_mt);
+  EXPECT_EQ(lateral.feet[1].heel_mt_length_m, plain.feet[1].heel_mt_length_m);
+  // Toes twice as long: the heel-MT function's COP stays put behind B; the sole function's moves.
+  ContactCalibration long_toes = r.calibration.contact;
+  for (auto& f : long_toes.feet) f.hallux_local *= 2.0;
+  // B 30 mm further ahead (a lateral marker's allowance): the COP moves forward by s x 30 mm.
+  ContactCalibration longer_unit = r.calibration.contact;
+  for (auto& f : longer_unit.feet) f.heel_mt_length_m += 0.03;
+  int behind_b = 0;
+  for (CopLength length : {CopLength::HeelMt, CopLength::Sole}) {
+    ContactModelOptions co;
+    co.cop = CopFunction{};
+    co.cop.length = length;
+    co.cop.com_gain = 0.0;  // the angle's place alone (the centre-of-mass term, in metres, does not change with the unit)
+    co.running_cop.reset();
+    for (Eigen::Index i = 0; i < motion.frames(); i += 7) {
+      MotionFrame f = motion.frame(i);
+      FrameContacts c0, c1, c2;
+      contact_frame(model, r.calibration.contact, co, false, f, c0);
+      contact_frame(model, long_toes, co, false, f, c1);
+      contact_frame(model, longer_unit, co, false, f, c2);
+      for (int side = 0; side < 2; ++side) {
+        const auto k = static_cast<std::size_t>(side);
+        const auto& sp = c0.sole[k];
+        const double s = c0.cop_fraction[side], l1 = (sp[1] - sp[0]).norm();
+        const double x0 = c0.points[k].position.x(), x1 = c1.points[k].position.x(), x2 = c2.points[k].position.x();
+        if (length == CopLength::HeelMt) {
+          if (s * r.calibration.contact.feet[k].heel_mt_length_m >= l1 || s <= 0.0 || s >= 1.25) continue;  // on the rear foot only
+          ++behind_b;
+          EXPECT_EQ(x1, x0) << "frame " << i << " side " << side;
+          EXPECT_NEAR(x2 - x0, s * 0.03 * (sp[1].x() - sp[0].x()) / l1, 1e-12) << "frame " << i << " side " << side;
+        } else if (s > 0.05) {
+          EXPECT_GT(x1 - x0, 1e-3) << "the sole's length follows the toe marker; frame " << i << " side " << side;
+          EXPECT_EQ(x2, x0) << "the sole function does not read the heel-MT length";
+        }
+      }
+    }
+  }
+  EXPECT_GE(behind_b, 20);
+}
+
+// The landmark stage marks a set's 5th-metatarsal MT marker ("surface": "lateral") for the
+// calibration, and only that side's unit lengthens.
+TEST(Contact, AFifthMetatarsalMarkerLengthensTheHeelToMetatarsalHeadsUnit) {
+  const Trial walk = make_example_walk();
+  MarkerSet set = *find_marker_set("kin2grf-example");
+  const auto plain = estimate(walk, nullptr, set, EstimateOptions{});
+  set.rules[static_cast<std::size_t>(landmark(kLeft, kMt))].lateral_surface = true;
+  const auto lateral = estimate(walk, nullptr, set, EstimateOptions{});
+  const auto& p = plain.calibration.contact.feet, &l = lateral.calibration.contact.feet;
+  EXPECT_EQ(l[kRight].heel_mt_length_m, p[kRight].heel_mt_length_m);
+  EXPECT_NEAR(l[kLeft].heel_mt_length_m - p[kLeft].heel_mt_length_m, kLateralMtToeExtraShare * plain.model().bodies[kFootL].length_m,
+              0.02 * plain.model().bodies[kFootL].length_m);
+  EXPECT_NEAR(p[kLeft].heel_mt_length_m, (p[kLeft].mt_local - p[kLeft].heel_local).norm(), 1e-12);
 }
 
 // The pipeline makes each frame's contacts as it solves the frame, reusing one FrameContacts and

@@ -129,6 +129,25 @@ TEST(CopFit, JsonRoundTripAndFieldErrors) {
   }
 }
 
+// The length the fractions count in: kept through a round trip; absent, "sole" (every file written
+// before the heel-MT length, and the paper's form); anything else refused, naming the field.
+TEST(CopFit, TheFunctionsLengthRoundTripsAndAnOldFileCountsInSoleLengths) {
+  for (const CopFunction& f : {CopFunction{}, CopFunction::paper()})
+    EXPECT_EQ(cop_function_from_json(cop_function_json(f), "x.json").length, f.length);
+  auto j = cop_function_json(CopFunction{});
+  EXPECT_EQ(j["length"], "heel-mt");
+  j.erase("length");
+  EXPECT_EQ(cop_function_from_json(j, "x.json").length, CopLength::Sole);
+  j["length"] = "toe";
+  try {
+    (void)cop_function_from_json(j, "cop.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cop.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'length'"), std::string::npos) << e.what();
+  }
+}
+
 TEST(CopFit, BuiltInDefaultIsTheCommittedFit) {
   // The built-in COP function (contact.hpp) is the fit stored with its provenance.
   const CopFunction f = read_cop_function(std::string(KIN2GRF_SOURCE_DIR) + "/data/cop-function/walking-fitted.json");
@@ -136,6 +155,8 @@ TEST(CopFit, BuiltInDefaultIsTheCommittedFit) {
   for (auto [a, b] : {std::pair{f.delta_hs, d.delta_hs}, {f.delta_ho, d.delta_ho}, {f.delta_mo, d.delta_mo}, {f.delta_to, d.delta_to},
                       {f.s_hs, d.s_hs}, {f.s_ho, d.s_ho}, {f.s_mo, d.s_mo}, {f.s_to, d.s_to}, {f.com_gain, d.com_gain}})
     EXPECT_NEAR(a, b, 5e-4);
+  EXPECT_EQ(f.length, d.length);
+  EXPECT_EQ(d.length, CopLength::HeelMt);
   EXPECT_GT(d.com_gain, 0.0);
   // The running function likewise (the angle alone).
   EXPECT_EQ(CopFunction::running().com_gain, 0.0);
@@ -145,6 +166,9 @@ TEST(CopFit, BuiltInDefaultIsTheCommittedFit) {
   for (auto [a, b] : {std::pair{fr.delta_hs, dr.delta_hs}, {fr.delta_ho, dr.delta_ho}, {fr.delta_mo, dr.delta_mo},
                       {fr.delta_to, dr.delta_to}, {fr.s_hs, dr.s_hs}, {fr.s_ho, dr.s_ho}, {fr.s_mo, dr.s_mo}, {fr.s_to, dr.s_to}})
     EXPECT_NEAR(a, b, 5e-4);
+  EXPECT_EQ(fr.length, CopLength::Sole);
+  EXPECT_EQ(dr.length, CopLength::Sole);
+  EXPECT_EQ(CopFunction::paper().length, CopLength::Sole);
 }
 
 // fit-cop's leave-one-lab-out table: per trial the starting function's COP error, the built-in

@@ -1645,12 +1645,15 @@ TEST(LateralCop, EachFootsCopTurnsMediallyPastItsMtHeadInTheEstimate) {
 // A marker set's "surface": "lateral" (issue 28's landmarks): a 5th-metatarsal marker moves the
 // COP's lateral line's forefoot end medially by kLateralMtToMidline of the heel-MT length, and
 // lateral knee and ankle markers move the 3D joint centres medially by half the joint's width
-// plus the marker's radius; the sagittal results do not change.
+// plus the marker's radius; the sagittal results do not change with a COP function in sole lengths
+// (with the built-in one, in heel-MT lengths, the 5th-MT marker also moves the sagittal COP ahead:
+// Contact.AFifthMetatarsalMarkerLengthensTheHeelToMetatarsalHeadsUnit).
 TEST(LateralCop, LateralMarkersMoveTheCopLineAndTheJointCentresMediallyOnly) {
   const Trial t = make_synthetic_trial({});
   nlohmann::json j = read_json_file(std::string(KIN2GRF_SOURCE_DIR) + "/data/presets/kin2grf-example.json");
   EstimateOptions o;
   o.model = ModelKind::ThreeD;
+  o.contact.cop.length = CopLength::Sole;
   const EstimateResult centre = estimate(t, nullptr, parse_marker_set(j, "centre"), o);
   for (const char* id : {"mt_r", "mt_l", "knee_r", "knee_l", "ankle_r", "ankle_l"}) j["landmarks"][id]["surface"] = "lateral";
   const EstimateResult lateral = estimate(t, nullptr, parse_marker_set(j, "lateral"), o);

@@ -195,9 +195,9 @@ TEST(Validate, MisregisteredPlateCopIsFlaggedNotScored) {
   EXPECT_TRUE(noted);
   // And the COP fit does not learn from it.
   CopSamples smp;
-  collect_cop_samples(s.estimate, v, 0.2, smp);
+  collect_cop_samples(s.estimate, v, 0.2, CopLength::Sole, smp);
   CopSamples clean;
-  collect_cop_samples(s.estimate, validate(synthetic_with_exact_plates().estimate, synthetic_with_exact_plates().plates), 0.2, clean);
+  collect_cop_samples(s.estimate, validate(synthetic_with_exact_plates().estimate, synthetic_with_exact_plates().plates), 0.2, CopLength::Sole, clean);
   EXPECT_GT(smp.theta_rad.size(), 0u);
   EXPECT_LT(smp.theta_rad.size(), clean.theta_rad.size());
 }

@@ -150,6 +150,11 @@ int main(int argc, char** argv) {
     fit_cop->add_flag("--fit-angles", fit_args.fit_angles, "Fit the event angles too (default: the paper's, fixed)");
     fit_cop->add_flag("--fit-com", fit_args.fit_com,
                       "Fit the COP's gain on the body's centre of mass ahead of the heel too (com_gain; default: 0, the paper's function of the angle alone)");
+    fit_cop->add_option("--length", fit_args.length,
+                        "What the fitted positions count in: heel-mt (the heel to the 2nd metatarsal head, the built-in walking "
+                        "function's) or sole (the sole's heel-to-toe length, the paper's)")
+        ->check(CLI::IsMember({"heel-mt", "sole"}))
+        ->capture_default_str();
     fit_cop->add_flag("--leave-one-out", fit_args.leave_one_out,
                       "Also report each trial's COP error with a fit on the other labs' trials (leave one lab out)");
     fit_cop->add_option("-o,--output", fit_args.out, "Write the fitted function and its provenance (JSON)");

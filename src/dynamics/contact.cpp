@@ -143,12 +143,14 @@ void contact_frame(const Model& model, const ContactCalibration& soles, const Co
       }
       continue;
     }
-    // Model 2: D at arc fraction s of A -> B -> C, at the lowest sole point's height (Eq. 2).
+    // Model 2: D at arc fraction s of A -> B -> C, at the lowest sole point's height (Eq. 2); s
+    // counted in the function's length (CopLength), at most kMaxCopFraction sole lengths.
     const double l1 = (sp[1] - sp[0]).norm(), l2 = (sp[2] - sp[1]).norm();
-    const double com_place = F.com_gain != 0.0 && l1 + l2 > 0 ? (com_x - sp[0].x()) / (l1 + l2) : 0.0;
+    const double unit = cop_length_m(F.length, soles.feet[static_cast<std::size_t>(side)], l1, l2);
+    const double com_place = F.com_gain != 0.0 && unit > 0 ? (com_x - sp[0].x()) / unit : 0.0;
     const double s = F.fraction(fc.foot_inclination_rad[side], com_place);
     fc.cop_fraction[side] = s;
-    const double along = s * (l1 + l2);
+    const double along = F.length == CopLength::Sole ? s * (l1 + l2) : std::min(s * unit, kMaxCopFraction * (l1 + l2));
     const Eigen::Vector2d on = along <= l1 ? sp[0] + (sp[1] - sp[0]) * (l1 > 0 ? along / l1 : 0.0)
                                            : sp[1] + (sp[2] - sp[1]) * (l2 > 0 ? (along - l1) / l2 : 0.0);
     const double yD = std::min({sp[0].y(), sp[1].y(), sp[2].y()});
@@ -390,6 +392,10 @@ ContactCalibration calibrate_contact(const SagittalLandmarks& lm, double ground_
     fg.heel_local = Eigen::Vector2d(median_or_zero(ax), median_or_zero(ay));
     fg.mt_local = Eigen::Vector2d(median_or_zero(bx), median_or_zero(by));
     fg.hallux_local = Eigen::Vector2d(median_or_zero(cx), median_or_zero(cy));
+    std::vector<double> ankle_mt;
+    for (auto i : f) ankle_mt.push_back((M.row(i) - A.row(i)).norm());
+    fg.heel_mt_length_m = (fg.mt_local - fg.heel_local).norm() +
+                          lm.mt_head_ahead_share[static_cast<std::size_t>(side)] * median_or_zero(ankle_mt);
   }
   // A foot that never stands on the floor in the window (a hop on the other leg) has no flat
   // frames at ground level: it takes the other foot's sole geometry instead of a sole drawn

@@ -12,12 +12,14 @@ nlohmann::json cop_function_json(const CopFunction& f) {
   nlohmann::json j = {{"delta_hs", f.delta_hs}, {"delta_ho", f.delta_ho}, {"delta_mo", f.delta_mo}, {"delta_to", f.delta_to},
                       {"s_hs", f.s_hs},         {"s_ho", f.s_ho},         {"s_mo", f.s_mo},         {"s_to", f.s_to}};
   if (f.com_gain != 0.0) j["com_gain"] = f.com_gain;
+  j["length"] = f.length == CopLength::Sole ? "sole" : "heel-mt";
   return j;
 }
 
 CopFunction cop_function_from_json(const nlohmann::json& j, const std::string& path) {
   CopFunction f;
-  f.com_gain = 0.0;  // a file without the field is a function of the angle alone (the paper's form)
+  f.com_gain = 0.0;            // a file without the field is a function of the angle alone (the paper's form)
+  f.length = CopLength::Sole;  // and one without "length" counts in sole lengths, as the paper's (and every file before it)
   auto get = [&](const char* key, double& out, bool fraction) {
     if (!j.is_object() || !j.contains(key)) throw InputError(path + ": COP function: missing field '" + key + "'");
     if (!j[key].is_number()) throw InputError(path + ": COP function: field '" + key + "' is not a number");
@@ -32,6 +34,12 @@ CopFunction cop_function_from_json(const nlohmann::json& j, const std::string& p
     get("com_gain", f.com_gain, false);
     // Above 1 the COP would outrun the body over the foot; below 0 it would roll back.
     if (f.com_gain < 0 || f.com_gain > 1) throw InputError(path + ": COP function: field 'com_gain' must be within 0..1");
+  }
+  if (j.is_object() && j.contains("length")) {
+    const auto& l = j["length"];
+    if (l == "sole") f.length = CopLength::Sole;
+    else if (l == "heel-mt") f.length = CopLength::HeelMt;
+    else throw InputError(path + ": COP function: field 'length' must be \"sole\" or \"heel-mt\"");
   }
   if (!(f.delta_hs < f.delta_ho && f.delta_ho < f.delta_mo && f.delta_mo < f.delta_to))
     throw InputError(path + ": COP function: the event angles must increase (delta_hs < delta_ho < delta_mo < delta_to)");

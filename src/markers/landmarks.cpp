@@ -1217,6 +1217,7 @@ SagittalWindow sagittal_landmarks(Landmarks3D lm3, const MarkerSet& set, const S
     // 5th-metatarsal marker ("surface": "lateral") is kLateralMtToMidline of the heel-MT length
     // lateral of it.
     const bool lateral_mt = set.rules[static_cast<std::size_t>(landmark(side, kMt))].lateral_surface;
+    s.mt_head_ahead_share[static_cast<std::size_t>(side)] = lateral_mt ? kLateralMtToeExtraShare : 0.0;
     const double to_medial = side == kRight ? -1.0 : 1.0;
     if (keep_lateral) w.foot_line[side].resize(best_len, 4);
     std::vector<double> shift_m;

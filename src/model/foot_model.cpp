@@ -19,7 +19,7 @@ double CopFunction::fraction(double th, double com_place) const {
   else if (th <= delta_to) s = s_mo + (s_to - s_mo) * (th - delta_mo) / (delta_to - delta_mo);
   else s = s_to;
   if (com_gain == 0.0) return s;
-  return std::clamp(s + com_gain * com_place, 0.0, 1.25);
+  return std::clamp(s + com_gain * com_place, 0.0, kMaxCopFraction);
 }
 
 }  // namespace kin2grf

@@ -34,7 +34,8 @@ Eigen::Vector4d weights(const CopFunction& f, double th) {
 
 }  // namespace
 
-void collect_cop_samples(const EstimateResult& e, const ValidationResult& v, double min_force_fraction, CopSamples& out) {
+void collect_cop_samples(const EstimateResult& e, const ValidationResult& v, double min_force_fraction, CopLength length,
+                         CopSamples& out) {
   const double bw = e.mass_kg * e.model().gravity_mps2;
   for (const auto& s : v.stances) {
     if (s.cop_reference_suspect) continue;  // the plate's COP is not where the foot is
@@ -53,10 +54,12 @@ void collect_cop_samples(const EstimateResult& e, const ValidationResult& v, dou
       else if (x <= B.x()) along = l1 * (x - A.x()) / (B.x() - A.x());
       else if (C.x() > B.x()) along = l1 + l2 * (x - B.x()) / (C.x() - B.x());  // beyond C: extrapolated
       else along = l1 + l2;
-      along = std::min(along, kMaxFraction * (l1 + l2));
+      along = std::min(along, kMaxCopFraction * (l1 + l2));
+      const double unit = cop_length_m(length, e.calibration.contact.feet[static_cast<std::size_t>(s.foot)], l1, l2);
+      if (!(unit > 0)) continue;
       out.theta_rad.push_back(f.inclination_rad[i]);
-      out.fraction.push_back(along / (l1 + l2));
-      out.com_place.push_back((whole_body_com(e.model(), e.motion.frame(i)).x() - A.x()) / (l1 + l2));
+      out.fraction.push_back(along / unit);
+      out.com_place.push_back((whole_body_com(e.model(), e.motion.frame(i)).x() - A.x()) / unit);
     }
   }
 }
@@ -95,10 +98,10 @@ CopFit fit_cop_function(const CopSamples& smp, const CopFunction& start, bool fi
   CopFit fit;
   fit.function = start;
   if (fit_com) fit.function.com_gain = s[4];
-  fit.function.s_hs = std::clamp(s[0], 0.0, kMaxFraction);
-  fit.function.s_ho = std::clamp(s[1], 0.0, kMaxFraction);
-  fit.function.s_mo = std::clamp(s[2], 0.0, kMaxFraction);
-  fit.function.s_to = std::clamp(s[3], 0.0, kMaxFraction);
+  fit.function.s_hs = std::clamp(s[0], 0.0, kMaxCopFraction);
+  fit.function.s_ho = std::clamp(s[1], 0.0, kMaxCopFraction);
+  fit.function.s_mo = std::clamp(s[2], 0.0, kMaxCopFraction);
+  fit.function.s_to = std::clamp(s[3], 0.0, kMaxCopFraction);
   fit.samples = static_cast<int>(n);
   double e0 = 0, e1 = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -148,7 +151,7 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
     const auto& t = trials[k];
     const StudyTrialData d = t.data();
     const auto e = estimate(*d.trial, d.static_trial, *d.marker_set, t.options);
-    collect_cop_samples(e, validate(e, *d.plates), min_force, per[k]);
+    collect_cop_samples(e, validate(e, *d.plates), min_force, start.length, per[k]);
     out.samples_per_trial.push_back(per[k].theta_rad.size());
   }
   // Leave one LAB out: a trial's held-out fit uses no trial of its lab (same lab, same set-up).
@@ -234,11 +237,12 @@ std::string format_cop_fit(const CopFitOnTrials& res, const std::vector<StudyTri
   out += b;
   std::snprintf(b, sizeof b, "  event angles (rad)   HS %.3f  HO %.3f  MO %.3f  TO %.3f\n", f.delta_hs, f.delta_ho, f.delta_mo, f.delta_to);
   out += b;
-  std::snprintf(b, sizeof b, "  positions (fraction) HS %.3f  HO %.3f  MO %.3f  TO %.3f   (start %.3f %.3f %.3f %.3f)\n", f.s_hs, f.s_ho,
-                f.s_mo, f.s_to, start.s_hs, start.s_ho, start.s_mo, start.s_to);
+  std::snprintf(b, sizeof b, "  positions (fraction of the %s length) HS %.3f  HO %.3f  MO %.3f  TO %.3f   (start %.3f %.3f %.3f %.3f)\n",
+                f.length == CopLength::Sole ? "sole" : "heel-MT", f.s_hs, f.s_ho, f.s_mo, f.s_to, start.s_hs, start.s_ho, start.s_mo, start.s_to);
   out += b;
   if (f.com_gain != 0.0 || start.com_gain != 0.0) {
-    std::snprintf(b, sizeof b, "  centre-of-mass gain   %.3f per sole length ahead of the heel   (start %.3f)\n", f.com_gain, start.com_gain);
+    std::snprintf(b, sizeof b, "  centre-of-mass gain   %.3f per %s length ahead of the heel   (start %.3f)\n", f.com_gain,
+                  f.length == CopLength::Sole ? "sole" : "heel-MT", start.com_gain);
     out += b;
   }
   std::snprintf(b, sizeof b, "  RMS of F(theta) - s: %.3f (start: %.3f)\n", res.fit.rms_fraction, res.fit.rms_fraction_before);

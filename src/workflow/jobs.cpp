@@ -196,13 +196,14 @@ int fit_cop_job(const FitCopJob& a, std::ostream& out) {
   check_outputs({a.out}, list_input_files(inputs));
   const auto trials = study_trials(inputs);
   // Start (and, without --fit-angles, keep) the paper's event angles.
-  const CopFunction start = CopFunction::paper();
+  CopFunction start = CopFunction::paper();
+  start.length = a.length == "sole" ? CopLength::Sole : CopLength::HeelMt;
   const auto res = fit_cop_on_trials(trials, start, a.min_force, a.fit_angles, a.leave_one_out, a.fit_com);
   CopFitProvenance prov;
   char min_force[32];
   std::snprintf(min_force, sizeof min_force, "%g", a.min_force);
   prov.command = "kin2grf fit-cop --trial-list " + a.trial_list + " --activity " + a.activity + (a.fit_angles ? " --fit-angles" : "") +
-                 (a.fit_com ? " --fit-com" : "") + " --min-force " + min_force + (a.leave_one_out ? " --leave-one-out" : "");
+                 (a.fit_com ? " --fit-com" : "") + " --length " + a.length + " --min-force " + min_force + (a.leave_one_out ? " --leave-one-out" : "");
   prov.activity = a.activity;
   prov.min_force_fraction = a.min_force;
   prov.fit_angles = a.fit_angles;

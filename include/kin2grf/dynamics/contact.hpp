@@ -7,8 +7,10 @@
 // (toes up), so that the paper's event angles keep their signs (HS -0.3, HO 0, MO 0.15, TO 1 rad).
 //
 // Foot model 2 ("cop", the paper's, Eq. 2): one contact point D, the COP, with
-//   y_D = min(y_A, y_B, y_C),  x_D = the point at arc fraction s = F(theta_A) of the sole
-//   polyline A -> B -> C (s = 0 at A, 1 at C).
+//   y_D = min(y_A, y_B, y_C),  x_D = the point at arc length s = F(theta_A) x l along the sole
+//   polyline A -> B -> C, l the function's length (CopLength): the sole's |AB| + |BC| (the
+//   paper's: s = 1 at C) or the heel-to-MT-heads length (FootContactGeometry::heel_mt_length_m);
+//   at most 1.25 sole lengths (beyond C along B -> C).
 // F is piecewise between the four event angles: half-cosine (sinusoidal) HS->HO and HO->MO,
 // linear MO->TO, constant outside, through the positions s_HS, s_HO, s_MO, s_TO (fitted, see
 // docs/METHOD-NOTES.md). D* is the foot's material point at D this frame; contact at D*:
@@ -36,7 +38,18 @@ struct FootContactGeometry {
   Eigen::Vector2d mt_local = Eigen::Vector2d::Zero();      ///< B, foot frame
   Eigen::Vector2d hallux_local = Eigen::Vector2d::Zero();  ///< C, toes frame
   double flat_angle_rad = 0.0;  ///< theta_foot (ankle->MT direction) in the foot-flat pose
+  /// The heel-to-MT-heads length (m), the unit of a CopLength::HeelMt COP function: |AB| plus,
+  /// where B is a 5th-metatarsal marker, SagittalLandmarks::mt_head_ahead_share of the median
+  /// ankle-MT length (the 2nd head lies ahead of the 5th). 0: not measured, |AB| is taken.
+  double heel_mt_length_m = 0.0;
 };
+
+/// The length (m) a COP function's fractions count in on a foot whose sole segments are l1 = |AB|
+/// and l2 = |BC| this frame (CopLength).
+inline double cop_length_m(CopLength length, const FootContactGeometry& foot, double l1, double l2) {
+  if (length == CopLength::Sole) return l1 + l2;
+  return foot.heel_mt_length_m > 0 ? foot.heel_mt_length_m : l1;
+}
 
 /// The floor and the soles of one trial (Sect. 2.3), measured once from its foot-flat frames
 /// (calibrate_contact) and const afterwards.

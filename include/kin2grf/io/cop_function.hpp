@@ -1,9 +1,11 @@
 // kin2grf I/O: the COP function of foot model 2 as JSON (written by `kin2grf fit-cop`, read by
 // `--cop-function`). Fields: delta_hs, delta_ho, delta_mo, delta_to (rad), s_hs, s_ho, s_mo,
-// s_to (arc fractions of the sole A -> B -> C: 0 at A, 1 at C, up to 1.25 beyond C); optional
-// com_gain (0..1; absent: 0, the function of the angle alone), the COP's arc fraction per sole
-// length of the body's centre of mass ahead of the heel (model/foot_model.hpp); any other field
-// (e.g. "provenance") is kept for the reader and ignored here.
+// s_to (arc fractions along the sole A -> B -> C from A, 0..1.25, in the lengths `length` says);
+// optional length ("sole": the sole's |AB| + |BC|, 1 at C, the paper's; "heel-mt": the heel to
+// the 2nd metatarsal head; absent: "sole"); optional com_gain (0..1; absent: 0, the function of the
+// angle alone), the COP's arc fraction per length of the body's centre of mass ahead of the heel
+// (model/foot_model.hpp); any other field (e.g. "provenance") is kept for the reader and ignored
+// here.
 #pragma once
 
 #include <nlohmann/json.hpp>

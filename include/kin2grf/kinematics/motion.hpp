@@ -34,6 +34,11 @@ struct SagittalLandmarks {
   double rate_hz = 0.0;
   Eigen::VectorXd time_s;
   std::array<Eigen::MatrixX2d, kLandmarkCount> p;
+  /// Per side, how far ahead of the MT landmark the foot's 2nd metatarsal head lies, as a share of
+  /// the ankle-MT length: the marker set's (kLateralMtToeExtraShare for a 5th-metatarsal marker,
+  /// markers/landmarks.hpp), 0 for a landmark on the 2nd head or the heads' midpoint. The contact
+  /// calibration's heel-to-MT-heads length takes it (FootContactGeometry::heel_mt_length_m).
+  std::array<double, 2> mt_head_ahead_share{};
   [[nodiscard]] Eigen::Index frames() const { return time_s.size(); }
 };
 

@@ -26,6 +26,9 @@
 //       projection is the same); the 3D joint moments move a knee or ankle medially by half the
 //       joint's width plus the marker's radius (dynamics/joint_moments_3d.hpp), the COP's lateral
 //       line moves its forefoot end medially by kLateralMtToMidline of the heel-MT length.
+//       For the COP function's heel-to-MT-heads length (CopLength::HeelMt) the 2nd head lies
+//       kLateralMtToeExtraShare of the ankle-MT length ahead of a 5th-metatarsal marker
+//       (SagittalLandmarks::mt_head_ahead_share).
 //   {"virtual_hallux": 0.30}                  hallux fallback: a toes segment of that fraction of
 //       the ankle-MT length, straight along the foot in swing, held at the MT head's foot-flat
 //       height while the heel rises (the toes stay on the ground at push-off); from a

@@ -3,9 +3,11 @@
 //
 // Samples: on the kept plate stances of validate(), every frame where the plate carries at least
 // min_force_fraction of body weight gives (theta_A, s_measured): the foot inclination and the
-// arc fraction along the sole polyline A -> B -> C of the point whose x is the measured COP
-// (0 behind A; beyond C the polyline is extended along B -> C, up to kMaxFraction: the hallux
-// landmark is a marker on the toe, and the COP rolls on to the toe tip at push-off). With the event angles fixed, F is linear in the four event positions
+// arc length along the sole polyline A -> B -> C of the point whose x is the measured COP, in the
+// function's lengths (CopLength: sole lengths, or heel-to-MT-heads lengths) (0 behind A; beyond C
+// the polyline is extended along B -> C, up to kMaxCopFraction sole lengths: the hallux landmark
+// is a marker on the toe, and the COP rolls on to the toe tip at push-off). With the event angles
+// fixed, F is linear in the four event positions
 // (s_HS, s_HO, s_MO, s_TO): each sample's F value is a weighted sum of two of them (half-cosine or
 // linear weights), so the fit is an ordinary linear least-squares problem, solved by QR.
 #pragma once
@@ -21,17 +23,15 @@
 
 namespace kin2grf {
 
-/// Largest arc fraction: C plus a quarter of the sole beyond it.
-inline constexpr double kMaxFraction = 1.25;
-
 struct CopSamples {
-  /// com_place: the whole body's centre of mass ahead of the heel point A, in sole lengths
-  /// (CopFunction::fraction's second argument).
+  /// fraction and com_place (the whole body's centre of mass ahead of the heel point A;
+  /// CopFunction::fraction's second argument) in the lengths of the CopLength they were collected for.
   std::vector<double> theta_rad, fraction, com_place;
 };
 
-/// Append the samples of one validated trial.
-void collect_cop_samples(const EstimateResult& e, const ValidationResult& v, double min_force_fraction, CopSamples& out);
+/// Append the samples of one validated trial, counted in `length` (the function to be fitted's).
+void collect_cop_samples(const EstimateResult& e, const ValidationResult& v, double min_force_fraction, CopLength length,
+                         CopSamples& out);
 
 struct CopFit {
   CopFunction function;

@@ -46,6 +46,9 @@ struct FitCopJob {
   /// extrapolation: held out 6.44 -> 6.23 % walking COP, docs/METHOD-NOTES.md).
   double min_force = ValidationOptions{}.cop_min_force_fraction;
   bool leave_one_out = false, fit_angles = false, fit_com = false;
+  /// What the fitted fractions count in (CopLength): "heel-mt" (the built-in walking function's)
+  /// or "sole" (the paper's).
+  std::string length = "heel-mt";
 };
 
 struct BatchJob {
