@@ -12,13 +12,12 @@ enum class FootModel { Cop, ThreePoint };
 /// - Sole: the sole's whole length |AB| + |BC| (the paper's "foot length"; 1 at C).
 /// - HeelMt: the heel-to-metatarsal-heads length, A to the 2nd metatarsal head (|AB|, plus
 ///   FootContactGeometry::heel_mt_length_m's allowance where B is a 5th-metatarsal marker); the
-///   sole past B is followed as before. Why (session 47): a toe marker's place differs more between
-///   labs than the heel and MT markers' do (25 to 117 mm ahead of B on the development walks, a
-///   virtual toe elsewhere), and the rear foot's rocker, which carries the COP until heel-off, does
-///   not lengthen with the toes. Over the development walks, the plates' COP place per 0.1 rad of
-///   foot angle spreads 6-13 mm between walks in heel-MT lengths against 10-17 mm in sole lengths
-///   up to 0.3 rad; with the function refitted without each lab, walking COP rRMSE 6.0 -> 5.5 %
-///   (docs/METHOD-NOTES.md).
+///   sole past B is followed as before. Why (session 47): a toe marker's place varies between labs
+///   (25 to 117 mm ahead of B on the development walks, virtual toes elsewhere), and the rear
+///   foot's rocker, which carries the COP until heel-off, does not lengthen with the toes. The plates' COP place per 0.1 rad of foot angle spreads between
+///   the walks by 6-16 mm in heel-MT lengths against 10-17 mm in sole lengths from -0.3 to 0.3 rad
+///   (less in 5 bins of 7); with the function refitted without each lab, walking COP rRMSE 6.2 ->
+///   5.7 % (docs/METHOD-NOTES.md).
 enum class CopLength { Sole, HeelMt };
 
 /// Largest COP fraction, in the function's lengths: with Sole, C plus a quarter of the sole
@@ -39,13 +38,14 @@ inline constexpr double kMaxCopFraction = 1.25;
 ///
 /// The defaults are kin2grf's fit to the plate COPs of the 10 development walking trials (7 labs;
 /// 1359 frames of the plate stances loaded above 5 % body weight, the frames validate judges the
-/// COP on; event angles, positions and com_gain fitted; `kin2grf fit-cop --fit-angles --fit-com`).
-/// Leave-one-lab-out (each lab scored with the function refitted on the other labs; `fit-cop
-/// --leave-one-out`, mean over the trials), walking COP rRMSE 6.6 % with the angle alone and 6.2 %
-/// with the centre-of-mass term (fitted above 20 % body weight: 6.9 and 6.4 %).
+/// COP on; event angles, positions and com_gain fitted, in heel-MT lengths; `kin2grf fit-cop
+/// --fit-angles --fit-com`). Leave-one-lab-out (each lab scored with the function refitted on the
+/// other labs; `fit-cop --leave-one-out`, mean over the trials), walking COP rRMSE: in sole lengths
+/// 6.6 % with the angle alone and 6.2 % with the centre-of-mass term (session 46); in heel-MT
+/// lengths 6.4 and 5.7 % (session 47; over the stances 6.39 -> 6.24 %).
 /// Provenance and the command that remakes it: data/cop-function/walking-fitted.json and
 /// docs/METHOD-NOTES.md. paper() keeps the paper's event angles (-0.3, 0, 0.15, 1 rad) with
-/// positions fitted for them and no centre-of-mass term (--paper).
+/// positions fitted for them in sole lengths and no centre-of-mass term (--paper).
 struct CopFunction {
   double delta_hs = -0.15, delta_ho = -0.05, delta_mo = 0.06, delta_to = 1.48;
   double s_hs = 0.2862, s_ho = 0.3578, s_mo = 0.7631, s_to = 1.1135;
