@@ -185,7 +185,8 @@ nlohmann::json cop_json(const CopFunction& c, const std::string& source) {
   return {{"source", source},
           {"delta_rad", {c.delta_hs, c.delta_ho, c.delta_mo, c.delta_to}},
           {"s", {c.s_hs, c.s_ho, c.s_mo, c.s_to}},
-          {"com_gain", c.com_gain}};
+          {"com_gain", c.com_gain},
+          {"length", c.length == CopLength::Sole ? "sole" : "heel-mt"}};
 }
 }  // namespace
 
