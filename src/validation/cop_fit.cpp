@@ -232,7 +232,7 @@ std::string format_cop_fit(const CopFitOnTrials& res, const std::vector<StudyTri
                            const CopFitProvenance& how) {
   const CopFunction& f = res.fit.function;
   std::string out;
-  char b[512];
+  char b[1024];
   std::snprintf(b, sizeof b, "COP function fitted on %d samples of %zu trials (%s)\n", res.fit.samples, trials.size(), how.activity.c_str());
   out += b;
   std::snprintf(b, sizeof b, "  event angles (rad)   HS %.3f  HO %.3f  MO %.3f  TO %.3f\n", f.delta_hs, f.delta_ho, f.delta_mo, f.delta_to);
@@ -249,7 +249,8 @@ std::string format_cop_fit(const CopFitOnTrials& res, const std::vector<StudyTri
   out += b;
   if (!res.leave_one_out.empty()) {
     std::snprintf(b, sizeof b,
-                  "\nleave-one-lab-out: COP rRMSE %% (mean over the trial's stances; 'built-in': kin2grf's default function;\n"
+                  "\nleave-one-lab-out: COP rRMSE %% (mean over the trial's stances; 'start': the fit's starting function, the\n"
+                  "paper's angles and positions counted in the fit's length; 'built-in': kin2grf's default function;\n"
                   "'all': this fit; 'other labs': fitted without the trial's lab, with the trial's vertical and\n"
                   "anterior rRMSE %% and total GRM rRMSE %% under that fit)\n"
                   "%-26s %8s %9s %8s %11s %9s %9s %6s\n",
