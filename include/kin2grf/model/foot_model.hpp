@@ -14,10 +14,10 @@ enum class FootModel { Cop, ThreePoint };
 ///   FootContactGeometry::heel_mt_length_m's allowance where B is a 5th-metatarsal marker); the
 ///   sole past B is followed as before. Why (session 47): a toe marker's place varies between labs
 ///   (25 to 117 mm ahead of B on the development walks, virtual toes elsewhere), and the rear
-///   foot's rocker, which carries the COP until heel-off, does not lengthen with the toes. The plates' COP place per 0.1 rad of foot angle spreads between
-///   the walks by 6-16 mm in heel-MT lengths against 10-17 mm in sole lengths from -0.3 to 0.3 rad
-///   (less in 5 bins of 7); with the function refitted without each lab, walking COP rRMSE 6.2 ->
-///   5.7 % (docs/METHOD-NOTES.md).
+///   foot's rocker, which carries the COP until heel-off, does not lengthen with the toes. The
+///   plates' COP place per 0.1 rad of foot angle spreads between the walks by 6-16 mm in heel-MT
+///   lengths against 10-17 mm in sole lengths from -0.3 to 0.3 rad (less in 5 bins of 7); with
+///   the function refitted without each lab, walking COP rRMSE 6.2 -> 5.7 % (docs/METHOD-NOTES.md).
 enum class CopLength { Sole, HeelMt };
 
 /// Largest COP fraction, in the function's lengths: with Sole, C plus a quarter of the sole
@@ -29,8 +29,8 @@ inline constexpr double kMaxCopFraction = 1.25;
 /// B -> C: the hallux landmark is a marker on the toe and the COP rolls on to the toe tip).
 ///
 /// kin2grf adds one term to the paper's function (session 46): com_gain times how far the whole
-/// body's centre of mass is ahead of the heel point A, in the function's lengths. Why: the foot's angle
-/// barely moves in foot-flat (the fitted HO -> MO events are 0.13 rad apart) while the COP rolls
+/// body's centre of mass is ahead of the heel point A, in the function's lengths. Why: the foot's
+/// angle barely moves in foot-flat (the fitted HO -> MO events are 0.11 rad apart) while the COP rolls
 /// from the heel to the metatarsal heads as the body passes over the foot (the second rocker);
 /// the angle alone cannot tell how far it has rolled, and a long or slow foot-flat holds it
 /// still. In single support the ground reaction points from the COP towards the centre of mass,
