@@ -417,8 +417,11 @@ if cv_kinds:
                 forces = f"{mean('other_labs_vertical'):.1f} / {mean('other_labs_anterior'):.1f}"
                 g = [x["other_labs_total_grm"] for x in loo if x.get("other_labs_total_grm") is not None]
                 grm = f"{statistics.mean(g):.1f}" if g else "-"
+            cop_mm = ""
+            if all(x.get("other_labs_cop_rmse_mm") is not None for x in loo):
+                cop_mm = f" ({mean('other_labs_cop_rmse_mm'):.1f} mm)"
             print(f"| cop-function | built in (10 walks, angle and centre of mass, heel-MT lengths, session 47) | walking | - / - / {mean('builtin'):.1f}, - | "
-                  f"{forces} / {mean('other_labs'):.1f}, {grm} | - | - | {worst['trial']} {worst['other_labs']:.1f} (COP) | - |")
+                  f"{forces} / {mean('other_labs'):.1f}{cop_mm}, {grm} | - | - | {worst['trial']} {worst['other_labs']:.1f} (COP) | - |")
     if held:
         print("\nThe figure a default changes by, the criterion with each lab at the choice made without it, against "
               "kin2grf's default on every lab (%; in brackets the criterion whose vertical force is over the loaded span, "

@@ -209,7 +209,17 @@ TEST(CopFit, LeaveOneLabOutReportsTheBuiltInFunctionBesideTheRefits) {
     EXPECT_NEAR(l.others_vertical, m.vertical, 1e-9) << l.trial;
     EXPECT_NEAR(l.others_anterior, m.anterior, 1e-9) << l.trial;
     EXPECT_NEAR(l.others_grm, v.total->metrics.moment->rrmse_percent, 1e-9) << l.trial;
+    EXPECT_NEAR(l.others_cop_mm, m.cop_rmse_mm, 1e-9) << l.trial;
   }
+  // The COP's mm: the mean of the stances' RMSE along progression.
+  double mm = 0;
+  int n = 0;
+  for (const auto& s : v.stances)
+    if (s.metrics.cop && !s.cop_reference_suspect) mm += 1000 * s.metrics.cop->rmse, ++n;
+  ASSERT_GT(n, 0);
+  EXPECT_NEAR(m.cop_rmse_mm, mm / n, 1e-9);
+  EXPECT_GT(m.cop_rmse_mm, 0.0);
   const auto j = cop_fit_json(res, trials, CopFunction::paper(), CopFitProvenance{});
   EXPECT_TRUE(j["provenance"]["leave_one_lab_out_cop_rrmse_percent"][0].contains("other_labs_vertical"));
+  EXPECT_TRUE(j["provenance"]["leave_one_lab_out_cop_rrmse_percent"][0].contains("other_labs_cop_rmse_mm"));
 }

@@ -187,7 +187,7 @@ CopFitOnTrials fit_cop_on_trials(const std::vector<StudyTrial>& trials, const Co
     const ValidationResult held = validated(fit_fn(others).function);
     const MeanMetrics m = mean_rrmse(held.stances);
     CopFitOnTrials::LeaveOneOut l{t.name, cop_rrmse(start), cop_rrmse(CopFunction{}), cop_rrmse(out.fit.function), m.cop};
-    l.others_vertical = m.vertical, l.others_anterior = m.anterior;
+    l.others_vertical = m.vertical, l.others_anterior = m.anterior, l.others_cop_mm = m.cop_rmse_mm;
     l.others_grm = held.total && held.total->metrics.moment ? held.total->metrics.moment->rrmse_percent
                                                              : std::numeric_limits<double>::quiet_NaN();
     out.leave_one_out.push_back(l);
@@ -221,7 +221,8 @@ nlohmann::json cop_fit_json(const CopFitOnTrials& res, const std::vector<StudyTr
                      {"other_labs", l.others},
                      {"other_labs_vertical", num(l.others_vertical)},
                      {"other_labs_anterior", num(l.others_anterior)},
-                     {"other_labs_total_grm", num(l.others_grm)}});
+                     {"other_labs_total_grm", num(l.others_grm)},
+                     {"other_labs_cop_rmse_mm", num(l.others_cop_mm)}});
     prov["leave_one_lab_out_cop_rrmse_percent"] = loo;
   }
   j["provenance"] = prov;
@@ -251,14 +252,14 @@ std::string format_cop_fit(const CopFitOnTrials& res, const std::vector<StudyTri
     std::snprintf(b, sizeof b,
                   "\nleave-one-lab-out: COP rRMSE %% (mean over the trial's stances; 'start': the fit's starting function, the\n"
                   "paper's angles and positions counted in the fit's length; 'built-in': kin2grf's default function;\n"
-                  "'all': this fit; 'other labs': fitted without the trial's lab, with the trial's vertical and\n"
-                  "anterior rRMSE %% and total GRM rRMSE %% under that fit)\n"
-                  "%-26s %8s %9s %8s %11s %9s %9s %6s\n",
-                  "trial", "start", "built-in", "all", "other labs", "vertical", "anterior", "GRM");
+                  "'all': this fit; 'other labs': fitted without the trial's lab, with the trial's COP RMSE in mm,\n"
+                  "vertical and anterior rRMSE %% and total GRM rRMSE %% under that fit)\n"
+                  "%-26s %8s %9s %8s %11s %7s %9s %9s %6s\n",
+                  "trial", "start", "built-in", "all", "other labs", "COP mm", "vertical", "anterior", "GRM");
     out += b;
     for (const auto& l : res.leave_one_out) {
-      std::snprintf(b, sizeof b, "%-26s %8.1f %9.1f %8.1f %11.1f %9.1f %9.1f %6.1f\n", l.trial.c_str(), l.start, l.builtin, l.all, l.others,
-                    l.others_vertical, l.others_anterior, l.others_grm);
+      std::snprintf(b, sizeof b, "%-26s %8.1f %9.1f %8.1f %11.1f %7.1f %9.1f %9.1f %6.1f\n", l.trial.c_str(), l.start, l.builtin, l.all,
+                    l.others, l.others_cop_mm, l.others_vertical, l.others_anterior, l.others_grm);
       out += b;
     }
   }

@@ -984,7 +984,7 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
 MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
   MeanMetrics mm;
   std::array<std::vector<double>, 5> vals;
-  std::vector<double> lateral_rmse, cop_lateral_rmse, onset_abs, loaded_span, double_support, single_support;
+  std::vector<double> lateral_rmse, cop_lateral_rmse, cop_rmse, onset_abs, loaded_span, double_support, single_support;
   double sq_double = 0, sq_all = 0;
   // The stance parameters' |estimate - plate| (peaks, % body weight; impulses, body weight x ms)
   // and the loading rate's |error| and plate value.
@@ -1031,6 +1031,7 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
         vals[k].push_back((*c[k])->rrmse_percent);
     if (s.metrics.cop_lateral && std::isfinite(s.metrics.cop_lateral->rmse) && !s.cop_reference_suspect)
       cop_lateral_rmse.push_back(1000 * s.metrics.cop_lateral->rmse);
+    if (s.metrics.cop && std::isfinite(s.metrics.cop->rmse) && !s.cop_reference_suspect) cop_rmse.push_back(1000 * s.metrics.cop->rmse);
     if (s.metrics.lateral && std::isfinite(s.metrics.lateral->rmse) && s.body_weight_N > 0)
       lateral_rmse.push_back(100 * s.metrics.lateral->rmse / s.body_weight_N);
     ++mm.n;
@@ -1042,6 +1043,7 @@ MeanMetrics mean_rrmse(const std::vector<StanceValidation>& stances, int foot) {
     return x.empty() ? kNaN : sum / static_cast<double>(x.size());
   };
   mm.cop_lateral_rmse_mm = mean_of(cop_lateral_rmse);
+  mm.cop_rmse_mm = mean_of(cop_rmse);
   mm.onset_abs_ms = mean_of(onset_abs);
   mm.vertical_loaded_span = mean_of(loaded_span);
   mm.vertical_rmse_double_support_percent_bw = mean_of(double_support);

@@ -64,6 +64,8 @@ struct CopFitOnTrials {
     /// With the fit on the other labs: the trial's mean vertical and anterior rRMSE (%) and its
     /// total GRM rRMSE (%, NaN without a total window): what the COP's place does to the forces.
     double others_vertical = 0, others_anterior = 0, others_grm = 0;
+    /// With the fit on the other labs: the trial's mean COP RMSE, mm (issue 29's "with the mm beside it").
+    double others_cop_mm = 0;
   };
   std::vector<LeaveOneOut> leave_one_out;
 };

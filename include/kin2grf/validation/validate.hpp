@@ -381,6 +381,9 @@ struct MeanMetrics {
   /// by a range of 10-15 % body weight, so a few newtons read large.
   double lateral_rmse_percent_bw = 0;
   double cop_lateral_rmse_mm = 0;  ///< mean over the stances (NaN without --mediolateral)
+  /// The COP's RMSE along progression, mm: mean over the stances whose plate passes the
+  /// registration check (as `cop`; NaN without such a stance).
+  double cop_rmse_mm = 0;
   /// Mean |onset error| (ms) over the stances that have one (NaN without): the contact timing,
   /// which the rRMSEs, scored from the plate's onset on, do not see.
   double onset_abs_ms = 0;
