@@ -150,7 +150,7 @@ void contact_frame(const Model& model, const ContactCalibration& soles, const Co
     const double com_place = F.com_gain != 0.0 && unit > 0 ? (com_x - sp[0].x()) / unit : 0.0;
     const double s = F.fraction(fc.foot_inclination_rad[side], com_place);
     fc.cop_fraction[side] = s;
-    const double along = F.length == CopLength::Sole ? s * (l1 + l2) : std::min(s * unit, kMaxCopFraction * (l1 + l2));
+    const double along = std::min(s * unit, kMaxCopFraction * (l1 + l2));
     const Eigen::Vector2d on = along <= l1 ? sp[0] + (sp[1] - sp[0]) * (l1 > 0 ? along / l1 : 0.0)
                                            : sp[1] + (sp[2] - sp[1]) * (l2 > 0 ? (along - l1) / l2 : 0.0);
     const double yD = std::min({sp[0].y(), sp[1].y(), sp[2].y()});

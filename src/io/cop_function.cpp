@@ -8,11 +8,19 @@
 
 namespace kin2grf {
 
+const char* cop_length_name(CopLength length) { return length == CopLength::Sole ? "sole" : "heel-mt"; }
+
+std::optional<CopLength> parse_cop_length(const std::string& name) {
+  if (name == cop_length_name(CopLength::Sole)) return CopLength::Sole;
+  if (name == cop_length_name(CopLength::HeelMt)) return CopLength::HeelMt;
+  return std::nullopt;
+}
+
 nlohmann::json cop_function_json(const CopFunction& f) {
   nlohmann::json j = {{"delta_hs", f.delta_hs}, {"delta_ho", f.delta_ho}, {"delta_mo", f.delta_mo}, {"delta_to", f.delta_to},
                       {"s_hs", f.s_hs},         {"s_ho", f.s_ho},         {"s_mo", f.s_mo},         {"s_to", f.s_to}};
   if (f.com_gain != 0.0) j["com_gain"] = f.com_gain;
-  j["length"] = f.length == CopLength::Sole ? "sole" : "heel-mt";
+  j["length"] = cop_length_name(f.length);
   return j;
 }
 
@@ -24,7 +32,7 @@ CopFunction cop_function_from_json(const nlohmann::json& j, const std::string& p
     if (!j.is_object() || !j.contains(key)) throw InputError(path + ": COP function: missing field '" + key + "'");
     if (!j[key].is_number()) throw InputError(path + ": COP function: field '" + key + "' is not a number");
     out = j[key].get<double>();
-    if (!std::isfinite(out) || (fraction && (out < 0 || out > 1.25)))
+    if (!std::isfinite(out) || (fraction && (out < 0 || out > kMaxCopFraction)))
       throw InputError(path + ": COP function: field '" + key + "' must be " + (fraction ? "within 0..1.25" : "finite"));
   };
   get("delta_hs", f.delta_hs, false), get("delta_ho", f.delta_ho, false), get("delta_mo", f.delta_mo, false),
@@ -37,9 +45,9 @@ CopFunction cop_function_from_json(const nlohmann::json& j, const std::string& p
   }
   if (j.is_object() && j.contains("length")) {
     const auto& l = j["length"];
-    if (l == "sole") f.length = CopLength::Sole;
-    else if (l == "heel-mt") f.length = CopLength::HeelMt;
-    else throw InputError(path + ": COP function: field 'length' must be \"sole\" or \"heel-mt\"");
+    const std::optional<CopLength> length = l.is_string() ? parse_cop_length(l.get<std::string>()) : std::nullopt;
+    if (!length) throw InputError(path + ": COP function: field 'length' must be \"sole\" or \"heel-mt\"");
+    f.length = *length;
   }
   if (!(f.delta_hs < f.delta_ho && f.delta_ho < f.delta_mo && f.delta_mo < f.delta_to))
     throw InputError(path + ": COP function: the event angles must increase (delta_hs < delta_ho < delta_mo < delta_to)");

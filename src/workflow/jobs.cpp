@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "kin2grf/error.hpp"
+#include "kin2grf/io/cop_function.hpp"
 #include "kin2grf/io/json.hpp"
 #include "kin2grf/io/load.hpp"
 #include "kin2grf/io/marker_labels.hpp"
@@ -197,7 +198,9 @@ int fit_cop_job(const FitCopJob& a, std::ostream& out) {
   const auto trials = study_trials(inputs);
   // Start (and, without --fit-angles, keep) the paper's event angles.
   CopFunction start = CopFunction::paper();
-  start.length = a.length == "sole" ? CopLength::Sole : CopLength::HeelMt;
+  const std::optional<CopLength> length = parse_cop_length(a.length);
+  if (!length) throw InputError("fit-cop: --length must be heel-mt or sole, not '" + a.length + "'");
+  start.length = *length;
   const auto res = fit_cop_on_trials(trials, start, a.min_force, a.fit_angles, a.leave_one_out, a.fit_com);
   CopFitProvenance prov;
   char min_force[32];

@@ -186,7 +186,7 @@ nlohmann::json cop_json(const CopFunction& c, const std::string& source) {
           {"delta_rad", {c.delta_hs, c.delta_ho, c.delta_mo, c.delta_to}},
           {"s", {c.s_hs, c.s_ho, c.s_mo, c.s_to}},
           {"com_gain", c.com_gain},
-          {"length", c.length == CopLength::Sole ? "sole" : "heel-mt"}};
+          {"length", cop_length_name(c.length)}};
 }
 }  // namespace
 

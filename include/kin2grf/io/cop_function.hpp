@@ -9,11 +9,17 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "kin2grf/model/foot_model.hpp"
 
 namespace kin2grf {
+
+/// CopLength's name in a COP-function file and on the command line: "sole" or "heel-mt".
+const char* cop_length_name(CopLength length);
+/// The CopLength a name says; nullopt for any other name.
+std::optional<CopLength> parse_cop_length(const std::string& name);
 
 nlohmann::json cop_function_json(const CopFunction& f);
 /// Throws InputError naming the file and the field when a field is missing, not a number, out
