@@ -82,6 +82,41 @@ TEST(CopFit, RecoversTheCentreOfMassGainOfSamplesThatFollowTheBody) {
   EXPECT_THROW((void)fit_cop_function(bare, CopFunction::paper(), true), InputError);
 }
 
+// The fit keeps the COP rolling forward (s_HS <= s_HO <= s_MO <= s_TO). Samples whose COP falls
+// back between heel strike and heel-off (a heel-strike transient) would pull an unconstrained
+// least squares to s_HS > s_HO; the fit ties the two at their joint least-squares value instead
+// and leaves the ordered positions as they fit.
+TEST(CopFit, ThePositionsNeverMoveTheCopBackwards) {
+  const CopFunction start = CopFunction::paper();  // HS -0.3, HO 0, MO 0.15, TO 1.0 rad
+  CopSamples smp;
+  auto add = [&](double th, double s, int n) {
+    for (int k = 0; k < n; ++k) smp.theta_rad.push_back(th), smp.fraction.push_back(s), smp.com_place.push_back(0.0);
+  };
+  add(-0.4, 0.40, 30);  // at and before heel strike: weight on s_HS alone
+  add(0.0, 0.30, 10);   // at heel-off: s_HO alone
+  add(0.15, 0.70, 20);  // mid-stance to toe-off, in order
+  add(1.0, 0.95, 20);
+  const auto fit = fit_cop_function(smp, start);
+  const CopFunction& f = fit.function;
+  EXPECT_LE(f.s_hs, f.s_ho);
+  EXPECT_LE(f.s_ho, f.s_mo);
+  EXPECT_LE(f.s_mo, f.s_to);
+  // Tied: the mean of the two groups' fractions weighted by their counts, (30 x 0.40 + 10 x 0.30) / 40.
+  EXPECT_NEAR(f.s_hs, 0.375, 1e-5);
+  EXPECT_NEAR(f.s_ho, 0.375, 1e-5);
+  EXPECT_NEAR(f.s_mo, 0.70, 1e-5);
+  EXPECT_NEAR(f.s_to, 0.95, 1e-5);
+  // Fitted with the centre-of-mass gain, the gain's column stays free and the tie still holds.
+  const auto with_com = fit_cop_function(smp, start, true);
+  EXPECT_NEAR(with_com.function.s_hs, with_com.function.s_ho, 1e-9);
+  EXPECT_LE(with_com.function.s_mo, with_com.function.s_to);
+  // The event-angle search fits positions the same way.
+  const auto searched = fit_cop_function_and_angles(smp, start);
+  EXPECT_LE(searched.function.s_hs, searched.function.s_ho);
+  EXPECT_LE(searched.function.s_ho, searched.function.s_mo);
+  EXPECT_LE(searched.function.s_mo, searched.function.s_to);
+}
+
 // The term's arithmetic: added to the angle's fraction, kept within the sole's 0..1.25, and off
 // (the paper's function exactly) at a gain of 0.
 TEST(CopFit, TheCentreOfMassTermAddsToTheAnglesFractionWithinTheSole) {

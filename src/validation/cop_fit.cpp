@@ -1,6 +1,7 @@
 #include "kin2grf/validation/cop_fit.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -30,6 +31,44 @@ Eigen::Vector4d weights(const CopFunction& f, double th) {
     w[3] = 1;
   }
   return w;
+}
+
+/// The least-squares positions with the COP rolling forward: s_HS <= s_HO <= s_MO <= s_TO. The
+/// foot turns forward through the stance, heel strike to toe-off, and the COP rolls forward under
+/// it (the paper's Fig. 3 and every plate's stance); a fit whose positions fall from one event to
+/// the next has fitted something else (a lab's heel-strike transient, a ridge-held event no sample
+/// reaches) and moves the COP backwards under a foot that turns on. Pool adjacent violators: two
+/// positions out of order are tied (one column, the sum of their weights) and the problem solved
+/// again, until the order holds (at most three ties). Columns past the fourth (the centre-of-mass
+/// gain) stay free.
+Eigen::VectorXd solve_rolling_forward(const Eigen::MatrixXd& Wa, const Eigen::VectorXd& ya) {
+  const Eigen::Index p = Wa.cols();
+  Eigen::VectorXd s = Wa.colPivHouseholderQr().solve(ya);
+  std::array<int, 4> group{0, 1, 2, 3};  // the event positions' tie groups, in order
+  for (int pass = 0; pass < 3; ++pass) {
+    bool ordered = true;
+    for (int k = 0; k < 3; ++k)
+      if (group[static_cast<std::size_t>(k)] != group[static_cast<std::size_t>(k + 1)] && s[k] > s[k + 1]) {
+        ordered = false;
+        const int from = group[static_cast<std::size_t>(k + 1)], to = group[static_cast<std::size_t>(k)];
+        for (int& g : group)
+          if (g == from) g = to;
+      }
+    if (ordered) break;
+    // Tie matrix T: s = T t, one column per group, then the free columns.
+    std::array<int, 4> column{};
+    Eigen::Index groups = 0;
+    for (int k = 0; k < 4; ++k) {
+      const bool first = k == 0 || group[static_cast<std::size_t>(k)] != group[static_cast<std::size_t>(k - 1)];
+      if (first) ++groups;
+      column[static_cast<std::size_t>(k)] = static_cast<int>(groups - 1);
+    }
+    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(p, groups + (p - 4));
+    for (int k = 0; k < 4; ++k) T(k, column[static_cast<std::size_t>(k)]) = 1.0;
+    for (Eigen::Index j = 4; j < p; ++j) T(j, groups + (j - 4)) = 1.0;
+    s = T * (Wa * T).colPivHouseholderQr().solve(ya);
+  }
+  return s;
 }
 
 }  // namespace
@@ -87,7 +126,7 @@ CopFit fit_cop_function(const CopSamples& smp, const CopFunction& start, bool fi
   if (fit_com) s0[4] = start.com_gain;
   Wa << W, ridge * Eigen::MatrixXd::Identity(p, p);
   ya << y, ridge * s0;
-  const Eigen::VectorXd s = Wa.colPivHouseholderQr().solve(ya);
+  const Eigen::VectorXd s = solve_rolling_forward(Wa, ya);
   if (fit_com && (s[4] < 0.0 || s[4] > 1.0)) {
     // Outside what a COP function may hold (io/cop_function.hpp: a COP rolling back as the body
     // moves on, or outrunning it): the gain at its bound, the positions fitted for it.

@@ -9,7 +9,8 @@
 // is a marker on the toe, and the COP rolls on to the toe tip at push-off). With the event angles
 // fixed, F is linear in the four event positions
 // (s_HS, s_HO, s_MO, s_TO): each sample's F value is a weighted sum of two of them (half-cosine or
-// linear weights), so the fit is an ordinary linear least-squares problem, solved by QR.
+// linear weights), so the fit is an ordinary linear least-squares problem, solved by QR, with the
+// positions kept in order (the COP rolls forward; adjacent positions out of order tied).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -41,7 +42,9 @@ struct CopFit {
 };
 
 /// Least-squares event positions for the event angles of `start` (its positions are only the
-/// reference for rms_fraction_before). Throws InputError with fewer than 20 samples.
+/// reference for rms_fraction_before), in order, s_HS <= s_HO <= s_MO <= s_TO: the COP rolls
+/// forward as the foot turns forward (positions the data would put out of order are tied at their
+/// joint least-squares value). Throws InputError with fewer than 20 samples.
 /// fit_com: com_gain fitted with them (otherwise start's is kept); a least-squares gain outside
 /// 0..1 is held at the bound it passes.
 CopFit fit_cop_function(const CopSamples& samples, const CopFunction& start, bool fit_com = false);
