@@ -555,3 +555,52 @@ TEST(Study, SubjectScaleStudyScalesTheSubjectItsPlatesAndTheValidation) {
     }
   }
 }
+
+// The marker-placement study puts each foot's heel or MT markers 15 mm further back or forward
+// along the foot: the moved markers go exactly that far along the heel -> MT line and no other
+// marker moves; on the example walk every row keeps its stances and model 2's COP, placed in
+// lengths between the heel and MT landmarks, moves in each.
+TEST(Study, MarkerPlacementStudyMovesTheHeelOrMtMarkersAlongTheFoot) {
+  const Trial walk = make_example_walk();
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  for (const LegLandmark which : {kHeel, kMt}) {
+    MarkerTrajectories moved = walk.markers;
+    shift_markers_along_foot(moved, set, which, -0.015);
+    std::vector<int> expected;
+    for (int side = 0; side < 2; ++side)
+      for (const std::string& name : set.rules[static_cast<std::size_t>(landmark(side, which))].markers) expected.push_back(moved.find(name));
+    ASSERT_EQ(expected.size(), 2u);
+    for (std::size_t k = 0; k < moved.names.size(); ++k) {
+      const Eigen::MatrixX3d d = moved.positions_m[k] - walk.markers.positions_m[k];
+      const bool is_moved = std::find(expected.begin(), expected.end(), static_cast<int>(k)) != expected.end();
+      if (!is_moved) {
+        EXPECT_EQ(d.cwiseAbs().maxCoeff(), 0.0) << moved.names[k];
+        continue;
+      }
+      const int side = k == static_cast<std::size_t>(expected[0]) ? 0 : 1;
+      const int heel = walk.markers.find(set.rules[static_cast<std::size_t>(landmark(side, kHeel))].markers[0]);
+      const int mt = walk.markers.find(set.rules[static_cast<std::size_t>(landmark(side, kMt))].markers[0]);
+      for (Eigen::Index i = 0; i < d.rows(); i += 25) {
+        const Eigen::RowVector3d u = (walk.markers.positions_m[static_cast<std::size_t>(mt)].row(i) -
+                                      walk.markers.positions_m[static_cast<std::size_t>(heel)].row(i)).normalized();
+        EXPECT_NEAR(d.row(i).norm(), 0.015, 1e-12) << moved.names[k] << " frame " << i;
+        EXPECT_NEAR(d.row(i).dot(u), -0.015, 1e-12) << "back along the heel -> MT line";
+      }
+    }
+  }
+  StudyTrial t;
+  t.name = "walk", t.activity = "walking", t.lab = "lab", t.trial = &walk, t.plates = &*walk.plates, t.marker_set = &set;
+  const StudyResult r = run_study("marker-placement", {t});
+  ASSERT_EQ(r.rows.size(), 5u);
+  ASSERT_TRUE(r.failures.empty()) << r.failures.front();
+  EXPECT_TRUE(r.rows[0].is_default);
+  const auto& recorded = r.per_trial[0][0].stances;
+  ASSERT_GT(recorded.size(), 0u);
+  for (std::size_t row = 1; row < r.rows.size(); ++row) {
+    const auto& placed = r.per_trial[row][0].stances;
+    ASSERT_EQ(placed.size(), recorded.size()) << r.rows[row].label;
+    double cop_change = 0;
+    for (std::size_t k = 0; k < placed.size(); ++k) cop_change += std::abs(placed[k].metrics.cop->rmse - recorded[k].metrics.cop->rmse);
+    EXPECT_GT(cop_change, 1e-4) << r.rows[row].label << ": the COP's lengths are the markers' distances";
+  }
+}

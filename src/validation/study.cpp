@@ -46,6 +46,10 @@ struct Setting {
   /// stances timed this way.
   double plate_export_hz = 0.0;
   ValidationOptions::Timing timing = ValidationOptions::Timing::Auto;
+  /// The `marker-placement` study: each foot's heel or MT markers (placement_landmark) placed this
+  /// far along the foot (m, + towards the toes; 0: as recorded), in the trial and its static trial.
+  LegLandmark placement_landmark = kMt;
+  double placement_shift_m = 0.0;
 };
 
 /// Marks the settings that leave the fields `get` reads at kin2grf's defaults (the added marker
@@ -339,6 +343,63 @@ std::vector<Setting> marker_gaps_settings() {
   return s;
 }
 
+/// Robustness to where a lab puts the foot's markers: the heel markers, then the MT markers, of
+/// both feet placed kPlacementShiftM further back and further forward along the foot (the line
+/// from the heel markers to the MT markers) in every frame of the trial and of its static trial.
+/// Model 2 places the COP in lengths measured between these markers (the heel point A, the MT
+/// head B), so their placement is the foot's geometry to it; a rule that leans on one of them
+/// shows it here. 15 mm is about a marker's diameter: a palpation of the calcaneus or of a
+/// metatarsal head a little off, or a lab's habit (Plug-in Gait's TOE "on the mid-foot side" of
+/// the 2nd MT head or on it).
+constexpr double kPlacementShiftM = 0.015;
+std::vector<Setting> marker_placement_settings() {
+  std::vector<Setting> s{{"as recorded", 0, [](EstimateOptions&) {}, 0.0, true}};
+  for (const LegLandmark which : {kHeel, kMt})
+    for (const double shift : {-kPlacementShiftM, kPlacementShiftM}) {
+      char b[64];
+      std::snprintf(b, sizeof b, "%s %.0f mm %s", which == kHeel ? "heels" : "MT heads", 1000 * kPlacementShiftM,
+                    shift < 0 ? "back" : "forward");
+      Setting c{b, static_cast<double>(s.size()), [](EstimateOptions&) {}};
+      c.placement_landmark = which, c.placement_shift_m = shift;
+      s.push_back(std::move(c));
+    }
+  return s;
+}
+
+}  // namespace
+
+/// A rule of several markers (a mean) moves by the same vector; the direction is taken from the
+/// positions before the move.
+void shift_markers_along_foot(MarkerTrajectories& m, const MarkerSet& set, LegLandmark which, double shift_m) {
+  for (int side = 0; side < 2; ++side) {
+    const auto& heel = set.rules[static_cast<std::size_t>(landmark(side, kHeel))].markers;
+    const auto& mt = set.rules[static_cast<std::size_t>(landmark(side, kMt))].markers;
+    const auto& moved = set.rules[static_cast<std::size_t>(landmark(side, which))].markers;
+    auto indices = [&](const std::vector<std::string>& names) {
+      std::vector<int> k;
+      for (const std::string& name : names)
+        if (const int i = m.find(name); i >= 0) k.push_back(i);
+      return k;
+    };
+    const std::vector<int> h = indices(heel), t = indices(mt), mv = indices(moved);
+    if (h.empty() || t.empty()) continue;
+    auto mean = [&](const std::vector<int>& k, Eigen::Index i) {
+      Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+      for (int j : k) sum += m.positions_m[static_cast<std::size_t>(j)].row(i);
+      return Eigen::RowVector3d(sum / static_cast<double>(k.size()));
+    };
+    for (Eigen::Index i = 0; i < m.frames(); ++i) {
+      const Eigen::RowVector3d u = mean(t, i) - mean(h, i);
+      const double len = u.norm();
+      if (!std::isfinite(len) || len <= 0) continue;
+      const Eigen::RowVector3d d = shift_m / len * u;
+      for (int j : mv) m.positions_m[static_cast<std::size_t>(j)].row(i) += d;
+    }
+  }
+}
+
+namespace {
+
 /// marker_gaps_settings' gaps: `names` lost (NaN) within gap_s / 2 of the middle of each of the
 /// plates' loaded runs (plate_loaded_runs_s) that lasts a stance's kMinStanceS at least (shorter:
 /// a noisy channel's crossings, not a stance).
@@ -401,6 +462,7 @@ const std::vector<StudyKind>& special_studies() {
       {"trial-cut", trial_cut_settings},
       {"marker-gaps", marker_gaps_settings},
       {"toe-ablation", toe_ablation_settings},
+      {"marker-placement", marker_placement_settings},
       {"plate-export", plate_export_settings},
       {"subject-scale", subject_scale_settings},
       {"torso-length", torso_length_settings},
@@ -490,7 +552,8 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
     }
     const int factor = s.marker_rate_hz > 0 ? decimation_factor(d.trial->markers.rate_hz, s.marker_rate_hz) : 1;
     const bool scaled = s.body_scale != 1.0;
-    const bool changed = s.marker_noise_m > 0 || factor > 1 || s.cut_margin_s >= 0 || s.gap_s > 0 || scaled;
+    const bool placed = s.placement_shift_m != 0.0;
+    const bool changed = s.marker_noise_m > 0 || factor > 1 || s.cut_margin_s >= 0 || s.gap_s > 0 || scaled || placed;
     // A dynamically similar subject: its static trial, plates, mass and floor scaled with it.
     std::optional<Trial> scaled_static;
     std::optional<ForcePlateRecording> scaled_plates;
@@ -506,6 +569,11 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
     }
     if (s.plate_export_hz > 0) scaled_plates = exported_plates(*d.plates, s.plate_export_hz);
     vo.timing = s.timing;
+    if (placed && d.static_trial) {
+      // The markers stand where the lab put them in the static trial too.
+      if (!scaled_static) scaled_static = *d.static_trial;
+      shift_markers_along_foot(scaled_static->markers, ablated ? *ablated : *d.marker_set, s.placement_landmark, s.placement_shift_m);
+    }
     const Trial* static_trial = scaled_static ? &*scaled_static : d.static_trial;
     const ForcePlateRecording& plates = scaled_plates ? *scaled_plates : *d.plates;
     for (int seed = 1; seed <= draws; ++seed) {
@@ -521,6 +589,7 @@ StudyTrialResult run_setting(const StudyTrial& t, const StudyTrialData& d, const
             for (const std::string& name : set.rules[static_cast<std::size_t>(landmark(side, s.gap_landmark))].markers) names.push_back(name);
           lose_markers_at_plate_stances(working.markers, *d.plates, names, s.gap_s);
         }
+        if (placed) shift_markers_along_foot(working.markers, ablated ? *ablated : *d.marker_set, s.placement_landmark, s.placement_shift_m);
         if (factor > 1) working.markers = decimated(std::move(working.markers), factor);
         if (s.marker_noise_m > 0) add_marker_noise(working.markers, s.marker_noise_m, static_cast<unsigned>(seed));
       }

@@ -17,6 +17,9 @@
 //   toe-ablation  each toe marker replaced by virtual toes (a lab whose set has none), then with the
 //                 trunk and arm markers removed too (a lower-body clinical set: Plug-in Gait lower
 //                 body, Helen-Hayes)
+//   marker-placement  the heel or the MT markers placed 15 mm further back or forward along the
+//                 foot (robustness to where a lab puts them: model 2's COP is placed in lengths
+//                 between them)
 //   plate-export  the plates through a 6 and a 10 Hz zero-lag low-pass, as a filtered GRF export,
 //                 timed by the threshold's crossings and by validate's default (its timing, not the
 //                 estimate, is what moves)
@@ -134,6 +137,12 @@ const std::vector<std::string>& study_kinds();
 
 /// The kinds above; throws InputError for another.
 StudyResult run_study(const std::string& kind, const std::vector<StudyTrial>& trials);
+
+/// The marker-placement study's condition: on each foot, the markers of `which`'s rule in `set`
+/// (kHeel or kMt) moved by shift_m (+ towards the toes) along the unit vector from the mean of the
+/// heel rule's markers to the mean of the MT rule's, frame by frame (frames where either is unseen
+/// are left as they are). As if the lab had put them that far along the foot.
+void shift_markers_along_foot(MarkerTrajectories& m, const MarkerSet& set, LegLandmark which, double shift_m);
 
 /// Leave-one-lab-out: for each lab, the setting with the lowest criterion on the other labs'
 /// trials, scored on that lab's. Needs trials from at least 2 labs (InputError otherwise).
