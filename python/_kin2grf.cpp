@@ -43,6 +43,9 @@ py::dict estimate_dict(const kin2grf::Settings& s, const kin2grf::EstimateOption
   py::dict d;
   d["columns"] = table.columns;
   d["values"] = table.values;
+  const auto curves = kin2grf::stance_curves_table(r);
+  d["stance_curves_columns"] = curves.columns;
+  d["stance_curves_values"] = curves.values;
   d["summary"] = to_python(kin2grf::results_summary(r, kin2grf::settings_json(s, o)));
   d["messages"] = r.messages;
   return d;

@@ -317,7 +317,8 @@ TEST(CliBatch, RunsEveryTrialPastAFailureAndTheTableDoesNotDependOnJobs) {
   EXPECT_FALSE(j["trials"][2]["validated"].get<bool>());  // a TRC has no plates
   EXPECT_TRUE(j["trials"][2]["vertical_rrmse_percent"].is_null());
   for (const char* f : {"with-plates.csv", "with-plates_grf.mot", "with-plates.json", "with-plates_markers.trc",
-                        "with-plates_external_loads.xml", "with-plates_stances.csv", "markers-only.csv", "markers-only_stances.csv"})
+                        "with-plates_external_loads.xml", "with-plates_stances.csv", "with-plates_stance_curves.csv", "markers-only.csv",
+                        "markers-only_stances.csv", "markers-only_stance_curves.csv"})
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / f)) << f;
   // The batch's GRF is the OpenSim set's (one convention everywhere).
   EXPECT_NE(kin2grf::read_file_text((dir / "out" / "with-plates_grf.mot").string()).find("kin2grf_frame=OpenSim ground"),

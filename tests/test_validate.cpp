@@ -1079,6 +1079,101 @@ TEST(StanceParameters, APiecewiseLinearStancesPeaksImpulsesAndLoadingRateAreExac
   EXPECT_EQ(stance_parameters(f, 100.0, 0, 60).braking_impulse_Ns, 0.0);
 }
 
+// Time normalisation: a ramp comes back exactly at every percent (an instant between frames takes
+// the line between them); the ends are the stance's first and last frames; a NaN frame spoils only
+// the instants beside it; a one-frame stance is that frame throughout; bad frames or too few
+// points are refused.
+TEST(StanceParameters, TimeNormalisationResamplesAStanceLinearlyFromFootStrikeToFootOff) {
+  Eigen::MatrixXd x(41, 2);
+  for (Eigen::Index i = 0; i <= 40; ++i) x(i, 0) = 3.0 * static_cast<double>(i), x(i, 1) = i % 2 ? 1.0 : 0.0;
+  const Eigen::MatrixXd n = stance_normalised(x, 10, 30);  // 20 frames: each percent is 0.2 frame
+  ASSERT_EQ(n.rows(), 101);
+  ASSERT_EQ(n.cols(), 2);
+  for (int k = 0; k <= 100; ++k) EXPECT_NEAR(n(k, 0), 3.0 * (10.0 + 0.2 * k), 1e-12) << k << " %";
+  EXPECT_EQ(n(0, 1), 0.0);    // frame 10
+  EXPECT_NEAR(n(1, 1), 0.2, 1e-12);  // 0.2 of the way to frame 11
+  EXPECT_EQ(n(100, 1), 0.0);  // frame 30
+  x(20, 0) = std::numeric_limits<double>::quiet_NaN();
+  const Eigen::MatrixXd gap = stance_normalised(x, 10, 30, 21);  // one instant a frame
+  for (int k = 0; k <= 20; ++k) EXPECT_EQ(std::isnan(gap(k, 0)), k == 10) << k;
+  const Eigen::MatrixXd one = stance_normalised(x, 5, 5, 3);
+  EXPECT_EQ(one(0, 0), 15.0);
+  EXPECT_EQ(one(2, 0), 15.0);
+  EXPECT_THROW((void)stance_normalised(x, 10, 41), std::invalid_argument);
+  EXPECT_THROW((void)stance_normalised(x, 12, 11), std::invalid_argument);
+  EXPECT_THROW((void)stance_normalised(x, 0, 40, 1), std::invalid_argument);
+}
+
+// The --stance-curves table: every complete stance of the estimate's own contact (the --stances
+// rows with complete = 1) at 0, 1, ..., 100 %; at 0 % and 100 % each value is the per-frame CSV's at
+// the stance's first and last frame, the forces in body weights and the torques and powers per kg;
+// the COP's progression starts at 0 and the stance's COP travel ends it. With the 3D model the
+// lateral force and the knee adduction moment come too.
+TEST(Results, TheStanceCurvesAreThePerFrameSeriesAtEachPercentOfEveryCompleteStance) {
+  for (const ModelKind model : {ModelKind::Sagittal, ModelKind::ThreeD}) {
+    const Trial walk = make_example_walk();
+    EstimateOptions o;
+    o.mass_kg = 70.0;
+    o.model = model;
+    const EstimateResult e = estimate(walk, nullptr, *find_marker_set("kin2grf-example"), o);
+    const ResultsTable t = stance_curves_table(e);
+    const ResultsTable frames = results_table(e);
+    const auto col = [](const ResultsTable& tab, const std::string& name) {
+      const auto it = std::find(tab.columns.begin(), tab.columns.end(), name);
+      EXPECT_NE(it, tab.columns.end()) << name;
+      return static_cast<Eigen::Index>(it - tab.columns.begin());
+    };
+    const bool three_d = model == ModelKind::ThreeD;
+    EXPECT_EQ(std::find(t.columns.begin(), t.columns.end(), "grf_lateral_bw") != t.columns.end(), three_d);
+    EXPECT_EQ(std::find(t.columns.begin(), t.columns.end(), "knee_adduction_moment_Nm_per_kg") != t.columns.end(), three_d);
+    // The complete stances, from the summary.
+    const auto summary = results_summary(e, nlohmann::json::object());
+    std::vector<std::pair<int, double>> complete;
+    for (int side = 0; side < 2; ++side)
+      for (const auto& st : summary["stance_parameters"][side_name(side)])
+        if (st["complete"].get<bool>()) complete.emplace_back(side, st["start_s"].get<double>());
+    ASSERT_GE(complete.size(), 2u);
+    ASSERT_EQ(t.values.rows(), static_cast<Eigen::Index>(101 * complete.size()));
+    const double bw = e.mass_kg * e.model().gravity_mps2;
+    for (Eigen::Index row0 = 0; row0 < t.values.rows(); row0 += 101) {
+      const int side = static_cast<int>(t.values(row0, col(t, "side")));
+      const double start = t.values(row0, col(t, "start_s"));
+      EXPECT_NE(std::find(complete.begin(), complete.end(), std::pair<int, double>{side, start}), complete.end());
+      const Eigen::Index first = static_cast<Eigen::Index>(t.values(row0, col(t, "frame_first"))) - e.first_frame_number;
+      const Eigen::Index last = first + static_cast<Eigen::Index>(std::lround(t.values(row0, col(t, "duration_s")) * e.motion.rate_hz)) - 1;
+      const std::string s = side ? "_l" : "_r";
+      EXPECT_EQ(t.values(row0, col(t, "percent")), 0.0);
+      EXPECT_EQ(t.values(row0 + 100, col(t, "percent")), 100.0);
+      EXPECT_EQ(t.values(row0 + 50, col(t, "percent")), 50.0);
+      for (const auto& [end, at] : {std::pair<Eigen::Index, Eigen::Index>{row0, first}, {row0 + 100, last}}) {
+        EXPECT_NEAR(t.values(end, col(t, "grf_vertical_bw")), frames.values(at, col(frames, "grf_vertical" + s + "_N")) / bw, 1e-12);
+        EXPECT_NEAR(t.values(end, col(t, "grf_anterior_bw")), frames.values(at, col(frames, "grf_anterior" + s + "_N")) / bw, 1e-12);
+        EXPECT_NEAR(t.values(end, col(t, "torque_knee_Nm_per_kg")), frames.values(at, col(frames, "torque_knee" + s + "_Nm")) / e.mass_kg, 1e-12);
+        EXPECT_NEAR(t.values(end, col(t, "power_ankle_W_per_kg")), frames.values(at, col(frames, "power_ankle" + s + "_W")) / e.mass_kg, 1e-12);
+        if (three_d) {
+          EXPECT_NEAR(t.values(end, col(t, "knee_adduction_moment_Nm_per_kg")),
+                      frames.values(at, col(frames, "knee_adduction_moment" + s + "_Nm")) / e.mass_kg, 1e-12);
+        }
+      }
+      EXPECT_EQ(t.values(row0, col(t, "cop_progression_m")), 0.0);
+      EXPECT_NEAR(t.values(row0 + 100, col(t, "cop_progression_m")),
+                  frames.values(last, col(frames, "cop_x" + s + "_m")) - frames.values(first, col(frames, "cop_x" + s + "_m")), 1e-12);
+      EXPECT_GT(t.values(row0 + 100, col(t, "cop_progression_m")), 0.1);  // heel to toe
+      // A walk's stance: loaded well within it, more than at either end.
+      const double peak = t.values.block(row0, col(t, "grf_vertical_bw"), 101, 1).maxCoeff();
+      EXPECT_GT(peak, 0.8);
+      EXPECT_GT(peak, t.values(row0, col(t, "grf_vertical_bw")) + 0.3);
+      EXPECT_GT(peak, t.values(row0 + 100, col(t, "grf_vertical_bw")) + 0.3);
+    }
+    // The CSV: the table's rows under its header, the side as a word.
+    const std::string csv = stance_curves_csv(e);
+    EXPECT_EQ(static_cast<Eigen::Index>(std::count(csv.begin(), csv.end(), '\n')), t.values.rows() + 1);
+    EXPECT_EQ(csv.rfind("side,frame_first,start_s,duration_s,percent,grf_vertical_bw,grf_anterior_bw,", 0), 0u);
+    EXPECT_NE(csv.find("\nright,"), std::string::npos);
+    EXPECT_NE(csv.find("\nleft,"), std::string::npos);
+  }
+}
+
 // The sagittal joint torques against the plates' inverse dynamics (validate_joint_torques). The
 // example walk's right foot given its plate's force and COP over the stance: the torques bottom-up
 // from the estimate and from the plate are then one; its COP then moved 2 cm forward: the ground's

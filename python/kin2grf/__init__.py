@@ -98,6 +98,8 @@ class Estimate:
     def __init__(self, d: dict, trial: str = "", words: list[str] | None = None):
         self.columns: list[str] = list(d["columns"])
         self.values: np.ndarray = np.asarray(d["values"])
+        self._curves_columns: list[str] = list(d.get("stance_curves_columns", []))
+        self._curves_values: np.ndarray = np.asarray(d.get("stance_curves_values", np.zeros((0, 0))))
         self.summary: dict = d["summary"]
         self.messages: list[str] = list(d["messages"])
         self._trial, self._words = trial, list(words or [])
@@ -137,6 +139,23 @@ class Estimate:
         except ImportError:
             return rows
         return pd.DataFrame(rows)
+
+    @property
+    def stance_curves(self):
+        """Each complete stance time-normalised, 0 to 100 % of the stance (the rows of ``kin2grf
+        estimate --stance-curves``, full precision): the force in body weights, the COP's progression,
+        the hip, knee and ankle torques (N m/kg) and powers (W/kg), a ``side`` column of "right" /
+        "left": a pandas DataFrame (a dict of arrays without pandas)."""
+        cols = {c: self._curves_values[:, k] for k, c in enumerate(self._curves_columns)}
+        if "side" in cols:
+            cols["side"] = np.where(cols["side"] == 0, "right", "left")
+        if "frame_first" in cols:
+            cols["frame_first"] = cols["frame_first"].astype(np.int64)
+        try:
+            import pandas as pd
+        except ImportError:
+            return cols
+        return pd.DataFrame(cols, columns=self._curves_columns)
 
     def __getitem__(self, column: str) -> np.ndarray:
         return self.values[:, self.columns.index(column)]

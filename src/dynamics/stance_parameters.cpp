@@ -98,4 +98,22 @@ StanceParameters stance_parameters(const Eigen::MatrixX2d& force_N, double rate_
   return p;
 }
 
+Eigen::MatrixXd stance_normalised(const Eigen::MatrixXd& series, Eigen::Index first, Eigen::Index last, int points) {
+  if (!(first >= 0 && first <= last && last < series.rows()))
+    throw std::invalid_argument("stance_normalised: frames " + std::to_string(first) + "-" + std::to_string(last) + " outside 0-" +
+                                std::to_string(series.rows() - 1));
+  if (points < 2) throw std::invalid_argument("stance_normalised: " + std::to_string(points) + " points (2 or more)");
+  Eigen::MatrixXd out(points, series.cols());
+  const double span = static_cast<double>(last - first);
+  for (int k = 0; k < points; ++k) {
+    // k * span / (points - 1) in frames, exact at both ends.
+    const double at = span * static_cast<double>(k) / static_cast<double>(points - 1);
+    const auto i = std::min(first + static_cast<Eigen::Index>(std::floor(at)), last);
+    const double w = at - static_cast<double>(i - first);
+    if (w <= 0.0 || i == last) out.row(k) = series.row(i);
+    else out.row(k) = (1.0 - w) * series.row(i) + w * series.row(i + 1);
+  }
+  return out;
+}
+
 }  // namespace kin2grf

@@ -126,7 +126,7 @@ std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const 
   const auto base = (std::filesystem::path(out_dir) / file_stem(entry.name)).string();
   const auto opensim = opensim_export_paths(out_dir, file_stem(entry.name));
   std::vector<std::string> out = {base + ".csv", opensim.grf_mot, base + ".json", opensim.markers_trc, opensim.external_loads_xml,
-                                  base + "_stances.csv"};
+                                  base + "_stances.csv", base + "_stance_curves.csv"};
   if (c3d) out.push_back(base + ".c3d");
   return out;
 }
@@ -160,6 +160,7 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
       const std::string &csv = written[0], &json = written[2];
       write_results_csv(csv, r);
       write_file_text(written[5], stance_parameters_csv(r));
+      write_file_text(written[6], stance_curves_csv(r));
       auto settings = settings_json(entry.settings, estimate_options);
       // The OpenSim set, as `estimate --opensim` writes it: the GRF in OpenSim's frame over the
       // whole trial, the markers, the ExternalLoads file.

@@ -72,6 +72,9 @@ void add_estimate_options(CLI::App* c, EstimateJob& a, bool outputs) {
   c->add_option("--stances", a.out_stances,
                 "Each stance's ground reaction parameters as CSV, one row per stance: the vertical peaks and valley, the braking and "
                 "propulsive peaks and impulses, the loading rate, in N and body weights (docs/FORMATS.md)");
+  c->add_option("--stance-curves", a.out_stance_curves,
+                "Each complete stance time-normalised, 0 to 100 % of the stance (101 rows a stance), as CSV: the foot's force in body "
+                "weights, the COP's progression, the hip, knee and ankle torques (N m/kg) and powers (W/kg) (docs/FORMATS.md)");
   c->add_option("--report", a.out_report, "Self-contained HTML report with plots (no plates needed)");
   c->add_option("--opensim", a.opensim_dir,
                 "Write FOLDER/TRIAL_grf.mot (whole trial), TRIAL_markers.trc and TRIAL_external_loads.xml in OpenSim's frame "
@@ -85,8 +88,8 @@ void add_estimate_options(CLI::App* c, EstimateJob& a, bool outputs) {
 
 int estimate_job(const EstimateJob& a, std::ostream& out, std::ostream& log) {
   {
-    std::vector<std::string> files = {a.out_mot, a.out_csv, a.out_json, a.out_events, a.out_stances, a.out_report, a.out_c3d},
-                             names = {"-o", "--csv", "--json", "--events", "--stances", "--report", "--c3d"};
+    std::vector<std::string> files = {a.out_mot, a.out_csv, a.out_json, a.out_events, a.out_stances, a.out_stance_curves, a.out_report, a.out_c3d},
+                             names = {"-o", "--csv", "--json", "--events", "--stances", "--stance-curves", "--report", "--c3d"};
     if (!a.opensim_dir.empty()) {
       const auto f = opensim_export_paths(a.opensim_dir, std::filesystem::path(a.trial).stem().string());
       files.insert(files.end(), {f.grf_mot, f.markers_trc, f.external_loads_xml});
@@ -124,11 +127,13 @@ int estimate_job(const EstimateJob& a, std::ostream& out, std::ostream& log) {
   }
   if (!a.out_events.empty()) write_file_text(a.out_events, gait_events_csv(r));
   if (!a.out_stances.empty()) write_file_text(a.out_stances, stance_parameters_csv(r));
+  if (!a.out_stance_curves.empty()) write_file_text(a.out_stance_curves, stance_curves_csv(r));
   if (!a.out_c3d.empty())
     for (const auto& m : write_c3d_export(a.out_c3d, trial, r)) log << "kin2grf: " << m << "\n";
   out << format_results_text(r);
   for (const auto& [file, what] : {std::pair{a.out_mot, a.lab_frame ? "GRF, lab frame" : "GRF, OpenSim's frame"}, {a.out_csv, "per-frame CSV"}, {a.out_json, "JSON summary"},
-                                   {a.out_events, "gait events CSV"}, {a.out_stances, "stance parameters CSV"}, {a.out_report, "HTML report"},
+                                   {a.out_events, "gait events CSV"}, {a.out_stances, "stance parameters CSV"},
+                                   {a.out_stance_curves, "time-normalised stances CSV"}, {a.out_report, "HTML report"},
                                    {a.out_c3d, "C3D: the markers with the estimated GRF as force platforms 1 (right) and 2 (left)"}})
     if (!file.empty()) out << "wrote " << file << " (" << what << ")\n";
   if (!a.opensim_dir.empty()) {
@@ -139,7 +144,7 @@ int estimate_job(const EstimateJob& a, std::ostream& out, std::ostream& log) {
     out << "wrote " << f.grf_mot << ", " << f.markers_trc << " and " << f.external_loads_xml << " (OpenSim: Y up, X forward; "
         << (a.mediolateral ? "with the mediolateral force; no free moment)\n" : "sagittal model: no mediolateral force or free moment)\n");
   }
-  if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty() && a.out_events.empty() && a.out_stances.empty() && a.out_report.empty() &&
+  if (a.out_mot.empty() && a.out_csv.empty() && a.out_json.empty() && a.out_events.empty() && a.out_stances.empty() && a.out_stance_curves.empty() && a.out_report.empty() &&
       a.opensim_dir.empty() &&
       a.out_c3d.empty())
     out << "(-o GRF.mot, --csv FILE and --json FILE write the per-frame results and the full summary)\n";

@@ -119,6 +119,25 @@ def test_stances_are_the_cli_stances_csv(example, tmp_path):
             assert abs(float(theirs[k]) - mine[k]) <= 1e-5 * abs(mine[k]) + 1e-9, k
 
 
+def test_stance_curves_are_the_cli_stance_curves_csv(example, tmp_path):
+    """Estimate.stance_curves: every complete stance at 0..100 % as ``--stance-curves`` writes it."""
+    trial = example / "example_walk.c3d"
+    r = kin2grf.estimate(trial)
+    out = tmp_path / "curves.csv"
+    subprocess.run([CLI, "estimate", str(trial), "--stance-curves", str(out)], check=True, capture_output=True)
+    with open(out, newline="") as f:
+        rows = list(csv.DictReader(f))
+    c = r.stance_curves
+    records = c.to_dict("records") if hasattr(c, "to_dict") else [dict(zip(c, v)) for v in zip(*c.values())]
+    assert len(records) == len(rows) >= 2 * 101
+    assert [float(x["percent"]) for x in rows[:101]] == list(range(101))
+    for mine, theirs in zip(records, rows):
+        assert mine["side"] == theirs["side"]
+        assert int(mine["frame_first"]) == int(theirs["frame_first"])
+        for k in ("percent", "grf_vertical_bw", "cop_progression_m", "torque_knee_Nm_per_kg"):
+            assert abs(float(theirs[k]) - mine[k]) <= 1e-5 * abs(mine[k]) + 1e-9, k
+
+
 def test_mediolateral_adds_the_lateral_columns(example):
     r0 = kin2grf.estimate(example / "example_walk.c3d")
     r1 = kin2grf.estimate(example / "example_walk.c3d", mediolateral=True)

@@ -62,6 +62,21 @@ std::string format_results_text(const EstimateResult& r);
 /// (`_bw`), the impulses (N s) and the loading rate (N/s, body weights/s); an empty cell where a
 /// value does not exist. For spreadsheets and statistics packages (docs/FORMATS.md).
 std::string stance_parameters_csv(const EstimateResult& r);
+/// Each complete stance time-normalised (stance_normalised: 0 to 100 % of the stance, foot strike
+/// to foot off as the gait events mark it, `points` instants), one row per stance and instant, in
+/// the units gait reports and normative data use: side (0 right, 1 left), frame_first (the file's
+/// frame number of the foot strike: the `--stances` CSV's row), start_s, duration_s, percent; the
+/// foot's force in body weights (grf_vertical_bw, grf_anterior_bw, and with the lateral force
+/// grf_lateral_bw), the COP's progression from where it was at foot strike (cop_progression_m,
+/// along progression), the foot's inclination (rad), the side's hip, knee and ankle torques (N m
+/// per kg of body mass, the per-frame CSV's torque_* signs) and powers (W/kg), and with
+/// ModelKind::ThreeD the external knee adduction moment (N m/kg). The values are the per-frame
+/// CSV's (results_row) between frames. A stance the processed window cuts is left out: part of a
+/// stance is not its 0-100 %.
+ResultsTable stance_curves_table(const EstimateResult& r, int points = 101);
+/// stance_curves_table as CSV (side as right / left, numbers to 6 significant digits, an empty
+/// cell where a value does not exist): `estimate --stance-curves` (docs/FORMATS.md).
+std::string stance_curves_csv(const EstimateResult& r);
 /// The gait events (gait_events: foot strike, foot off per side) as CSV: side,event,frame,time_s
 /// (frame: the file's frame number).
 std::string gait_events_csv(const EstimateResult& r);

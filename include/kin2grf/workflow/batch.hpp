@@ -72,7 +72,8 @@ const char* timing_name(ValidationOptions::Timing timing);
 
 /// The files a trial of the batch writes into `out_dir`: NAME.csv, NAME_grf.mot (OpenSim's frame), NAME.json,
 /// NAME_markers.trc and NAME_external_loads.xml (the OpenSim set, as `estimate --opensim` writes it),
-/// NAME_stances.csv (as `estimate --stances`), and with `c3d` NAME.c3d (as `estimate --c3d` writes it).
+/// NAME_stances.csv (as `estimate --stances`), NAME_stance_curves.csv (as `estimate --stance-curves`), and with
+/// `c3d` NAME.c3d (as `estimate --c3d` writes it).
 std::vector<std::string> batch_trial_outputs(const TrialListEntry& entry, const std::string& out_dir, bool c3d = false);
 /// One trial: never throws for the trial's own faults (they are the row's error).
 BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& options = {});

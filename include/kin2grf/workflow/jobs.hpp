@@ -20,7 +20,7 @@ namespace kin2grf {
 struct EstimateJob : Settings {
   std::string opensim_dir;
   std::vector<std::string> opensim_bodies;
-  std::string out_mot, out_csv, out_json, out_events, out_stances, out_report, out_c3d;
+  std::string out_mot, out_csv, out_json, out_events, out_stances, out_stance_curves, out_report, out_c3d;
   bool lab_frame = false;
 };
 
