@@ -1174,6 +1174,63 @@ TEST(Results, TheStanceCurvesAreThePerFrameSeriesAtEachPercentOfEveryCompleteSta
   }
 }
 
+// validate --stance-curves: every scored plate stance over its plate's own stance, 101 rows, the
+// estimate's and the plate's side by side; at 0 % and 100 % the two series' values at the plate
+// stance's first and last frames, in body weights; both COPs from the plate's first COP (so the
+// plate's reads 0 at foot strike); with the estimate's right foot given its plate's force and COP,
+// the two columns agree at every percent.
+TEST(Validate, TheStanceCurvesPutTheEstimateBesideThePlateOverThePlatesStance) {
+  ExampleWalkValidated x = example_walk_validated();
+  ASSERT_FALSE(HasFailure());
+  EstimateResult& e = x.estimate;
+  const ValidationResult& v = x.before;
+  const ResultsTable t = validation_stance_curves_table(e, v);
+  ASSERT_EQ(t.values.rows(), static_cast<Eigen::Index>(101 * v.stances.size()));
+  const auto col = [&](const std::string& name) {
+    const auto it = std::find(t.columns.begin(), t.columns.end(), name);
+    EXPECT_NE(it, t.columns.end()) << name;
+    return static_cast<Eigen::Index>(it - t.columns.begin());
+  };
+  const double bw = e.mass_kg * e.model().gravity_mps2;
+  for (std::size_t k = 0; k < v.stances.size(); ++k) {
+    const StanceValidation& st = v.stances[k];
+    const auto row0 = static_cast<Eigen::Index>(101 * k);
+    const auto f = static_cast<std::size_t>(st.foot);
+    EXPECT_EQ(t.values(row0, col("side")), st.foot);
+    EXPECT_EQ(t.values(row0, col("plate")), st.plate_index);
+    EXPECT_EQ(t.values(row0, col("frame_first")), static_cast<double>(v.first_frame_number + st.first));
+    for (const auto& [row, frame] : {std::pair<Eigen::Index, Eigen::Index>{row0, st.first}, {row0 + 100, st.last}}) {
+      EXPECT_NEAR(t.values(row, col("vertical_bw_estimate")), e.feet[f].force_N(frame, 1) / bw, 1e-12);
+      EXPECT_NEAR(t.values(row, col("vertical_bw_plate")), v.measured_force_N[f](frame, 1) / bw, 1e-12);
+      EXPECT_NEAR(t.values(row, col("anterior_bw_plate")), v.measured_force_N[f](frame, 0) / bw, 1e-12);
+    }
+    double first_cop = std::numeric_limits<double>::quiet_NaN();
+    for (Eigen::Index i = st.first; i <= st.last && !std::isfinite(first_cop); ++i) first_cop = v.measured_cop_x_m[f][i];
+    if (std::isfinite(v.measured_cop_x_m[f][st.first])) {
+      EXPECT_EQ(t.values(row0, col("cop_progression_m_plate")), 0.0);
+    }
+    EXPECT_NEAR(t.values(row0 + 50, col("cop_progression_m_plate")) + first_cop,
+                0.5 * (v.measured_cop_x_m[f][(st.first + st.last) / 2] + v.measured_cop_x_m[f][(st.first + st.last + 1) / 2]), 1e-9);
+  }
+  // The right foot given its plate's force and COP: both columns alike, frame for frame.
+  const StanceValidation& r0 = x.right;
+  for (Eigen::Index i = r0.first; i <= r0.last; ++i) {
+    e.feet[0].force_N.row(i) = v.measured_force_N[0].row(i);
+    if (std::isfinite(v.measured_cop_x_m[0][i])) e.feet[0].cop_x_m[i] = v.measured_cop_x_m[0][i];
+  }
+  const ResultsTable same = validation_stance_curves_table(e, v);
+  const auto right = static_cast<Eigen::Index>(101 * (right_of(v) - v.stances.begin()));
+  for (Eigen::Index k = 0; k <= 100; ++k) {
+    EXPECT_NEAR(same.values(right + k, col("vertical_bw_estimate")), same.values(right + k, col("vertical_bw_plate")), 1e-12);
+    const double a = same.values(right + k, col("cop_progression_m_estimate")), b = same.values(right + k, col("cop_progression_m_plate"));
+    EXPECT_TRUE((std::isnan(a) && std::isnan(b)) || std::abs(a - b) < 1e-12) << k;
+  }
+  const std::string csv = validation_stance_curves_csv(e, v);
+  EXPECT_EQ(csv.rfind("side,plate,frame_first,start_s,duration_s,percent,vertical_bw_estimate,vertical_bw_plate,", 0), 0u);
+  EXPECT_EQ(static_cast<Eigen::Index>(std::count(csv.begin(), csv.end(), '\n')), t.values.rows() + 1);
+  EXPECT_NE(csv.find("\nright," + v.plates[static_cast<std::size_t>(r0.plate_index)].name + ","), std::string::npos);
+}
+
 // The sagittal joint torques against the plates' inverse dynamics (validate_joint_torques). The
 // example walk's right foot given its plate's force and COP over the stance: the torques bottom-up
 // from the estimate and from the plate are then one; its COP then moved 2 cm forward: the ground's

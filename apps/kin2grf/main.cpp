@@ -94,6 +94,9 @@ int main(int argc, char** argv) {
     validate->add_option("--plates", val.plates, "Measured forces from this file (GRF .mot/.sto or C3D) instead of the trial's plates");
     validate->add_option("--json", val.out_json, "Validation results as JSON (schema in docs/FORMATS.md)");
     validate->add_option("--report", val.report, "Self-contained HTML report with plots");
+    validate->add_option("--stance-curves", val.stance_curves,
+                         "Each scored plate stance time-normalised (0 to 100 %, 101 rows), the estimate's and the plate's forces "
+                         "in body weights and COPs side by side, as CSV (docs/FORMATS.md)");
     validate->add_option("--threshold", val.options.threshold_N, "Stance: measured vertical force above this, N")->capture_default_str();
     validate->add_option("--zero-offset", val.zero_offset, "C3D plate offsets: none, zero or unloaded")
         ->check(CLI::IsMember({"none", "zero", "unloaded"}))->capture_default_str();

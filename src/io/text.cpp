@@ -381,4 +381,11 @@ std::string extension(const std::string& path) {
   return ext.empty() ? "" : to_lower(ext.substr(1));
 }
 
+std::string csv_quoted(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : c == '\n' ? std::string(" ") : std::string(1, c);
+  return q + "\"";
+}
+
 }  // namespace kin2grf

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -9,6 +10,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/numeric.hpp"
 #include "kin2grf/output/results.hpp"
@@ -1362,6 +1364,76 @@ std::string total_grm_note(const TotalValidation& t) {
   return buf;
 }
 }  // namespace
+
+ResultsTable validation_stance_curves_table(const EstimateResult& e, const ValidationResult& v, int points) {
+  const bool lateral = e.feet[0].force_lateral_N.size() > 0 && v.measured_lateral_N[0].size() > 0;
+  ResultsTable t;
+  t.columns = {"side", "plate", "frame_first", "start_s", "duration_s", "percent", "vertical_bw_estimate", "vertical_bw_plate",
+               "anterior_bw_estimate", "anterior_bw_plate"};
+  if (lateral) t.columns.insert(t.columns.end(), {"lateral_bw_estimate", "lateral_bw_plate"});
+  t.columns.insert(t.columns.end(), {"cop_progression_m_estimate", "cop_progression_m_plate"});
+  const double bw = e.mass_kg * e.model().gravity_mps2;
+  const auto nan = std::numeric_limits<double>::quiet_NaN();
+  const Eigen::Index series_columns = static_cast<Eigen::Index>(t.columns.size()) - 6;
+  t.values.resize(static_cast<Eigen::Index>(v.stances.size()) * points, static_cast<Eigen::Index>(t.columns.size()));
+  Eigen::Index out = 0;
+  for (const StanceValidation& st : v.stances) {
+    const auto f = static_cast<std::size_t>(st.foot);
+    const FootResult& foot = e.feet[f];
+    const Eigen::Index frames = st.last - st.first + 1;
+    Eigen::MatrixXd series(frames, series_columns);
+    double origin = nan;
+    for (Eigen::Index k = 0; k < frames && !std::isfinite(origin); ++k) origin = v.measured_cop_x_m[f][st.first + k];
+    if (st.cop_reference_suspect) origin = nan;  // a misplaced plate's COP: not compared
+    for (Eigen::Index k = 0; k < frames; ++k) {
+      const Eigen::Index i = st.first + k;
+      Eigen::Index c = 0;
+      series(k, c++) = foot.force_N(i, 1) / bw;
+      series(k, c++) = v.measured_force_N[f](i, 1) / bw;
+      series(k, c++) = foot.force_N(i, 0) / bw;
+      series(k, c++) = v.measured_force_N[f](i, 0) / bw;
+      if (lateral) {
+        series(k, c++) = foot.force_lateral_N[i] / bw;
+        series(k, c++) = v.measured_lateral_N[f][i] / bw;
+      }
+      const bool compared = std::isfinite(v.measured_cop_x_m[f][i]);  // where the plate's COP is over its threshold
+      series(k, c++) = compared ? foot.cop_x_m[i] - origin : nan;
+      series(k, c++) = v.measured_cop_x_m[f][i] - origin;
+    }
+    const Eigen::MatrixXd curves = stance_normalised(series, 0, frames - 1, points);
+    for (int k = 0; k < points; ++k, ++out) {
+      t.values(out, 0) = st.foot;
+      t.values(out, 1) = st.plate_index;
+      t.values(out, 2) = static_cast<double>(v.first_frame_number + st.first);
+      t.values(out, 3) = e.time_s[st.first];
+      t.values(out, 4) = static_cast<double>(frames) / e.motion.rate_hz;
+      t.values(out, 5) = 100.0 * k / (points - 1);
+      t.values.row(out).tail(series_columns) = curves.row(k);
+    }
+  }
+  return t;
+}
+
+std::string validation_stance_curves_csv(const EstimateResult& e, const ValidationResult& v) {
+  const ResultsTable t = validation_stance_curves_table(e, v);
+  std::string out;
+  for (std::size_t k = 0; k < t.columns.size(); ++k) (out += k ? "," : "") += t.columns[k];
+  out += '\n';
+  char num[64];
+  for (Eigen::Index i = 0; i < t.values.rows(); ++i) {
+    out += side_name(static_cast<int>(t.values(i, 0)));
+    out += ',' + csv_quoted(v.plates[static_cast<std::size_t>(t.values(i, 1))].name);
+    out += ',' + std::to_string(static_cast<long long>(t.values(i, 2))) + ',';
+    out.append(num, std::to_chars(num, num + sizeof num, t.values(i, 3)).ptr);  // the start at full precision
+    for (Eigen::Index k = 4; k < t.values.cols(); ++k) {
+      out += ',';
+      const double x = t.values(i, k);
+      if (std::isfinite(x)) out.append(num, std::to_chars(num, num + sizeof num, x, std::chars_format::general, 6).ptr);
+    }
+    out += '\n';
+  }
+  return out;
+}
 
 std::string format_validation_table(const std::string& trial, const ValidationResult& v) {
   std::ostringstream os;

@@ -269,12 +269,6 @@ std::string cell(double v) {
   const auto r = std::to_chars(buf, buf + sizeof buf, v);
   return std::string(buf, r.ptr);
 }
-std::string quoted(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : c == '\n' ? std::string(" ") : std::string(1, c);
-  return q + "\"";
-}
 nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 }  // namespace
 
@@ -293,12 +287,12 @@ std::string batch_csv(const std::vector<BatchRow>& rows) {
   for (std::size_t k = 0; k < batch_csv_columns().size(); ++k) os << (k ? "," : "") << batch_csv_columns()[k];
   os << '\n';
   for (const auto& r : rows)
-    os << quoted(r.activity) << ',' << quoted(r.lab) << ',' << quoted(r.name) << ',' << quoted(r.trial) << ','
+    os << csv_quoted(r.activity) << ',' << csv_quoted(r.lab) << ',' << csv_quoted(r.name) << ',' << csv_quoted(r.trial) << ','
        << (r.ok ? 1 : 0) << ',' << r.frames << ',' << cell(r.duration_s) << ',' << cell(r.seconds) << ','
        << cell(r.seconds > 0 ? static_cast<double>(r.frames) / r.seconds : NAN) << ',' << cell(r.mass_kg) << ','
-       << quoted(r.marker_set) << ',' << r.stances << ',' << cell(r.vertical) << ',' << cell(r.anterior) << ','
+       << csv_quoted(r.marker_set) << ',' << r.stances << ',' << cell(r.vertical) << ',' << cell(r.anterior) << ','
        << cell(r.cop) << ',' << cell(r.moment) << ',' << cell(r.total_vertical) << ',' << cell(r.total_grm) << ','
-       << quoted(r.error) << '\n';
+       << csv_quoted(r.error) << '\n';
   return os.str();
 }
 

@@ -155,13 +155,14 @@ int estimate_job(const EstimateJob& a, std::ostream& out, std::ostream& log) {
 int validate_job(const ValidateJob& a, std::ostream& out, std::ostream& log) {
   auto in = input_files(a.est);
   in.push_back(a.plates);
-  check_outputs({a.out_json, a.report}, in, {"--json", "--report"});
+  check_outputs({a.out_json, a.report, a.stance_curves}, in, {"--json", "--report", "--stance-curves"});
   const auto run = validate_trial(a.est, a.plates, a.options, a.zero_offset, solve_progress(stderr));
   print_messages(run.estimate, log);
   out << format_validation_table(a.est.trial, run.validation);
   const auto j = validation_json(a.est.trial, run.estimate, run.validation, run.settings);
   if (!a.out_json.empty()) write_file_text(a.out_json, json_text(j));
   if (!a.report.empty()) write_file_text(a.report, validation_report_html(a.est.trial, run.estimate, run.validation, j));
+  if (!a.stance_curves.empty()) write_file_text(a.stance_curves, validation_stance_curves_csv(run.estimate, run.validation));
   return 0;
 }
 

@@ -99,6 +99,9 @@ bool parse_plain_fields(std::string_view line, char delim, std::span<double> out
 /// a slip (at most a third of the word's length, at least 1, at most 3 edits); else empty. For
 /// "did you mean ...?" on a misspelt option, subcommand or preset.
 std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
+/// A CSV cell for text (RFC 4180): as it is, or in double quotes (inner quotes doubled) where it
+/// holds a comma, a quote or a line break (a line break becomes a space: one row a line).
+std::string csv_quoted(const std::string& s);
 /// Lower-case file extension without the dot ("c3d", "trc", "mot", "sto").
 std::string extension(const std::string& path);
 

@@ -58,6 +58,7 @@
 #include "kin2grf/trial.hpp"
 #include "kin2grf/dynamics/joint_moments_2d.hpp"
 #include "kin2grf/dynamics/stance_parameters.hpp"
+#include "kin2grf/output/results.hpp"
 #include "kin2grf/pipeline.hpp"
 #include "kin2grf/validation/metrics.hpp"
 
@@ -421,5 +422,20 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
 
 /// Plain-text table in the layout of the paper's Table 1 (rRMSE %, mean (SD)).
 std::string format_validation_table(const std::string& trial, const ValidationResult& v);
+
+/// `validate --stance-curves`: each scored plate stance (v.stances) time-normalised over the
+/// plate's stance (stance_normalised: its first to its last frame, `points` instants), the
+/// estimate's and the plate's side by side, as a paper's mean curves of both are drawn: side (0
+/// right, 1 left), plate (the index into v.plates), frame_first (the file's frame number), start_s,
+/// duration_s, percent, vertical_bw_estimate, vertical_bw_plate, anterior_bw_estimate,
+/// anterior_bw_plate, with the lateral force lateral_bw_estimate and lateral_bw_plate, then
+/// cop_progression_m_estimate and cop_progression_m_plate: both COPs along progression from the
+/// plate's first COP of the stance (one origin for both, so their difference is the COP's error;
+/// NaN where the plate's COP is below its threshold, and for a stance whose plate fails the
+/// registration check, whose COP the means leave out too).
+ResultsTable validation_stance_curves_table(const EstimateResult& e, const ValidationResult& v, int points = 101);
+/// The same as CSV (side as right / left, the plate by its name; 6 significant digits, an empty
+/// cell where a value does not exist; docs/FORMATS.md).
+std::string validation_stance_curves_csv(const EstimateResult& e, const ValidationResult& v);
 
 }  // namespace kin2grf

@@ -26,7 +26,7 @@ struct EstimateJob : Settings {
 
 struct ValidateJob {
   EstimateJob est;
-  std::string plates, out_json, report, zero_offset = "unloaded";
+  std::string plates, out_json, report, stance_curves, zero_offset = "unloaded";
   ValidationOptions options;
 };
 
