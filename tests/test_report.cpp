@@ -65,10 +65,13 @@ TEST(Report, RendersInHeadlessChromium) {
   write_file_text(html.string(), validation_report_html("synthetic", s.estimate, v, j));
   const std::string dom = rendered_dom(browser, dir, html);
   ASSERT_FALSE(dom.empty());
-  // 3 figures per foot (GRF, COP), 3 per foot of joint torques and 2 totals, each drawn by
-  // Chart.js (the script sets the attribute only after every chart was constructed).
+  // 3 figures per foot (GRF, COP), 3 per foot of joint torques, 3 time-normalised (the stances'
+  // mean, per cent of stance) and 2 totals, each drawn by Chart.js (the script sets the attribute
+  // only after every chart was constructed).
   ASSERT_EQ(v.measured_joint_torque_Nm.rows(), s.estimate.time_s.size());
-  EXPECT_NE(dom.find("data-charts-rendered=\"14\""), std::string::npos) << dom.substr(0, 400);
+  ASSERT_FALSE(v.stances.empty());
+  EXPECT_NE(dom.find("data-charts-rendered=\"17\""), std::string::npos) << dom.substr(0, 400);
+  EXPECT_NE(page.find("per cent of the plate's stance (mean of the "), std::string::npos);
   const auto p = dom.find("data-points=\"");
   ASSERT_NE(p, std::string::npos);
   EXPECT_GT(std::stoi(dom.substr(p + 13)), 1000);

@@ -1,10 +1,12 @@
 #include "kin2grf/output/report.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <tuple>
 
 #include "kin2grf/dynamics/joint_moments_2d.hpp"
 #include "kin2grf/numeric.hpp"
@@ -307,6 +309,40 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
       g.shaded = shaded;
       g.series.push_back({"with the plates' GRF", time, to_vec(plate), true});
       g.series.push_back({"with kin2grf's GRF", time, to_vec(knee_adduction_moment(e.legs_3d->moments, f)), false});
+      rep.figures.push_back(g);
+    }
+  }
+  if (!v.stances.empty()) {
+    // Time-normalised (validate --stance-curves): the scored stances' mean at each per cent of the
+    // plate's stance, kin2grf's beside the plates', as papers draw them.
+    const ResultsTable c = validation_stance_curves_table(e, v);
+    const auto column = [&](const std::string& name) {
+      return static_cast<Eigen::Index>(std::find(c.columns.begin(), c.columns.end(), name) - c.columns.begin());
+    };
+    const Eigen::Index points = 101, stances = c.values.rows() / points;
+    std::vector<double> percent(static_cast<std::size_t>(points));
+    for (Eigen::Index k = 0; k < points; ++k) percent[static_cast<std::size_t>(k)] = c.values(k, column("percent"));
+    const auto mean = [&](const std::string& name) {
+      std::vector<double> m(static_cast<std::size_t>(points), std::numeric_limits<double>::quiet_NaN());
+      for (Eigen::Index k = 0; k < points; ++k) {
+        double sum = 0;
+        int n = 0;
+        for (Eigen::Index st = 0; st < stances; ++st)
+          if (const double x = c.values(st * points + k, column(name)); std::isfinite(x)) sum += x, ++n;
+        if (n > 0) m[static_cast<std::size_t>(k)] = sum / n;
+      }
+      return m;
+    };
+    const std::string of = " (mean of the " + std::to_string(stances) + " plate stance" + (stances == 1 ? "" : "s") + " compared)";
+    for (const auto& [what, unit, key] : {std::tuple{"vertical GRF", "body weights", "vertical_bw"},
+                                          {"anterior GRF", "body weights", "anterior_bw"},
+                                          {"COP along progression from the plate's first COP", "m", "cop_progression_m"}}) {
+      ReportFigure g;
+      g.title = std::string(what) + ", per cent of the plate's stance" + of;
+      g.x_label = "% of stance";
+      g.y_label = unit;
+      g.series.push_back({"force plates", percent, mean(std::string(key) + "_plate"), true});
+      g.series.push_back({"kin2grf estimate", percent, mean(std::string(key) + "_estimate"), false});
       rep.figures.push_back(g);
     }
   }
