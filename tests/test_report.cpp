@@ -97,9 +97,13 @@ TEST(Report, AnEstimateReportWithoutPlatesRendersWithItsGaitEvents) {
   write_file_text(file.string(), html);
   const std::string dom = rendered_dom(browser, dir, file);
   ASSERT_FALSE(dom.empty());
-  // 5 figures per foot (vertical, anterior, COP, joint torques, joint powers) and the GRM.
-  EXPECT_NE(dom.find("data-charts-rendered=\"11\""), std::string::npos) << dom.substr(0, 400);
+  // 5 figures per foot (vertical, anterior, COP, joint torques, joint powers), the GRM, and 5
+  // time-normalised (the vertical and anterior GRF, the hip, knee and ankle torques: each side's
+  // complete stances' mean at each per cent of the stance).
+  ASSERT_GT(stance_curves_table(e).values.rows(), 0);
+  EXPECT_NE(dom.find("data-charts-rendered=\"16\""), std::string::npos) << dom.substr(0, 400);
   EXPECT_NE(html.find("right leg: joint powers"), std::string::npos);
+  EXPECT_NE(html.find("knee torque, per cent of stance (mean of "), std::string::npos);
 }
 
 // The 3D model's validation report (issue 28: "the HTML report plots them"): per foot the

@@ -439,6 +439,45 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
     std::snprintf(b, sizeof b, "sagittal GRM about x = %.3f m, y = %.3f m", e.grm_reference_m.x(), e.grm_reference_m.y());
     figure(b, "N m", -1, {{"kin2grf estimate", time, to_vec(e.grm_Nm), false}});
   }
+  // Time-normalised (estimate --stance-curves): each side's complete stances' mean at each per
+  // cent of the stance, in body weights and N m per kg, as a gait report draws them.
+  const ResultsTable c = stance_curves_table(e);
+  if (c.values.rows() > 0) {
+    const auto column = [&](const std::string& name) {
+      return static_cast<Eigen::Index>(std::find(c.columns.begin(), c.columns.end(), name) - c.columns.begin());
+    };
+    const Eigen::Index points = 101, curves = c.values.rows() / points;
+    std::vector<double> percent(static_cast<std::size_t>(points));
+    for (Eigen::Index k = 0; k < points; ++k) percent[static_cast<std::size_t>(k)] = c.values(k, column("percent"));
+    std::array<int, 2> count{0, 0};
+    for (Eigen::Index st = 0; st < curves; ++st) ++count[static_cast<std::size_t>(c.values(st * points, column("side")))];
+    const auto mean = [&](int side, const std::string& name) {
+      std::vector<double> m(static_cast<std::size_t>(points), std::numeric_limits<double>::quiet_NaN());
+      for (Eigen::Index k = 0; k < points; ++k) {
+        double sum = 0;
+        int n = 0;
+        for (Eigen::Index st = 0; st < curves; ++st)
+          if (const double x = c.values(st * points + k, column(name)); c.values(st * points, column("side")) == side && std::isfinite(x))
+            sum += x, ++n;
+        if (n > 0) m[static_cast<std::size_t>(k)] = sum / n;
+      }
+      return m;
+    };
+    const std::string of = " (mean of " + std::to_string(count[0]) + " right and " + std::to_string(count[1]) + " left complete stances)";
+    for (const auto& [what, unit, key] : {std::tuple{"vertical GRF", "body weights", "grf_vertical_bw"},
+                                          {"anterior GRF", "body weights", "grf_anterior_bw"},
+                                          {"hip torque", "N m/kg", "torque_hip_Nm_per_kg"},
+                                          {"knee torque", "N m/kg", "torque_knee_Nm_per_kg"},
+                                          {"ankle torque", "N m/kg", "torque_ankle_Nm_per_kg"}}) {
+      ReportFigure g;
+      g.title = std::string(what) + ", per cent of stance" + of;
+      g.x_label = "% of stance";
+      g.y_label = unit;
+      for (int side = 0; side < 2; ++side)
+        if (count[static_cast<std::size_t>(side)] > 0) g.series.push_back({side_name(side), percent, mean(side, key), false});
+      rep.figures.push_back(std::move(g));
+    }
+  }
   rep.sections_html.push_back("<h2>Settings</h2><pre>" + html_escape(j["settings"].dump(2)) + "</pre>");
   return render_report_html(rep);
 }
