@@ -100,6 +100,12 @@ py::dict validate(const std::string& trial, const std::vector<std::string>& word
   py::dict d;
   d["validation"] = to_python(kin2grf::validation_json(s.trial, run->estimate, run->validation, run->settings));
   d["estimate"] = estimate_dict(s, kin2grf::to_options(s), run->estimate);
+  const auto curves = kin2grf::validation_stance_curves_table(run->estimate, run->validation);
+  d["stance_curves_columns"] = curves.columns;
+  d["stance_curves_values"] = curves.values;
+  std::vector<std::string> plate_names;
+  for (const auto& p : run->validation.plates) plate_names.push_back(p.name);
+  d["plate_names"] = plate_names;
   return d;
 }
 

@@ -180,11 +180,24 @@ def validate(trial: str | os.PathLike, plates: str | os.PathLike | None = None, 
     "auto" (compare after shifting the plates by it) or a shift in seconds (+ when the plates led).
     `timing`: how onsets and offsets are timed, as ``--timing``: "auto" (the loading ramp's zero
     intercept for the onsets on a plate low-pass filtered before export, the threshold's crossings
-    elsewhere), "crossing" or "ramp"."""
+    elsewhere), "crossing" or "ramp". Under "stance_curves": each scored plate stance time-normalised,
+    the estimate's and the plate's side by side, as ``--stance-curves`` writes them (a pandas
+    DataFrame; a dict of arrays without pandas)."""
     d = _kin2grf.validate(os.fspath(trial), _words(settings), os.fspath(plates) if plates else "", float(threshold), zero_offset,
                           _text(sync), timing)
     out = d["validation"]
     out["estimate"] = Estimate(d["estimate"], os.fspath(trial), _words(settings))
+    columns = list(d["stance_curves_columns"])
+    values = np.asarray(d["stance_curves_values"]).reshape(-1, len(columns))
+    cols = {c: values[:, k] for k, c in enumerate(columns)}
+    cols["side"] = np.where(cols["side"] == 0, "right", "left")
+    cols["plate"] = np.asarray([d["plate_names"][int(k)] for k in cols["plate"]], dtype=object)
+    cols["frame_first"] = cols["frame_first"].astype(np.int64)
+    try:
+        import pandas as pd
+        out["stance_curves"] = pd.DataFrame(cols, columns=columns)
+    except ImportError:
+        out["stance_curves"] = cols
     return out
 
 

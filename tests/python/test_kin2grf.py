@@ -138,6 +138,23 @@ def test_stance_curves_are_the_cli_stance_curves_csv(example, tmp_path):
             assert abs(float(theirs[k]) - mine[k]) <= 1e-5 * abs(mine[k]) + 1e-9, k
 
 
+def test_validate_gives_the_cli_stance_curves(example, tmp_path):
+    """validate()["stance_curves"]: every scored plate stance at 0..100 %, as ``validate --stance-curves``."""
+    trial = example / "example_walk.c3d"
+    v = kin2grf.validate(trial)
+    out = tmp_path / "curves.csv"
+    subprocess.run([CLI, "validate", str(trial), "--stance-curves", str(out)], check=True, capture_output=True)
+    with open(out, newline="") as f:
+        rows = list(csv.DictReader(f))
+    c = v["stance_curves"]
+    records = c.to_dict("records") if hasattr(c, "to_dict") else [dict(zip(c, x)) for x in zip(*c.values())]
+    assert len(records) == len(rows) == 101 * len(v["per_foot"]) > 0
+    for mine, theirs in zip(records, rows):
+        assert (mine["side"], mine["plate"]) == (theirs["side"], theirs["plate"])
+        for k in ("percent", "vertical_bw_estimate", "vertical_bw_plate"):
+            assert abs(float(theirs[k]) - mine[k]) <= 1e-5 * abs(mine[k]) + 1e-9, k
+
+
 def test_mediolateral_adds_the_lateral_columns(example):
     r0 = kin2grf.estimate(example / "example_walk.c3d")
     r1 = kin2grf.estimate(example / "example_walk.c3d", mediolateral=True)
