@@ -309,33 +309,41 @@ std::string stance_parameters_csv(const EstimateResult& r) {
   return os.str();
 }
 
-ResultsTable stance_curves_table(const EstimateResult& r, int points) {
+namespace {
+
+/// stance_curves_table's columns.
+std::vector<std::string> stance_curve_columns(bool lateral, bool three_d) {
+  std::vector<std::string> c = {"side", "frame_first", "start_s", "duration_s", "percent", "grf_vertical_bw", "grf_anterior_bw"};
+  if (lateral) c.emplace_back("grf_lateral_bw");
+  for (const char* name : {"cop_progression_m", "foot_inclination_rad", "torque_hip_Nm_per_kg", "torque_knee_Nm_per_kg",
+                           "torque_ankle_Nm_per_kg", "power_hip_W_per_kg", "power_knee_W_per_kg", "power_ankle_W_per_kg"})
+    c.emplace_back(name);
+  if (three_d) c.emplace_back("knee_adduction_moment_Nm_per_kg");
+  return c;
+}
+
+/// Every complete stance's rows of stance_curves_table (points x its columns), one stance at a
+/// time to `emit`: a long trial's curves are never held together.
+template <class Emit>
+void each_stance_curve(const EstimateResult& r, int points, Emit emit) {
   const bool lateral = r.feet[0].force_lateral_N.size() > 0, three_d = r.legs_3d.has_value();
   const std::vector<std::string> columns = results_columns(lateral, three_d);
   const auto column = [&](const std::string& name) {
     const auto it = std::find(columns.begin(), columns.end(), name);
-    if (it == columns.end()) throw std::logic_error("stance_curves_table: no column " + name);
-    return static_cast<Eigen::Index>(it - columns.begin());
+    if (it == columns.end()) throw std::logic_error("stance curves: no column " + name);
+    return static_cast<std::size_t>(it - columns.begin());
   };
-  ResultsTable t;
-  t.columns = {"side", "frame_first", "start_s", "duration_s", "percent", "grf_vertical_bw", "grf_anterior_bw"};
-  if (lateral) t.columns.emplace_back("grf_lateral_bw");
-  for (const char* c : {"cop_progression_m", "foot_inclination_rad", "torque_hip_Nm_per_kg", "torque_knee_Nm_per_kg",
-                        "torque_ankle_Nm_per_kg", "power_hip_W_per_kg", "power_knee_W_per_kg", "power_ankle_W_per_kg"})
-    t.columns.emplace_back(c);
-  if (three_d) t.columns.emplace_back("knee_adduction_moment_Nm_per_kg");
+  const auto width = static_cast<Eigen::Index>(stance_curve_columns(lateral, three_d).size());
   const double bw = r.mass_kg * r.model().gravity_mps2, kg = r.mass_kg;
-  std::vector<EstimatedStance> stances = estimated_stances(r);
-  std::erase_if(stances, [](const EstimatedStance& st) { return !st.complete; });
-  t.values.resize(static_cast<Eigen::Index>(stances.size()) * points, static_cast<Eigen::Index>(t.columns.size()));
   std::vector<double> row(columns.size());
-  Eigen::Index out = 0;
-  for (const EstimatedStance& st : stances) {
+  for (const EstimatedStance& st : estimated_stances(r)) {
+    if (!st.complete) continue;  // part of a stance is not its 0-100 %
     const std::string s = st.side == kLeft ? "_l" : "_r";
     // The series to normalise, each with its scale: force / body weight, moment and power / mass.
-    std::vector<std::pair<Eigen::Index, double>> picks = {{column("grf_vertical" + s + "_N"), 1 / bw},
-                                                          {column("grf_anterior" + s + "_N"), 1 / bw}};
+    std::vector<std::pair<std::size_t, double>> picks = {{column("grf_vertical" + s + "_N"), 1 / bw},
+                                                         {column("grf_anterior" + s + "_N"), 1 / bw}};
     if (lateral) picks.emplace_back(column("grf_lateral" + s + "_N"), 1 / bw);
+    const auto cop = static_cast<Eigen::Index>(picks.size());
     picks.emplace_back(column("cop_x" + s + "_m"), 1.0);
     picks.emplace_back(column("foot_inclination" + s + "_rad"), 1.0);
     for (const char* quantity : {"torque_", "power_"})
@@ -346,45 +354,69 @@ ResultsTable stance_curves_table(const EstimateResult& r, int points) {
     Eigen::MatrixXd series(frames, static_cast<Eigen::Index>(picks.size()));
     for (Eigen::Index i = 0; i < frames; ++i) {
       results_row(r, st.run.first + i, row);
-      for (std::size_t k = 0; k < picks.size(); ++k)
-        series(i, static_cast<Eigen::Index>(k)) = row[static_cast<std::size_t>(picks[k].first)] * picks[k].second;
+      for (std::size_t k = 0; k < picks.size(); ++k) series(i, static_cast<Eigen::Index>(k)) = row[picks[k].first] * picks[k].second;
     }
     // The COP's progression from the first frame it exists on (a landing's first frame can be unloaded).
-    const Eigen::Index cop = lateral ? 3 : 2;
     double origin = std::numeric_limits<double>::quiet_NaN();
     for (Eigen::Index i = 0; i < frames && !std::isfinite(origin); ++i) origin = series(i, cop);
     series.col(cop).array() -= origin;
-    const Eigen::MatrixXd curves = stance_normalised(series, 0, frames - 1, points);
-    for (int k = 0; k < points; ++k, ++out) {
-      t.values(out, 0) = st.side;
-      t.values(out, 1) = static_cast<double>(r.first_frame_number + st.run.first);
-      t.values(out, 2) = r.time_s[st.run.first];
-      t.values(out, 3) = st.parameters.duration_s;
-      t.values(out, 4) = 100.0 * k / (points - 1);
-      t.values.row(out).tail(curves.cols()) = curves.row(k);
+    Eigen::MatrixXd block(points, width);
+    block.rightCols(series.cols()) = stance_normalised(series, 0, frames - 1, points);
+    for (int k = 0; k < points; ++k) {
+      block(k, 0) = st.side;
+      block(k, 1) = static_cast<double>(r.first_frame_number + st.run.first);
+      block(k, 2) = r.time_s[st.run.first];
+      block(k, 3) = st.parameters.duration_s;
+      block(k, 4) = 100.0 * k / (points - 1);
     }
+    emit(block);
   }
+}
+
+}  // namespace
+
+ResultsTable stance_curves_table(const EstimateResult& r, int points) {
+  ResultsTable t;
+  t.columns = stance_curve_columns(r.feet[0].force_lateral_N.size() > 0, r.legs_3d.has_value());
+  std::vector<Eigen::MatrixXd> blocks;
+  each_stance_curve(r, points, [&](const Eigen::MatrixXd& b) { blocks.push_back(b); });
+  t.values.resize(static_cast<Eigen::Index>(blocks.size()) * points, static_cast<Eigen::Index>(t.columns.size()));
+  for (std::size_t k = 0; k < blocks.size(); ++k) t.values.middleRows(static_cast<Eigen::Index>(k) * points, points) = blocks[k];
   return t;
 }
 
-std::string stance_curves_csv(const EstimateResult& r) {
-  const ResultsTable t = stance_curves_table(r);
-  std::string out;
-  for (std::size_t k = 0; k < t.columns.size(); ++k) (out += k ? "," : "") += t.columns[k];
-  out += '\n';
+void write_stance_curves_csv(std::ostream& os, const EstimateResult& r) {
+  const auto columns = stance_curve_columns(r.feet[0].force_lateral_N.size() > 0, r.legs_3d.has_value());
+  std::string buf;
+  for (std::size_t k = 0; k < columns.size(); ++k) (buf += k ? "," : "") += columns[k];
+  buf += '\n';
   char num[64];
-  for (Eigen::Index i = 0; i < t.values.rows(); ++i) {
-    out += side_name(static_cast<int>(t.values(i, 0)));
-    out += ',' + std::to_string(static_cast<long long>(t.values(i, 1))) + ',';
-    out.append(num, std::to_chars(num, num + sizeof num, t.values(i, 2)).ptr);  // the start at full precision, as --stances
-    for (Eigen::Index k = 3; k < t.values.cols(); ++k) {
-      out += ',';
-      const double x = t.values(i, k);
-      if (std::isfinite(x)) out.append(num, std::to_chars(num, num + sizeof num, x, std::chars_format::general, 6).ptr);
+  each_stance_curve(r, 101, [&](const Eigen::MatrixXd& b) {
+    for (Eigen::Index i = 0; i < b.rows(); ++i) {
+      buf += side_name(static_cast<int>(b(i, 0)));
+      buf += ',' + std::to_string(static_cast<long long>(b(i, 1))) + ',';
+      buf.append(num, std::to_chars(num, num + sizeof num, b(i, 2)).ptr);  // the start at full precision, as --stances
+      for (Eigen::Index k = 3; k < b.cols(); ++k) {
+        buf += ',';
+        if (std::isfinite(b(i, k))) buf.append(num, std::to_chars(num, num + sizeof num, b(i, k), std::chars_format::general, 6).ptr);
+      }
+      buf += '\n';
     }
-    out += '\n';
-  }
-  return out;
+    flush_if_full(buf, os);
+  });
+  flush_if_full(buf, os, true);
+}
+
+void write_stance_curves_csv(const std::string& path, const EstimateResult& r) {
+  AtomicFile file(path);
+  write_stance_curves_csv(file.stream(), r);
+  file.commit();
+}
+
+std::string stance_curves_csv(const EstimateResult& r) {
+  std::ostringstream os;
+  write_stance_curves_csv(os, r);
+  return os.str();
 }
 
 nlohmann::json results_summary(const EstimateResult& r, const nlohmann::json& settings) {

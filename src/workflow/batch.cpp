@@ -160,7 +160,7 @@ BatchRow run_batch_entry(const TrialListEntry& entry, const BatchOptions& option
       const std::string &csv = written[0], &json = written[2];
       write_results_csv(csv, r);
       write_file_text(written[5], stance_parameters_csv(r));
-      write_file_text(written[6], stance_curves_csv(r));
+      write_stance_curves_csv(written[6], r);
       auto settings = settings_json(entry.settings, estimate_options);
       // The OpenSim set, as `estimate --opensim` writes it: the GRF in OpenSim's frame over the
       // whole trial, the markers, the ExternalLoads file.

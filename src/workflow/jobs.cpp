@@ -127,7 +127,7 @@ int estimate_job(const EstimateJob& a, std::ostream& out, std::ostream& log) {
   }
   if (!a.out_events.empty()) write_file_text(a.out_events, gait_events_csv(r));
   if (!a.out_stances.empty()) write_file_text(a.out_stances, stance_parameters_csv(r));
-  if (!a.out_stance_curves.empty()) write_file_text(a.out_stance_curves, stance_curves_csv(r));
+  if (!a.out_stance_curves.empty()) write_stance_curves_csv(a.out_stance_curves, r);
   if (!a.out_c3d.empty())
     for (const auto& m : write_c3d_export(a.out_c3d, trial, r)) log << "kin2grf: " << m << "\n";
   out << format_results_text(r);

@@ -75,7 +75,10 @@ std::string stance_parameters_csv(const EstimateResult& r);
 /// stance is not its 0-100 %.
 ResultsTable stance_curves_table(const EstimateResult& r, int points = 101);
 /// stance_curves_table as CSV (side as right / left, numbers to 6 significant digits, an empty
-/// cell where a value does not exist): `estimate --stance-curves` (docs/FORMATS.md).
+/// cell where a value does not exist): `estimate --stance-curves` (docs/FORMATS.md). Written
+/// stance by stance as made, never held whole; the file through AtomicFile.
+void write_stance_curves_csv(std::ostream& os, const EstimateResult& r);
+void write_stance_curves_csv(const std::string& path, const EstimateResult& r);
 std::string stance_curves_csv(const EstimateResult& r);
 /// The gait events (gait_events: foot strike, foot off per side) as CSV: side,event,frame,time_s
 /// (frame: the file's frame number).
