@@ -21,15 +21,17 @@ mkdir -p "$rec"
 echo "== A recorded walk (data/example/walking2.c3d; its source and licence: data/example/README.md)"
 $k estimate data/example/walking2.c3d --mass 64.9 -o "$rec/estimated_grf.mot" --csv "$rec/estimated.csv" \
   --json "$rec/estimated.json" --events "$rec/gait_events.csv" --report "$rec/estimate.html" --opensim "$rec/opensim" \
-  --c3d "$rec/estimated.c3d"
-$k validate data/example/walking2.c3d --mass 64.9 --json "$rec/validation.json" --report "$rec/validation.html"
+  --c3d "$rec/estimated.c3d" --stances "$rec/stances.csv" --stance-curves "$rec/stance_curves.csv"
+$k validate data/example/walking2.c3d --mass 64.9 --json "$rec/validation.json" --report "$rec/validation.html" \
+  --stance-curves "$rec/validation_stance_curves.csv"
 echo
 echo "Outputs in out/example/: the synthetic walk (example_walk.c3d, .trc, _grf.mot), a squat, and the walk's"
 echo "  estimate (estimated_grf.mot, estimated.csv, estimated.json, opensim/). Its plates are synthetic (the"
 echo "  model's own totals shared between the feet by a fixed rule), so the demo does not score against them."
 echo "Outputs in out/recorded-walk/: the recorded walk's estimate (estimated_grf.mot in OpenSim's frame,"
-echo "  estimated.csv, estimated.json, gait_events.csv, estimate.html: its plots without plates), its"
-echo "  validation against the walk's own force plate above (validation.html, validation.json), and opensim/"
+echo "  estimated.csv, estimated.json, gait_events.csv, estimate.html: its plots without plates; stances.csv,"
+echo "  each stance's parameters; stance_curves.csv, each stance at 0-100 % of it), its validation against the"
+echo "  walk's own force plate above (validation.html, validation.json, validation_stance_curves.csv), and opensim/"
 echo "  (GRF .mot, markers .trc and ExternalLoads .xml for OpenSim's inverse dynamics), and estimated.c3d"
 echo "  (the markers with the estimate as force platforms 1 right and 2 left, for Nexus, Visual3D or ezc3d)."
 echo "docs/VALIDATION.md has the accuracy on 16 recorded trials from 8 labs."
