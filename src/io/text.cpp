@@ -381,6 +381,12 @@ std::string extension(const std::string& path) {
   return ext.empty() ? "" : to_lower(ext.substr(1));
 }
 
+void append_csv_number(std::string& out, double x) {
+  if (!std::isfinite(x)) return;
+  char num[64];
+  out.append(num, std::to_chars(num, num + sizeof num, x, std::chars_format::general, 6).ptr);
+}
+
 std::string csv_quoted(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string q = "\"";

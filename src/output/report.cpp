@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <tuple>
 
 #include "kin2grf/dynamics/joint_moments_2d.hpp"
@@ -138,6 +139,43 @@ std::string stance_parameter_cells(const nlohmann::json& p) {
 constexpr const char* kStanceParameterHeads =
     "<th>vertical first peak BW</th><th>valley BW</th><th>second peak BW</th><th>braking peak BW</th>"
     "<th>propulsive peak BW</th><th>braking impulse N s</th><th>propulsive impulse N s</th><th>loading rate BW/s</th>";
+
+}  // namespace
+
+namespace {
+
+/// The time-normalised tables' instants a stance (stance_curves_table, validation_stance_curves_table).
+constexpr Eigen::Index kCurvePoints = 101;
+
+Eigen::Index curve_column_index(const ResultsTable& c, const std::string& name) {
+  const auto it = std::find(c.columns.begin(), c.columns.end(), name);
+  if (it == c.columns.end()) throw std::logic_error("report: no stance-curve column " + name);
+  return static_cast<Eigen::Index>(it - c.columns.begin());
+}
+
+/// One stance's curve of `name` (the stance-th block of kCurvePoints rows).
+std::vector<double> curve_column(const ResultsTable& c, const std::string& name, Eigen::Index stance) {
+  const Eigen::Index col = curve_column_index(c, name);
+  std::vector<double> out(static_cast<std::size_t>(kCurvePoints));
+  for (Eigen::Index k = 0; k < kCurvePoints; ++k) out[static_cast<std::size_t>(k)] = c.values(stance * kCurvePoints + k, col);
+  return out;
+}
+
+/// The stances' mean curve of `name` at each instant, over the stances of `side` (-1: every
+/// stance), each instant over the stances where the value exists (NaN where none has it).
+std::vector<double> mean_curve(const ResultsTable& c, const std::string& name, int side) {
+  const Eigen::Index col = curve_column_index(c, name), side_col = curve_column_index(c, "side");
+  std::vector<double> m(static_cast<std::size_t>(kCurvePoints), std::numeric_limits<double>::quiet_NaN());
+  for (Eigen::Index k = 0; k < kCurvePoints; ++k) {
+    double sum = 0;
+    int n = 0;
+    for (Eigen::Index st = 0; st < c.values.rows() / kCurvePoints; ++st)
+      if (const double x = c.values(st * kCurvePoints + k, col); (side < 0 || c.values(st * kCurvePoints, side_col) == side) && std::isfinite(x))
+        sum += x, ++n;
+    if (n > 0) m[static_cast<std::size_t>(k)] = sum / n;
+  }
+  return m;
+}
 
 }  // namespace
 
@@ -316,23 +354,9 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
     // Time-normalised (validate --stance-curves): the scored stances' mean at each per cent of the
     // plate's stance, kin2grf's beside the plates', as papers draw them.
     const ResultsTable c = validation_stance_curves_table(e, v);
-    const auto column = [&](const std::string& name) {
-      return static_cast<Eigen::Index>(std::find(c.columns.begin(), c.columns.end(), name) - c.columns.begin());
-    };
-    const Eigen::Index points = 101, stances = c.values.rows() / points;
-    std::vector<double> percent(static_cast<std::size_t>(points));
-    for (Eigen::Index k = 0; k < points; ++k) percent[static_cast<std::size_t>(k)] = c.values(k, column("percent"));
-    const auto mean = [&](const std::string& name) {
-      std::vector<double> m(static_cast<std::size_t>(points), std::numeric_limits<double>::quiet_NaN());
-      for (Eigen::Index k = 0; k < points; ++k) {
-        double sum = 0;
-        int n = 0;
-        for (Eigen::Index st = 0; st < stances; ++st)
-          if (const double x = c.values(st * points + k, column(name)); std::isfinite(x)) sum += x, ++n;
-        if (n > 0) m[static_cast<std::size_t>(k)] = sum / n;
-      }
-      return m;
-    };
+    const Eigen::Index stances = c.values.rows() / kCurvePoints;
+    const std::vector<double> percent = curve_column(c, "percent", 0);
+    const auto mean = [&](const std::string& name) { return mean_curve(c, name, -1); };
     const std::string of = " (mean of the " + std::to_string(stances) + " plate stance" + (stances == 1 ? "" : "s") + " compared)";
     for (const auto& [what, unit, key] : {std::tuple{"vertical GRF", "body weights", "vertical_bw"},
                                           {"anterior GRF", "body weights", "anterior_bw"},
@@ -443,26 +467,11 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
   // cent of the stance, in body weights and N m per kg, as a gait report draws them.
   const ResultsTable c = stance_curves_table(e);
   if (c.values.rows() > 0) {
-    const auto column = [&](const std::string& name) {
-      return static_cast<Eigen::Index>(std::find(c.columns.begin(), c.columns.end(), name) - c.columns.begin());
-    };
-    const Eigen::Index points = 101, curves = c.values.rows() / points;
-    std::vector<double> percent(static_cast<std::size_t>(points));
-    for (Eigen::Index k = 0; k < points; ++k) percent[static_cast<std::size_t>(k)] = c.values(k, column("percent"));
+    const std::vector<double> percent = curve_column(c, "percent", 0);
     std::array<int, 2> count{0, 0};
-    for (Eigen::Index st = 0; st < curves; ++st) ++count[static_cast<std::size_t>(c.values(st * points, column("side")))];
-    const auto mean = [&](int side, const std::string& name) {
-      std::vector<double> m(static_cast<std::size_t>(points), std::numeric_limits<double>::quiet_NaN());
-      for (Eigen::Index k = 0; k < points; ++k) {
-        double sum = 0;
-        int n = 0;
-        for (Eigen::Index st = 0; st < curves; ++st)
-          if (const double x = c.values(st * points + k, column(name)); c.values(st * points, column("side")) == side && std::isfinite(x))
-            sum += x, ++n;
-        if (n > 0) m[static_cast<std::size_t>(k)] = sum / n;
-      }
-      return m;
-    };
+    for (Eigen::Index st = 0; st < c.values.rows() / kCurvePoints; ++st)
+      ++count[static_cast<std::size_t>(c.values(st * kCurvePoints, curve_column_index(c, "side")))];
+    const auto mean = [&](int side, const std::string& name) { return mean_curve(c, name, side); };
     const std::string of = " (mean of " + std::to_string(count[0]) + " right and " + std::to_string(count[1]) + " left complete stances)";
     for (const auto& [what, unit, key] : {std::tuple{"vertical GRF", "body weights", "grf_vertical_bw"},
                                           {"anterior GRF", "body weights", "grf_anterior_bw"},

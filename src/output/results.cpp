@@ -396,10 +396,7 @@ void write_stance_curves_csv(std::ostream& os, const EstimateResult& r) {
       buf += side_name(static_cast<int>(b(i, 0)));
       buf += ',' + std::to_string(static_cast<long long>(b(i, 1))) + ',';
       buf.append(num, std::to_chars(num, num + sizeof num, b(i, 2)).ptr);  // the start at full precision, as --stances
-      for (Eigen::Index k = 3; k < b.cols(); ++k) {
-        buf += ',';
-        if (std::isfinite(b(i, k))) buf.append(num, std::to_chars(num, num + sizeof num, b(i, k), std::chars_format::general, 6).ptr);
-      }
+      for (Eigen::Index k = 3; k < b.cols(); ++k) append_csv_number(buf += ',', b(i, k));
       buf += '\n';
     }
     flush_if_full(buf, os);

@@ -1425,11 +1425,7 @@ std::string validation_stance_curves_csv(const EstimateResult& e, const Validati
     out += ',' + csv_quoted(v.plates[static_cast<std::size_t>(t.values(i, 1))].name);
     out += ',' + std::to_string(static_cast<long long>(t.values(i, 2))) + ',';
     out.append(num, std::to_chars(num, num + sizeof num, t.values(i, 3)).ptr);  // the start at full precision
-    for (Eigen::Index k = 4; k < t.values.cols(); ++k) {
-      out += ',';
-      const double x = t.values(i, k);
-      if (std::isfinite(x)) out.append(num, std::to_chars(num, num + sizeof num, x, std::chars_format::general, 6).ptr);
-    }
+    for (Eigen::Index k = 4; k < t.values.cols(); ++k) append_csv_number(out += ',', t.values(i, k));
     out += '\n';
   }
   return out;

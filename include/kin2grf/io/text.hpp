@@ -102,6 +102,9 @@ std::string closest_match(const std::string& word, const std::vector<std::string
 /// A CSV cell for text (RFC 4180): as it is, or in double quotes (inner quotes doubled) where it
 /// holds a comma, a quote or a line break (a line break becomes a space: one row a line).
 std::string csv_quoted(const std::string& s);
+/// A CSV cell for a number, appended to `out`: 6 significant digits (as %.6g), nothing for NaN
+/// or an infinity (an empty cell: the value does not exist).
+void append_csv_number(std::string& out, double x);
 /// Lower-case file extension without the dot ("c3d", "trc", "mot", "sto").
 std::string extension(const std::string& path);
 
