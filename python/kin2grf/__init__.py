@@ -75,6 +75,23 @@ def _is_integer_column(name: str) -> bool:
     return name in ("frame", "iterations") or name.startswith("contact_")
 
 
+def _stance_curves(columns: list[str], values, plate_names: list[str] | None = None):
+    """A stance-curves table (``--stance-curves``'s rows) as a DataFrame: the side as "right" /
+    "left", a plate by its name, frame_first an integer (a dict of arrays without pandas)."""
+    columns = list(columns)
+    values = np.asarray(values, dtype=float).reshape(-1, len(columns))
+    cols = {c: values[:, k] for k, c in enumerate(columns)}
+    cols["side"] = np.where(cols["side"] == 0, "right", "left")
+    cols["frame_first"] = cols["frame_first"].astype(np.int64)
+    if plate_names is not None:
+        cols["plate"] = np.asarray([plate_names[int(k)] for k in cols["plate"]], dtype=object)
+    try:
+        import pandas as pd
+    except ImportError:
+        return cols
+    return pd.DataFrame(cols, columns=columns)
+
+
 def _table(columns: list[str], values: np.ndarray):
     try:
         import pandas as pd
@@ -146,16 +163,7 @@ class Estimate:
         estimate --stance-curves``, full precision): the force in body weights, the COP's progression,
         the hip, knee and ankle torques (N m/kg) and powers (W/kg), a ``side`` column of "right" /
         "left": a pandas DataFrame (a dict of arrays without pandas)."""
-        cols = {c: self._curves_values[:, k] for k, c in enumerate(self._curves_columns)}
-        if "side" in cols:
-            cols["side"] = np.where(cols["side"] == 0, "right", "left")
-        if "frame_first" in cols:
-            cols["frame_first"] = cols["frame_first"].astype(np.int64)
-        try:
-            import pandas as pd
-        except ImportError:
-            return cols
-        return pd.DataFrame(cols, columns=self._curves_columns)
+        return _stance_curves(self._curves_columns, self._curves_values)
 
     def __getitem__(self, column: str) -> np.ndarray:
         return self.values[:, self.columns.index(column)]
@@ -187,17 +195,7 @@ def validate(trial: str | os.PathLike, plates: str | os.PathLike | None = None, 
                           _text(sync), timing)
     out = d["validation"]
     out["estimate"] = Estimate(d["estimate"], os.fspath(trial), _words(settings))
-    columns = list(d["stance_curves_columns"])
-    values = np.asarray(d["stance_curves_values"]).reshape(-1, len(columns))
-    cols = {c: values[:, k] for k, c in enumerate(columns)}
-    cols["side"] = np.where(cols["side"] == 0, "right", "left")
-    cols["plate"] = np.asarray([d["plate_names"][int(k)] for k in cols["plate"]], dtype=object)
-    cols["frame_first"] = cols["frame_first"].astype(np.int64)
-    try:
-        import pandas as pd
-        out["stance_curves"] = pd.DataFrame(cols, columns=columns)
-    except ImportError:
-        out["stance_curves"] = cols
+    out["stance_curves"] = _stance_curves(d["stance_curves_columns"], d["stance_curves_values"], d["plate_names"])
     return out
 
 
