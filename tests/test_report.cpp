@@ -128,6 +128,23 @@ TEST(Report, TheThreeDReportPlotsTheLateralForceAndTheKneeAdductionMoment) {
   EXPECT_EQ(count("foot: COP's lateral place"), 2);
   EXPECT_EQ(count("knee: external knee adduction moment"), 2);
   EXPECT_EQ(count("<h3>3D model</h3>"), 1);
+  // Time-normalised, the KAM with each ground reaction (validate --stance-curves): at the plate
+  // stance's first frame the estimate-driven and the plate-driven moments per kg.
+  EXPECT_EQ(count("external knee adduction moment, with each ground reaction, per cent of the plate's stance"), 1);
+  const ResultsTable curves = validation_stance_curves_table(e, v);
+  const auto column = [&](const std::string& name) {
+    const auto it = std::find(curves.columns.begin(), curves.columns.end(), name);
+    EXPECT_NE(it, curves.columns.end()) << name;
+    return static_cast<Eigen::Index>(it - curves.columns.begin());
+  };
+  ASSERT_TRUE(v.measured_moments_3d.has_value());
+  const StanceValidation& st = v.stances.front();
+  EXPECT_NEAR(curves.values(0, column("knee_adduction_moment_Nm_per_kg_estimate")),
+              knee_adduction_moment(e.legs_3d->moments, st.foot, st.first) / e.mass_kg, 1e-12);
+  if (!st.cop_reference_suspect) {
+    EXPECT_NEAR(curves.values(0, column("knee_adduction_moment_Nm_per_kg_plate")),
+                knee_adduction_moment(*v.measured_moments_3d, st.foot, st.first) / e.mass_kg, 1e-12);
+  }
   // The sagittal model's report has none of it.
   EstimateOptions sagittal;
   sagittal.mass_kg = 64.9;

@@ -358,15 +358,19 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
     const std::vector<double> percent = curve_column(c, "percent", 0);
     const auto mean = [&](const std::string& name) { return mean_curve(c, name, -1); };
     const std::string of = " (mean of the " + std::to_string(stances) + " plate stance" + (stances == 1 ? "" : "s") + " compared)";
-    for (const auto& [what, unit, key] : {std::tuple{"vertical GRF", "body weights", "vertical_bw"},
-                                          {"anterior GRF", "body weights", "anterior_bw"},
-                                          {"COP along progression from the plate's first COP", "m", "cop_progression_m"}}) {
+    std::vector<std::tuple<std::string, std::string, std::string>> figures = {
+        {"vertical GRF", "body weights", "vertical_bw"},
+        {"anterior GRF", "body weights", "anterior_bw"},
+        {"COP along progression from the plate's first COP", "m", "cop_progression_m"}};
+    if (std::find(c.columns.begin(), c.columns.end(), "knee_adduction_moment_Nm_per_kg_plate") != c.columns.end())
+      figures.emplace_back("external knee adduction moment, with each ground reaction", "N m/kg", "knee_adduction_moment_Nm_per_kg");
+    for (const auto& [what, unit, key] : figures) {
       ReportFigure g;
-      g.title = std::string(what) + ", per cent of the plate's stance" + of;
+      g.title = what + ", per cent of the plate's stance" + of;
       g.x_label = "% of stance";
       g.y_label = unit;
-      g.series.push_back({"force plates", percent, mean(std::string(key) + "_plate"), true});
-      g.series.push_back({"kin2grf estimate", percent, mean(std::string(key) + "_estimate"), false});
+      g.series.push_back({"force plates", percent, mean(key + "_plate"), true});
+      g.series.push_back({"kin2grf estimate", percent, mean(key + "_estimate"), false});
       rep.figures.push_back(g);
     }
   }
@@ -477,7 +481,9 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
                                           {"anterior GRF", "body weights", "grf_anterior_bw"},
                                           {"hip torque", "N m/kg", "torque_hip_Nm_per_kg"},
                                           {"knee torque", "N m/kg", "torque_knee_Nm_per_kg"},
-                                          {"ankle torque", "N m/kg", "torque_ankle_Nm_per_kg"}}) {
+                                          {"ankle torque", "N m/kg", "torque_ankle_Nm_per_kg"},
+                                          {"external knee adduction moment", "N m/kg", "knee_adduction_moment_Nm_per_kg"}}) {
+      if (std::find(c.columns.begin(), c.columns.end(), key) == c.columns.end()) continue;  // the KAM: --model 3d
       ReportFigure g;
       g.title = std::string(what) + ", per cent of stance" + of;
       g.x_label = "% of stance";

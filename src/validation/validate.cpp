@@ -1372,6 +1372,10 @@ ResultsTable validation_stance_curves_table(const EstimateResult& e, const Valid
                "anterior_bw_estimate", "anterior_bw_plate"};
   if (lateral) t.columns.insert(t.columns.end(), {"lateral_bw_estimate", "lateral_bw_plate"});
   t.columns.insert(t.columns.end(), {"cop_progression_m_estimate", "cop_progression_m_plate"});
+  // The 3D model: the external knee adduction moment by inverse dynamics with each ground reaction
+  // on the same kinematics (validate_joint_moments_3d), N m per kg.
+  const bool kam = e.legs_3d.has_value() && v.measured_moments_3d.has_value();
+  if (kam) t.columns.insert(t.columns.end(), {"knee_adduction_moment_Nm_per_kg_estimate", "knee_adduction_moment_Nm_per_kg_plate"});
   const double bw = e.mass_kg * e.model().gravity_mps2;
   const auto nan = std::numeric_limits<double>::quiet_NaN();
   const Eigen::Index series_columns = static_cast<Eigen::Index>(t.columns.size()) - 6;
@@ -1399,6 +1403,11 @@ ResultsTable validation_stance_curves_table(const EstimateResult& e, const Valid
       const bool compared = std::isfinite(v.measured_cop_x_m[f][i]);  // where the plate's COP is over its threshold
       series(k, c++) = compared ? foot.cop_x_m[i] - origin : nan;
       series(k, c++) = v.measured_cop_x_m[f][i] - origin;
+      if (kam) {
+        // A misplaced plate's moments take its COP as their lever: not compared, as the means do.
+        series(k, c++) = knee_adduction_moment(e.legs_3d->moments, st.foot, i) / e.mass_kg;
+        series(k, c++) = st.cop_reference_suspect ? nan : knee_adduction_moment(*v.measured_moments_3d, st.foot, i) / e.mass_kg;
+      }
     }
     const Eigen::MatrixXd curves = stance_normalised(series, 0, frames - 1, points);
     for (int k = 0; k < points; ++k, ++out) {

@@ -432,7 +432,10 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
 /// cop_progression_m_estimate and cop_progression_m_plate: both COPs along progression from the
 /// plate's first COP of the stance (one origin for both, so their difference is the COP's error;
 /// NaN where the plate's COP is below its threshold, and for a stance whose plate fails the
-/// registration check, whose COP the means leave out too).
+/// registration check, whose COP the means leave out too); with ModelKind::ThreeD the external
+/// knee adduction moment, N m/kg, by inverse dynamics with kin2grf's and with the plate's ground
+/// reaction on the same kinematics (knee_adduction_moment_Nm_per_kg_estimate, _plate; the plate's
+/// NaN where its registration fails).
 ResultsTable validation_stance_curves_table(const EstimateResult& e, const ValidationResult& v, int points = 101);
 /// The same as CSV (side as right / left, the plate by its name; 6 significant digits, an empty
 /// cell where a value does not exist; docs/FORMATS.md).
