@@ -1174,6 +1174,44 @@ TEST(Results, TheStanceCurvesAreThePerFrameSeriesAtEachPercentOfEveryCompleteSta
   }
 }
 
+// On a treadmill the belt carries the foot back: the stance curves' COP progression is over the
+// belt, so the example walk put on a treadmill (every marker carried back at the walk's own speed,
+// the pelvis then still) reads as it does overground, stance for stance, within a few mm, where its
+// lab-frame COP ends a stance's duration times the speed behind.
+TEST(Results, TheStanceCurvesCopProgressionOnATreadmillIsOverTheBelt) {
+  Trial walk = make_example_walk();
+  walk.plates.reset();
+  EstimateOptions o;
+  o.mass_kg = 70.0;
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  const EstimateResult over = estimate(walk, nullptr, set, o);
+  const double speed = over.calibration.progression_speed_mps;
+  ASSERT_GT(speed, 0.5);
+  Trial belt = walk;
+  for (auto& p : belt.markers.positions_m)
+    for (Eigen::Index i = 0; i < p.rows(); ++i)
+      p.row(i) -= speed * (belt.markers.time_s[i] - belt.markers.time_s[0]) * over.frame.forward.transpose();
+  const EstimateResult on = estimate(belt, nullptr, set, o);
+  ASSERT_TRUE(on.frame.treadmill);
+  EXPECT_NEAR(on.calibration.belt_velocity_mps, -speed, 0.05 * speed);
+  const ResultsTable a = stance_curves_table(over), b = stance_curves_table(on);
+  const auto col = [](const ResultsTable& t, const std::string& name) {
+    return static_cast<Eigen::Index>(std::find(t.columns.begin(), t.columns.end(), name) - t.columns.begin());
+  };
+  int matched = 0;
+  for (Eigen::Index i = 0; i < a.values.rows(); i += 101)
+    for (Eigen::Index j = 0; j < b.values.rows(); j += 101) {
+      if (a.values(i, col(a, "side")) != b.values(j, col(b, "side")) ||
+          std::abs(a.values(i, col(a, "start_s")) - b.values(j, col(b, "start_s"))) > 0.011)
+        continue;
+      ++matched;
+      for (const Eigen::Index k : {Eigen::Index{50}, Eigen::Index{100}})
+        EXPECT_NEAR(b.values(j + k, col(b, "cop_progression_m")), a.values(i + k, col(a, "cop_progression_m")), 0.005) << k << " %";
+      EXPECT_GT(a.values(i + 100, col(a, "cop_progression_m")), 0.1);
+    }
+  EXPECT_GE(matched, 2);
+}
+
 // validate --stance-curves: every scored plate stance over its plate's own stance, 101 rows, the
 // estimate's and the plate's side by side; at 0 % and 100 % the two series' values at the plate
 // stance's first and last frames, in body weights; both COPs from the plate's first COP (so the

@@ -356,7 +356,11 @@ void each_stance_curve(const EstimateResult& r, int points, Emit emit) {
       results_row(r, st.run.first + i, row);
       for (std::size_t k = 0; k < picks.size(); ++k) series(i, static_cast<Eigen::Index>(k)) = row[picks[k].first] * picks[k].second;
     }
-    // The COP's progression from the first frame it exists on (a landing's first frame can be unloaded).
+    // The COP's progression over the ground: on a treadmill over the belt, which carries the foot
+    // back (TrialCalibration::belt_velocity_mps; 0 overground), so that it reads as overground.
+    // From the first frame it exists on (a landing's first frame can be unloaded).
+    const double belt = r.calibration.belt_velocity_mps;
+    for (Eigen::Index i = 0; i < frames; ++i) series(i, cop) -= belt * (r.time_s[st.run.first + i] - r.time_s[st.run.first]);
     double origin = std::numeric_limits<double>::quiet_NaN();
     for (Eigen::Index i = 0; i < frames && !std::isfinite(origin); ++i) origin = series(i, cop);
     series.col(cop).array() -= origin;

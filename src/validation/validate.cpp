@@ -1401,8 +1401,10 @@ ResultsTable validation_stance_curves_table(const EstimateResult& e, const Valid
         series(k, c++) = v.measured_lateral_N[f][i] / bw;
       }
       const bool compared = std::isfinite(v.measured_cop_x_m[f][i]);  // where the plate's COP is over its threshold
-      series(k, c++) = compared ? foot.cop_x_m[i] - origin : nan;
-      series(k, c++) = v.measured_cop_x_m[f][i] - origin;
+      // Over the ground: on a treadmill over the belt, which carries the foot back (0 overground).
+      const double belt = e.calibration.belt_velocity_mps * (e.time_s[i] - e.time_s[st.first]);
+      series(k, c++) = compared ? foot.cop_x_m[i] - origin - belt : nan;
+      series(k, c++) = v.measured_cop_x_m[f][i] - origin - belt;
       if (kam) {
         // A misplaced plate's moments take its COP as their lever: not compared, as the means do.
         series(k, c++) = knee_adduction_moment(e.legs_3d->moments, st.foot, i) / e.mass_kg;

@@ -68,7 +68,8 @@ std::string stance_parameters_csv(const EstimateResult& r);
 /// frame number of the foot strike: the `--stances` CSV's row), start_s, duration_s, percent; the
 /// foot's force in body weights (grf_vertical_bw, grf_anterior_bw, and with the lateral force
 /// grf_lateral_bw), the COP's progression from where it was at foot strike (cop_progression_m,
-/// along progression), the foot's inclination (rad), the side's hip, knee and ankle torques (N m
+/// along progression over the ground: on a treadmill over the belt, which carries the foot back),
+/// the foot's inclination (rad), the side's hip, knee and ankle torques (N m
 /// per kg of body mass, the per-frame CSV's torque_* signs) and powers (W/kg), and with
 /// ModelKind::ThreeD the external knee adduction moment (N m/kg). The values are the per-frame
 /// CSV's (results_row) between frames. A stance the processed window cuts is left out: part of a

@@ -429,8 +429,9 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
 /// right, 1 left), plate (the index into v.plates), frame_first (the file's frame number), start_s,
 /// duration_s, percent, vertical_bw_estimate, vertical_bw_plate, anterior_bw_estimate,
 /// anterior_bw_plate, with the lateral force lateral_bw_estimate and lateral_bw_plate, then
-/// cop_progression_m_estimate and cop_progression_m_plate: both COPs along progression from the
-/// plate's first COP of the stance (one origin for both, so their difference is the COP's error;
+/// cop_progression_m_estimate and cop_progression_m_plate: both COPs along progression over the
+/// ground (on a treadmill over the belt) from the plate's first COP of the stance (one origin for
+/// both, so their difference is the COP's error;
 /// NaN where the plate's COP is below its threshold, and for a stance whose plate fails the
 /// registration check, whose COP the means leave out too); with ModelKind::ThreeD the external
 /// knee adduction moment, N m/kg, by inverse dynamics with kin2grf's and with the plate's ground
