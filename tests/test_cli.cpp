@@ -501,6 +501,31 @@ TEST(CliFiles, OneFileGivenAsTwoOutputsIsRefusedNamingBoth) {
   EXPECT_FALSE(std::filesystem::exists(x));
 }
 
+// --stance-curves (estimate and validate) is checked as every output: never the trial, not even
+// through a symlink to it, never another output of the run; /dev/stdout prints it.
+TEST(CliFiles, TheStanceCurvesOutputIsCheckedAsEveryOutput) {
+  const auto dir = kin2grf::test::temp_dir("cli_stance_curves");
+  const auto trial = dir / "walk.c3d";
+  std::filesystem::copy_file(example_dir() / "example_walk.c3d", trial);
+  std::filesystem::create_symlink(trial, dir / "link.csv");
+  const auto before = kin2grf::read_file_text(trial.string());
+  for (const char* cmd : {"estimate ", "validate "})
+    for (const auto& target : {trial, dir / "link.csv"}) {
+      const CliRun r = run(cmd + trial.string() + " --mass 70 --stance-curves " + target.string());
+      EXPECT_EQ(r.status, 2) << cmd << r.out;
+      EXPECT_NE(r.out.find("is an input of this run"), std::string::npos) << cmd << r.out;
+    }
+  EXPECT_EQ(kin2grf::read_file_text(trial.string()), before);
+  const auto x = (dir / "x.csv").string();
+  const CliRun twice = run("estimate " + trial.string() + " --mass 70 --csv " + x + " --stance-curves " + x);
+  EXPECT_EQ(twice.status, 2) << twice.out;
+  EXPECT_NE(twice.out.find("given twice as an output"), std::string::npos) << twice.out;
+  EXPECT_FALSE(std::filesystem::exists(x));
+  const CliRun out = run("validate " + trial.string() + " --mass 70 --stance-curves /dev/stdout", "2>/dev/null");
+  EXPECT_EQ(out.status, 0) << out.out;
+  EXPECT_NE(out.out.find("side,plate,frame_first,start_s,duration_s,percent,"), std::string::npos) << out.out.substr(0, 300);
+}
+
 // A device stays a device, a FIFO gets the file through it, /dev/stdout prints it.
 TEST(CliFiles, DevicesFifosAndStandardOutputAreWrittenInPlace) {
   const auto dir = kin2grf::test::temp_dir("cli_devices");

@@ -356,7 +356,6 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
     const ResultsTable c = validation_stance_curves_table(e, v);
     const Eigen::Index stances = c.values.rows() / kCurvePoints;
     const std::vector<double> percent = curve_column(c, "percent", 0);
-    const auto mean = [&](const std::string& name) { return mean_curve(c, name, -1); };
     const std::string of = " (mean of the " + std::to_string(stances) + " plate stance" + (stances == 1 ? "" : "s") + " compared)";
     std::vector<std::tuple<std::string, std::string, std::string>> figures = {
         {"vertical GRF", "body weights", "vertical_bw"},
@@ -369,8 +368,8 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
       g.title = what + ", per cent of the plate's stance" + of;
       g.x_label = "% of stance";
       g.y_label = unit;
-      g.series.push_back({"force plates", percent, mean(key + "_plate"), true});
-      g.series.push_back({"kin2grf estimate", percent, mean(key + "_estimate"), false});
+      g.series.push_back({"force plates", percent, mean_curve(c, key + "_plate", -1), true});
+      g.series.push_back({"kin2grf estimate", percent, mean_curve(c, key + "_estimate", -1), false});
       rep.figures.push_back(g);
     }
   }
@@ -475,7 +474,6 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
     std::array<int, 2> count{0, 0};
     for (Eigen::Index st = 0; st < c.values.rows() / kCurvePoints; ++st)
       ++count[static_cast<std::size_t>(c.values(st * kCurvePoints, curve_column_index(c, "side")))];
-    const auto mean = [&](int side, const std::string& name) { return mean_curve(c, name, side); };
     const std::string of = " (mean of " + std::to_string(count[0]) + " right and " + std::to_string(count[1]) + " left complete stances)";
     for (const auto& [what, unit, key] : {std::tuple{"vertical GRF", "body weights", "grf_vertical_bw"},
                                           {"anterior GRF", "body weights", "grf_anterior_bw"},
@@ -489,7 +487,7 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
       g.x_label = "% of stance";
       g.y_label = unit;
       for (int side = 0; side < 2; ++side)
-        if (count[static_cast<std::size_t>(side)] > 0) g.series.push_back({side_name(side), percent, mean(side, key), false});
+        if (count[static_cast<std::size_t>(side)] > 0) g.series.push_back({side_name(side), percent, mean_curve(c, key, side), false});
       rep.figures.push_back(std::move(g));
     }
   }

@@ -5,9 +5,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <sstream>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 
@@ -311,14 +311,46 @@ std::string stance_parameters_csv(const EstimateResult& r) {
 
 namespace {
 
-/// stance_curves_table's columns.
-std::vector<std::string> stance_curve_columns(bool lateral, bool three_d) {
-  std::vector<std::string> c = {"side", "frame_first", "start_s", "duration_s", "percent", "grf_vertical_bw", "grf_anterior_bw"};
-  if (lateral) c.emplace_back("grf_lateral_bw");
-  for (const char* name : {"cop_progression_m", "foot_inclination_rad", "torque_hip_Nm_per_kg", "torque_knee_Nm_per_kg",
-                           "torque_ankle_Nm_per_kg", "power_hip_W_per_kg", "power_knee_W_per_kg", "power_ankle_W_per_kg"})
-    c.emplace_back(name);
-  if (three_d) c.emplace_back("knee_adduction_moment_Nm_per_kg");
+/// The five columns that place a stance's rows, before its series.
+constexpr const char* kStanceCurveKeys[] = {"side", "frame_first", "start_s", "duration_s", "percent"};
+
+/// One series of stance_curves_table: its column, and its value on `side` at frame i (the
+/// per-frame CSV's, results_row's, times the series' scale); `w`: the frame's joint angular
+/// velocities, which the powers take.
+struct CurveSeries {
+  std::string name;
+  std::function<double(int side, Eigen::Index i, const std::array<double, kJointCount>& w)> at;
+};
+
+/// stance_curves_table's series, in its columns' order: forces per body weight, moments and
+/// powers per kg of body mass.
+std::vector<CurveSeries> stance_curve_series(const EstimateResult& r) {
+  const double per_bw = 1 / (r.mass_kg * r.model().gravity_mps2), per_kg = 1 / r.mass_kg;
+  const auto foot = [&r](int side) -> const FootResult& { return r.feet[static_cast<std::size_t>(side)]; };
+  std::vector<CurveSeries> c;
+  c.push_back({"grf_vertical_bw", [=](int s, Eigen::Index i, const auto&) { return foot(s).force_N(i, 1) * per_bw; }});
+  c.push_back({"grf_anterior_bw", [=](int s, Eigen::Index i, const auto&) { return foot(s).force_N(i, 0) * per_bw; }});
+  if (r.feet[0].force_lateral_N.size() > 0)
+    c.push_back({"grf_lateral_bw", [=](int s, Eigen::Index i, const auto&) { return foot(s).force_lateral_N[i] * per_bw; }});
+  c.push_back({"cop_progression_m", [=](int s, Eigen::Index i, const auto&) { return foot(s).cop_x_m[i]; }});  // made progression below
+  c.push_back({"foot_inclination_rad", [=](int s, Eigen::Index i, const auto&) { return foot(s).inclination_rad[i]; }});
+  static const char* const kJoint[] = {"hip", "knee", "ankle"};  // joint_torque_Nm: per side hip, knee, ankle, MTP
+  for (int k = 0; k < 3; ++k)
+    c.push_back({std::string("torque_") + kJoint[k] + "_Nm_per_kg",
+                 [&r, k, per_kg](int s, Eigen::Index i, const auto&) { return r.joint_torque_Nm(i, 4 * s + k) * per_kg; }});
+  for (int k = 0; k < 3; ++k)
+    c.push_back({std::string("power_") + kJoint[k] + "_W_per_kg", [&r, k, per_kg](int s, Eigen::Index i, const auto& w) {
+                   return r.joint_torque_Nm(i, 4 * s + k) * w[static_cast<std::size_t>(4 * s + k)] * per_kg;
+                 }});
+  if (r.legs_3d)
+    c.push_back({"knee_adduction_moment_Nm_per_kg",
+                 [&r, per_kg](int s, Eigen::Index i, const auto&) { return knee_adduction_moment(r.legs_3d->moments, s, i) * per_kg; }});
+  return c;
+}
+
+std::vector<std::string> stance_curve_columns(const EstimateResult& r) {
+  std::vector<std::string> c(std::begin(kStanceCurveKeys), std::end(kStanceCurveKeys));
+  for (const CurveSeries& x : stance_curve_series(r)) c.push_back(x.name);
   return c;
 }
 
@@ -326,35 +358,17 @@ std::vector<std::string> stance_curve_columns(bool lateral, bool three_d) {
 /// time to `emit`: a long trial's curves are never held together.
 template <class Emit>
 void each_stance_curve(const EstimateResult& r, int points, Emit emit) {
-  const bool lateral = r.feet[0].force_lateral_N.size() > 0, three_d = r.legs_3d.has_value();
-  const std::vector<std::string> columns = results_columns(lateral, three_d);
-  const auto column = [&](const std::string& name) {
-    const auto it = std::find(columns.begin(), columns.end(), name);
-    if (it == columns.end()) throw std::logic_error("stance curves: no column " + name);
-    return static_cast<std::size_t>(it - columns.begin());
-  };
-  const auto width = static_cast<Eigen::Index>(stance_curve_columns(lateral, three_d).size());
-  const double bw = r.mass_kg * r.model().gravity_mps2, kg = r.mass_kg;
-  std::vector<double> row(columns.size());
+  const std::vector<CurveSeries> series_of = stance_curve_series(r);
+  const auto cop = static_cast<Eigen::Index>(
+      std::find_if(series_of.begin(), series_of.end(), [](const CurveSeries& x) { return x.name == "cop_progression_m"; }) - series_of.begin());
+  const auto keys = static_cast<Eigen::Index>(std::size(kStanceCurveKeys)), n = static_cast<Eigen::Index>(series_of.size());
   for (const EstimatedStance& st : estimated_stances(r)) {
     if (!st.complete) continue;  // part of a stance is not its 0-100 %
-    const std::string s = st.side == kLeft ? "_l" : "_r";
-    // The series to normalise, each with its scale: force / body weight, moment and power / mass.
-    std::vector<std::pair<std::size_t, double>> picks = {{column("grf_vertical" + s + "_N"), 1 / bw},
-                                                         {column("grf_anterior" + s + "_N"), 1 / bw}};
-    if (lateral) picks.emplace_back(column("grf_lateral" + s + "_N"), 1 / bw);
-    const auto cop = static_cast<Eigen::Index>(picks.size());
-    picks.emplace_back(column("cop_x" + s + "_m"), 1.0);
-    picks.emplace_back(column("foot_inclination" + s + "_rad"), 1.0);
-    for (const char* quantity : {"torque_", "power_"})
-      for (const char* joint : {"hip", "knee", "ankle"})
-        picks.emplace_back(column(quantity + std::string(joint) + s + (quantity[0] == 't' ? "_Nm" : "_W")), 1 / kg);
-    if (three_d) picks.emplace_back(column("knee_adduction_moment" + s + "_Nm"), 1 / kg);
     const Eigen::Index frames = st.run.last - st.run.first + 1;
-    Eigen::MatrixXd series(frames, static_cast<Eigen::Index>(picks.size()));
+    Eigen::MatrixXd series(frames, n);
     for (Eigen::Index i = 0; i < frames; ++i) {
-      results_row(r, st.run.first + i, row);
-      for (std::size_t k = 0; k < picks.size(); ++k) series(i, static_cast<Eigen::Index>(k)) = row[picks[k].first] * picks[k].second;
+      const std::array<double, kJointCount> w = joint_angular_velocities(r.motion, st.run.first + i);
+      for (Eigen::Index k = 0; k < n; ++k) series(i, k) = series_of[static_cast<std::size_t>(k)].at(st.side, st.run.first + i, w);
     }
     // The COP's progression over the ground: on a treadmill over the belt, which carries the foot
     // back (TrialCalibration::belt_velocity_mps; 0 overground), so that it reads as overground.
@@ -364,8 +378,8 @@ void each_stance_curve(const EstimateResult& r, int points, Emit emit) {
     double origin = std::numeric_limits<double>::quiet_NaN();
     for (Eigen::Index i = 0; i < frames && !std::isfinite(origin); ++i) origin = series(i, cop);
     series.col(cop).array() -= origin;
-    Eigen::MatrixXd block(points, width);
-    block.rightCols(series.cols()) = stance_normalised(series, 0, frames - 1, points);
+    Eigen::MatrixXd block(points, keys + n);
+    block.rightCols(n) = stance_normalised(series, 0, frames - 1, points);
     for (int k = 0; k < points; ++k) {
       block(k, 0) = st.side;
       block(k, 1) = static_cast<double>(r.first_frame_number + st.run.first);
@@ -381,7 +395,7 @@ void each_stance_curve(const EstimateResult& r, int points, Emit emit) {
 
 ResultsTable stance_curves_table(const EstimateResult& r, int points) {
   ResultsTable t;
-  t.columns = stance_curve_columns(r.feet[0].force_lateral_N.size() > 0, r.legs_3d.has_value());
+  t.columns = stance_curve_columns(r);
   std::vector<Eigen::MatrixXd> blocks;
   each_stance_curve(r, points, [&](const Eigen::MatrixXd& b) { blocks.push_back(b); });
   t.values.resize(static_cast<Eigen::Index>(blocks.size()) * points, static_cast<Eigen::Index>(t.columns.size()));
@@ -390,22 +404,27 @@ ResultsTable stance_curves_table(const EstimateResult& r, int points) {
 }
 
 void write_stance_curves_csv(std::ostream& os, const EstimateResult& r) {
-  const auto columns = stance_curve_columns(r.feet[0].force_lateral_N.size() > 0, r.legs_3d.has_value());
+  const auto columns = stance_curve_columns(r);
   std::string buf;
   for (std::size_t k = 0; k < columns.size(); ++k) (buf += k ? "," : "") += columns[k];
   buf += '\n';
-  char num[64];
   each_stance_curve(r, 101, [&](const Eigen::MatrixXd& b) {
-    for (Eigen::Index i = 0; i < b.rows(); ++i) {
-      buf += side_name(static_cast<int>(b(i, 0)));
-      buf += ',' + std::to_string(static_cast<long long>(b(i, 1))) + ',';
-      buf.append(num, std::to_chars(num, num + sizeof num, b(i, 2)).ptr);  // the start at full precision, as --stances
-      for (Eigen::Index k = 3; k < b.cols(); ++k) append_csv_number(buf += ',', b(i, k));
-      buf += '\n';
-    }
+    for (Eigen::Index i = 0; i < b.rows(); ++i)
+      append_stance_curve_row(buf, static_cast<int>(b(i, 0)), nullptr, b(i, 1), b(i, 2), b.row(i).tail(b.cols() - 3));
     flush_if_full(buf, os);
   });
   flush_if_full(buf, os, true);
+}
+
+void append_stance_curve_row(std::string& out, int side, const std::string* label, double frame_first, double start_s,
+                             const Eigen::Ref<const Eigen::RowVectorXd>& rest) {
+  out += side_name(side);
+  if (label) out += ',' + csv_quoted(*label);
+  out += ',' + std::to_string(static_cast<long long>(frame_first)) + ',';
+  char num[64];
+  out.append(num, std::to_chars(num, num + sizeof num, start_s).ptr);  // the start at full precision, as --stances
+  for (Eigen::Index k = 0; k < rest.size(); ++k) append_csv_number(out += ',', rest[k]);
+  out += '\n';
 }
 
 void write_stance_curves_csv(const std::string& path, const EstimateResult& r) {

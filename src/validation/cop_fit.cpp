@@ -277,12 +277,13 @@ std::string format_cop_fit(const CopFitOnTrials& res, const std::vector<StudyTri
   out += b;
   std::snprintf(b, sizeof b, "  event angles (rad)   HS %.3f  HO %.3f  MO %.3f  TO %.3f\n", f.delta_hs, f.delta_ho, f.delta_mo, f.delta_to);
   out += b;
+  const char* unit = f.length == CopLength::Sole ? "sole" : "heel-MT";
   std::snprintf(b, sizeof b, "  positions (fraction of the %s length) HS %.3f  HO %.3f  MO %.3f  TO %.3f   (start %.3f %.3f %.3f %.3f)\n",
-                f.length == CopLength::Sole ? "sole" : "heel-MT", f.s_hs, f.s_ho, f.s_mo, f.s_to, start.s_hs, start.s_ho, start.s_mo, start.s_to);
+                unit, f.s_hs, f.s_ho, f.s_mo, f.s_to, start.s_hs, start.s_ho, start.s_mo, start.s_to);
   out += b;
   if (f.com_gain != 0.0 || start.com_gain != 0.0) {
-    std::snprintf(b, sizeof b, "  centre-of-mass gain   %.3f per %s length ahead of the heel   (start %.3f)\n", f.com_gain,
-                  f.length == CopLength::Sole ? "sole" : "heel-MT", start.com_gain);
+    std::snprintf(b, sizeof b, "  centre-of-mass gain   %.3f per %s length ahead of the heel   (start %.3f)\n", f.com_gain, unit,
+                  start.com_gain);
     out += b;
   }
   std::snprintf(b, sizeof b, "  RMS of F(theta) - s: %.3f (start: %.3f)\n", res.fit.rms_fraction, res.fit.rms_fraction_before);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -10,7 +9,6 @@
 #include <sstream>
 #include <tuple>
 
-#include "kin2grf/io/text.hpp"
 #include "kin2grf/kinematics/filter.hpp"
 #include "kin2grf/numeric.hpp"
 #include "kin2grf/output/results.hpp"
@@ -1430,15 +1428,9 @@ std::string validation_stance_curves_csv(const EstimateResult& e, const Validati
   std::string out;
   for (std::size_t k = 0; k < t.columns.size(); ++k) (out += k ? "," : "") += t.columns[k];
   out += '\n';
-  char num[64];
-  for (Eigen::Index i = 0; i < t.values.rows(); ++i) {
-    out += side_name(static_cast<int>(t.values(i, 0)));
-    out += ',' + csv_quoted(v.plates[static_cast<std::size_t>(t.values(i, 1))].name);
-    out += ',' + std::to_string(static_cast<long long>(t.values(i, 2))) + ',';
-    out.append(num, std::to_chars(num, num + sizeof num, t.values(i, 3)).ptr);  // the start at full precision
-    for (Eigen::Index k = 4; k < t.values.cols(); ++k) append_csv_number(out += ',', t.values(i, k));
-    out += '\n';
-  }
+  for (Eigen::Index i = 0; i < t.values.rows(); ++i)
+    append_stance_curve_row(out, static_cast<int>(t.values(i, 0)), &v.plates[static_cast<std::size_t>(t.values(i, 1))].name,
+                            t.values(i, 2), t.values(i, 3), t.values.row(i).tail(t.values.cols() - 4));
   return out;
 }
 

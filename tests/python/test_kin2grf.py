@@ -101,58 +101,63 @@ def test_table_and_columns(example):
     assert r.summary["mass_kg"] == 70.0
 
 
+def _cli_csv_rows(tmp_path, command, trial, option):
+    """The rows of a CSV the CLI writes: `kin2grf COMMAND TRIAL OPTION FILE`."""
+    out = tmp_path / "cli.csv"
+    subprocess.run([CLI, command, str(trial), option, str(out)], check=True, capture_output=True)
+    with open(out, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def _records(table):
+    """A DataFrame's rows as dicts, or those of a dict of arrays / a list of dicts (without pandas)."""
+    if hasattr(table, "to_dict"):
+        return table.to_dict("records")
+    if isinstance(table, dict):
+        return [dict(zip(table, v)) for v in zip(*table.values())]
+    return table
+
+
+def _same_numbers(mine, theirs, keys):
+    for k in keys:
+        assert abs(float(theirs[k]) - mine[k]) <= 1e-5 * abs(mine[k]) + 1e-9, k
+
+
 def test_stances_are_the_cli_stances_csv(example, tmp_path):
     """Estimate.stances: the summary's stance parameters as ``--stances`` writes them, row for row."""
     trial = example / "example_walk.c3d"
-    r = kin2grf.estimate(trial)
-    out = tmp_path / "stances.csv"
-    subprocess.run([CLI, "estimate", str(trial), "--stances", str(out)], check=True, capture_output=True)
-    with open(out, newline="") as f:
-        rows = list(csv.DictReader(f))
-    st = r.stances
-    records = st.to_dict("records") if hasattr(st, "to_dict") else st
+    rows = _cli_csv_rows(tmp_path, "estimate", trial, "--stances")
+    records = _records(kin2grf.estimate(trial).stances)
     assert len(records) == len(rows) >= 4
     for mine, theirs in zip(records, rows):
         assert mine["side"] == theirs["side"]
         assert int(theirs["complete"]) == int(mine["complete"])
-        for k in ("start_s", "duration_s", "vertical_first_peak_N", "braking_impulse_Ns"):
-            assert abs(float(theirs[k]) - mine[k]) <= 1e-5 * abs(mine[k]) + 1e-9, k
+        _same_numbers(mine, theirs, ("start_s", "duration_s", "vertical_first_peak_N", "braking_impulse_Ns"))
 
 
 def test_stance_curves_are_the_cli_stance_curves_csv(example, tmp_path):
     """Estimate.stance_curves: every complete stance at 0..100 % as ``--stance-curves`` writes it."""
     trial = example / "example_walk.c3d"
-    r = kin2grf.estimate(trial)
-    out = tmp_path / "curves.csv"
-    subprocess.run([CLI, "estimate", str(trial), "--stance-curves", str(out)], check=True, capture_output=True)
-    with open(out, newline="") as f:
-        rows = list(csv.DictReader(f))
-    c = r.stance_curves
-    records = c.to_dict("records") if hasattr(c, "to_dict") else [dict(zip(c, v)) for v in zip(*c.values())]
+    rows = _cli_csv_rows(tmp_path, "estimate", trial, "--stance-curves")
+    records = _records(kin2grf.estimate(trial).stance_curves)
     assert len(records) == len(rows) >= 2 * 101
     assert [float(x["percent"]) for x in rows[:101]] == list(range(101))
     for mine, theirs in zip(records, rows):
         assert mine["side"] == theirs["side"]
         assert int(mine["frame_first"]) == int(theirs["frame_first"])
-        for k in ("percent", "grf_vertical_bw", "cop_progression_m", "torque_knee_Nm_per_kg"):
-            assert abs(float(theirs[k]) - mine[k]) <= 1e-5 * abs(mine[k]) + 1e-9, k
+        _same_numbers(mine, theirs, ("percent", "grf_vertical_bw", "cop_progression_m", "torque_knee_Nm_per_kg"))
 
 
 def test_validate_gives_the_cli_stance_curves(example, tmp_path):
     """validate()["stance_curves"]: every scored plate stance at 0..100 %, as ``validate --stance-curves``."""
     trial = example / "example_walk.c3d"
+    rows = _cli_csv_rows(tmp_path, "validate", trial, "--stance-curves")
     v = kin2grf.validate(trial)
-    out = tmp_path / "curves.csv"
-    subprocess.run([CLI, "validate", str(trial), "--stance-curves", str(out)], check=True, capture_output=True)
-    with open(out, newline="") as f:
-        rows = list(csv.DictReader(f))
-    c = v["stance_curves"]
-    records = c.to_dict("records") if hasattr(c, "to_dict") else [dict(zip(c, x)) for x in zip(*c.values())]
+    records = _records(v["stance_curves"])
     assert len(records) == len(rows) == 101 * len(v["per_foot"]) > 0
     for mine, theirs in zip(records, rows):
         assert (mine["side"], mine["plate"]) == (theirs["side"], theirs["plate"])
-        for k in ("percent", "vertical_bw_estimate", "vertical_bw_plate"):
-            assert abs(float(theirs[k]) - mine[k]) <= 1e-5 * abs(mine[k]) + 1e-9, k
+        _same_numbers(mine, theirs, ("percent", "vertical_bw_estimate", "vertical_bw_plate"))
 
 
 def test_mediolateral_adds_the_lateral_columns(example):

@@ -79,6 +79,11 @@ ResultsTable stance_curves_table(const EstimateResult& r, int points = 101);
 /// cell where a value does not exist): `estimate --stance-curves` (docs/FORMATS.md). Written
 /// stance by stance as made, never held whole; the file through AtomicFile.
 void write_stance_curves_csv(std::ostream& os, const EstimateResult& r);
+/// One row of a stance-curves CSV (this one's and `validate --stance-curves`'): the side as right /
+/// left, then `label` (a CSV cell, e.g. the plate) where given, frame_first as an integer, start_s at
+/// full precision, then `rest` to 6 significant digits (empty where a value does not exist).
+void append_stance_curve_row(std::string& out, int side, const std::string* label, double frame_first, double start_s,
+                             const Eigen::Ref<const Eigen::RowVectorXd>& rest);
 void write_stance_curves_csv(const std::string& path, const EstimateResult& r);
 std::string stance_curves_csv(const EstimateResult& r);
 /// The gait events (gait_events: foot strike, foot off per side) as CSV: side,event,frame,time_s
