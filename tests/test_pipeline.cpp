@@ -1524,12 +1524,29 @@ TEST(Mediolateral, TheOptionChangesNoSagittalResult) {
   }
   const Eigen::Index i = n / 2;
   EXPECT_NEAR(r1.frame.lateral_at(r1.first_index + i).dot(lab_foot_frame(r1, 0, i).force_N), r1.feet[0].force_lateral_N[i], 1e-9);
-  // The per-frame table gains the two lateral columns, last; without the option it has none.
+  // The per-frame table gains the lateral force's and the lateral COP's columns, last; without the
+  // option it has none. The COP's columns are the place of the wrench the .mot and the 3D
+  // moments take (lab_foot_frame), empty where the foot is not in contact, as cop_x.
   const ResultsTable t0 = results_table(r0), t1 = results_table(r1);
-  ASSERT_EQ(t1.columns.size(), t0.columns.size() + 2);
-  EXPECT_EQ(t1.columns.back(), "grf_lateral_l_N");
-  EXPECT_EQ(t1.values(i, t1.values.cols() - 2), r1.feet[0].force_lateral_N[i]);
+  ASSERT_EQ(t1.columns.size(), t0.columns.size() + 4);
+  const auto col = [&](const std::string& name) {
+    return std::find(t1.columns.begin(), t1.columns.end(), name) - t1.columns.begin();
+  };
+  EXPECT_EQ(col("grf_lateral_r_N"), t0.values.cols());
+  EXPECT_EQ(t1.columns.back(), "cop_lateral_l_m");
+  EXPECT_EQ(t1.values(i, col("grf_lateral_r_N")), r1.feet[0].force_lateral_N[i]);
   EXPECT_EQ(t1.values.leftCols(t0.values.cols()).row(i), t0.values.row(i));
+  int in_contact = 0;
+  for (Eigen::Index f = 0; f < n; ++f)
+    for (int k = 0; k < 2; ++k) {
+      const double lateral = t1.values(f, col(k == 0 ? "cop_lateral_r_m" : "cop_lateral_l_m"));
+      const double along = t1.values(f, col(k == 0 ? "cop_x_r_m" : "cop_x_l_m"));
+      ASSERT_EQ(std::isnan(lateral), std::isnan(along)) << "frame " << f << " foot " << k;
+      if (std::isnan(along)) continue;
+      ++in_contact;
+      EXPECT_NEAR(r1.frame.lateral_at(r1.first_index + f).dot(lab_foot_frame(r1, k, f).cop_m), lateral, 1e-9);
+    }
+  EXPECT_GT(in_contact, n / 2);
   // The 3D model likewise: the sagittal results and the 2D joint torques unchanged, the lateral
   // force and the joint moments added.
   EstimateOptions three_d;

@@ -79,7 +79,7 @@ std::vector<std::string> results_columns(bool mediolateral, bool moments_3d) {
   }
   for (const char* name : {"residual_x_N", "residual_y_N", "residual_moment_Nm", "iterations"}) c.emplace_back(name);
   if (mediolateral)
-    for (const char* name : {"grf_lateral_r_N", "grf_lateral_l_N"}) c.emplace_back(name);
+    for (const char* name : {"grf_lateral_r_N", "grf_lateral_l_N", "cop_lateral_r_m", "cop_lateral_l_m"}) c.emplace_back(name);
   if (moments_3d)
     for (const char* s : {"r", "l"}) {
       for (const char* joint : {"ankle", "knee", "hip"})
@@ -109,8 +109,11 @@ void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> v) {
   for (int j = 0; j < 2 * kJointCount; ++j) v[k++] = held ? r.joint_force_N(i, j) : t.joint_force_N[static_cast<std::size_t>(j)];
   for (int j = 0; j < 3; ++j) v[k++] = held ? r.residual(i, j) : t.residual[j];
   v[k++] = r.iterations[static_cast<std::size_t>(i)];
-  if (r.feet[0].force_lateral_N.size() > 0)
+  if (r.feet[0].force_lateral_N.size() > 0) {
     for (const auto& f : r.feet) v[k++] = f.force_lateral_N[i];
+    // The COP's lateral place, as the ground reaction's wrench takes it (lab_foot_frame).
+    for (const auto& f : r.feet) v[k++] = f.cop_lateral_m.size() > i ? f.cop_lateral_m[i] : std::numeric_limits<double>::quiet_NaN();
+  }
   if (r.legs_3d)
     for (std::size_t s = 0; s < 2; ++s) {
       const JointMoments3D& m = r.legs_3d->moments;

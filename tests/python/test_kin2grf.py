@@ -163,8 +163,12 @@ def test_validate_gives_the_cli_stance_curves(example, tmp_path):
 def test_mediolateral_adds_the_lateral_columns(example):
     r0 = kin2grf.estimate(example / "example_walk.c3d")
     r1 = kin2grf.estimate(example / "example_walk.c3d", mediolateral=True)
-    assert r1.columns == r0.columns + ["grf_lateral_r_N", "grf_lateral_l_N"]
+    assert r1.columns == r0.columns + ["grf_lateral_r_N", "grf_lateral_l_N", "cop_lateral_r_m", "cop_lateral_l_m"]
     assert np.array_equal(r1["grf_vertical_r_N"], r0["grf_vertical_r_N"])
+    # The lateral COP where, and only where, the COP along the foot exists.
+    for s in "rl":
+        assert np.array_equal(np.isnan(r1[f"cop_lateral_{s}_m"]), np.isnan(r1[f"cop_x_{s}_m"]))
+        assert np.isfinite(r1[f"cop_lateral_{s}_m"]).sum() > 0
     assert r1.summary["settings"]["mediolateral"] is True
 
 
