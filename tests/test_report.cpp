@@ -145,6 +145,21 @@ TEST(Report, TheThreeDReportPlotsTheLateralForceAndTheKneeAdductionMoment) {
     EXPECT_NEAR(curves.values(0, column("knee_adduction_moment_Nm_per_kg_plate")),
                 knee_adduction_moment(*v.measured_moments_3d, st.foot, st.first) / e.mass_kg, 1e-12);
   }
+  // Every joint in every plane: a table of their rRMSE and a time-normalised figure each, the
+  // curves at the stance's first frame the moments of each inverse dynamics per kg.
+  EXPECT_EQ(count("internal moments in the three planes, estimate-driven against plate-driven"), 1);
+  EXPECT_EQ(count(" moment (internal, + "), 9);
+  EXPECT_EQ(count("hip frontal moment (internal, + adducts the distal segment), with each ground reaction, per cent of the plate's stance"), 1);
+  for (int joint = 0; joint < 3; ++joint)
+    for (int a = 0; a < 3; ++a) {
+      const std::string name = std::string(kJoint3DNames[joint]) + "_" + kPlaneNames[a] + "_Nm_per_kg";
+      EXPECT_NEAR(curves.values(0, column(name + "_estimate")), joint_moments_of(e.legs_3d->moments, joint, st.foot)(st.first, a) / e.mass_kg,
+                  1e-12);
+      if (!st.cop_reference_suspect) {
+        EXPECT_NEAR(curves.values(0, column(name + "_plate")), joint_moments_of(*v.measured_moments_3d, joint, st.foot)(st.first, a) / e.mass_kg,
+                    1e-12);
+      }
+    }
   // The sagittal model's report has none of it.
   EstimateOptions sagittal;
   sagittal.mass_kg = 64.9;

@@ -1126,6 +1126,7 @@ TEST(Results, TheStanceCurvesAreThePerFrameSeriesAtEachPercentOfEveryCompleteSta
     const bool three_d = model == ModelKind::ThreeD;
     EXPECT_EQ(std::find(t.columns.begin(), t.columns.end(), "grf_lateral_bw") != t.columns.end(), three_d);
     EXPECT_EQ(std::find(t.columns.begin(), t.columns.end(), "knee_adduction_moment_Nm_per_kg") != t.columns.end(), three_d);
+    EXPECT_EQ(std::find(t.columns.begin(), t.columns.end(), "hip_frontal_Nm_per_kg") != t.columns.end(), three_d);
     // The complete stances, from the summary.
     const auto summary = results_summary(e, nlohmann::json::object());
     std::vector<std::pair<int, double>> complete;
@@ -1153,6 +1154,13 @@ TEST(Results, TheStanceCurvesAreThePerFrameSeriesAtEachPercentOfEveryCompleteSta
         if (three_d) {
           EXPECT_NEAR(t.values(end, col(t, "knee_adduction_moment_Nm_per_kg")),
                       frames.values(at, col(frames, "knee_adduction_moment" + s + "_Nm")) / e.mass_kg, 1e-12);
+          // Every joint's 3D moment in every plane, as the per-frame CSV's.
+          for (const char* joint : {"ankle", "knee", "hip"})
+            for (const char* plane : {"sagittal", "frontal", "transverse"}) {
+              const std::string name = std::string(joint) + "_" + plane;
+              EXPECT_NEAR(t.values(end, col(t, name + "_Nm_per_kg")), frames.values(at, col(frames, name + s + "_Nm")) / e.mass_kg, 1e-12)
+                  << name;
+            }
         }
       }
       EXPECT_EQ(t.values(row0, col(t, "cop_progression_m")), 0.0);

@@ -161,6 +161,13 @@ std::vector<double> curve_column(const ResultsTable& c, const std::string& name,
   return out;
 }
 
+/// The sign of a 3D joint moment's plane (dynamics/joint_moments_3d.hpp), for a figure's title.
+std::string plane_sign(const std::string& plane) {
+  if (plane == "sagittal") return "+ counter-clockwise in the sagittal frame";
+  if (plane == "frontal") return "+ adducts the distal segment";
+  return "+ rotates the distal segment internally";
+}
+
 /// The stances' mean curve of `name` at each instant, over the stances of `side` (-1: every
 /// stance), each instant over the stances where the value exists (NaN where none has it).
 std::vector<double> mean_curve(const ResultsTable& c, const std::string& name, int side) {
@@ -289,6 +296,28 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
         << "</td></tr>\n";
     }
     t << "</table>\n";
+    // Every joint in every plane (issue 28: "what the estimate does to the hip, knee and ankle
+    // moments in all three planes").
+    t << "<p>The hip's, the knee's and the ankle's internal moments in the three planes, estimate-driven against "
+         "plate-driven: rRMSE % (r).</p>\n<table><tr><th class=l>foot</th><th class=l>plate</th>";
+    for (const char* joint : {"hip", "knee", "ankle"})
+      for (const char* plane : kPlaneNames) t << "<th>" << joint << " " << plane << "</th>";
+    t << "</tr>\n";
+    for (const auto& s : j["per_foot"]) {
+      if (!s.contains("joint_moments_3d") || s["joint_moments_3d"].is_null()) continue;
+      t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>()) << "</td>";
+      for (const char* joint : {"hip", "knee", "ankle"})
+        for (const char* plane : kPlaneNames) {
+          const auto& m = s["joint_moments_3d"][joint][plane];
+          if (m.is_null()) {
+            t << "<td>-</td>";
+            continue;
+          }
+          t << "<td>" << fmt_cop(s, m["rrmse_percent"]) << " (" << fmt(m["r"], "%.2f") << ")</td>";
+        }
+      t << "</tr>\n";
+    }
+    t << "</table>\n";
   }
   rep.sections_html.push_back(t.str());
 
@@ -361,8 +390,13 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
         {"vertical GRF", "body weights", "vertical_bw"},
         {"anterior GRF", "body weights", "anterior_bw"},
         {"COP along progression from the plate's first COP", "m", "cop_progression_m"}};
-    if (std::find(c.columns.begin(), c.columns.end(), "knee_adduction_moment_Nm_per_kg_plate") != c.columns.end())
+    if (std::find(c.columns.begin(), c.columns.end(), "knee_adduction_moment_Nm_per_kg_plate") != c.columns.end()) {
       figures.emplace_back("external knee adduction moment, with each ground reaction", "N m/kg", "knee_adduction_moment_Nm_per_kg");
+      for (const char* joint : {"hip", "knee", "ankle"})
+        for (const char* plane : kPlaneNames)
+          figures.emplace_back(std::string(joint) + " " + plane + " moment (internal, " + plane_sign(plane) + "), with each ground reaction",
+                               "N m/kg", std::string(joint) + "_" + plane + "_Nm_per_kg");
+    }
     for (const auto& [what, unit, key] : figures) {
       ReportFigure g;
       g.title = what + ", per cent of the plate's stance" + of;
@@ -475,13 +509,19 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
     for (Eigen::Index st = 0; st < c.values.rows() / kCurvePoints; ++st)
       ++count[static_cast<std::size_t>(c.values(st * kCurvePoints, curve_column_index(c, "side")))];
     const std::string of = " (mean of " + std::to_string(count[0]) + " right and " + std::to_string(count[1]) + " left complete stances)";
-    for (const auto& [what, unit, key] : {std::tuple{"vertical GRF", "body weights", "grf_vertical_bw"},
-                                          {"anterior GRF", "body weights", "grf_anterior_bw"},
-                                          {"hip torque", "N m/kg", "torque_hip_Nm_per_kg"},
-                                          {"knee torque", "N m/kg", "torque_knee_Nm_per_kg"},
-                                          {"ankle torque", "N m/kg", "torque_ankle_Nm_per_kg"},
-                                          {"external knee adduction moment", "N m/kg", "knee_adduction_moment_Nm_per_kg"}}) {
-      if (std::find(c.columns.begin(), c.columns.end(), key) == c.columns.end()) continue;  // the KAM: --model 3d
+    std::vector<std::tuple<std::string, std::string, std::string>> curves = {
+        {"vertical GRF", "body weights", "grf_vertical_bw"},
+        {"anterior GRF", "body weights", "grf_anterior_bw"},
+        {"hip torque", "N m/kg", "torque_hip_Nm_per_kg"},
+        {"knee torque", "N m/kg", "torque_knee_Nm_per_kg"},
+        {"ankle torque", "N m/kg", "torque_ankle_Nm_per_kg"},
+        {"external knee adduction moment", "N m/kg", "knee_adduction_moment_Nm_per_kg"}};
+    for (const char* joint : {"hip", "knee", "ankle"})  // --model 3d
+      for (const char* plane : kPlaneNames)
+        curves.emplace_back(std::string(joint) + " " + plane + " moment (internal, " + plane_sign(plane) + ")", "N m/kg",
+                            std::string(joint) + "_" + plane + "_Nm_per_kg");
+    for (const auto& [what, unit, key] : curves) {
+      if (std::find(c.columns.begin(), c.columns.end(), key) == c.columns.end()) continue;  // the KAM and the 3D moments: --model 3d
       ReportFigure g;
       g.title = std::string(what) + ", per cent of stance" + of;
       g.x_label = "% of stance";

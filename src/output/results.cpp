@@ -82,8 +82,8 @@ std::vector<std::string> results_columns(bool mediolateral, bool moments_3d) {
     for (const char* name : {"grf_lateral_r_N", "grf_lateral_l_N", "cop_lateral_r_m", "cop_lateral_l_m"}) c.emplace_back(name);
   if (moments_3d)
     for (const char* s : {"r", "l"}) {
-      for (const char* joint : {"ankle", "knee", "hip"})
-        for (const char* plane : {"sagittal", "frontal", "transverse"}) c.push_back(std::string(joint) + "_" + plane + "_" + s + "_Nm");
+      for (const char* joint : kJoint3DNames)
+        for (const char* plane : kPlaneNames) c.push_back(std::string(joint) + "_" + plane + "_" + s + "_Nm");
       c.push_back(std::string("knee_adduction_moment_") + s + "_Nm");
     }
   return c;
@@ -115,11 +115,11 @@ void results_row(const EstimateResult& r, Eigen::Index i, std::span<double> v) {
     for (const auto& f : r.feet) v[k++] = f.cop_lateral_m.size() > i ? f.cop_lateral_m[i] : std::numeric_limits<double>::quiet_NaN();
   }
   if (r.legs_3d)
-    for (std::size_t s = 0; s < 2; ++s) {
+    for (int s = 0; s < 2; ++s) {
       const JointMoments3D& m = r.legs_3d->moments;
-      for (const Eigen::MatrixX3d* joint : {&m.ankle_Nm[s], &m.knee_Nm[s], &m.hip_Nm[s]})
-        for (int a = 0; a < 3; ++a) v[k++] = (*joint)(i, a);
-      v[k++] = knee_adduction_moment(m, static_cast<int>(s), i);
+      for (int joint = 0; joint < 3; ++joint)
+        for (int a = 0; a < 3; ++a) v[k++] = joint_moments_of(m, joint, s)(i, a);
+      v[k++] = knee_adduction_moment(m, s, i);
     }
 }
 
@@ -345,9 +345,17 @@ std::vector<CurveSeries> stance_curve_series(const EstimateResult& r) {
     c.push_back({std::string("power_") + kJoint[k] + "_W_per_kg", [&r, k, per_kg](int s, Eigen::Index i, const auto& w) {
                    return r.joint_torque_Nm(i, 4 * s + k) * w[static_cast<std::size_t>(4 * s + k)] * per_kg;
                  }});
-  if (r.legs_3d)
+  if (r.legs_3d) {
     c.push_back({"knee_adduction_moment_Nm_per_kg",
                  [&r, per_kg](int s, Eigen::Index i, const auto&) { return knee_adduction_moment(r.legs_3d->moments, s, i) * per_kg; }});
+    // The 3D joint moments in every plane, as the per-frame CSV's (a 3D gait report's curves).
+    for (int joint = 0; joint < 3; ++joint)
+      for (int a = 0; a < 3; ++a)
+        c.push_back({std::string(kJoint3DNames[joint]) + "_" + kPlaneNames[a] + "_Nm_per_kg",
+                     [&r, joint, a, per_kg](int s, Eigen::Index i, const auto&) {
+                       return joint_moments_of(r.legs_3d->moments, joint, s)(i, a) * per_kg;
+                     }});
+  }
   return c;
 }
 

@@ -1120,12 +1120,11 @@ nlohmann::json power_metrics_json(const std::optional<SeriesMetrics>& m) { retur
 /// r, estimate-driven against plate-driven; the KAM's and its peaks.
 nlohmann::json joint_moments_json(const JointMomentValidation& jm) {
   nlohmann::json j;
-  const char* planes[] = {"sagittal", "frontal", "transverse"};
   const auto metrics = moment_metrics_json;
   for (std::size_t c = 0; c < 3; ++c) {
-    j["ankle"][planes[c]] = metrics(jm.ankle[c]);
-    j["knee"][planes[c]] = metrics(jm.knee[c]);
-    j["hip"][planes[c]] = metrics(jm.hip[c]);
+    j["ankle"][kPlaneNames[c]] = metrics(jm.ankle[c]);
+    j["knee"][kPlaneNames[c]] = metrics(jm.knee[c]);
+    j["hip"][kPlaneNames[c]] = metrics(jm.hip[c]);
   }
   j["knee_adduction_moment"] = metrics(jm.knee_adduction);
   j["knee_adduction_moment"]["peaks_estimated_Nm"] = {num(jm.kam_peak_estimated_Nm[0]), num(jm.kam_peak_estimated_Nm[1])};
@@ -1373,7 +1372,14 @@ ResultsTable validation_stance_curves_table(const EstimateResult& e, const Valid
   // The 3D model: the external knee adduction moment by inverse dynamics with each ground reaction
   // on the same kinematics (validate_joint_moments_3d), N m per kg.
   const bool kam = e.legs_3d.has_value() && v.measured_moments_3d.has_value();
-  if (kam) t.columns.insert(t.columns.end(), {"knee_adduction_moment_Nm_per_kg_estimate", "knee_adduction_moment_Nm_per_kg_plate"});
+  if (kam) {
+    t.columns.insert(t.columns.end(), {"knee_adduction_moment_Nm_per_kg_estimate", "knee_adduction_moment_Nm_per_kg_plate"});
+    // And every joint's moments in every plane with each ground reaction (the estimate's
+    // --stance-curves columns, the per-frame CSV's order).
+    for (const char* joint : kJoint3DNames)
+      for (const char* plane : kPlaneNames)
+        for (const char* which : {"_estimate", "_plate"}) t.columns.push_back(std::string(joint) + "_" + plane + "_Nm_per_kg" + which);
+  }
   const double bw = e.mass_kg * e.model().gravity_mps2;
   const auto nan = std::numeric_limits<double>::quiet_NaN();
   const Eigen::Index series_columns = static_cast<Eigen::Index>(t.columns.size()) - 6;
@@ -1407,6 +1413,11 @@ ResultsTable validation_stance_curves_table(const EstimateResult& e, const Valid
         // A misplaced plate's moments take its COP as their lever: not compared, as the means do.
         series(k, c++) = knee_adduction_moment(e.legs_3d->moments, st.foot, i) / e.mass_kg;
         series(k, c++) = st.cop_reference_suspect ? nan : knee_adduction_moment(*v.measured_moments_3d, st.foot, i) / e.mass_kg;
+        for (int joint = 0; joint < 3; ++joint)
+          for (int a = 0; a < 3; ++a) {
+            series(k, c++) = joint_moments_of(e.legs_3d->moments, joint, st.foot)(i, a) / e.mass_kg;
+            series(k, c++) = st.cop_reference_suspect ? nan : joint_moments_of(*v.measured_moments_3d, joint, st.foot)(i, a) / e.mass_kg;
+          }
       }
     }
     const Eigen::MatrixXd curves = stance_normalised(series, 0, frames - 1, points);

@@ -144,6 +144,16 @@ JointMoments3D joint_moments_3d_in_blocks(const Model& model, std::array<Eigen::
                                           const JointCentreOffsets& offsets, const std::array<FootWrench3D, 2>& feet,
                                           Eigen::Index block_frames = 2000);
 
+/// JointMoments3D's joints in the per-frame CSV's order, and its columns' planes (its matrices'
+/// columns 0, 1, 2).
+inline constexpr const char* kJoint3DNames[] = {"ankle", "knee", "hip"};
+inline constexpr const char* kPlaneNames[] = {"sagittal", "frontal", "transverse"};
+/// The moments (N m, frames x planes) of joint 0 ankle, 1 knee, 2 hip (kJoint3DNames) on `side`.
+inline const Eigen::MatrixX3d& joint_moments_of(const JointMoments3D& m, int joint, int side) {
+  const std::array<Eigen::MatrixX3d, 2>& j = joint == 0 ? m.ankle_Nm : joint == 1 ? m.knee_Nm : m.hip_Nm;
+  return j[static_cast<std::size_t>(side)];
+}
+
 /// The external knee adduction moment (N m) from joint_moments_3d's knee: -frontal; at frame i.
 inline Eigen::VectorXd knee_adduction_moment(const JointMoments3D& m, int side) { return -m.knee_Nm[static_cast<std::size_t>(side)].col(1); }
 inline double knee_adduction_moment(const JointMoments3D& m, int side, Eigen::Index i) { return -m.knee_Nm[static_cast<std::size_t>(side)](i, 1); }
