@@ -886,6 +886,19 @@ TEST(Landmarks, AStaticPointIsCarriedByItsWholeClusterInAnyOrder) {
     return parse_marker_set(j, "test");
   };
   const auto [still, unused] = make(20, 0.0, false);
+  {
+    // Without the static trial: an error naming what to give, and the way without one.
+    const auto [walk, knee] = make(30, 0.0, true);
+    try {
+      (void)compute_landmarks(set_with({"TH1", "TH2", "TH3", "TH4"}), walk, nullptr, {}, "synthetic");
+      ADD_FAILURE() << "no error without the static trial";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("knee_r"), std::string::npos) << what;
+      EXPECT_NE(what.find("give --static STATIC (it needs markers KLAT, KMED)"), std::string::npos) << what;
+      EXPECT_NE(what.find("--markers labels"), std::string::npos) << what;
+    }
+  }
   for (const double skin : {0.0, 0.006}) {
     const auto [walk, knee] = make(300, skin, true);
     const Landmarks3D a = compute_landmarks(set_with({"TH1", "TH2", "TH3", "TH4"}), walk, &still, {}, "synthetic");

@@ -655,7 +655,9 @@ Eigen::MatrixX3d static_landmark(const MarkerSet& set, const LandmarkRule& r, in
   if (!st) {
     throw InputError(path + ": landmark " + kNames[id] + " of marker set '" + set.name +
                      "' is a virtual point calibrated on a static trial: give --static STATIC (it needs markers " +
-                     r.markers[0] + (r.markers.size() > 1 ? ", " + r.markers[1] : "") + ")");
+                     r.markers[0] + (r.markers.size() > 1 ? ", " + r.markers[1] : "") +
+                     "); without a static trial, --markers labels maps the set from the trial's own labels (a joint centre "
+                     "from its markers, or the functional centre of the clusters on either side)");
   }
   std::vector<Eigen::MatrixX3d> cs, cm;
   for (const auto& c : r.cluster) {
