@@ -544,7 +544,19 @@ def trial_3d(j, mass):
     kam = [x["knee_adduction_moment"] for x in jm if x.get("knee_adduction_moment")]
     first = [(k["peaks_estimated_Nm"][0], k["peaks_measured_Nm"][0]) for k in kam
              if k["peaks_estimated_Nm"][0] is not None and k["peaks_measured_Nm"][0] is not None]
+    second = [(k["peaks_estimated_Nm"][1], k["peaks_measured_Nm"][1]) for k in kam
+              if k["peaks_estimated_Nm"][1] is not None and k["peaks_measured_Nm"][1] is not None]
+    joints = {}
+    for joint in JOINTS_3D:
+        for plane in PLANES_3D:
+            v = [x[joint][plane]["rrmse_percent"] for x in jm
+                 if x.get(joint) and x[joint].get(plane) and x[joint][plane].get("rrmse_percent") is not None]
+            joints[(joint, plane)] = m(v)
     return {
+        "joints": joints,
+        "kam2_est": m([e / mass for e, _ in second]),
+        "kam2_plates": m([p / mass for _, p in second]),
+        "kam2_error": m([abs(e - p) / mass for e, p in second]),
         "stances": len(st),
         "lateral": m([s["rrmse_percent"]["lateral"] for s in st]),
         "lateral_bw": m([s["rmse_percent_bw"]["lateral"] for s in st]),
@@ -562,6 +574,10 @@ def trial_3d(j, mass):
         "free": m([s["rmse"]["free_moment_Nm"] for s in placed if s["rmse"].get("free_moment_Nm") is not None]),
         "transverse": total_moment(j, "transverse_moment"),
     }
+
+
+JOINTS_3D = ("hip", "knee", "ankle")
+PLANES_3D = ("sagittal", "frontal", "transverse")
 
 
 def total_moment(j, key):
@@ -642,6 +658,25 @@ for a, xs in by_activity.items():
     print(f"| {a} | {len(xs)} | {summary('lateral', '{:.1f}')} | {summary('cop_mm', '{:.0f}')} | {summary('kam', '{:.1f}')} | "
           f"{summary('kam_rmse', '{:.2f}')} | {peak_text} | {'-' if not ks else f'{statistics.mean(ks):.1f}'} | {summary('hip_frontal', '{:.1f}')} | "
           f"{summary('frontal', '{:.1f}')} |")
+
+print("\nThe 3D joint moments in every plane (since session 49; `validate --model 3d`'s `joint_moments_3d`, its report's "
+      "table and time-normalised curves), estimate-driven against plate-driven on the same kinematics: rRMSE %, mean over "
+      "the activity's trials of each trial's mean over its stances (the plates that pass the registration check), and the "
+      "knee adduction moment's first and second peaks (the largest value in each half of the stance) as the mean "
+      "absolute difference, estimate - plates, in N m/kg beside the plates' mean peak.\n")
+print("| activity | trials | " + " | ".join(f"{j} {p}" for j in JOINTS_3D for p in PLANES_3D)
+      + " | KAM 1st peak abs. error / plates N m/kg | KAM 2nd peak abs. error / plates N m/kg |")
+print("|---|---|" + "---|" * (len(JOINTS_3D) * len(PLANES_3D) + 2))
+for a, xs in by_activity.items():
+    cells = []
+    for j_ in JOINTS_3D:
+        for p_ in PLANES_3D:
+            v = [t["joints"][(j_, p_)] for _, t in xs if t["joints"][(j_, p_)] is not None]
+            cells.append("-" if not v else f"{statistics.mean(v):.1f}")
+    for k in ("kam1", "kam2"):
+        ps = [t for _, t in xs if t[k + "_error"] is not None]
+        cells.append("-" if not ps else f"{statistics.mean(t[k + '_error'] for t in ps):.2f} / {statistics.mean(t[k + '_plates'] for t in ps):.2f}")
+    print(f"| {a} | {len(xs)} | " + " | ".join(cells) + " |")
 
 labs = sorted({lab_of[name] for _, name, _ in rows})
 LATERAL_SPLITS = {"load": "3d-load", "own-leg": "3d"}
