@@ -280,6 +280,7 @@ def test_the_readme_example_runs_as_written(tmp_path):
     done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr[-2000:]
     assert "grf_vertical_r_N" in done.stdout
+    assert "cop_lateral_r_m" in done.stdout and "hip_frontal_Nm_per_kg" in done.stdout  # the 3D lines
     assert (tmp_path / "out" / "python-opensim" / "walking2_grf.mot").exists()
     assert (tmp_path / "out" / "python-grf.mot").read_text() == (tmp_path / "out" / "python-opensim" / "walking2_grf.mot").read_text()
 
