@@ -160,6 +160,14 @@ TEST(Report, TheThreeDReportPlotsTheLateralForceAndTheKneeAdductionMoment) {
                     1e-12);
       }
     }
+  // The estimate's report likewise draws each side's mean curve of every joint's moment in every plane.
+  const std::string estimate_html = estimate_report_html("walking2", e, results_summary(e, nlohmann::json::object()));
+  int moment_curves = 0;
+  for (auto p = estimate_html.find(" moment (internal, + "); p != std::string::npos; p = estimate_html.find(" moment (internal, + ", p + 1))
+    ++moment_curves;
+  EXPECT_EQ(moment_curves, 9);
+  EXPECT_NE(estimate_html.find("knee transverse moment (internal, + rotates the distal segment internally), per cent of stance"),
+            std::string::npos);
   // The sagittal model's report has none of it.
   EstimateOptions sagittal;
   sagittal.mass_kg = 64.9;
