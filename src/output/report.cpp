@@ -161,6 +161,9 @@ std::vector<double> curve_column(const ResultsTable& c, const std::string& name,
   return out;
 }
 
+/// The joints as a gait report lists them, proximal first (the sagittal torques' and the 3D moments').
+constexpr const char* kReportJoints[] = {"hip", "knee", "ankle"};
+
 /// The sign of a 3D joint moment's plane (dynamics/joint_moments_3d.hpp), for a figure's title.
 std::string plane_sign(const std::string& plane) {
   if (plane == "sagittal") return "+ counter-clockwise in the sagittal frame";
@@ -258,7 +261,7 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
       };
       t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>()) << "</td>";
       for (const char* k : {"rrmse_percent", "rmse_Nm"})
-        for (const char* joint : {"hip", "knee", "ankle"}) t << "<td>" << cell(joint, "least_squares", k) << "</td>";
+        for (const char* joint : kReportJoints) t << "<td>" << cell(joint, "least_squares", k) << "</td>";
       t << "<td>" << cell("hip", "bottom_up", "rrmse_percent") << " / " << cell("knee", "bottom_up", "rrmse_percent") << " / "
         << cell("ankle", "bottom_up", "rrmse_percent") << "</td></tr>\n";
     }
@@ -300,13 +303,13 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
     // moments in all three planes").
     t << "<p>The hip's, the knee's and the ankle's internal moments in the three planes, estimate-driven against "
          "plate-driven: rRMSE % (r).</p>\n<table><tr><th class=l>foot</th><th class=l>plate</th>";
-    for (const char* joint : {"hip", "knee", "ankle"})
+    for (const char* joint : kReportJoints)
       for (const char* plane : kPlaneNames) t << "<th>" << joint << " " << plane << "</th>";
     t << "</tr>\n";
     for (const auto& s : j["per_foot"]) {
       if (!s.contains("joint_moments_3d") || s["joint_moments_3d"].is_null()) continue;
       t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>()) << "</td>";
-      for (const char* joint : {"hip", "knee", "ankle"})
+      for (const char* joint : kReportJoints)
         for (const char* plane : kPlaneNames) {
           const auto& m = s["joint_moments_3d"][joint][plane];
           if (m.is_null()) {
@@ -352,9 +355,8 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
     if (v.measured_joint_torque_Nm.rows() == e.time_s.size())
       for (int c = 0; c < 3; ++c) {
         const int joint = 4 * f + c;
-        const char* names[] = {"hip", "knee", "ankle"};
         ReportFigure g;
-        g.title = foot + " " + names[c] + ": sagittal joint torque (on the distal segment, + counter-clockwise), kin2grf's "
+        g.title = foot + " " + kReportJoints[c] + ": sagittal joint torque (on the distal segment, + counter-clockwise), kin2grf's "
                   "and the plates' inverse dynamics";
         g.x_label = "time (s)";
         g.y_label = "N m";
@@ -392,7 +394,7 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
         {"COP along progression from the plate's first COP", "m", "cop_progression_m"}};
     if (std::find(c.columns.begin(), c.columns.end(), "knee_adduction_moment_Nm_per_kg_plate") != c.columns.end()) {
       figures.emplace_back("external knee adduction moment, with each ground reaction", "N m/kg", "knee_adduction_moment_Nm_per_kg");
-      for (const char* joint : {"hip", "knee", "ankle"})
+      for (const char* joint : kReportJoints)
         for (const char* plane : kPlaneNames)
           figures.emplace_back(std::string(joint) + " " + plane + " moment (internal, " + plane_sign(plane) + "), with each ground reaction",
                                "N m/kg", std::string(joint) + "_" + plane + "_Nm_per_kg");
@@ -485,12 +487,11 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
     figure(foot + " foot: COP along progression", "m", f, {{"kin2grf estimate", time, to_vec(fe.cop_x_m), false}});
     // Hip, knee, ankle of this side (joint_torque_Nm: per side hip, knee, ankle, MTP); the powers,
     // each torque times its joint's angular velocity (+ generation, - absorption).
-    static const char* const kJoint[] = {"hip", "knee", "ankle"};
     std::vector<ReportSeries> torques, powers;
     for (int k = 0; k < 3; ++k) {
       const int joint = 4 * f + k;
-      torques.push_back({kJoint[k], time, to_vec(e.joint_torque_Nm.col(joint)), false});
-      powers.push_back({kJoint[k], time, to_vec(e.joint_torque_Nm.col(joint).cwiseProduct(omega.col(joint))), false});
+      torques.push_back({kReportJoints[k], time, to_vec(e.joint_torque_Nm.col(joint)), false});
+      powers.push_back({kReportJoints[k], time, to_vec(e.joint_torque_Nm.col(joint).cwiseProduct(omega.col(joint))), false});
     }
     figure(foot + " leg: joint torques", "N m", f, std::move(torques));
     figure(foot + " leg: joint powers (+ generation, - absorption)", "W", f, std::move(powers));
@@ -516,7 +517,7 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
         {"knee torque", "N m/kg", "torque_knee_Nm_per_kg"},
         {"ankle torque", "N m/kg", "torque_ankle_Nm_per_kg"},
         {"external knee adduction moment", "N m/kg", "knee_adduction_moment_Nm_per_kg"}};
-    for (const char* joint : {"hip", "knee", "ankle"})  // --model 3d
+    for (const char* joint : kReportJoints)  // --model 3d
       for (const char* plane : kPlaneNames)
         curves.emplace_back(std::string(joint) + " " + plane + " moment (internal, " + plane_sign(plane) + ")", "N m/kg",
                             std::string(joint) + "_" + plane + "_Nm_per_kg");
