@@ -561,6 +561,14 @@ TEST(Validate, AMisregisteredPlatesJointMomentsAreKeptButNotScored) {
   ASSERT_NE(fp1_row, std::string::npos) << table;
   const std::string line = table.substr(fp1_row, table.find('\n', fp1_row) - fp1_row);
   EXPECT_NE(line.find('['), std::string::npos) << line;
+  // Every joint in every plane: the well-placed stance's figures alone.
+  char planes[160];
+  const JointMomentValidation& g = *good.moments_3d;
+  ASSERT_TRUE(g.hip[1] && g.knee[1] && g.ankle[1]);
+  std::snprintf(planes, sizeof planes, "frontal %.1f / %.1f / %.1f", g.hip[1]->rrmse_percent, g.knee[1]->rrmse_percent, g.ankle[1]->rrmse_percent);
+  const auto all = table.find("3D joint moments' mean rRMSE % hip / knee / ankle: sagittal ");
+  ASSERT_NE(all, std::string::npos) << table;
+  EXPECT_NE(table.substr(all, table.find('\n', all) - all).find(planes), std::string::npos) << planes << "\n" << table;
 }
 
 // The marker-plate time offset (step 6): plates whose clock runs 30 ms late are found 30 ms

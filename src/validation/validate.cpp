@@ -1348,6 +1348,27 @@ void format_joint_moment_rows(std::ostream& os, const ValidationResult& v, const
   };
   os << table_label("per foot, mean; peaks |error|") << cell(m.knee_sagittal, "") << cell(m.knee_adduction, "")
      << cell(m.kam_peak_error_percent[0], " %") << cell(m.kam_peak_error_percent[1], " %") << "\n";
+  // Every joint in every plane, over the stances whose plate passes the registration check (the
+  // report's table, the JSON's joint_moments_3d): what the estimate does to each moment.
+  os << "  per foot, 3D joint moments' mean rRMSE % hip / knee / ankle:";
+  for (int plane = 0; plane < 3; ++plane) {
+    std::array<double, 3> mean{};
+    for (int joint = 0; joint < 3; ++joint) {
+      double sum = 0;
+      int n = 0;
+      for (const auto& s : v.stances) {
+        if (!s.moments_3d || s.cop_reference_suspect) continue;
+        const JointMomentValidation& j = *s.moments_3d;
+        const auto& metric = (joint == 0 ? j.hip : joint == 1 ? j.knee : j.ankle)[static_cast<std::size_t>(plane)];
+        if (metric && std::isfinite(metric->rrmse_percent)) sum += metric->rrmse_percent, ++n;
+      }
+      mean[static_cast<std::size_t>(joint)] = n ? sum / n : std::numeric_limits<double>::quiet_NaN();
+    }
+    char text[96];
+    std::snprintf(text, sizeof text, "%s %s %.1f / %.1f / %.1f", plane ? "," : "", kPlaneNames[plane], mean[0], mean[1], mean[2]);
+    os << text;
+  }
+  os << "\n";
 }
 
 /// The total GRM row's tail: its RMSE in N m and the range Eq. 12 divides by (the mean of the
