@@ -77,6 +77,32 @@ TEST(Report, RendersInHeadlessChromium) {
   EXPECT_GT(std::stoi(dom.substr(p + 13)), 1000);
 }
 
+// The marker-plate time offset (validate's step 6) in the report as in the text and the JSON
+// (issue 29: "report it with its confidence, in the text, the JSON and the report"): plates 30 ms
+// late read -30 ms, compared as recorded unless --sync aligns them, which the report says.
+TEST(Report, TheMarkerPlateOffsetIsReportedWithItsUncertaintyAndTheShiftApplied) {
+  auto s = synthetic_with_exact_plates();
+  s.plates.time_s.array() += 0.03;
+  const auto page = [&](const ValidationOptions& o) {
+    const ValidationResult v = validate(s.estimate, s.plates, o);
+    EXPECT_TRUE(v.sync.has_value());
+    const std::string html = validation_report_html("synthetic", s.estimate, v, validation_json("synthetic", s.estimate, v, nlohmann::json::object()));
+    const auto p = html.find("<p>Marker-plate time offset: ");
+    EXPECT_NE(p, std::string::npos);
+    return p == std::string::npos ? std::string() : html.substr(p, html.find("</p>", p) - p);
+  };
+  const std::string recorded = page({});
+  EXPECT_TRUE(recorded.find("offset: -30 ms (&plusmn;") != std::string::npos || recorded.find("offset: -29 ms (&plusmn;") != std::string::npos ||
+              recorded.find("offset: -31 ms (&plusmn;") != std::string::npos)
+      << recorded;
+  EXPECT_NE(recorded.find("+ = the plates lead"), std::string::npos) << recorded;
+  EXPECT_NE(recorded.find("compare the plates as recorded"), std::string::npos) << recorded;
+  ValidationOptions fixed;
+  fixed.sync = ValidationOptions::Sync::Fixed;
+  fixed.plate_shift_s = -0.03;
+  EXPECT_NE(page(fixed).find("compare the plates shifted by -30 ms"), std::string::npos) << page(fixed);
+}
+
 // estimate's report without plates (issue 30, item 8): per foot GRF, COP, joint torques and powers, the
 // GRM, the gait events in a table; drawn by Chart.js in headless Chromium.
 TEST(Report, AnEstimateReportWithoutPlatesRendersWithItsGaitEvents) {

@@ -233,6 +233,22 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   }
   t << "<tr><td class=l colspan=3>paper, Table 1 (24 gait trials)</td><td>4.1 (1.1)</td><td>11.2 (1.7)</td><td>-</td>"
        "<td>5.3 (1.1)</td><td colspan=7></td></tr>\n</table>\n";
+  // The marker-plate time offset (validate's step 6, issue 29: "report it with its confidence, in
+  // the text, the JSON and the report"), as the text gives it.
+  if (const auto& sync = j.value("sync", nlohmann::json()); sync.is_object()) {
+    t << "<p>Marker-plate time offset: ";
+    if (sync.value("estimated_offset_ms", nlohmann::json()).is_number())
+      t << fmt(sync["estimated_offset_ms"], "%+.0f") << " ms (&plusmn;" << fmt(sync["uncertainty_ms"], "%.1f")
+        << " ms; + = the plates lead), from the plates' total vertical force against the whole body's from the markers "
+           "(median |plates - kinematics| "
+        << fmt(sync["total_vertical_error_as_recorded_N"], "%.0f") << " N as recorded, "
+        << fmt(sync["total_vertical_error_at_offset_N"], "%.0f") << " N at the offset)";
+    else
+      t << "not estimated (too few loaded frames clear of the recording's ends, or the best shift at the search's limit)";
+    const double shift = sync.value("applied_shift_ms", 0.0);
+    if (std::abs(shift) < 0.5) t << "; the figures above compare the plates as recorded (--sync auto aligns them first).</p>\n";
+    else t << "; the figures above compare the plates shifted by " << fmt(sync["applied_shift_ms"], "%+.0f") << " ms (--sync).</p>\n";
+  }
   t << "<h3>Stance parameters</h3>\n<p>Each stance's ground reaction parameters, kin2grf's against the plate's over the "
        "stance's loaded span: the vertical force's largest value in each half of the stance and the least between them, "
        "the braking and propulsive peaks and impulses, the loading rate (20-80 % of the first peak).</p>\n"
