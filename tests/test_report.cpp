@@ -236,6 +236,12 @@ TEST(Report, AMisregisteredPlatesFiguresAreBracketed) {
                   s.moments_3d->knee_adduction->rrmse_percent);
     EXPECT_EQ(s.cop_reference_suspect, s.plate == "FP1");
     EXPECT_NE(html.find(cell), std::string::npos) << s.plate << ": " << cell;
+    // The COP's RMSE in mm and in % of the foot's length (issue 29), bracketed likewise.
+    ASSERT_TRUE(s.metrics.cop && s.foot_length_m > 0);
+    char mm[80];
+    std::snprintf(mm, sizeof mm, s.cop_reference_suspect ? "<td>[%.1f (%.1f %%)]</td>" : "<td>%.1f (%.1f %%)</td>", 1000 * s.metrics.cop->rmse,
+                  100 * s.metrics.cop->rmse / s.foot_length_m);
+    EXPECT_NE(html.find(mm), std::string::npos) << s.plate << ": " << mm;
   }
 }
 

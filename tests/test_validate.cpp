@@ -561,6 +561,12 @@ TEST(Validate, AMisregisteredPlatesJointMomentsAreKeptButNotScored) {
   ASSERT_NE(fp1_row, std::string::npos) << table;
   const std::string line = table.substr(fp1_row, table.find('\n', fp1_row) - fp1_row);
   EXPECT_NE(line.find('['), std::string::npos) << line;
+  // The COP's RMSE in mm and in % of the foot's length: the well-placed stance's alone.
+  ASSERT_TRUE(good.metrics.cop && good.foot_length_m > 0);
+  char cop[120];
+  std::snprintf(cop, sizeof cop, "per foot, COP RMSE %.1f mm, %.1f %% of the foot's length", 1000 * good.metrics.cop->rmse,
+                100 * good.metrics.cop->rmse / good.foot_length_m);
+  EXPECT_NE(table.find(cop), std::string::npos) << cop << "\n" << table;
   // Every joint in every plane: the well-placed stance's figures alone.
   char planes[160];
   const JointMomentValidation& g = *good.moments_3d;

@@ -164,6 +164,15 @@ std::vector<double> curve_column(const ResultsTable& c, const std::string& name,
 /// The joints as a gait report lists them, proximal first (the sagittal torques' and the 3D moments').
 constexpr const char* kReportJoints[] = {"hip", "knee", "ankle"};
 
+/// A stance's COP RMSE in mm and in % of the foot's length (issue 29), bracketed as fmt_cop does.
+std::string cop_mm_cell(const nlohmann::json& stance) {
+  const auto& mm = stance["rmse"]["cop_mm"];
+  if (!mm.is_number()) return "-";
+  const auto& foot = stance.value("cop_rmse_percent_foot", nlohmann::json());
+  const std::string text = fmt(mm) + (foot.is_number() ? " (" + fmt(foot) + " %)" : std::string());
+  return stance.value("cop_reference_suspect", false) ? "[" + text + "]" : text;
+}
+
 /// The sign of a 3D joint moment's plane (dynamics/joint_moments_3d.hpp), for a figure's title.
 std::string plane_sign(const std::string& plane) {
   if (plane == "sagittal") return "+ counter-clockwise in the sagittal frame";
@@ -205,7 +214,7 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
        "not where the markers put the foot (validate's registration check), kept for the record, left out of the "
        "means.</p>\n";
   t << "<table><tr><th class=l>foot</th><th class=l>plate</th><th>frames</th><th>vertical rRMSE %</th><th>anterior rRMSE %</th>"
-       "<th>COP rRMSE %</th><th>moment rRMSE %</th><th>vertical RMSE N</th><th>anterior RMSE N</th><th>COP RMSE mm</th>"
+       "<th>COP rRMSE %</th><th>moment rRMSE %</th><th>vertical RMSE N</th><th>anterior RMSE N</th><th>COP RMSE mm (% of foot length)</th>"
        "<th>vertical r</th><th>onset ms</th><th>offset ms</th><th>vertical rRMSE % over the loaded span</th></tr>\n";
   // A stance timed by the ramps' intercepts (a filtered export's) is marked, the crossings' figure beside it.
   const auto timing = [](const nlohmann::json& s, const std::string& key) {
@@ -219,7 +228,8 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
       << "</td><td>" << s["frames"][0] << "-" << s["frames"][1] << "</td><td>" << fmt(s["rrmse_percent"]["vertical"]) << "</td><td>"
       << fmt(s["rrmse_percent"]["anterior"]) << "</td><td>" << fmt_cop(s, s["rrmse_percent"]["cop"]) << "</td><td>"
       << fmt_cop(s, s["rrmse_percent"]["moment"]) << "</td><td>" << fmt(s["rmse"]["vertical_N"]) << "</td><td>"
-      << fmt(s["rmse"]["anterior_N"]) << "</td><td>" << fmt_cop(s, s["rmse"]["cop_mm"]) << "</td><td>" << fmt(s["r"]["vertical"], "%.3f")
+      << fmt(s["rmse"]["anterior_N"]) << "</td><td>"
+      << cop_mm_cell(s) << "</td><td>" << fmt(s["r"]["vertical"], "%.3f")
       << "</td><td>" << timing(s, "onset") << "</td><td>" << timing(s, "offset") << "</td><td>"
       << fmt(s.contains("loaded_span") ? s["loaded_span"]["vertical_rrmse_percent"] : nlohmann::json()) << "</td></tr>\n";
   }

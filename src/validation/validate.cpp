@@ -1502,6 +1502,17 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
   if (m.n > 0)
     os << table_label("per foot, mean (SD), n = " + std::to_string(m.n)) << table_msd(m.vertical, m.vertical_sd)
        << table_msd(m.anterior, m.anterior_sd) << table_msd(m.cop, m.cop_sd) << table_msd(m.moment, m.moment_sd) << "\n";
+  if (m.n > 0 && std::isfinite(m.cop_rmse_mm)) {
+    // The COP's error in mm and in % of the foot's length beside its rRMSE (issue 29): an rRMSE
+    // divides by the COP's range, a few cm overground and half a metre on a treadmill.
+    double percent = 0;
+    int n = 0;
+    for (const auto& s : v.stances)
+      if (s.metrics.cop && !s.cop_reference_suspect && s.foot_length_m > 0) percent += 100 * s.metrics.cop->rmse / s.foot_length_m, ++n;
+    std::snprintf(buf, sizeof buf, "  per foot, COP RMSE %.1f mm, %s %% of the foot's length (heel to toe sole points)\n", m.cop_rmse_mm,
+                  n ? number_or_dash(percent / n).c_str() : "-");
+    os << buf;
+  }
   if (m.n > 0 && std::isfinite(m.vertical_loaded_span)) {
     // The early and late loaded frames the stance columns do not see.
     long early = 0, late = 0;
