@@ -210,6 +210,18 @@ TEST(Report, TheThreeDReportPlotsTheLateralForceAndTheKneeAdductionMoment) {
   EXPECT_GT(v.total->frontal_moment->pearson_r, 0.9);
   EXPECT_GT(v.total->transverse_moment->pearson_r, 0.5);
   EXPECT_FALSE(v2.total->frontal_moment.has_value());
+  // Both tabulated and drawn in the report: their rRMSE in a sentence, their series over the total's
+  // frames (NaN elsewhere) in a figure each; the sagittal report has neither.
+  char sentence[96];
+  std::snprintf(sentence, sizeof sentence, "frontal rRMSE %.1f %% (RMSE %.1f N m", v.total->frontal_moment->rrmse_percent, v.total->frontal_moment->rmse);
+  EXPECT_EQ(count(sentence), 1) << sentence;
+  EXPECT_EQ(count("total frontal moment, about the forward axis through the GRM reference"), 1);
+  EXPECT_EQ(count("total transverse moment, about the vertical through the GRM reference"), 1);
+  EXPECT_EQ(html2.find("total frontal moment"), std::string::npos);
+  ASSERT_EQ(v.total->frontal_estimated_Nm.size(), e.time_s.size());
+  EXPECT_EQ(static_cast<std::size_t>(v.total->frontal_estimated_Nm.array().isFinite().count()), v.total->frames.size());
+  EXPECT_EQ(static_cast<std::size_t>(v.total->transverse_measured_Nm.array().isFinite().count()), v.total->frames.size());
+  EXPECT_EQ(count("plate's free moment RMS N m (the estimate's is zero)"), 1);
   // The plate's free moment (the estimate's is zero): a few N m in walking. Leaving out the COP's
   // c x F would read the plate's whole moment about the origin, hundreds of N m.
   ASSERT_TRUE(v.stances[0].metrics.free_moment.has_value());

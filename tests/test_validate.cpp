@@ -561,6 +561,18 @@ TEST(Validate, AMisregisteredPlatesJointMomentsAreKeptButNotScored) {
   ASSERT_NE(fp1_row, std::string::npos) << table;
   const std::string line = table.substr(fp1_row, table.find('\n', fp1_row) - fp1_row);
   EXPECT_NE(line.find('['), std::string::npos) << line;
+  // The plate's free moment per stance (bracketed where the plate is misplaced: the free moment is
+  // taken about its COP) and the totals' frontal and transverse moments.
+  const auto mediolateral = table.find("mediolateral force");
+  ASSERT_NE(mediolateral, std::string::npos) << table;
+  ASSERT_TRUE(bad.metrics.free_moment);
+  char free[40];
+  std::snprintf(free, sizeof free, "[%.1f]", bad.metrics.free_moment->rmse);
+  const auto bad_row = table.find("foot on FP1", mediolateral);
+  ASSERT_NE(bad_row, std::string::npos) << table;
+  EXPECT_NE(table.substr(bad_row, table.find('\n', bad_row) - bad_row).find(free), std::string::npos) << free << "\n" << table;
+  ASSERT_TRUE(v.total && v.total->frontal_moment) << table;
+  EXPECT_NE(table.find("total, frontal / transverse moment rRMSE % "), std::string::npos) << table;
   // The COP's RMSE in mm and in % of the foot's length: the well-placed stance's alone.
   ASSERT_TRUE(good.metrics.cop && good.foot_length_m > 0);
   char cop[120];

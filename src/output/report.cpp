@@ -306,7 +306,7 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
          "a plate that fails the registration check (its moments take its COP as their lever).</p>\n"
          "<table><tr><th class=l>foot</th><th class=l>plate</th><th>lateral rRMSE %</th><th>lateral RMSE N</th>"
          "<th>lateral COP RMSE mm</th><th>KAM rRMSE %</th><th>KAM peaks, kin2grf N m</th><th>KAM peaks, plates N m</th>"
-         "<th>knee sagittal rRMSE %</th></tr>\n";
+         "<th>knee sagittal rRMSE %</th><th>plate's free moment RMS N m (the estimate's is zero)</th></tr>\n";
     for (const auto& s : j["per_foot"]) {
       const nlohmann::json none;
       const auto& jm = s.contains("joint_moments_3d") ? s["joint_moments_3d"] : none;
@@ -322,9 +322,21 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
         << fmt_cop(s, s["rmse"].value("cop_lateral_mm", nlohmann::json()), "%.0f") << "</td><td>"
         << fmt_cop(s, kam.is_null() ? none : kam["rrmse_percent"]) << "</td><td>" << peaks("peaks_estimated_Nm") << "</td><td>"
         << peaks("peaks_measured_Nm") << "</td><td>" << fmt_cop(s, jm.is_null() ? none : jm["knee"]["sagittal"]["rrmse_percent"])
-        << "</td></tr>\n";
+        << "</td><td>" << fmt_cop(s, s["rmse"].value("free_moment_Nm", nlohmann::json())) << "</td></tr>\n";
     }
     t << "</table>\n";
+    // The totals' frontal and transverse moments (validate_total_3d), about the GRM reference on
+    // the walker's midline, where every loaded foot stands on a plate.
+    if (const auto& total = j.value("total", nlohmann::json()); total.is_object() && total.contains("frontal_moment")) {
+      const auto& fm = total["frontal_moment"];
+      const auto& tm = total["transverse_moment"];
+      t << "<p>The total ground reaction's moments about the GRM reference on the walker's midline, where every loaded "
+           "foot stands on a plate (the plates' free moments in theirs): frontal rRMSE "
+        << fmt(fm.value("rrmse_percent", nlohmann::json())) << " % (RMSE " << fmt(fm.value("rmse_Nm", nlohmann::json())) << " N m, r "
+        << fmt(fm.value("r", nlohmann::json()), "%.2f") << "), transverse rRMSE " << fmt(tm.value("rrmse_percent", nlohmann::json()))
+        << " % (RMSE " << fmt(tm.value("rmse_Nm", nlohmann::json())) << " N m, r " << fmt(tm.value("r", nlohmann::json()), "%.2f")
+        << ").</p>\n";
+    }
     // Every joint in every plane (issue 28: "what the estimate does to the hip, knee and ankle
     // moments in all three planes").
     t << "<p>The hip's, the knee's and the ankle's internal moments in the three planes, estimate-driven against "
@@ -443,6 +455,22 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
     g.series.push_back({"force plates", time, to_vec(v.total->vertical_measured_N), true});
     g.series.push_back({"kin2grf estimate", time, to_vec(v.total->vertical_estimated_N), false});
     rep.figures.push_back(g);
+    if (v.total->frontal_estimated_Nm.size() == e.time_s.size()) {
+      for (const auto& [what, est, meas] :
+           {std::tuple{"total frontal moment, about the forward axis through the GRM reference on the walker's midline",
+                       &v.total->frontal_estimated_Nm, &v.total->frontal_measured_Nm},
+            {"total transverse moment, about the vertical through the GRM reference on the walker's midline (the plates' free "
+             "moments in theirs)",
+             &v.total->transverse_estimated_Nm, &v.total->transverse_measured_Nm}}) {
+        ReportFigure g3;
+        g3.title = what;
+        g3.x_label = "time (s)";
+        g3.y_label = "N m";
+        g3.series.push_back({"force plates", time, to_vec(*meas), true});
+        g3.series.push_back({"kin2grf estimate", time, to_vec(*est), false});
+        rep.figures.push_back(g3);
+      }
+    }
     ReportFigure m;
     char b[96];
     std::snprintf(b, sizeof b, "sagittal GRM about x = %.3f m, y = %.3f m", v.total->grm_reference_m.x(), v.total->grm_reference_m.y());

@@ -149,6 +149,14 @@ void validate_total_3d(const EstimateResult& e, ValidationResult& v) {
   }
   t.frontal_moment = compare_series(ef, mf);
   t.transverse_moment = compare_series(et, mt);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (Eigen::VectorXd* x : {&t.frontal_estimated_Nm, &t.frontal_measured_Nm, &t.transverse_estimated_Nm, &t.transverse_measured_Nm})
+    x->setConstant(n, nan);
+  for (Eigen::Index q = 0; q < m; ++q) {
+    const Eigen::Index k = t.frames[static_cast<std::size_t>(q)];
+    t.frontal_estimated_Nm[k] = ef[q], t.frontal_measured_Nm[k] = mf[q];
+    t.transverse_estimated_Nm[k] = et[q], t.transverse_measured_Nm[k] = mt[q];
+  }
 }
 
 }  // namespace kin2grf

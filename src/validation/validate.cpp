@@ -1308,7 +1308,7 @@ std::string table_label(const std::string& l) {
 void format_lateral_rows(std::ostream& os, const ValidationResult& v, const MeanMetrics& m) {
   char buf[64];
   os << table_label("mediolateral force") << table_text("rRMSE %") << table_text("RMSE %BW") << table_text("r") << table_text("COP mm")
-     << "\n";
+     << table_text("free N m") << "   free: the plate's free moment's RMS (the estimate's is zero)\n";
   for (const auto& s : v.stances) {
     if (!s.metrics.lateral) continue;
     char pct[40], r[40];
@@ -1317,13 +1317,21 @@ void format_lateral_rows(std::ostream& os, const ValidationResult& v, const Mean
     char cop[40] = "-";
     if (s.metrics.cop_lateral)
       std::snprintf(cop, sizeof cop, s.cop_reference_suspect ? "[%.0f]" : "%.0f", 1000 * s.metrics.cop_lateral->rmse);
+    char free[40] = "-";
+    if (s.metrics.free_moment)
+      std::snprintf(free, sizeof free, s.cop_reference_suspect ? "[%.1f]" : "%.1f", s.metrics.free_moment->rmse);
     os << table_label(std::string(side_name(s.foot)) + " foot on " + s.plate) << table_cell(s.metrics.lateral) << table_text(pct)
-       << table_text(r) << table_text(cop) << "\n";
+       << table_text(r) << table_text(cop) << table_text(free) << "\n";
   }
   std::snprintf(buf, sizeof buf, "%.1f", m.lateral_rmse_percent_bw);
   os << table_label("per foot, mean (SD)") << table_msd(m.lateral, m.lateral_sd) << table_text(buf) << table_text("-");
   std::snprintf(buf, sizeof buf, "%.0f", m.cop_lateral_rmse_mm);
-  os << table_text(buf) << "\n";
+  os << table_text(buf);
+  double free = 0;
+  int n = 0;
+  for (const auto& s : v.stances)
+    if (s.metrics.free_moment && !s.cop_reference_suspect) free += s.metrics.free_moment->rmse, ++n;
+  os << table_text(n ? number_or_dash(free / n) : "-") << "\n";
 }
 /// The 3D joint moments' rows (--model 3d): per stance the knee's sagittal and adduction moments'
 /// rRMSE and the KAM's two peaks, estimate-driven / plate-driven, then the means; in brackets (not
@@ -1580,6 +1588,14 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
   if (v.total)
     os << table_label("total, GRM (" + std::to_string(v.total->frames.size()) + " frames)") << table_cell(v.total->metrics.vertical)
        << table_cell(v.total->metrics.anterior) << table_text("-") << table_cell(v.total->metrics.moment) << total_grm_note(*v.total) << "\n";
+  if (v.total && v.total->frontal_moment && v.total->transverse_moment) {
+    // The 3D totals (validate_total_3d): the ground reaction's frontal and transverse moments about
+    // the GRM reference on the walker's midline, the plates' free moments in theirs.
+    std::snprintf(buf, sizeof buf, "  total, frontal / transverse moment rRMSE %% %.1f / %.1f (RMSE %.1f / %.1f N m)\n",
+                  v.total->frontal_moment->rrmse_percent, v.total->transverse_moment->rrmse_percent, v.total->frontal_moment->rmse,
+                  v.total->transverse_moment->rmse);
+    os << buf;
+  }
   os << table_label("paper, Table 1 (24 gait)") << table_text("4.1 (1.1)") << table_text("11.2 (1.7)") << table_text("-") << table_text("5.3 (1.1)") << "\n";
   os << table_label("Fluit et al. (paper's Tab. 1)") << table_text("2.7") << table_text("9.3") << table_text("-") << table_text("7.4") << "\n";
   if (v.sync) {

@@ -307,6 +307,8 @@ struct TotalValidation {
   /// about the GRM reference point on the walker's midline (`lateral_reference_m`, the mean of
   /// the two feet's lateral places over `frames`).
   std::optional<SeriesMetrics> frontal_moment, transverse_moment;
+  /// Their series over all frames (NaN outside `frames`), estimate and plates: the report's plots.
+  Eigen::VectorXd frontal_estimated_Nm, frontal_measured_Nm, transverse_estimated_Nm, transverse_measured_Nm;
   double lateral_reference_m = 0.0;
 };
 
