@@ -409,6 +409,53 @@ TEST(Batch, TheCsvKeepsFullPrecision) {
   EXPECT_GT(cells[12].size(), 6u) << "more than 4 significant figures";
 }
 
+// The batch summary gives the COP's RMSE in mm beside its rRMSE (issue 29), and with --model 3d
+// the lateral force's rRMSE, the lateral COP's RMSE and the knee adduction moment's rRMSE (issue
+// 28): the validation's own means, by column name; empty cells without the 3D model.
+TEST(Batch, TheSummaryCarriesTheCopInMmAndThe3DFiguresByName) {
+  const auto dir = test::temp_dir("batch_3d");
+  const auto files = write_examples(dir.string(), 3.0, 100.0, 0.0);
+  const auto cells_of = [](const BatchRow& row) {
+    const std::string csv = batch_csv({row});
+    std::map<std::string, std::string> out;
+    const auto split = [](const std::string& text) {  // every cell, the empty last one too
+      std::vector<std::string> cells(1);
+      for (char c : text) {
+        if (c == ',') cells.emplace_back();
+        else cells.back().push_back(c);
+      }
+      return cells;
+    };
+    const auto first = csv.find('\n');
+    const auto header = split(csv.substr(0, first)), line = split(csv.substr(first + 1, csv.find('\n', first + 1) - first - 1));
+    EXPECT_EQ(header.size(), line.size());
+    for (std::size_t k = 0; k < std::min(header.size(), line.size()); ++k) out[header[k]] = line[k];
+    return out;
+  };
+  for (const bool three_d : {false, true}) {
+    TrialListEntry e = parse_trial_list_line(
+        "walking|lab|walk|" + (dir / "example_walk.c3d").string() + " --mass 70" + (three_d ? " --model 3d" : ""), "list:1");
+    const BatchRow row = run_batch_entry(e);
+    ASSERT_TRUE(row.ok) << row.error;
+    const auto cells = cells_of(row);
+    ASSERT_TRUE(std::isfinite(row.cop_mm));
+    EXPECT_EQ(std::stod(cells.at("cop_rmse_mm")), row.cop_mm);
+    // Each cell is the row's value, empty where it does not exist (the example's plates carry no
+    // lateral force, whose rRMSE then has no range to divide by).
+    for (const auto& [key, value] : {std::pair{"lateral_rrmse_percent", row.lateral}, {"cop_lateral_rmse_mm", row.cop_lateral_mm},
+                                     {"knee_adduction_rrmse_percent", row.knee_adduction}}) {
+      EXPECT_EQ(cells.at(key).empty(), !std::isfinite(value)) << key << ": " << cells.at(key);
+      if (std::isfinite(value)) {
+        EXPECT_EQ(std::stod(cells.at(key)), value) << key;
+      }
+    }
+    // The 3D model's figures exist with it and only with it.
+    EXPECT_EQ(std::isfinite(row.cop_lateral_mm), three_d);
+    EXPECT_EQ(std::isfinite(row.knee_adduction), three_d);
+    EXPECT_EQ(cells.at("error"), "");
+  }
+}
+
 namespace {
 /// A two-row robustness study (as recorded, then the condition) on the example walk with `set`:
 /// its rows' stances, checked to be the same stances.

@@ -42,7 +42,10 @@ void fill_validation(BatchRow& row, const ValidationResult& v) {
   row.validated = true;
   const MeanMetrics m = mean_rrmse(v.stances);
   row.stances = m.n;
-  if (m.n > 0) row.vertical = m.vertical, row.anterior = m.anterior, row.cop = m.cop, row.moment = m.moment;
+  if (m.n > 0) {
+    row.vertical = m.vertical, row.anterior = m.anterior, row.cop = m.cop, row.moment = m.moment, row.cop_mm = m.cop_rmse_mm;
+    row.lateral = m.lateral, row.cop_lateral_mm = m.cop_lateral_rmse_mm, row.knee_adduction = m.knee_adduction;
+  }
   if (v.total) {
     if (v.total->metrics.vertical) row.total_vertical = v.total->metrics.vertical->rrmse_percent;
     if (v.total->metrics.moment) row.total_grm = v.total->metrics.moment->rrmse_percent;
@@ -278,7 +281,8 @@ const std::vector<std::string>& batch_csv_columns() {
       "frames",          "duration_s",  "seconds",  "frames_per_s",
       "mass_kg",         "marker_set",  "stances",  "vertical_rrmse_percent",
       "anterior_rrmse_percent", "cop_rrmse_percent", "moment_rrmse_percent", "total_vertical_rrmse_percent",
-      "total_grm_rrmse_percent", "error"};
+      "total_grm_rrmse_percent", "cop_rmse_mm", "lateral_rrmse_percent", "cop_lateral_rmse_mm",
+      "knee_adduction_rrmse_percent", "error"};
   return columns;
 }
 
@@ -292,6 +296,7 @@ std::string batch_csv(const std::vector<BatchRow>& rows) {
        << cell(r.seconds > 0 ? static_cast<double>(r.frames) / r.seconds : NAN) << ',' << cell(r.mass_kg) << ','
        << csv_quoted(r.marker_set) << ',' << r.stances << ',' << cell(r.vertical) << ',' << cell(r.anterior) << ','
        << cell(r.cop) << ',' << cell(r.moment) << ',' << cell(r.total_vertical) << ',' << cell(r.total_grm) << ','
+       << cell(r.cop_mm) << ',' << cell(r.lateral) << ',' << cell(r.cop_lateral_mm) << ',' << cell(r.knee_adduction) << ','
        << csv_quoted(r.error) << '\n';
   return os.str();
 }
@@ -323,6 +328,8 @@ nlohmann::json batch_row_json(const BatchRow& r) {
           {"validated", r.validated}, {"stances", r.stances}, {"vertical_rrmse_percent", number(r.vertical)},
           {"anterior_rrmse_percent", number(r.anterior)}, {"cop_rrmse_percent", number(r.cop)}, {"moment_rrmse_percent", number(r.moment)},
           {"total_vertical_rrmse_percent", number(r.total_vertical)}, {"total_grm_rrmse_percent", number(r.total_grm)},
+          {"cop_rmse_mm", number(r.cop_mm)}, {"lateral_rrmse_percent", number(r.lateral)},
+          {"cop_lateral_rmse_mm", number(r.cop_lateral_mm)}, {"knee_adduction_rrmse_percent", number(r.knee_adduction)},
           {"messages", r.messages}, {"outputs", r.outputs}};
 }
 

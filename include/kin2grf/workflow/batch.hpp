@@ -32,6 +32,11 @@ struct BatchRow {
   int stances = 0;
   double vertical = std::numeric_limits<double>::quiet_NaN(), anterior = vertical, cop = vertical, moment = vertical;
   double total_vertical = vertical, total_grm = vertical;  ///< whole-body comparison, %
+  double cop_mm = vertical;  ///< the COP's RMSE along progression, mm (MeanMetrics::cop_rmse_mm)
+  /// With the lateral force (--mediolateral, --model 3d; NaN otherwise): the per-foot lateral
+  /// force's mean rRMSE (%) and the lateral COP's mean RMSE (mm); with --model 3d the knee
+  /// adduction moment's mean rRMSE (%), estimate-driven against plate-driven.
+  double lateral = vertical, cop_lateral_mm = vertical, knee_adduction = vertical;
   std::vector<std::string> messages;  ///< the estimate's notes and the readers' warnings
   std::vector<std::string> outputs;   ///< files written (BatchOptions::out_dir)
 };
