@@ -145,7 +145,7 @@ constexpr const char* kStanceParameterHeads =
 namespace {
 
 /// The time-normalised tables' instants a stance (stance_curves_table, validation_stance_curves_table).
-constexpr Eigen::Index kCurvePoints = 101;
+constexpr Eigen::Index kCurvePoints = kStanceCurvePoints;
 
 Eigen::Index curve_column_index(const ResultsTable& c, const std::string& name) {
   const auto it = std::find(c.columns.begin(), c.columns.end(), name);
@@ -173,11 +173,19 @@ std::string cop_mm_cell(const nlohmann::json& stance) {
   return stance.value("cop_reference_suspect", false) ? "[" + text + "]" : text;
 }
 
-/// The sign of a 3D joint moment's plane (dynamics/joint_moments_3d.hpp), for a figure's title.
-std::string plane_sign(const std::string& plane) {
-  if (plane == "sagittal") return "+ counter-clockwise in the sagittal frame";
-  if (plane == "frontal") return "+ adducts the distal segment";
-  return "+ rotates the distal segment internally";
+/// Both reports' time-normalised 3D joint moments (--model 3d): per joint and plane, the figure's
+/// title (the moment and its sign, dynamics/joint_moments_3d.hpp) and its stance-curves column.
+std::vector<std::pair<std::string, std::string>> joint_moment_curves() {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const char* joint : kReportJoints)
+    for (const char* plane : kPlaneNames) {
+      const std::string p = plane;
+      const char* sign = p == "sagittal" ? "+ counter-clockwise in the sagittal frame"
+                         : p == "frontal" ? "+ adducts the distal segment"
+                                          : "+ rotates the distal segment internally";
+      out.emplace_back(std::string(joint) + " " + p + " moment (internal, " + sign + ")", joint_moment_curve_name(joint, p));
+    }
+  return out;
 }
 
 /// The stances' mean curve of `name` at each instant, over the stances of `side` (-1: every
@@ -432,10 +440,7 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
         {"COP along progression from the plate's first COP", "m", "cop_progression_m"}};
     if (std::find(c.columns.begin(), c.columns.end(), "knee_adduction_moment_Nm_per_kg_plate") != c.columns.end()) {
       figures.emplace_back("external knee adduction moment, with each ground reaction", "N m/kg", "knee_adduction_moment_Nm_per_kg");
-      for (const char* joint : kReportJoints)
-        for (const char* plane : kPlaneNames)
-          figures.emplace_back(std::string(joint) + " " + plane + " moment (internal, " + plane_sign(plane) + "), with each ground reaction",
-                               "N m/kg", std::string(joint) + "_" + plane + "_Nm_per_kg");
+      for (const auto& [title, key] : joint_moment_curves()) figures.emplace_back(title + ", with each ground reaction", "N m/kg", key);
     }
     for (const auto& [what, unit, key] : figures) {
       ReportFigure g;
@@ -571,10 +576,7 @@ std::string estimate_report_html(const std::string& trial, const EstimateResult&
         {"knee torque", "N m/kg", "torque_knee_Nm_per_kg"},
         {"ankle torque", "N m/kg", "torque_ankle_Nm_per_kg"},
         {"external knee adduction moment", "N m/kg", "knee_adduction_moment_Nm_per_kg"}};
-    for (const char* joint : kReportJoints)  // --model 3d
-      for (const char* plane : kPlaneNames)
-        curves.emplace_back(std::string(joint) + " " + plane + " moment (internal, " + plane_sign(plane) + ")", "N m/kg",
-                            std::string(joint) + "_" + plane + "_Nm_per_kg");
+    for (const auto& [title, key] : joint_moment_curves()) curves.emplace_back(title, "N m/kg", key);  // --model 3d
     for (const auto& [what, unit, key] : curves) {
       if (std::find(c.columns.begin(), c.columns.end(), key) == c.columns.end()) continue;  // the KAM and the 3D moments: --model 3d
       ReportFigure g;

@@ -312,6 +312,8 @@ std::string stance_parameters_csv(const EstimateResult& r) {
   return os.str();
 }
 
+std::string joint_moment_curve_name(const std::string& joint, const std::string& plane) { return joint + "_" + plane + "_Nm_per_kg"; }
+
 namespace {
 
 /// The five columns that place a stance's rows, before its series.
@@ -351,7 +353,7 @@ std::vector<CurveSeries> stance_curve_series(const EstimateResult& r) {
     // The 3D joint moments in every plane, as the per-frame CSV's (a 3D gait report's curves).
     for (int joint = 0; joint < 3; ++joint)
       for (int a = 0; a < 3; ++a)
-        c.push_back({std::string(kJoint3DNames[joint]) + "_" + kPlaneNames[a] + "_Nm_per_kg",
+        c.push_back({joint_moment_curve_name(kJoint3DNames[joint], kPlaneNames[a]),
                      [&r, joint, a, per_kg](int s, Eigen::Index i, const auto&) {
                        return joint_moments_of(r.legs_3d->moments, joint, s)(i, a) * per_kg;
                      }});
@@ -419,7 +421,7 @@ void write_stance_curves_csv(std::ostream& os, const EstimateResult& r) {
   std::string buf;
   for (std::size_t k = 0; k < columns.size(); ++k) (buf += k ? "," : "") += columns[k];
   buf += '\n';
-  each_stance_curve(r, 101, [&](const Eigen::MatrixXd& b) {
+  each_stance_curve(r, kStanceCurvePoints, [&](const Eigen::MatrixXd& b) {
     for (Eigen::Index i = 0; i < b.rows(); ++i)
       append_stance_curve_row(buf, static_cast<int>(b(i, 0)), nullptr, b(i, 1), b(i, 2), b.row(i).tail(b.cols() - 3));
     flush_if_full(buf, os);

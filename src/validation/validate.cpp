@@ -1407,7 +1407,7 @@ ResultsTable validation_stance_curves_table(const EstimateResult& e, const Valid
     // --stance-curves columns, the per-frame CSV's order).
     for (const char* joint : kJoint3DNames)
       for (const char* plane : kPlaneNames)
-        for (const char* which : {"_estimate", "_plate"}) t.columns.push_back(std::string(joint) + "_" + plane + "_Nm_per_kg" + which);
+        for (const char* which : {"_estimate", "_plate"}) t.columns.push_back(joint_moment_curve_name(joint, plane) + which);
   }
   const double bw = e.mass_kg * e.model().gravity_mps2;
   const auto nan = std::numeric_limits<double>::quiet_NaN();

@@ -74,7 +74,8 @@ void add_estimate_options(CLI::App* c, EstimateJob& a, bool outputs) {
                 "propulsive peaks and impulses, the loading rate, in N and body weights (docs/FORMATS.md)");
   c->add_option("--stance-curves", a.out_stance_curves,
                 "Each complete stance time-normalised, 0 to 100 % of the stance (101 rows a stance), as CSV: the foot's force in body "
-                "weights, the COP's progression, the hip, knee and ankle torques (N m/kg) and powers (W/kg) (docs/FORMATS.md)");
+                "weights, the COP's progression, the hip, knee and ankle torques (N m/kg) and powers (W/kg); with --model 3d the knee adduction "
+                "moment and every joint's 3D moment in each plane (docs/FORMATS.md)");
   c->add_option("--report", a.out_report, "Self-contained HTML report with plots (no plates needed)");
   c->add_option("--opensim", a.opensim_dir,
                 "Write FOLDER/TRIAL_grf.mot (whole trial), TRIAL_markers.trc and TRIAL_external_loads.xml in OpenSim's frame "

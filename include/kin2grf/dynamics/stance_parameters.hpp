@@ -50,12 +50,16 @@ struct StanceParameters {
 /// rows. std::invalid_argument on frames outside it or a rate that is not positive and finite.
 StanceParameters stance_parameters(const Eigen::MatrixX2d& force_N, double rate_hz, Eigen::Index first, Eigen::Index last);
 
+/// The instants of a time-normalised stance: 0, 1, ..., 100 % (the stance-curves tables' and CSVs').
+inline constexpr int kStanceCurvePoints = 101;
+
 /// Time normalisation, as gait reports and normative data give a stance: the columns of `series`
 /// over frames [first, last] at `points` equally spaced instants from the first frame (0 % of the
 /// stance, foot strike) to the last (100 %, foot off), each linear between the two frames around
 /// it (an instant on a frame takes that frame alone; a NaN frame beside an instant gives NaN).
 /// Row k is k / (points - 1) of the stance: 101 points are 0, 1, ..., 100 %. std::invalid_argument
 /// on frames outside the series or fewer than 2 points.
-Eigen::MatrixXd stance_normalised(const Eigen::MatrixXd& series, Eigen::Index first, Eigen::Index last, int points = 101);
+Eigen::MatrixXd stance_normalised(const Eigen::MatrixXd& series, Eigen::Index first, Eigen::Index last,
+                                  int points = kStanceCurvePoints);
 
 }  // namespace kin2grf

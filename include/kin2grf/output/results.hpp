@@ -71,10 +71,14 @@ std::string stance_parameters_csv(const EstimateResult& r);
 /// along progression over the ground: on a treadmill over the belt, which carries the foot back),
 /// the foot's inclination (rad), the side's hip, knee and ankle torques (N m
 /// per kg of body mass, the per-frame CSV's torque_* signs) and powers (W/kg), and with
-/// ModelKind::ThreeD the external knee adduction moment (N m/kg). The values are the per-frame
-/// CSV's (results_row) between frames. A stance the processed window cuts is left out: part of a
-/// stance is not its 0-100 %.
-ResultsTable stance_curves_table(const EstimateResult& r, int points = 101);
+/// ModelKind::ThreeD the external knee adduction moment (N m/kg), then every joint's 3D moment in
+/// every plane (joint_moment_curve_name, N m/kg, the per-frame CSV's order and signs). The values
+/// are the per-frame CSV's (results_row) between frames. A stance the processed window cuts is
+/// left out: part of a stance is not its 0-100 %.
+ResultsTable stance_curves_table(const EstimateResult& r, int points = kStanceCurvePoints);
+/// The stance-curves column of a 3D joint moment per kg (kJoint3DNames, kPlaneNames):
+/// "hip_frontal_Nm_per_kg"; `validate --stance-curves` adds _estimate and _plate.
+std::string joint_moment_curve_name(const std::string& joint, const std::string& plane);
 /// stance_curves_table as CSV (side as right / left, numbers to 6 significant digits, an empty
 /// cell where a value does not exist): `estimate --stance-curves` (docs/FORMATS.md). Written
 /// stance by stance as made, never held whole; the file through AtomicFile.

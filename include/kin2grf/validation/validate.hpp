@@ -438,8 +438,9 @@ std::string format_validation_table(const std::string& trial, const ValidationRe
 /// registration check, whose COP the means leave out too); with ModelKind::ThreeD the external
 /// knee adduction moment, N m/kg, by inverse dynamics with kin2grf's and with the plate's ground
 /// reaction on the same kinematics (knee_adduction_moment_Nm_per_kg_estimate, _plate; the plate's
-/// NaN where its registration fails).
-ResultsTable validation_stance_curves_table(const EstimateResult& e, const ValidationResult& v, int points = 101);
+/// NaN where its registration fails), then likewise every joint's 3D moment in every plane
+/// (joint_moment_curve_name + _estimate, _plate).
+ResultsTable validation_stance_curves_table(const EstimateResult& e, const ValidationResult& v, int points = kStanceCurvePoints);
 /// The same as CSV (side as right / left, the plate by its name; 6 significant digits, an empty
 /// cell where a value does not exist; docs/FORMATS.md).
 std::string validation_stance_curves_csv(const EstimateResult& e, const ValidationResult& v);
