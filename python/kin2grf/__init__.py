@@ -161,8 +161,9 @@ class Estimate:
     def stance_curves(self):
         """Each complete stance time-normalised, 0 to 100 % of the stance (the rows of ``kin2grf
         estimate --stance-curves``, full precision): the force in body weights, the COP's progression,
-        the hip, knee and ankle torques (N m/kg) and powers (W/kg), a ``side`` column of "right" /
-        "left": a pandas DataFrame (a dict of arrays without pandas)."""
+        the hip, knee and ankle torques (N m/kg) and powers (W/kg), with ``model="3d"`` the knee adduction
+        moment and every joint's 3D moment in each plane (``hip_frontal_Nm_per_kg``, ...), a ``side``
+        column of "right" / "left": a pandas DataFrame (a dict of arrays without pandas)."""
         return _stance_curves(self._curves_columns, self._curves_values)
 
     def __getitem__(self, column: str) -> np.ndarray:
