@@ -67,12 +67,20 @@ const std::vector<NumericOption>& numeric_options() {
        "Each thigh's fore-aft lag behind its femur, s: the thigh's fore-aft inertial force is delayed by this time where its knee "
        "point is a marker on the bone (not where a thigh cluster carries it; 0 = none, the paper)",
        {0.0, 0.01, 0.015, 0.02, 0.025, 0.03, 0.04}, "%.0f ms", 1000.0, "off"},
-      // Off by default: on the development adults it is mixed (docs/METHOD-NOTES.md, session 39).
+      // A fixed reference, off by default: on the development adults it is mixed (docs/METHOD-NOTES.md,
+      // session 39); the development range's ends below act outside it alone (session 50).
       {"time-scale-leg", "time_scale_leg_m", [](O& o) -> double& { return o.time_scale_leg_m; }, 0.0, 3.0, std::nullopt,
        "The leg length (thigh + shank, m) the settings in seconds and hertz (the kinematic, torso-vertical, lateral and fixed "
        "post-filter cut-offs, the torso and thigh lags) are for: a subject's are scaled by sqrt(its leg / this), its gait's time "
-       "scale at the same Froude number (0.85: the development adults' mean leg, for a child or a very tall subject; default 0 = "
-       "as given)"},
+       "scale at the same Froude number (0.85: the development adults' mean leg; default 0 = the development range's nearer end "
+       "for a leg outside --time-scale-short-leg .. --time-scale-long-leg, as given within it)"},
+      // The development subjects' legs (0.763-0.896 m): their figures are the same with these.
+      {"time-scale-short-leg", "time_scale_short_leg_m", [](O& o) -> double& { return o.time_scale_short_leg_m; }, 0.0, 3.0, 0.0,
+       "A subject whose leg (thigh + shank) is shorter than this, m, has the settings in seconds and hertz scaled by sqrt(its leg / "
+       "this): the shortest leg they were chosen for (default 0.76, the development subjects'; 0 = never)"},
+      {"time-scale-long-leg", "time_scale_long_leg_m", [](O& o) -> double& { return o.time_scale_long_leg_m; }, 0.0, 3.0, 0.0,
+       "A subject whose leg (thigh + shank) is longer than this, m, has the settings in seconds and hertz scaled by sqrt(its leg / "
+       "this): the longest leg they were chosen for (default 0.90, the development subjects'; 0 = never)"},
       {"torso-vertical-cutoff", "torso_vertical_cutoff_hz", [](O& o) -> double& { return o.torso_vertical_cutoff_hz; }, 0.0, 100.0, 0.0,
        "The HAT's vertical inertial force is low-passed at this cut-off, Hz (the upper body does not pass on the pelvis markers' "
        "heel-strike jolt), in a trial without flight phases, below the kinematic cut-off (0 = none, the paper)",

@@ -140,6 +140,13 @@ void check_options(const EstimateOptions& o) {
           "split distance (m)", o.solver.min_split_distance_m, "between 0 (none) and 1");
   require(finite(o.time_scale_leg_m) && o.time_scale_leg_m >= 0 && o.time_scale_leg_m <= 3, "time scale's leg (m)",
           o.time_scale_leg_m, "between 0 (the settings as given) and 3");
+  require(finite(o.time_scale_short_leg_m) && o.time_scale_short_leg_m >= 0 && o.time_scale_short_leg_m <= 3,
+          "time scale's shortest unscaled leg (m)", o.time_scale_short_leg_m, "between 0 (none) and 3");
+  require(finite(o.time_scale_long_leg_m) && o.time_scale_long_leg_m >= 0 && o.time_scale_long_leg_m <= 3,
+          "time scale's longest unscaled leg (m)", o.time_scale_long_leg_m, "between 0 (none) and 3");
+  if (o.time_scale_short_leg_m > 0 && o.time_scale_long_leg_m > 0 && o.time_scale_short_leg_m > o.time_scale_long_leg_m)
+    throw InputError("time scale: the shortest unscaled leg (" + std::to_string(o.time_scale_short_leg_m) +
+                     " m) is longer than the longest (" + std::to_string(o.time_scale_long_leg_m) + " m)");
   require(finite(o.torque_length_legs) && o.torque_length_legs >= 0 && o.torque_length_legs <= 10, "torque length (leg lengths)",
           o.torque_length_legs, "between 0 (the fixed lever) and 10");
   require(finite(o.torso_lag_s) && o.torso_lag_s >= 0 && o.torso_lag_s <= 0.2, "torso lag (s)", o.torso_lag_s,
@@ -196,15 +203,24 @@ double lateral_cutoff(const EstimateOptions& o, double kinematic_cutoff_hz) {
 }
 
 /// The options as this subject's, from its leg length: the torque-scaled norm's lever
-/// (EstimateOptions::torque_length_legs) and, when asked (EstimateOptions::time_scale_leg_m), the
-/// settings in seconds and hertz scaled by sqrt(leg / the reference leg), its gait's time scale at
-/// the same Froude number, said in `messages`. Everything after the model reads these.
+/// (EstimateOptions::torque_length_legs) and the settings in seconds and hertz scaled by
+/// sqrt(leg / the reference leg), its gait's time scale at the same Froude number, said in
+/// `messages`: the reference is EstimateOptions::time_scale_leg_m when given, else the nearer end
+/// of the development range (time_scale_short_leg_m, time_scale_long_leg_m) for a leg outside it;
+/// none within it. Everything after the model reads these.
 EstimateOptions options_for_subject(const EstimateOptions& o, const Model& model, double rate_hz, Messages& messages) {
   EstimateOptions s = o;
   const double leg = leg_length_m(model);
   if (o.torque_length_legs > 0) s.solver.torque_length_m = o.torque_length_legs * leg;
-  if (!(o.time_scale_leg_m > 0)) return s;
-  const double f = std::sqrt(leg / o.time_scale_leg_m);
+  double reference = 0;
+  const char* why = "the settings'";
+  if (o.time_scale_leg_m > 0) reference = o.time_scale_leg_m;
+  else if (o.time_scale_short_leg_m > 0 && leg < o.time_scale_short_leg_m)
+    reference = o.time_scale_short_leg_m, why = "shorter than the shortest the settings were chosen for,";
+  else if (o.time_scale_long_leg_m > 0 && leg > o.time_scale_long_leg_m)
+    reference = o.time_scale_long_leg_m, why = "longer than the longest the settings were chosen for,";
+  if (!(reference > 0) || !std::isfinite(leg) || !(leg > 0)) return s;
+  const double f = std::sqrt(leg / reference);
   // A raised cut-off stays below what a zero-lag filter at this marker rate takes.
   const double limit = 0.95 * max_zero_lag_cutoff_hz(rate_hz);
   s.kinematic_cutoff_hz = std::min(s.kinematic_cutoff_hz / f, std::max(limit, o.kinematic_cutoff_hz));
@@ -215,9 +231,9 @@ EstimateOptions options_for_subject(const EstimateOptions& o, const Model& model
   s.thigh_lag_s *= f;
   char b[260];
   std::snprintf(b, sizeof b,
-                "time scale: the leg (thigh + shank) is %.3f m against the settings' %.3f m, so their cut-offs are divided and their lags "
+                "time scale: the leg (thigh + shank) is %.3f m against %s %.3f m, so the settings' cut-offs are divided and their lags "
                 "multiplied by %.3f (kinematic cut-off %.2f Hz, lags %.0f ms)",
-                leg, o.time_scale_leg_m, f, s.kinematic_cutoff_hz, 1000 * s.torso_lag_s);
+                leg, why, reference, f, s.kinematic_cutoff_hz, 1000 * s.torso_lag_s);
   messages.emplace_back(b);
   return s;
 }

@@ -1760,6 +1760,7 @@ TEST(Estimate, ADynamicallySimilarSmallerSubjectSharesItsDoubleSupportsAsTheLarg
   EstimateOptions legs, fixed_lever, adults_times;
   legs.time_scale_leg_m = fixed_lever.time_scale_leg_m = 0.85;  // off by default: mixed on the adults
   fixed_lever.torque_length_legs = 0.0;
+  adults_times.time_scale_short_leg_m = adults_times.time_scale_long_leg_m = 0.0;  // not even outside the adults' legs
   // 0.4 % body weight RMS with the leg's lever and time scale (the rest at the trailing foot's
   // last frames, its release), 3.7 % with the fixed 0.9 m lever, 1.2 % with the adults' cut-offs
   // and lags.
@@ -1769,6 +1770,66 @@ TEST(Estimate, ADynamicallySimilarSmallerSubjectSharesItsDoubleSupportsAsTheLarg
   // The time scale says what it did.
   const EstimateResult small_scaled = estimate(small, nullptr, set, dynamically_scaled_options(legs, L));
   EXPECT_TRUE(said(small_scaled, "time scale: the leg (thigh + shank) is"));
+}
+
+// The settings in seconds and hertz were chosen on subjects whose legs (thigh + shank) are
+// 0.76-0.90 m: a subject within that range keeps them as given, one outside it has them scaled
+// from the range's nearer end by its gait's time scale (sqrt(leg / that end)), a child's and a
+// very tall subject's alike, and the message says so. With them scaled the child's double
+// supports come nearer the full-size walk's than with the adults' own cut-offs and lags.
+TEST(Estimate, ALegOutsideTheDevelopmentSubjectsHasTheSettingsTimeScaledFromTheNearerEnd) {
+  const MarkerSet& set = *find_marker_set("kin2grf-example");
+  const SyntheticWalk walk = make_synthetic_walk({});
+  const EstimateOptions defaults;
+  const EstimateResult adult = estimate(walk.trial, nullptr, set, defaults);
+  const double leg = leg_length_m(adult.model());
+  ASSERT_GT(leg, defaults.time_scale_short_leg_m);
+  ASSERT_LT(leg, defaults.time_scale_long_leg_m);
+  EXPECT_FALSE(said(adult, "time scale:"));
+  EXPECT_DOUBLE_EQ(adult.kinematic_cutoff_hz, defaults.kinematic_cutoff_hz);
+  for (const double L : {0.6, 1.25}) {
+    const Trial scaled = dynamically_scaled(walk.trial, L);
+    const EstimateResult r = estimate(scaled, nullptr, set, dynamically_scaled_options(defaults, L));
+    const double end = L < 1 ? defaults.time_scale_short_leg_m : defaults.time_scale_long_leg_m;
+    const double f = std::sqrt(leg_length_m(r.model()) / end);
+    EXPECT_NEAR(leg_length_m(r.model()), L * leg, 1e-6 * leg);
+    EXPECT_TRUE(said(r, L < 1 ? "shorter than the shortest the settings were chosen for" : "longer than the longest the settings were chosen for"))
+        << L;
+    EXPECT_NEAR(r.kinematic_cutoff_hz, defaults.kinematic_cutoff_hz / f, 1e-9) << L;
+    // Off on both sides: as given.
+    EstimateOptions off = defaults;
+    off.time_scale_short_leg_m = off.time_scale_long_leg_m = 0;
+    const EstimateResult as_given = estimate(scaled, nullptr, set, dynamically_scaled_options(off, L));
+    EXPECT_FALSE(said(as_given, "time scale:"));
+    EXPECT_DOUBLE_EQ(as_given.kinematic_cutoff_hz, defaults.kinematic_cutoff_hz);
+  }
+  // The child's fore-aft forces in double support, body weights, against the full-size walk's.
+  const Trial small = dynamically_scaled(walk.trial, 0.6);
+  const auto fore_aft_rms = [&](const EstimateOptions& o) {
+    const EstimateResult b = estimate(small, nullptr, set, dynamically_scaled_options(o, 0.6));
+    const double wa = adult.mass_kg * 9.81, wb = b.mass_kg * 9.81;
+    double sum = 0;
+    int both = 0;
+    for (Eigen::Index i = 0; i < std::min(adult.time_s.size(), b.time_s.size()); ++i) {
+      if (!(adult.feet[0].force_N(i, 1) > 0.05 * wa && adult.feet[1].force_N(i, 1) > 0.05 * wa)) continue;
+      ++both;
+      for (int side = 0; side < 2; ++side) sum += std::pow(adult.feet[side].force_N(i, 0) / wa - b.feet[side].force_N(i, 0) / wb, 2);
+    }
+    EXPECT_GT(both, 20);
+    return std::sqrt(sum / (2.0 * std::max(both, 1)));
+  };
+  EstimateOptions off = defaults;
+  off.time_scale_short_leg_m = 0;
+  EXPECT_LT(fore_aft_rms(defaults), 0.8 * fore_aft_rms(off));
+  // A short leg longer than the long one is refused, naming both.
+  EstimateOptions bad = defaults;
+  bad.time_scale_short_leg_m = 0.95;
+  try {
+    (void)estimate(walk.trial, nullptr, set, bad);
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("shortest unscaled leg (0.95"), std::string::npos) << e.what();
+  }
 }
 
 // README's MATLAB section reads the CSV with readtable, which keeps a column's name as the

@@ -122,8 +122,20 @@ struct EstimateOptions {
   /// criterion goes 8.380 -> 8.369 % but mixed (walking vertical better, running's and the GRM
   /// worse by hundredths); on their subjects made 0.6 of their size it takes walking 5.71 / 8.05 %
   /// vertical / anterior to 5.4 / 7.4 % and running 5.79 / 11.28 % to 4.6 / 9.9 % (`kin2grf study
-  /// subject-scale`, docs/METHOD-NOTES.md): a pediatric lab sets it.
+  /// subject-scale`, docs/METHOD-NOTES.md): a pediatric lab sets it. When set, it takes the
+  /// place of the development range below.
   double time_scale_leg_m = 0.0;
+  /// The development subjects' legs (thigh + shank, m), the range in which the settings in seconds
+  /// and hertz were chosen (0.763-0.896 m over the 16 trials): a subject whose leg is shorter than
+  /// time_scale_short_leg_m (longer than time_scale_long_leg_m) has them scaled as
+  /// time_scale_leg_m does, by sqrt(its leg / that end of the range), the nearest leg they were
+  /// chosen for; within the range they are as given. Why: a child's gait is faster in cadence by
+  /// about sqrt(adult leg / its leg) at the same Froude number, and a fixed 6 Hz cut-off or 30 ms
+  /// lag chosen on adults is then a different share of its stance; the development subjects
+  /// themselves are untouched, so their figures are the same (session 50). 0: no scaling on that
+  /// side (the paper).
+  double time_scale_short_leg_m = 0.76;
+  double time_scale_long_leg_m = 0.90;
   /// The upper body's vertical smoothing, Hz (kin2grf): the HAT COM's vertical acceleration is
   /// low-passed at this cut-off (smooth_torso_vertical), since the pelvis markers carry the heel
   /// strike's jolt that the upper body's mass does not pass on. A trial with flight phases (a

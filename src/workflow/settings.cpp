@@ -99,7 +99,7 @@ void add_settings_options(CLI::App* c, Settings& a) {
                 "COP function near flight phases (running): builtin (kin2grf's running fit), off, or a JSON file")
       ->capture_default_str();
   c->add_option("--up-axis", a.up_axis, "Override the lab up axis (X, Y or Z)");
-  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length, no torso or thigh lag, no vertical smoothing of the torso, the kinematics filtered with the odd reflection at the window's ends");
+  c->add_flag("--paper", a.paper, "The paper's own configuration: plain pseudo-inverse norm, no speed gate, no side-by-side split, fixed torso length, no torso or thigh lag, no vertical smoothing of the torso, no time scale for a leg outside the development subjects', the kinematics filtered with the odd reflection at the window's ends");
   c->add_option("--max-gap", a.max_gap, "Longest landmark gap filled by cubic interpolation, frames")->capture_default_str();
   add_choice(c, "--rigid-fill", a.rigid_fill,
              "A marker's longer gap inside the trial: on (filled from three markers that move rigidly with it, where the "
