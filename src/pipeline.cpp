@@ -144,9 +144,12 @@ void check_options(const EstimateOptions& o) {
           "time scale's shortest unscaled leg (m)", o.time_scale_short_leg_m, "between 0 (none) and 3");
   require(finite(o.time_scale_long_leg_m) && o.time_scale_long_leg_m >= 0 && o.time_scale_long_leg_m <= 3,
           "time scale's longest unscaled leg (m)", o.time_scale_long_leg_m, "between 0 (none) and 3");
-  if (o.time_scale_short_leg_m > 0 && o.time_scale_long_leg_m > 0 && o.time_scale_short_leg_m > o.time_scale_long_leg_m)
-    throw InputError("time scale: the shortest unscaled leg (" + std::to_string(o.time_scale_short_leg_m) +
-                     " m) is longer than the longest (" + std::to_string(o.time_scale_long_leg_m) + " m)");
+  if (o.time_scale_short_leg_m > 0 && o.time_scale_long_leg_m > 0 && o.time_scale_short_leg_m > o.time_scale_long_leg_m) {
+    char b[200];
+    std::snprintf(b, sizeof b, "time scale: the shortest unscaled leg (%.3g m, --time-scale-short-leg) is longer than the longest (%.3g m, "
+                  "--time-scale-long-leg)", o.time_scale_short_leg_m, o.time_scale_long_leg_m);
+    throw InputError(b);
+  }
   require(finite(o.torque_length_legs) && o.torque_length_legs >= 0 && o.torque_length_legs <= 10, "torque length (leg lengths)",
           o.torque_length_legs, "between 0 (the fixed lever) and 10");
   require(finite(o.torso_lag_s) && o.torso_lag_s >= 0 && o.torso_lag_s <= 0.2, "torso lag (s)", o.torso_lag_s,
@@ -213,12 +216,12 @@ EstimateOptions options_for_subject(const EstimateOptions& o, const Model& model
   const double leg = leg_length_m(model);
   if (o.torque_length_legs > 0) s.solver.torque_length_m = o.torque_length_legs * leg;
   double reference = 0;
-  const char* why = "the settings'";
+  const char* against = "against the settings' %.3f m";
   if (o.time_scale_leg_m > 0) reference = o.time_scale_leg_m;
   else if (o.time_scale_short_leg_m > 0 && leg < o.time_scale_short_leg_m)
-    reference = o.time_scale_short_leg_m, why = "shorter than the shortest the settings were chosen for,";
+    reference = o.time_scale_short_leg_m, against = "shorter than the shortest leg the settings were chosen for (%.3f m)";
   else if (o.time_scale_long_leg_m > 0 && leg > o.time_scale_long_leg_m)
-    reference = o.time_scale_long_leg_m, why = "longer than the longest the settings were chosen for,";
+    reference = o.time_scale_long_leg_m, against = "longer than the longest leg the settings were chosen for (%.3f m)";
   if (!(reference > 0) || !std::isfinite(leg) || !(leg > 0)) return s;
   const double f = std::sqrt(leg / reference);
   // A raised cut-off stays below what a zero-lag filter at this marker rate takes.
@@ -229,11 +232,12 @@ EstimateOptions options_for_subject(const EstimateOptions& o, const Model& model
   s.lateral_cutoff_hz /= f;
   s.torso_lag_s *= f;
   s.thigh_lag_s *= f;
-  char b[260];
+  char ref[96], b[320];
+  std::snprintf(ref, sizeof ref, against, reference);
   std::snprintf(b, sizeof b,
-                "time scale: the leg (thigh + shank) is %.3f m against %s %.3f m, so the settings' cut-offs are divided and their lags "
-                "multiplied by %.3f (kinematic cut-off %.2f Hz, lags %.0f ms)",
-                leg, why, reference, f, s.kinematic_cutoff_hz, 1000 * s.torso_lag_s);
+                "time scale: the leg (thigh + shank) is %.3f m, %s, so the settings' cut-offs are divided and their lags multiplied by "
+                "%.3f (kinematic cut-off %.2f Hz, lags %.0f ms)",
+                leg, ref, f, s.kinematic_cutoff_hz, 1000 * s.torso_lag_s);
   messages.emplace_back(b);
   return s;
 }

@@ -1793,7 +1793,8 @@ TEST(Estimate, ALegOutsideTheDevelopmentSubjectsHasTheSettingsTimeScaledFromTheN
     const double end = L < 1 ? defaults.time_scale_short_leg_m : defaults.time_scale_long_leg_m;
     const double f = std::sqrt(leg_length_m(r.model()) / end);
     EXPECT_NEAR(leg_length_m(r.model()), L * leg, 1e-6 * leg);
-    EXPECT_TRUE(said(r, L < 1 ? "shorter than the shortest the settings were chosen for" : "longer than the longest the settings were chosen for"))
+    EXPECT_TRUE(said(r, L < 1 ? "shorter than the shortest leg the settings were chosen for (0.760 m)"
+                           : "longer than the longest leg the settings were chosen for (0.900 m)"))
         << L;
     EXPECT_NEAR(r.kinematic_cutoff_hz, defaults.kinematic_cutoff_hz / f, 1e-9) << L;
     // Off on both sides: as given.
@@ -1828,7 +1829,7 @@ TEST(Estimate, ALegOutsideTheDevelopmentSubjectsHasTheSettingsTimeScaledFromTheN
     (void)estimate(walk.trial, nullptr, set, bad);
     FAIL() << "expected an error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("shortest unscaled leg (0.95"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("shortest unscaled leg (0.95 m"), std::string::npos) << e.what();
   }
 }
 
