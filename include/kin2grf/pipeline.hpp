@@ -117,13 +117,13 @@ struct EstimateOptions {
   /// subject's are scaled by sqrt(its leg / this), the time scale of its gait at the same Froude
   /// number (a child 0.6 times an adult's size walks the same gait at sqrt(0.6) of its times;
   /// Alexander and Jayes 1983): cut-offs divided by it, lags multiplied. 0.85 m is the development
-  /// subjects' mean leg (0.76-0.90 m), at which those settings were chosen. 0 (the default): as
-  /// given, whatever the subject's size. Measured, not the default: on the development adults the
-  /// criterion goes 8.380 -> 8.369 % but mixed (walking vertical better, running's and the GRM
-  /// worse by hundredths); on their subjects made 0.6 of their size it takes walking 5.71 / 8.05 %
-  /// vertical / anterior to 5.4 / 7.4 % and running 5.79 / 11.28 % to 4.6 / 9.9 % (`kin2grf study
-  /// subject-scale`, docs/METHOD-NOTES.md): a pediatric lab sets it. When set, it takes the
-  /// place of the development range below.
+  /// subjects' mean leg (0.76-0.90 m), at which those settings were chosen. 0 (the default): no
+  /// fixed reference; the development range below decides. Measured, not the default: on the
+  /// development adults the criterion goes 8.380 -> 8.369 % but mixed (walking vertical better,
+  /// running's and the GRM worse by hundredths); on their subjects made 0.6 of their size it
+  /// takes walking 5.71 / 8.05 % vertical / anterior to 5.4 / 7.4 % and running 5.79 / 11.28 % to
+  /// 4.6 / 9.9 % (`kin2grf study subject-scale`, docs/METHOD-NOTES.md). When set, it takes the
+  /// place of the development range below, inside the range too.
   double time_scale_leg_m = 0.0;
   /// The development subjects' legs (thigh + shank, m), the range in which the settings in seconds
   /// and hertz were chosen (0.763-0.896 m over the 16 trials): a subject whose leg is shorter than
