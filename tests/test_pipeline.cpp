@@ -1724,6 +1724,23 @@ EstimateOptions dynamically_scaled_options(EstimateOptions o, double L) {
   o.allow_unusual_mass = true;
   return o;
 }
+
+/// The RMS difference of the two feet's fore-aft forces, in body weights, of a walk and its
+/// dynamically similar copy, over the frames where both of the walk's feet carry load (over 5 %
+/// body weight): how far the copy's double supports are from the walk's.
+double double_support_fore_aft_rms(const EstimateResult& a, const EstimateResult& b) {
+  EXPECT_EQ(a.time_s.size(), b.time_s.size());
+  const double wa = a.mass_kg * 9.81, wb = b.mass_kg * 9.81;
+  double sum = 0;
+  int both = 0;
+  for (Eigen::Index i = 0; i < std::min(a.time_s.size(), b.time_s.size()); ++i) {
+    if (!(a.feet[0].force_N(i, 1) > 0.05 * wa && a.feet[1].force_N(i, 1) > 0.05 * wa)) continue;
+    ++both;
+    for (int side = 0; side < 2; ++side) sum += std::pow(a.feet[side].force_N(i, 0) / wa - b.feet[side].force_N(i, 0) / wb, 2);
+  }
+  EXPECT_GT(both, 20);
+  return std::sqrt(sum / (2.0 * std::max(both, 1)));
+}
 }  // namespace
 
 // A subject 0.6 times the size walking the same gait (Froude similarity: a child's walk) gets the
@@ -1741,21 +1758,8 @@ TEST(Estimate, ADynamicallySimilarSmallerSubjectSharesItsDoubleSupportsAsTheLarg
   const Trial small = dynamically_scaled(walk.trial, L);
   ASSERT_NEAR(*small.body_mass_kg, *walk.trial.body_mass_kg * L * L * L, 1e-9);
   ASSERT_NEAR(small.markers.rate_hz, walk.trial.markers.rate_hz / std::sqrt(L), 1e-9);
-  // The RMS fore-aft difference, body weights, over frames where both feet carry load.
-  const auto fore_aft_rms = [&](EstimateOptions o) {
-    const EstimateResult a = estimate(walk.trial, nullptr, set, o);
-    const EstimateResult b = estimate(small, nullptr, set, dynamically_scaled_options(o, L));
-    EXPECT_EQ(a.time_s.size(), b.time_s.size());
-    const double wa = a.mass_kg * 9.81, wb = b.mass_kg * 9.81;
-    double sum = 0;
-    int both = 0;
-    for (Eigen::Index i = 0; i < std::min(a.time_s.size(), b.time_s.size()); ++i) {
-      if (!(a.feet[0].force_N(i, 1) > 0.05 * wa && a.feet[1].force_N(i, 1) > 0.05 * wa)) continue;
-      ++both;
-      for (int side = 0; side < 2; ++side) sum += std::pow(a.feet[side].force_N(i, 0) / wa - b.feet[side].force_N(i, 0) / wb, 2);
-    }
-    EXPECT_GT(both, 20);
-    return std::sqrt(sum / (2.0 * std::max(both, 1)));
+  const auto fore_aft_rms = [&](const EstimateOptions& o) {
+    return double_support_fore_aft_rms(estimate(walk.trial, nullptr, set, o), estimate(small, nullptr, set, dynamically_scaled_options(o, L)));
   };
   EstimateOptions legs, fixed_lever, adults_times;
   legs.time_scale_leg_m = fixed_lever.time_scale_leg_m = 0.85;  // off by default: mixed on the adults
@@ -1807,17 +1811,7 @@ TEST(Estimate, ALegOutsideTheDevelopmentSubjectsHasTheSettingsTimeScaledFromTheN
   // The child's fore-aft forces in double support, body weights, against the full-size walk's.
   const Trial small = dynamically_scaled(walk.trial, 0.6);
   const auto fore_aft_rms = [&](const EstimateOptions& o) {
-    const EstimateResult b = estimate(small, nullptr, set, dynamically_scaled_options(o, 0.6));
-    const double wa = adult.mass_kg * 9.81, wb = b.mass_kg * 9.81;
-    double sum = 0;
-    int both = 0;
-    for (Eigen::Index i = 0; i < std::min(adult.time_s.size(), b.time_s.size()); ++i) {
-      if (!(adult.feet[0].force_N(i, 1) > 0.05 * wa && adult.feet[1].force_N(i, 1) > 0.05 * wa)) continue;
-      ++both;
-      for (int side = 0; side < 2; ++side) sum += std::pow(adult.feet[side].force_N(i, 0) / wa - b.feet[side].force_N(i, 0) / wb, 2);
-    }
-    EXPECT_GT(both, 20);
-    return std::sqrt(sum / (2.0 * std::max(both, 1)));
+    return double_support_fore_aft_rms(adult, estimate(small, nullptr, set, dynamically_scaled_options(o, 0.6)));
   };
   EstimateOptions off = defaults;
   off.time_scale_short_leg_m = 0;
