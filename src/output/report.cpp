@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
@@ -162,7 +163,7 @@ std::vector<double> curve_column(const ResultsTable& c, const std::string& name,
 }
 
 /// The joints as a gait report lists them, proximal first (the sagittal torques' and the 3D moments').
-constexpr const char* kReportJoints[] = {"hip", "knee", "ankle"};
+constexpr std::span<const char* const> kReportJoints{kLegJointNames, 3};
 
 /// A stance's COP RMSE in mm and in % of the foot's length (issue 29), bracketed as fmt_cop does.
 std::string cop_mm_cell(const nlohmann::json& stance) {

@@ -339,12 +339,11 @@ std::vector<CurveSeries> stance_curve_series(const EstimateResult& r) {
     c.push_back({"grf_lateral_bw", [=](int s, Eigen::Index i, const auto&) { return foot(s).force_lateral_N[i] * per_bw; }});
   c.push_back({"cop_progression_m", [=](int s, Eigen::Index i, const auto&) { return foot(s).cop_x_m[i]; }});  // made progression below
   c.push_back({"foot_inclination_rad", [=](int s, Eigen::Index i, const auto&) { return foot(s).inclination_rad[i]; }});
-  static const char* const kJoint[] = {"hip", "knee", "ankle"};  // joint_torque_Nm: per side hip, knee, ankle, MTP
   for (int k = 0; k < 3; ++k)
-    c.push_back({std::string("torque_") + kJoint[k] + "_Nm_per_kg",
+    c.push_back({std::string("torque_") + kLegJointNames[k] + "_Nm_per_kg",
                  [&r, k, per_kg](int s, Eigen::Index i, const auto&) { return r.joint_torque_Nm(i, 4 * s + k) * per_kg; }});
   for (int k = 0; k < 3; ++k)
-    c.push_back({std::string("power_") + kJoint[k] + "_W_per_kg", [&r, k, per_kg](int s, Eigen::Index i, const auto& w) {
+    c.push_back({std::string("power_") + kLegJointNames[k] + "_W_per_kg", [&r, k, per_kg](int s, Eigen::Index i, const auto& w) {
                    return r.joint_torque_Nm(i, 4 * s + k) * w[static_cast<std::size_t>(4 * s + k)] * per_kg;
                  }});
   if (r.legs_3d) {

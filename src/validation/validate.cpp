@@ -1173,9 +1173,8 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
                        {"measured", stance_parameters_json(s.parameters_measured, s.body_weight_N)}};
     if (s.moments_3d) x["joint_moments_3d"] = joint_moments_json(*s.moments_3d);
     if (s.torques) {
-      const char* joints[] = {"hip", "knee", "ankle"};
       for (std::size_t c = 0; c < 3; ++c)
-        x["joint_torques"][joints[c]] = {{"least_squares", moment_metrics_json(s.torques->least_squares[c])},
+        x["joint_torques"][kLegJointNames[c]] = {{"least_squares", moment_metrics_json(s.torques->least_squares[c])},
                                          {"bottom_up", moment_metrics_json(s.torques->bottom_up[c])},
                                          {"power", power_metrics_json(s.torques->power[c])}};
       x["joint_torques"]["peaks"] = {{"estimated", joint_kinetic_peaks_json(s.torques->peaks_estimated, s.torques->mass_kg)},
@@ -1221,9 +1220,8 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
                                               {"loading_rate_percent", num(m.loading_rate_error_percent)}}}};
     if (std::isfinite(m.torque_least_squares[0])) {
       auto& x = means[f < 0 ? "all" : side_name(f)];
-      const char* joints[] = {"hip", "knee", "ankle"};
       for (std::size_t c = 0; c < 3; ++c)
-        x["joint_torques"][joints[c]] = {{"least_squares", num(m.torque_least_squares[c])},
+        x["joint_torques"][kLegJointNames[c]] = {{"least_squares", num(m.torque_least_squares[c])},
                                          {"bottom_up", num(m.torque_bottom_up[c])},
                                          {"least_squares_rmse_Nm_per_kg", num(m.torque_rmse_Nm_per_kg[c])},
                                          {"power", num(m.power[c])}};

@@ -78,6 +78,9 @@ constexpr int kBilateralCount = row::kCount;
 constexpr int joint_parent(int j) { return (j % 4 == 0) ? kTorso : segment(j / 4, static_cast<LegSegment>(j % 4 - 1)); }
 constexpr int joint_child(int j) { return segment(j / 4, static_cast<LegSegment>(j % 4)); }
 const char* joint_name(int j);
+/// A leg's joints by kind, in joint j's order within its side (j % 4): hip, knee, ankle, MTP. The
+/// first three are a gait report's, and joint_torque_Nm's columns 4 side + 0..2.
+inline constexpr const char* kLegJointNames[] = {"hip", "knee", "ankle", "mtp"};
 const char* segment_name(int s);
 
 /// One rigid body: its proximal landmark, the other landmarks it carries and its COM, all in
