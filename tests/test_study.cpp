@@ -491,7 +491,8 @@ TEST(Study, MarkerLabelsStudyRunsTheMappingFromTheLabelsBesideThePreset) {
 // the example walk, whose toes are markers, the COP moves (model 2's place is an arc fraction of
 // heel -> MT -> toe) and the forces' stances stay; a set whose toes are virtual already is the same
 // in both rows. Its third row removes the trunk and arm markers too (a lower-body clinical set):
-// the toes as in the second row, the whole body's motion no longer the trunk markers'.
+// the toes as in the second row, the whole body's motion no longer the trunk markers'. Its fourth
+// places that set's MT markers 15 mm back with 2 mm of noise (8 draws, their stances pooled).
 TEST(Study, ToeAblationStudyReplacesToeMarkersByVirtualToes) {
   const Trial walk = make_example_walk();
   const MarkerSet& set = *find_marker_set("kin2grf-example");
@@ -507,24 +508,30 @@ TEST(Study, ToeAblationStudyReplacesToeMarkersByVirtualToes) {
     StudyTrial t;
     t.name = "walk", t.activity = "walking", t.lab = "lab", t.trial = &walk, t.plates = &*walk.plates, t.marker_set = s;
     const StudyResult r = run_study("toe-ablation", {t});
-    ASSERT_EQ(r.rows.size(), 3u);
+    ASSERT_EQ(r.rows.size(), 4u);
     EXPECT_TRUE(r.failures.empty());
     EXPECT_TRUE(r.rows[0].is_default);
-    ASSERT_EQ(r.per_trial.size(), 3u);
+    ASSERT_EQ(r.per_trial.size(), 4u);
     const auto& recorded = r.per_trial[0][0].stances;
     const auto& ablated = r.per_trial[1][0].stances;
     const auto& lower_body = r.per_trial[2][0].stances;
+    const auto& clinical = r.per_trial[3][0].stances;
     ASSERT_GT(recorded.size(), 0u);
     ASSERT_EQ(ablated.size(), recorded.size());
     ASSERT_EQ(lower_body.size(), recorded.size());
-    double cop_change = 0, vertical_change = 0;
+    // The clinical row pools its noise draws' stances.
+    ASSERT_EQ(clinical.size(), 8 * recorded.size());
+    double cop_change = 0, vertical_change = 0, clinical_cop_change = 0;
     for (std::size_t k = 0; k < recorded.size(); ++k) {
       cop_change += std::abs(ablated[k].metrics.cop->rmse - recorded[k].metrics.cop->rmse);
       vertical_change += std::abs(lower_body[k].metrics.vertical->rmse - ablated[k].metrics.vertical->rmse);
+      clinical_cop_change += std::abs(clinical[k].metrics.cop->rmse - lower_body[k].metrics.cop->rmse);
     }
     if (s == &set) EXPECT_GT(cop_change, 1e-4) << "the toes' markers replaced: the COP moves";
     else EXPECT_EQ(cop_change, 0.0) << "virtual toes already: nothing to replace";
     EXPECT_GT(vertical_change, 1e-3) << "the trunk markers removed too: the whole body's motion changes";
+    // Model 2 places the COP in heel -> MT lengths: MT markers 15 mm back move it.
+    EXPECT_GT(clinical_cop_change, 1e-3) << "the MT markers placed back and noisy: the COP moves";
   }
 }
 
