@@ -16,7 +16,8 @@
 //                 off and on (robustness to occlusions)
 //   toe-ablation  each toe marker replaced by virtual toes (a lab whose set has none), then with the
 //                 trunk and arm markers removed too (a lower-body clinical set: Plug-in Gait lower
-//                 body, Helen-Hayes)
+//                 body, Helen-Hayes), then that set's MT markers 15 mm back with 2 mm of marker
+//                 noise, 8 draws (a clinical lab's capture)
 //   marker-placement  the heel or the MT markers placed 15 mm further back or forward along the
 //                 foot (robustness to where a lab puts them: model 2's COP is placed in lengths
 //                 between them)
