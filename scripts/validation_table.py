@@ -546,6 +546,8 @@ def trial_3d(j, mass):
              if k["peaks_estimated_Nm"][0] is not None and k["peaks_measured_Nm"][0] is not None]
     second = [(k["peaks_estimated_Nm"][1], k["peaks_measured_Nm"][1]) for k in kam
               if k["peaks_estimated_Nm"][1] is not None and k["peaks_measured_Nm"][1] is not None]
+    impulse = [(k["impulse_estimated_Nm_s"], k["impulse_measured_Nm_s"]) for k in kam
+               if k.get("impulse_estimated_Nm_s") is not None and k.get("impulse_measured_Nm_s") is not None]
     joints = {}
     for joint in JOINTS_3D:
         for plane in PLANES_3D:
@@ -557,6 +559,8 @@ def trial_3d(j, mass):
         "kam2_est": m([e / mass for e, _ in second]),
         "kam2_plates": m([p / mass for _, p in second]),
         "kam2_error": m([abs(e - p) / mass for e, p in second]),
+        "kamimp_plates": m([p / mass for _, p in impulse]),
+        "kamimp_error": m([abs(e - p) / mass for e, p in impulse]),
         "stances": len(st),
         "lateral": m([s["rrmse_percent"]["lateral"] for s in st]),
         "lateral_bw": m([s["rmse_percent_bw"]["lateral"] for s in st]),
@@ -663,10 +667,13 @@ print("\nThe 3D joint moments in every plane (since session 49; `validate --mode
       "table and time-normalised curves), estimate-driven against plate-driven on the same kinematics: rRMSE %, mean over "
       "the activity's trials of each trial's mean over its stances (the plates that pass the registration check), and the "
       "knee adduction moment's first and second peaks (the largest value in each half of the stance) as the mean "
-      "absolute difference, estimate - plates, in N m/kg beside the plates' mean peak.\n")
+      "absolute difference, estimate - plates, in N m/kg beside the plates' mean peak, and its angular impulse (since "
+      "session 51: the time integral of its positive part over the stance, the knee-osteoarthritis literature's KAM "
+      "impulse) likewise in N m s/kg.\n")
 print("| activity | trials | " + " | ".join(f"{j} {p}" for j in JOINTS_3D for p in PLANES_3D)
-      + " | KAM 1st peak abs. error / plates N m/kg | KAM 2nd peak abs. error / plates N m/kg |")
-print("|---|---|" + "---|" * (len(JOINTS_3D) * len(PLANES_3D) + 2))
+      + " | KAM 1st peak abs. error / plates N m/kg | KAM 2nd peak abs. error / plates N m/kg"
+      + " | KAM impulse abs. error / plates N m s/kg |")
+print("|---|---|" + "---|" * (len(JOINTS_3D) * len(PLANES_3D) + 3))
 for a, xs in by_activity.items():
     cells = []
     for j_ in JOINTS_3D:
@@ -676,6 +683,8 @@ for a, xs in by_activity.items():
     for k in ("kam1", "kam2"):
         ps = [t for _, t in xs if t[k + "_error"] is not None]
         cells.append("-" if not ps else f"{statistics.mean(t[k + '_error'] for t in ps):.2f} / {statistics.mean(t[k + '_plates'] for t in ps):.2f}")
+    ps = [t for _, t in xs if t["kamimp_error"] is not None]
+    cells.append("-" if not ps else f"{statistics.mean(t['kamimp_error'] for t in ps):.3f} / {statistics.mean(t['kamimp_plates'] for t in ps):.3f}")
     print(f"| {a} | {len(xs)} | " + " | ".join(cells) + " |")
 
 labs = sorted({lab_of[name] for _, name, _ in rows})

@@ -256,6 +256,13 @@ TEST(JointMoments3D, TheSummaryReportsEachStancesKneeAdductionPeaks) {
       EXPECT_DOUBLE_EQ(s["first_peak_Nm"].get<double>(), kam.segment(a, mid - a).maxCoeff());
       EXPECT_DOUBLE_EQ(s["second_peak_Nm"].get<double>(), kam.segment(mid, b - mid + 1).maxCoeff());
       EXPECT_DOUBLE_EQ(s["first_peak_Nm_per_kg"].get<double>(), s["first_peak_Nm"].get<double>() / 64.9);
+      // The impulse: the KAM's positive part over the same frames, no more than its peak times the
+      // stance's duration and (an adduction moment through mid-stance) more than none.
+      const double impulse = s["impulse_Nm_s"].get<double>();
+      EXPECT_DOUBLE_EQ(impulse, stance_impulse(kam, r.time_s, a, b));
+      EXPECT_GT(impulse, 0.0);
+      EXPECT_LE(impulse, std::max(s["first_peak_Nm"].get<double>(), s["second_peak_Nm"].get<double>()) * (r.time_s[b] - r.time_s[a]));
+      EXPECT_DOUBLE_EQ(s["impulse_Nm_s_per_kg"].get<double>(), impulse / 64.9);
       complete += s["complete"].get<bool>();
     }
   }
@@ -263,6 +270,36 @@ TEST(JointMoments3D, TheSummaryReportsEachStancesKneeAdductionPeaks) {
   EstimateOptions sagittal;
   sagittal.mass_kg = 64.9;
   EXPECT_FALSE(results_summary(estimate(walk, nullptr, *recognise_marker_set(walk.markers), sagittal), {}).contains("knee_adduction_moment"));
+}
+
+// The KAM impulse (stance_impulse): the trapezoidal integral of the KAM's positive part. A
+// half-sine of amplitude A over T integrates to 2 A T / pi; a KAM that dips below zero (an
+// abduction moment at heel strike or toe-off) adds nothing there; a frame without a value drops
+// the two intervals beside it; a stance without two finite neighbours has none.
+TEST(JointMoments3D, TheKneeAdductionImpulseIntegratesThePositivePartOverTheStance) {
+  const Eigen::Index n = 201;
+  const double A = 40.0, T = 0.6;
+  Eigen::VectorXd t(n), kam(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    t[i] = T * static_cast<double>(i) / static_cast<double>(n - 1);
+    kam[i] = A * std::sin(M_PI * t[i] / T);
+  }
+  EXPECT_NEAR(stance_impulse(kam, t, 0, n - 1), 2 * A * T / M_PI, 1e-4 * A * T);
+  // Half of it: the second half of the stance alone.
+  EXPECT_NEAR(stance_impulse(kam, t, (n - 1) / 2, n - 1), A * T / M_PI, 1e-4 * A * T);
+  // A full sine: the negative half adds nothing.
+  Eigen::VectorXd full(n);
+  for (Eigen::Index i = 0; i < n; ++i) full[i] = A * std::sin(2 * M_PI * t[i] / T);
+  EXPECT_NEAR(stance_impulse(full, t, 0, n - 1), A * T / M_PI, 2e-3 * A * T);
+  // A constant KAM over 0.6 s: its value times the duration (to round-off); one frame lost drops its two
+  // intervals.
+  const Eigen::VectorXd flat = Eigen::VectorXd::Constant(n, 10.0);
+  EXPECT_NEAR(stance_impulse(flat, t, 0, n - 1), 10.0 * T, 1e-12);
+  Eigen::VectorXd gap = flat;
+  gap[100] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NEAR(stance_impulse(gap, t, 0, n - 1), 10.0 * (T - 2 * T / static_cast<double>(n - 1)), 1e-12);
+  EXPECT_TRUE(std::isnan(stance_impulse(gap, t, 100, 100)));
+  EXPECT_TRUE(std::isnan(stance_impulse(Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN()), t, 0, n - 1)));
 }
 
 // The hip (JointCentreOffsets::hip_half_width_m): the still leg of the first test, each hip centre

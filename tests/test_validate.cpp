@@ -514,6 +514,11 @@ TEST(SyntheticWalk3D, TheFeetSplitTheModelsOwnLateralTotal) {
     const double peak = st.moments_3d->kam_peak_measured_Nm[0];
     EXPECT_GT(peak, 0.2 * 70) << side_name(st.foot) << ": an external adduction moment (N m)";
     EXPECT_NEAR(st.moments_3d->kam_peak_estimated_Nm[0], peak, 0.3 * peak) << side_name(st.foot);
+    // Its impulse: the plate-driven one an adduction's (more than the peak over a tenth of the
+    // stance), the estimate-driven within a third of it.
+    const double impulse = st.moments_3d->kam_impulse_measured_Nm_s;
+    EXPECT_GT(impulse, 0.1 * peak * (r.time_s[st.last] - r.time_s[st.first])) << side_name(st.foot);
+    EXPECT_NEAR(st.moments_3d->kam_impulse_estimated_Nm_s, impulse, impulse / 3) << side_name(st.foot);
   }
   ASSERT_TRUE(v.total && v.total->frontal_moment);
   EXPECT_LT(v.total->frontal_moment->rrmse_percent, 12.0);
@@ -550,6 +555,9 @@ TEST(Validate, AMisregisteredPlatesJointMomentsAreKeptButNotScored) {
   EXPECT_EQ(m.knee_adduction, good.moments_3d->knee_adduction->rrmse_percent);
   EXPECT_DOUBLE_EQ(m.kam_peak_error_percent[0], 100 * std::abs(good.moments_3d->kam_peak_estimated_Nm[0] - good.moments_3d->kam_peak_measured_Nm[0]) /
                                                     std::abs(good.moments_3d->kam_peak_measured_Nm[0]));
+  EXPECT_DOUBLE_EQ(m.kam_impulse_error_percent,
+                   100 * std::abs(good.moments_3d->kam_impulse_estimated_Nm_s - good.moments_3d->kam_impulse_measured_Nm_s) /
+                       good.moments_3d->kam_impulse_measured_Nm_s);
   ASSERT_TRUE(good.metrics.cop_lateral && bad.metrics.lateral && good.metrics.lateral);
   EXPECT_DOUBLE_EQ(m.cop_lateral_rmse_mm, 1000 * good.metrics.cop_lateral->rmse);
   EXPECT_DOUBLE_EQ(m.lateral, 0.5 * (bad.metrics.lateral->rrmse_percent + good.metrics.lateral->rrmse_percent));

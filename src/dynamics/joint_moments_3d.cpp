@@ -196,6 +196,17 @@ std::array<double, 2> stance_peaks(const Eigen::VectorXd& kam, Eigen::Index firs
   return {peak(first, mid - 1), peak(mid, last)};
 }
 
+double stance_impulse(const Eigen::VectorXd& kam, const Eigen::VectorXd& time_s, Eigen::Index first, Eigen::Index last) {
+  double impulse = 0;
+  bool any = false;
+  for (Eigen::Index i = first; i < last; ++i) {
+    if (!std::isfinite(kam[i]) || !std::isfinite(kam[i + 1]) || !std::isfinite(time_s[i]) || !std::isfinite(time_s[i + 1])) continue;
+    impulse += 0.5 * (time_s[i + 1] - time_s[i]) * (std::max(kam[i], 0.0) + std::max(kam[i + 1], 0.0));
+    any = true;
+  }
+  return any ? impulse : std::numeric_limits<double>::quiet_NaN();
+}
+
 FootWrench3D foot_wrench(const Eigen::MatrixX3d& force_N, const Eigen::MatrixX3d& cop_m, const Eigen::VectorXd& free_moment_Nm,
                          const Eigen::Vector3d& up) {
   const Eigen::Index n = force_N.rows();

@@ -311,10 +311,12 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
   if (e.legs_3d) {
     t << "<h3>3D model</h3>\n<p>Mediolateral force and the COP's lateral place against the plates; the external knee "
          "adduction moment (KAM) by inverse dynamics with kin2grf's GRF against with the plates' GRF, on the same "
-         "kinematics: rRMSE, and its first and second peaks (largest value in each half of the stance). In brackets: "
+         "kinematics: rRMSE, its first and second peaks (largest value in each half of the stance) and its impulse (the "
+         "time integral of its positive part over the stance). In brackets: "
          "a plate that fails the registration check (its moments take its COP as their lever).</p>\n"
          "<table><tr><th class=l>foot</th><th class=l>plate</th><th>lateral rRMSE %</th><th>lateral RMSE N</th>"
          "<th>lateral COP RMSE mm</th><th>KAM rRMSE %</th><th>KAM peaks, kin2grf N m</th><th>KAM peaks, plates N m</th>"
+         "<th>KAM impulse, kin2grf / plates N m s</th>"
          "<th>knee sagittal rRMSE %</th><th>plate's free moment RMS N m (the estimate's is zero)</th></tr>\n";
     for (const auto& s : j["per_foot"]) {
       const nlohmann::json none;
@@ -325,12 +327,19 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
         const std::string text = fmt(kam[key][0], "%.0f") + " / " + fmt(kam[key][1], "%.0f");
         return s.value("cop_reference_suspect", false) ? "[" + text + "]" : text;
       };
+      const auto impulse = [&]() {
+        if (kam.is_null()) return std::string("-");
+        const std::string text = fmt(kam.value("impulse_estimated_Nm_s", nlohmann::json()), "%.1f") + " / " +
+                                 fmt(kam.value("impulse_measured_Nm_s", nlohmann::json()), "%.1f");
+        return s.value("cop_reference_suspect", false) ? "[" + text + "]" : text;
+      };
       t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>())
         << "</td><td>" << fmt(s["rrmse_percent"].value("lateral", nlohmann::json())) << "</td><td>"
         << fmt(s["rmse"].value("lateral_N", nlohmann::json())) << "</td><td>"
         << fmt_cop(s, s["rmse"].value("cop_lateral_mm", nlohmann::json()), "%.0f") << "</td><td>"
         << fmt_cop(s, kam.is_null() ? none : kam["rrmse_percent"]) << "</td><td>" << peaks("peaks_estimated_Nm") << "</td><td>"
-        << peaks("peaks_measured_Nm") << "</td><td>" << fmt_cop(s, jm.is_null() ? none : jm["knee"]["sagittal"]["rrmse_percent"])
+        << peaks("peaks_measured_Nm") << "</td><td>" << impulse() << "</td><td>"
+        << fmt_cop(s, jm.is_null() ? none : jm["knee"]["sagittal"]["rrmse_percent"])
         << "</td><td>" << fmt_cop(s, s["rmse"].value("free_moment_Nm", nlohmann::json())) << "</td></tr>\n";
     }
     t << "</table>\n";

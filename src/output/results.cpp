@@ -182,9 +182,10 @@ std::vector<IndexRun> contact_runs(const std::vector<bool>& c) {
 }
 
 /// Per side, per stance (a contact run): the external knee adduction moment's first and second
-/// peaks, its largest value in the stance's first and second halves (N m and N m/kg), as validate
-/// takes them; `complete` is false for a stance the processed window cuts (its peaks may lie
-/// outside it).
+/// peaks, its largest value in the stance's first and second halves (N m and N m/kg), and its
+/// angular impulse (stance_impulse: the positive part's time integral, N m s and N m s/kg), as
+/// validate takes them; `complete` is false for a stance the processed window cuts (its peaks may
+/// lie outside it, and its impulse is the part inside).
 nlohmann::json knee_adduction_peaks_json(const EstimateResult& r) {
   nlohmann::json out = nlohmann::json::object();
   const auto n = r.time_s.size();
@@ -194,10 +195,12 @@ nlohmann::json knee_adduction_peaks_json(const EstimateResult& r) {
     for (const auto& run : contact_runs(r.feet[static_cast<std::size_t>(s)].contact)) {
       if (run.last <= run.first) continue;  // a stance of one frame has no halves
       const auto [first, second] = stance_peaks(kam, run.first, run.last);
+      const double impulse = stance_impulse(kam, r.time_s, run.first, run.last);
       stances.push_back({{"start_s", r.time_s[run.first]}, {"end_s", r.time_s[run.last]},
                          {"complete", run.first > 0 && run.last < n - 1},
                          {"first_peak_Nm", first}, {"second_peak_Nm", second},
-                         {"first_peak_Nm_per_kg", first / r.mass_kg}, {"second_peak_Nm_per_kg", second / r.mass_kg}});
+                         {"first_peak_Nm_per_kg", first / r.mass_kg}, {"second_peak_Nm_per_kg", second / r.mass_kg},
+                         {"impulse_Nm_s", impulse}, {"impulse_Nm_s_per_kg", impulse / r.mass_kg}});
     }
     out[side_name(s)] = stances;
   }

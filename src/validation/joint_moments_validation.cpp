@@ -56,6 +56,8 @@ void validate_joint_moments_3d(const EstimateResult& e, ValidationResult& v) {
     j.knee_adduction = compare_series(kam_e.segment(a, len), kam_m.segment(a, len));
     j.kam_peak_estimated_Nm = stance_peaks(kam_e, a, s.last);
     j.kam_peak_measured_Nm = stance_peaks(kam_m, a, s.last);
+    j.kam_impulse_estimated_Nm_s = stance_impulse(kam_e, e.time_s, a, s.last);
+    j.kam_impulse_measured_Nm_s = stance_impulse(kam_m, e.time_s, a, s.last);
     s.moments_3d = j;
   }
   v.measured_moments_3d = measured;

@@ -914,7 +914,7 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
   // percentage meaningless. A stance whose plate fails the registration check is left out: its
   // plate-driven moments take the plate's COP, which is not where the foot is (4-7 cm of lever on
   // Camargo's export are 0.3-0.7 N m/kg of knee adduction moment at 800 N).
-  std::array<std::vector<double>, 6> x;
+  std::array<std::vector<double>, 8> x;
   for (const auto& s : stances) {
     if ((foot >= 0 && s.foot != foot) || !s.moments_3d || s.cop_reference_suspect) continue;
     const JointMomentValidation& j = *s.moments_3d;
@@ -926,6 +926,10 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
         x[2 + 2 * p].push_back(std::abs(j.kam_peak_estimated_Nm[p] - m));
         x[3 + 2 * p].push_back(std::abs(m));
       }
+    }
+    if (std::isfinite(j.kam_impulse_estimated_Nm_s) && std::isfinite(j.kam_impulse_measured_Nm_s)) {
+      x[6].push_back(std::abs(j.kam_impulse_estimated_Nm_s - j.kam_impulse_measured_Nm_s));
+      x[7].push_back(j.kam_impulse_measured_Nm_s);
     }
   }
   const auto mean = [](const std::vector<double>& v) {
@@ -978,6 +982,8 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
     const double plates = mean(x[3 + 2 * p]);
     mm.kam_peak_error_percent[p] = plates > 0 ? 100 * mean(x[2 + 2 * p]) / plates : kNaN;
   }
+  const double impulse_plates = mean(x[7]);
+  mm.kam_impulse_error_percent = impulse_plates > 0 ? 100 * mean(x[6]) / impulse_plates : kNaN;
 }
 }  // namespace
 
@@ -1129,6 +1135,8 @@ nlohmann::json joint_moments_json(const JointMomentValidation& jm) {
   j["knee_adduction_moment"] = metrics(jm.knee_adduction);
   j["knee_adduction_moment"]["peaks_estimated_Nm"] = {num(jm.kam_peak_estimated_Nm[0]), num(jm.kam_peak_estimated_Nm[1])};
   j["knee_adduction_moment"]["peaks_measured_Nm"] = {num(jm.kam_peak_measured_Nm[0]), num(jm.kam_peak_measured_Nm[1])};
+  j["knee_adduction_moment"]["impulse_estimated_Nm_s"] = num(jm.kam_impulse_estimated_Nm_s);
+  j["knee_adduction_moment"]["impulse_measured_Nm_s"] = num(jm.kam_impulse_measured_Nm_s);
   return j;
 }
 
@@ -1237,6 +1245,7 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
       x["knee_sagittal_moment"] = num(m.knee_sagittal);
       x["knee_adduction_moment"] = num(m.knee_adduction);
       x["knee_adduction_moment_peak_error_percent"] = {num(m.kam_peak_error_percent[0]), num(m.kam_peak_error_percent[1])};
+      x["knee_adduction_moment_impulse_error_percent"] = num(m.kam_impulse_error_percent);
     }
     if (std::isfinite(m.lateral_rmse_percent_bw)) {
       means[f < 0 ? "all" : side_name(f)]["lateral"] = num(m.lateral);
@@ -1332,28 +1341,38 @@ void format_lateral_rows(std::ostream& os, const ValidationResult& v, const Mean
   os << table_text(n ? number_or_dash(free / n) : "-") << "\n";
 }
 /// The 3D joint moments' rows (--model 3d): per stance the knee's sagittal and adduction moments'
-/// rRMSE and the KAM's two peaks, estimate-driven / plate-driven, then the means; in brackets (not
-/// in the means) where the plate fails the registration check, since its moments take its COP.
+/// rRMSE, the KAM's two peaks and its impulse, estimate-driven / plate-driven, then the means; in
+/// brackets (not in the means) where the plate fails the registration check, since its moments
+/// take its COP.
 void format_joint_moment_rows(std::ostream& os, const ValidationResult& v, const MeanMetrics& m, double mass_kg) {
-  char a[40], b[40];
-  os << table_label("3D knee moments") << table_text("sagittal %") << table_text("KAM %") << table_text("KAM peak 1") << table_text("KAM peak 2")
-     << "   N m/kg, estimate / plates\n";
+  // The peaks' and the impulse's cells are wider than an rRMSE's: "[0.48/-0.03]" fills twelve.
+  const auto wide = [](const std::string& t) {
+    char w[48];
+    std::snprintf(w, sizeof w, "%14s", t.c_str());
+    return std::string(w);
+  };
+  char a[40], b[40], imp[40];
+  os << table_label("3D knee moments") << table_text("sagittal %") << table_text("KAM %") << wide("KAM peak 1") << wide("KAM peak 2")
+     << wide("KAM impulse") << "   N m/kg and N m s/kg, estimate / plates\n";
   for (const auto& s : v.stances) {
     if (!s.moments_3d) continue;
     const JointMomentValidation& j = *s.moments_3d;
     const char* peak = s.cop_reference_suspect ? "[%.2f/%.2f]" : "%.2f/%.2f";
     std::snprintf(a, sizeof a, peak, j.kam_peak_estimated_Nm[0] / mass_kg, j.kam_peak_measured_Nm[0] / mass_kg);
     std::snprintf(b, sizeof b, peak, j.kam_peak_estimated_Nm[1] / mass_kg, j.kam_peak_measured_Nm[1] / mass_kg);
+    std::snprintf(imp, sizeof imp, s.cop_reference_suspect ? "[%.3f/%.3f]" : "%.3f/%.3f", j.kam_impulse_estimated_Nm_s / mass_kg,
+                  j.kam_impulse_measured_Nm_s / mass_kg);
     os << table_label(std::string(side_name(s.foot)) + " foot on " + s.plate) << table_cell(j.knee[0], s.cop_reference_suspect)
-       << table_cell(j.knee_adduction, s.cop_reference_suspect) << table_text(a) << table_text(b) << "\n";
+       << table_cell(j.knee_adduction, s.cop_reference_suspect) << wide(a) << wide(b) << wide(imp) << "\n";
   }
   const auto cell = [](double x, const char* unit) {
     char c[40];
     std::snprintf(c, sizeof c, "%.1f%s", x, unit);
-    return table_text(std::isfinite(x) ? c : "-");
+    return std::isfinite(x) ? std::string(c) : std::string("-");
   };
-  os << table_label("per foot, mean; peaks |error|") << cell(m.knee_sagittal, "") << cell(m.knee_adduction, "")
-     << cell(m.kam_peak_error_percent[0], " %") << cell(m.kam_peak_error_percent[1], " %") << "\n";
+  os << table_label("per foot, mean; peaks |error|") << table_text(cell(m.knee_sagittal, "")) << table_text(cell(m.knee_adduction, ""))
+     << wide(cell(m.kam_peak_error_percent[0], " %")) << wide(cell(m.kam_peak_error_percent[1], " %"))
+     << wide(cell(m.kam_impulse_error_percent, " %")) << "\n";
   // Every joint in every plane, over the stances whose plate passes the registration check (the
   // report's table, the JSON's joint_moments_3d): what the estimate does to each moment.
   os << "  per foot, 3D joint moments' mean rRMSE % hip / knee / ankle:";

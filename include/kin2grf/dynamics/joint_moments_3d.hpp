@@ -163,4 +163,13 @@ inline double knee_adduction_moment(const JointMoments3D& m, int side, Eigen::In
 /// half has none (a stance of one frame has no first half).
 std::array<double, 2> stance_peaks(const Eigen::VectorXd& kam, Eigen::Index first, Eigen::Index last);
 
+/// A stance's KAM angular impulse (N m s): the time integral of the KAM's positive (adduction)
+/// part over frames [first, last] of `time_s`, by the trapezoidal rule, the KAM taken as 0 where
+/// it is negative:
+///   J = sum_i (t_{i+1} - t_i) (max(KAM_i, 0) + max(KAM_{i+1}, 0)) / 2.
+/// The knee-osteoarthritis literature's "KAM impulse" (Thorp et al. 2006, Kean et al. 2012): it
+/// weighs how long the medial compartment is loaded as well as how much, which the peaks do not.
+/// A pair of frames with a non-finite value adds nothing; NaN when no pair is finite.
+double stance_impulse(const Eigen::VectorXd& kam, const Eigen::VectorXd& time_s, Eigen::Index first, Eigen::Index last);
+
 }  // namespace kin2grf

@@ -213,6 +213,10 @@ struct JointMomentValidation {
   /// half of the stance, estimate-driven and plate-driven.
   std::array<double, 2> kam_peak_estimated_Nm{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
   std::array<double, 2> kam_peak_measured_Nm{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+  /// The KAM's angular impulse over the stance (N m s; stance_impulse: its positive part's time
+  /// integral), estimate-driven and plate-driven.
+  double kam_impulse_estimated_Nm_s = std::numeric_limits<double>::quiet_NaN();
+  double kam_impulse_measured_Nm_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// One stance's sagittal joint torques (hip, knee, ankle; every model): against the torques a
@@ -396,6 +400,9 @@ struct MeanMetrics {
   /// plate-driven peak near 0 N m would make its own percentage meaningless).
   double knee_sagittal = 0, knee_adduction = 0;
   std::array<double, 2> kam_peak_error_percent{0, 0};
+  /// The KAM's angular impulse: mean |estimate - plates| in % of the plate-driven impulses' mean
+  /// (a ratio of means, as the peaks'); NaN where no stance has both.
+  double kam_impulse_error_percent = 0;
   /// The sagittal joint torques (StanceValidation::torques), hip, knee, ankle: mean rRMSE (%) of
   /// kin2grf's least-squares torques and of the bottom-up ones from its forces, and the mean RMSE
   /// of the least-squares ones in N m per kg of body mass. NaN where no stance has them.
