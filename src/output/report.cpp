@@ -121,9 +121,13 @@ std::vector<double> to_vec(const Eigen::VectorXd& v) { return {v.data(), v.data(
 
 /// A figure that takes the plate's COP, in brackets where the plate fails validate's registration
 /// check (StanceValidation::cop_reference_suspect: kept for the record, left out of the means).
-std::string fmt_cop(const nlohmann::json& stance, const nlohmann::json& x, const char* f = "%.1f") {
-  const std::string text = fmt(x, f);
+/// A cell of a stance whose plate fails the registration check, in brackets (not scored); "-" as it is.
+std::string bracket_if_misregistered(const nlohmann::json& stance, const std::string& text) {
   return stance.value("cop_reference_suspect", false) && text != "-" ? "[" + text + "]" : text;
+}
+
+std::string fmt_cop(const nlohmann::json& stance, const nlohmann::json& x, const char* f = "%.1f") {
+  return bracket_if_misregistered(stance, fmt(x, f));
 }
 
 /// The stance parameters' table rows' cells (dynamics/stance_parameters.hpp): the vertical peaks and
@@ -170,8 +174,7 @@ std::string cop_mm_cell(const nlohmann::json& stance) {
   const auto& mm = stance["rmse"]["cop_mm"];
   if (!mm.is_number()) return "-";
   const auto& foot = stance.value("cop_rmse_percent_foot", nlohmann::json());
-  const std::string text = fmt(mm) + (foot.is_number() ? " (" + fmt(foot) + " %)" : std::string());
-  return stance.value("cop_reference_suspect", false) ? "[" + text + "]" : text;
+  return bracket_if_misregistered(stance, fmt(mm) + (foot.is_number() ? " (" + fmt(foot) + " %)" : std::string()));
 }
 
 /// Both reports' time-normalised 3D joint moments (--model 3d): per joint and plane, the figure's
@@ -324,14 +327,12 @@ std::string validation_report_html(const std::string& trial, const EstimateResul
       const auto& kam = jm.is_null() ? none : jm["knee_adduction_moment"];
       const auto peaks = [&](const char* key) {
         if (kam.is_null()) return std::string("-");
-        const std::string text = fmt(kam[key][0], "%.0f") + " / " + fmt(kam[key][1], "%.0f");
-        return s.value("cop_reference_suspect", false) ? "[" + text + "]" : text;
+        return bracket_if_misregistered(s, fmt(kam[key][0], "%.0f") + " / " + fmt(kam[key][1], "%.0f"));
       };
       const auto impulse = [&]() {
         if (kam.is_null()) return std::string("-");
-        const std::string text = fmt(kam.value("impulse_estimated_Nm_s", nlohmann::json()), "%.1f") + " / " +
-                                 fmt(kam.value("impulse_measured_Nm_s", nlohmann::json()), "%.1f");
-        return s.value("cop_reference_suspect", false) ? "[" + text + "]" : text;
+        return bracket_if_misregistered(s, fmt(kam.value("impulse_estimated_Nm_s", nlohmann::json()), "%.1f") + " / " +
+                                               fmt(kam.value("impulse_measured_Nm_s", nlohmann::json()), "%.1f"));
       };
       t << "<tr><td class=l>" << s["foot"].get<std::string>() << "</td><td class=l>" << html_escape(s["plate"].get<std::string>())
         << "</td><td>" << fmt(s["rrmse_percent"].value("lateral", nlohmann::json())) << "</td><td>"

@@ -297,14 +297,14 @@ std::vector<Setting> toe_ablation_settings() {
   Setting lower{"lower body, virtual toes", 2, [](EstimateOptions&) {}};
   lower.virtual_toes = kVirtualToeShare;
   lower.without_trunk = true;
-  s.push_back(lower);
   // A clinical lab's capture of that set, all at once: Plug-in Gait's and Helen-Hayes' TOE marker
   // stands over the second MT head on the midfoot side of the toes' break, so about a marker's
   // diameter behind where these labs put their MT markers, and markers as noisy as the noise
   // study's. Each costs a point or less alone; this row measures whether they add up.
-  Setting clinical{"lower body, MT 15 mm back, 2 mm noise", 3, [](EstimateOptions&) {}};
-  clinical.virtual_toes = kVirtualToeShare;
-  clinical.without_trunk = true;
+  Setting clinical = lower;
+  clinical.label = "lower body, MT 15 mm back, 2 mm noise";
+  clinical.value = 3;
+  s.push_back(std::move(lower));
   clinical.placement_landmark = kMt;
   clinical.placement_shift_m = -0.015;
   clinical.marker_noise_m = 0.002;

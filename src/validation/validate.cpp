@@ -914,7 +914,8 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
   // percentage meaningless. A stance whose plate fails the registration check is left out: its
   // plate-driven moments take the plate's COP, which is not where the foot is (4-7 cm of lever on
   // Camargo's export are 0.3-0.7 N m/kg of knee adduction moment at 800 N).
-  std::array<std::vector<double>, 8> x;
+  std::array<std::vector<double>, 6> x;
+  std::vector<double> impulse_error, impulse_plates;  // the KAM impulse's |error| and the plates' (N m s)
   for (const auto& s : stances) {
     if ((foot >= 0 && s.foot != foot) || !s.moments_3d || s.cop_reference_suspect) continue;
     const JointMomentValidation& j = *s.moments_3d;
@@ -928,8 +929,8 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
       }
     }
     if (std::isfinite(j.kam_impulse_estimated_Nm_s) && std::isfinite(j.kam_impulse_measured_Nm_s)) {
-      x[6].push_back(std::abs(j.kam_impulse_estimated_Nm_s - j.kam_impulse_measured_Nm_s));
-      x[7].push_back(j.kam_impulse_measured_Nm_s);
+      impulse_error.push_back(std::abs(j.kam_impulse_estimated_Nm_s - j.kam_impulse_measured_Nm_s));
+      impulse_plates.push_back(j.kam_impulse_measured_Nm_s);
     }
   }
   const auto mean = [](const std::vector<double>& v) {
@@ -982,8 +983,8 @@ void mean_joint_moments(const std::vector<StanceValidation>& stances, int foot, 
     const double plates = mean(x[3 + 2 * p]);
     mm.kam_peak_error_percent[p] = plates > 0 ? 100 * mean(x[2 + 2 * p]) / plates : kNaN;
   }
-  const double impulse_plates = mean(x[7]);
-  mm.kam_impulse_error_percent = impulse_plates > 0 ? 100 * mean(x[6]) / impulse_plates : kNaN;
+  const double plates_impulse = mean(impulse_plates);
+  mm.kam_impulse_error_percent = plates_impulse > 0 ? 100 * mean(impulse_error) / plates_impulse : kNaN;
 }
 }  // namespace
 
@@ -1279,9 +1280,11 @@ nlohmann::json validation_json(const std::string& trial, const EstimateResult& e
 
 namespace {
 // The plain-text table's columns: a 30-character label, then 12-character cells (a value, or mean (SD)).
-std::string table_text(const std::string& t) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%12s", t.c_str());
+/// A table cell right-aligned in `width` characters (12: an rRMSE's; the KAM's peaks and impulse,
+/// "[0.48/-0.03]", take 14).
+std::string table_text(const std::string& t, int width = 12) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%*s", width, t.c_str());
   return std::string(b);
 }
 /// An rRMSE cell; `bracketed`: a stance whose plate fails the registration check (not scored).
@@ -1346,11 +1349,7 @@ void format_lateral_rows(std::ostream& os, const ValidationResult& v, const Mean
 /// take its COP.
 void format_joint_moment_rows(std::ostream& os, const ValidationResult& v, const MeanMetrics& m, double mass_kg) {
   // The peaks' and the impulse's cells are wider than an rRMSE's: "[0.48/-0.03]" fills twelve.
-  const auto wide = [](const std::string& t) {
-    char w[48];
-    std::snprintf(w, sizeof w, "%14s", t.c_str());
-    return std::string(w);
-  };
+  const auto wide = [](const std::string& t) { return table_text(t, 14); };
   char a[40], b[40], imp[40];
   os << table_label("3D knee moments") << table_text("sagittal %") << table_text("KAM %") << wide("KAM peak 1") << wide("KAM peak 2")
      << wide("KAM impulse") << "   N m/kg and N m s/kg, estimate / plates\n";
